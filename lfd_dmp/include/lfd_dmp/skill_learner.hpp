@@ -1,0 +1,43 @@
+// Learner (paper II-D): cut every demonstration at its validated changepoints and learn one
+// SegmentDmp (end-effector position + orientation + gripper on one phase) per segment per demo.
+// ROS-free apart from the bag reader (demo_bag.hpp), so it is unit-tested without a master.
+#pragma once
+
+#include "lfd_dmp/skill_library.hpp"
+
+#include <string>
+#include <vector>
+
+namespace lfd_dmp {
+
+/// One recorded demonstration, resampled on the end-effector pose time stamps.
+struct DemoRecording {
+  std::string id;               ///< e.g. the bag path
+  Eigen::VectorXd times;        ///< M, strictly increasing (bag time, s)
+  Eigen::MatrixXd positions;    ///< M x 3, end effector in base_link
+  Eigen::MatrixXd quaternions;  ///< M x 4 (w, x, y, z)
+  Eigen::VectorXd gripper;      ///< M gripper opening (empty if not recorded)
+};
+
+struct LearnOptions {
+  std::string task;
+  std::vector<std::string> features;       ///< selected segmentation features (stored)
+  std::vector<std::string> segment_names;  ///< optional; default "segment_<i>"
+  lfd::DmpParameters params;
+};
+
+struct LearnOutcome {
+  SkillLibrary library;
+  std::vector<std::string> warnings;
+  size_t demos_used = 0;
+};
+
+/// changepoint_times[i]: sorted changepoint times of demos[i] (same clock as its times).
+/// The number of segments is the most common changepoint count + 1; demos with another count are
+/// skipped with a warning (they were not segmented consistently). Throws std::invalid_argument on
+/// unusable input (no demos, changepoints outside a demo, a segment too short to learn, NaN).
+LearnOutcome learnSkillLibrary(const std::vector<DemoRecording>& demos,
+                               const std::vector<std::vector<double>>& changepoint_times,
+                               const LearnOptions& options);
+
+}  // namespace lfd_dmp

@@ -1,0 +1,79 @@
+// Skill library: one readable, versioned JSON file per task holding, for every segment, the DMPs
+// learned on each demonstration with the task parameters (goal features) used to generalize.
+//
+// {
+//   "format": "lfd_skill_library", "version": 1, "task": "grasp",
+//   "features": ["gripper_opening", "ee_speed", "ee_x"],          // features used to segment
+//   "generalization_parameters": "goal_position",
+//   "position_names": ["x", "y", "z"],
+//   "dmp_parameters": {"num_basis": 50, "alpha_x": 6.9, ...},
+//   "segments": [
+//     {"index": 0, "name": "approach",
+//      "demos": [{"demo_id": "grasp_03.bag", "start_time": 0.0, "end_time": 4.1,
+//                 "parameters": [0.6, -0.1, 0.8],
+//                 "dmp": {"tau": 4.1,
+//                         "position": {"start": [...], "goal": [...], "start_velocity": [...],
+//                                      "weights": [[N values of x], [N of y], [N of z]]},
+//                         "orientation": {"start": [w,x,y,z], "goal": [w,x,y,z],
+//                                         "start_angular_velocity": [...], "weights": [[N]x3]},
+//                         "gripper": {"start": 0.08, "goal": 0.0, "start_velocity": 0.0,
+//                                     "weights": [N values]}}}]}]
+// }
+// Loading validates everything (format, version, shapes, finite numbers) and reports the exact
+// JSON location of the first problem.
+#pragma once
+
+#include <lfd_core/segment_dmp.hpp>
+
+#include <nlohmann/json.hpp>
+
+#include <string>
+#include <vector>
+
+namespace lfd_dmp {
+
+constexpr int kSkillLibraryVersion = 1;
+constexpr const char* kSkillLibraryFormat = "lfd_skill_library";
+
+/// The DMPs of one segment learned on one demonstration.
+struct DemoSkill {
+  std::string demo_id;         ///< e.g. the bag file name
+  double start_time = 0.0;     ///< segment start within the demo [s]
+  double end_time = 0.0;       ///< segment end within the demo [s]
+  Eigen::VectorXd parameters;  ///< task parameters for generalization (default: goal position)
+  lfd::SegmentDmp dmp;
+};
+
+struct SegmentSkills {
+  int index = 0;
+  std::string name;  ///< e.g. "approach", or "segment_0"
+  std::vector<DemoSkill> demos;
+};
+
+struct SkillLibrary {
+  int version = kSkillLibraryVersion;
+  std::string task;
+  std::vector<std::string> features;  ///< selected segmentation features
+  std::string generalization_parameters = "goal_position";
+  std::vector<std::string> position_names = {"x", "y", "z"};  ///< names of the position dims
+  lfd::DmpParameters dmp_parameters;
+  std::vector<SegmentSkills> segments;
+};
+
+nlohmann::json toJson(const lfd::DmpParameters& params);
+nlohmann::json toJson(const lfd::SegmentDmp& dmp);
+nlohmann::json toJson(const SkillLibrary& library);
+
+/// `where` prefixes error messages (a JSON path such as "segments[0].demos[1].dmp").
+lfd::DmpParameters dmpParametersFromJson(const nlohmann::json& j, const std::string& where);
+lfd::SegmentDmp segmentDmpFromJson(const nlohmann::json& j, const lfd::DmpParameters& params,
+                                   const std::string& where);
+/// Throws std::runtime_error naming the JSON location on any problem.
+SkillLibrary skillLibraryFromJson(const nlohmann::json& j);
+
+/// Writes pretty-printed JSON (atomically: temp file + rename). Throws std::runtime_error.
+void saveSkillLibrary(const SkillLibrary& library, const std::string& path);
+/// Throws std::runtime_error with the file name and the JSON location of the problem.
+SkillLibrary loadSkillLibrary(const std::string& path);
+
+}  // namespace lfd_dmp

@@ -1,0 +1,30 @@
+// CSV trajectories for the master-free dmp_tool: a header row, a time column, any number of
+// position columns, optional quaternion columns qw,qx,qy,qz and an optional gripper column.
+#pragma once
+
+#include <lfd_core/segment_dmp.hpp>
+
+#include <string>
+#include <vector>
+
+namespace lfd_dmp {
+
+struct CsvColumns {
+  std::string time;                 ///< empty: "t", "time" or "stamp" if present, else column 0
+  std::string gripper = "gripper";  ///< used when present
+};
+
+struct CsvTrajectory {
+  std::vector<std::string> position_names;
+  lfd::SegmentDemo demo;
+};
+
+/// Throws std::runtime_error naming the file, line and column of the first problem (missing
+/// header, ragged row, non-numeric or non-finite value, partial quaternion columns).
+CsvTrajectory readTrajectoryCsv(const std::string& path, const CsvColumns& columns = {});
+
+/// Writes t, the position columns, qw,qx,qy,qz (if any) and gripper (if any).
+void writeTrajectoryCsv(const std::string& path, const lfd::SegmentTrajectory& trajectory,
+                        const std::vector<std::string>& position_names);
+
+}  // namespace lfd_dmp

@@ -1,0 +1,130 @@
+#include "lfd_dmp/skill_learner.hpp"
+
+#include <lfd_core/dmp_generalization.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <sstream>
+#include <stdexcept>
+
+namespace lfd_dmp {
+namespace {
+
+lfd::SegmentDemo cut(const DemoRecording& rec, Eigen::Index first, Eigen::Index last) {
+  const Eigen::Index n = last - first + 1;
+  lfd::SegmentDemo seg;
+  seg.times = rec.times.segment(first, n);
+  seg.positions = rec.positions.middleRows(first, n);
+  if (rec.quaternions.cols() == 4) seg.quaternions = rec.quaternions.middleRows(first, n);
+  if (rec.gripper.size() > 0) seg.gripper = rec.gripper.segment(first, n);
+  return seg;
+}
+
+void checkRecording(const DemoRecording& rec) {
+  const Eigen::Index m = rec.times.size();
+  auto fail = [&](const std::string& why) {
+    throw std::invalid_argument("demo " + rec.id + ": " + why);
+  };
+  if (m < lfd::kMinDmpSamples) fail("has only " + std::to_string(m) + " pose samples");
+  if (rec.positions.rows() != m || rec.positions.cols() != 3) fail("positions must be M x 3");
+  if (rec.quaternions.size() > 0 && (rec.quaternions.rows() != m || rec.quaternions.cols() != 4)) {
+    fail("quaternions must be M x 4");
+  }
+  if (rec.gripper.size() > 0 && rec.gripper.size() != m) fail("gripper must have M samples");
+}
+
+}  // namespace
+
+LearnOutcome learnSkillLibrary(const std::vector<DemoRecording>& demos,
+                               const std::vector<std::vector<double>>& changepoint_times,
+                               const LearnOptions& options) {
+  if (demos.empty()) throw std::invalid_argument("learnSkillLibrary: no demonstrations");
+  if (changepoint_times.size() != demos.size()) {
+    throw std::invalid_argument("learnSkillLibrary: " + std::to_string(demos.size()) +
+                                " demos but " + std::to_string(changepoint_times.size()) +
+                                " changepoint lists");
+  }
+  options.params.validate();
+  // Majority vote on the number of segments (ties: fewer segments).
+  std::map<size_t, size_t> votes;
+  for (const auto& cps : changepoint_times) ++votes[cps.size()];
+  size_t cp_count = votes.begin()->first;
+  for (const auto& [count, n] : votes) {
+    if (n > votes[cp_count]) cp_count = count;
+  }
+  const size_t num_segments = cp_count + 1;
+
+  LearnOutcome outcome;
+  SkillLibrary& lib = outcome.library;
+  lib.task = options.task;
+  lib.features = options.features;
+  lib.dmp_parameters = options.params;
+  lib.position_names = {"x", "y", "z"};
+  lib.generalization_parameters = "goal_position";
+  for (size_t s = 0; s < num_segments; ++s) {
+    SegmentSkills seg;
+    seg.index = static_cast<int>(s);
+    seg.name = s < options.segment_names.size() ? options.segment_names[s]
+                                                : "segment_" + std::to_string(s);
+    lib.segments.push_back(seg);
+  }
+
+  for (size_t d = 0; d < demos.size(); ++d) {
+    const DemoRecording& rec = demos[d];
+    checkRecording(rec);
+    const auto& cps = changepoint_times[d];
+    if (cps.size() != cp_count) {
+      outcome.warnings.push_back("demo " + rec.id + " skipped: " + std::to_string(cps.size()) +
+                                 " changepoints, the other demos have " +
+                                 std::to_string(cp_count));
+      continue;
+    }
+    // Boundaries: sample indices nearest to each changepoint; segments share boundary samples so
+    // consecutive DMPs join at the same pose.
+    const Eigen::Index m = rec.times.size();
+    std::vector<Eigen::Index> bounds = {0};
+    for (double t : cps) {
+      if (!std::isfinite(t) || t <= rec.times[0] || t >= rec.times[m - 1]) {
+        std::ostringstream msg;
+        msg << "demo " << rec.id << ": changepoint at " << t << " s is outside the recording ["
+            << rec.times[0] << ", " << rec.times[m - 1] << "]";
+        throw std::invalid_argument(msg.str());
+      }
+      const auto it = std::lower_bound(rec.times.data(), rec.times.data() + m, t);
+      Eigen::Index idx = it - rec.times.data();
+      if (idx > 0 && t - rec.times[idx - 1] < rec.times[idx] - t) --idx;
+      if (idx <= bounds.back()) {
+        throw std::invalid_argument("demo " + rec.id + ": changepoints are not increasing");
+      }
+      bounds.push_back(idx);
+    }
+    bounds.push_back(m - 1);
+    for (size_t s = 0; s < num_segments; ++s) {
+      const Eigen::Index a = bounds[s], b = bounds[s + 1];
+      DemoSkill skill;
+      skill.demo_id = rec.id;
+      skill.start_time = rec.times[a];
+      skill.end_time = rec.times[b];
+      try {
+        skill.dmp = lfd::SegmentDmp::learn(cut(rec, a, b), options.params);
+      } catch (const std::invalid_argument& e) {
+        throw std::invalid_argument("demo " + rec.id + ", segment " + std::to_string(s) + " [" +
+                                    std::to_string(rec.times[a]) + ", " +
+                                    std::to_string(rec.times[b]) + "] s: " + e.what());
+      }
+      skill.parameters = lfd::goalParameters(skill.dmp);
+      for (const auto& w : skill.dmp.warnings) {
+        outcome.warnings.push_back("demo " + rec.id + ", segment " + std::to_string(s) + ": " + w);
+      }
+      lib.segments[s].demos.push_back(std::move(skill));
+    }
+    ++outcome.demos_used;
+  }
+  if (outcome.demos_used == 0) {
+    throw std::invalid_argument("learnSkillLibrary: no demonstration could be used");
+  }
+  return outcome;
+}
+
+}  // namespace lfd_dmp

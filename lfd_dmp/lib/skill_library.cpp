@@ -1,0 +1,313 @@
+#include "lfd_dmp/skill_library.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <stdexcept>
+
+namespace lfd_dmp {
+namespace {
+
+using nlohmann::json;
+
+[[noreturn]] void fail(const std::string& where, const std::string& what) {
+  throw std::runtime_error(where + ": " + what);
+}
+
+json vectorJson(const Eigen::VectorXd& v) {
+  return json(std::vector<double>(v.data(), v.data() + v.size()));
+}
+
+json quaternionJson(const Eigen::Quaterniond& q) {
+  return json::array({q.w(), q.x(), q.y(), q.z()});
+}
+
+/// Weights N x D as D arrays of N numbers (one array per dimension reads naturally).
+json weightsJson(const Eigen::MatrixXd& w) {
+  json out = json::array();
+  for (Eigen::Index d = 0; d < w.cols(); ++d) out.push_back(vectorJson(w.col(d)));
+  return out;
+}
+
+const json& member(const json& j, const char* key, const std::string& where) {
+  if (!j.is_object()) fail(where, "expected an object");
+  const auto it = j.find(key);
+  if (it == j.end()) fail(where, std::string("missing field \"") + key + "\"");
+  return *it;
+}
+
+double number(const json& j, const std::string& where) {
+  if (!j.is_number()) fail(where, "expected a number, got " + std::string(j.type_name()));
+  const double v = j.get<double>();
+  if (!std::isfinite(v)) fail(where, "number is not finite");
+  return v;
+}
+
+std::string text(const json& j, const std::string& where) {
+  if (!j.is_string()) fail(where, "expected a string, got " + std::string(j.type_name()));
+  return j.get<std::string>();
+}
+
+Eigen::VectorXd vector(const json& j, const std::string& where, long expected = -1) {
+  if (!j.is_array()) fail(where, "expected an array of numbers, got " + std::string(j.type_name()));
+  if (expected >= 0 && static_cast<long>(j.size()) != expected) {
+    fail(where,
+         "expected " + std::to_string(expected) + " numbers, got " + std::to_string(j.size()));
+  }
+  Eigen::VectorXd v(static_cast<Eigen::Index>(j.size()));
+  for (size_t i = 0; i < j.size(); ++i)
+    v[static_cast<Eigen::Index>(i)] = number(j[i], where + "[" + std::to_string(i) + "]");
+  return v;
+}
+
+Eigen::MatrixXd weights(const json& j, const std::string& where, long dims, int num_basis) {
+  if (!j.is_array()) fail(where, "expected an array of per-dimension weight arrays");
+  if (static_cast<long>(j.size()) != dims) {
+    fail(where,
+         "expected " + std::to_string(dims) + " weight arrays, got " + std::to_string(j.size()));
+  }
+  Eigen::MatrixXd w(num_basis, dims);
+  for (long d = 0; d < dims; ++d) {
+    w.col(d) = vector(j[static_cast<size_t>(d)], where + "[" + std::to_string(d) + "]", num_basis);
+  }
+  return w;
+}
+
+Eigen::Quaterniond quaternion(const json& j, const std::string& where) {
+  const Eigen::VectorXd v = vector(j, where, 4);
+  if (v.norm() < 1e-6) fail(where, "quaternion has zero norm");
+  return Eigen::Quaterniond(v[0], v[1], v[2], v[3]).normalized();
+}
+
+}  // namespace
+
+json toJson(const lfd::DmpParameters& p) {
+  return json{{"num_basis", p.num_basis},
+              {"alpha_x", p.alpha_x},
+              {"width_scale", p.width_scale},
+              {"alpha_z", p.alpha_z},
+              {"beta_z", p.beta_z},
+              {"ridge", p.ridge},
+              {"derivative_half_window", p.derivatives.half_window},
+              {"derivative_poly_order", p.derivatives.poly_order}};
+}
+
+json toJson(const lfd::SegmentDmp& dmp) {
+  json j{{"tau", dmp.tau}};
+  if (dmp.position) {
+    const auto& p = *dmp.position;
+    j["position"] = json{{"start", vectorJson(p.start())},
+                         {"goal", vectorJson(p.goal())},
+                         {"start_velocity", vectorJson(p.startVelocity())},
+                         {"weights", weightsJson(p.weights())}};
+  }
+  if (dmp.orientation) {
+    const auto& o = *dmp.orientation;
+    j["orientation"] = json{{"start", quaternionJson(o.start())},
+                            {"goal", quaternionJson(o.goal())},
+                            {"start_angular_velocity", vectorJson(o.startAngularVelocity())},
+                            {"weights", weightsJson(o.weights())}};
+  }
+  if (dmp.gripper) {
+    const auto& g = *dmp.gripper;
+    j["gripper"] = json{{"start", g.start()[0]},
+                        {"goal", g.goal()[0]},
+                        {"start_velocity", g.startVelocity()[0]},
+                        {"weights", vectorJson(g.weights().col(0))}};
+  }
+  if (!dmp.warnings.empty()) j["warnings"] = dmp.warnings;
+  return j;
+}
+
+json toJson(const SkillLibrary& lib) {
+  json segments = json::array();
+  for (const auto& seg : lib.segments) {
+    json demos = json::array();
+    for (const auto& d : seg.demos) {
+      demos.push_back(json{{"demo_id", d.demo_id},
+                           {"start_time", d.start_time},
+                           {"end_time", d.end_time},
+                           {"parameters", vectorJson(d.parameters)},
+                           {"dmp", toJson(d.dmp)}});
+    }
+    segments.push_back(json{{"index", seg.index}, {"name", seg.name}, {"demos", demos}});
+  }
+  return json{{"format", kSkillLibraryFormat},
+              {"version", lib.version},
+              {"task", lib.task},
+              {"features", lib.features},
+              {"generalization_parameters", lib.generalization_parameters},
+              {"position_names", lib.position_names},
+              {"dmp_parameters", toJson(lib.dmp_parameters)},
+              {"segments", segments}};
+}
+
+lfd::DmpParameters dmpParametersFromJson(const json& j, const std::string& where) {
+  lfd::DmpParameters p;
+  const double nb = number(member(j, "num_basis", where), where + ".num_basis");
+  if (nb != std::floor(nb)) fail(where + ".num_basis", "must be an integer");
+  p.num_basis = static_cast<int>(nb);
+  p.alpha_x = number(member(j, "alpha_x", where), where + ".alpha_x");
+  p.width_scale = number(member(j, "width_scale", where), where + ".width_scale");
+  p.alpha_z = number(member(j, "alpha_z", where), where + ".alpha_z");
+  p.beta_z = number(member(j, "beta_z", where), where + ".beta_z");
+  p.ridge = number(member(j, "ridge", where), where + ".ridge");
+  p.derivatives.half_window = static_cast<int>(
+      number(member(j, "derivative_half_window", where), where + ".derivative_half_window"));
+  p.derivatives.poly_order = static_cast<int>(
+      number(member(j, "derivative_poly_order", where), where + ".derivative_poly_order"));
+  try {
+    p.validate();
+  } catch (const std::invalid_argument& e) {
+    fail(where, e.what());
+  }
+  return p;
+}
+
+lfd::SegmentDmp segmentDmpFromJson(const json& j, const lfd::DmpParameters& params,
+                                   const std::string& where) {
+  lfd::SegmentDmp dmp;
+  dmp.params = params;
+  dmp.tau = number(member(j, "tau", where), where + ".tau");
+  if (!(dmp.tau > 0.0)) fail(where + ".tau", "must be positive");
+  const int n = params.num_basis;
+  try {
+    if (j.contains("position")) {
+      const std::string w = where + ".position";
+      const json& p = j["position"];
+      const Eigen::VectorXd goal = vector(member(p, "goal", w), w + ".goal");
+      const long d = goal.size();
+      if (d < 1) fail(w + ".goal", "needs at least one dimension");
+      dmp.position.emplace(params, dmp.tau, weights(member(p, "weights", w), w + ".weights", d, n),
+                           vector(member(p, "start", w), w + ".start", d), goal,
+                           vector(member(p, "start_velocity", w), w + ".start_velocity", d));
+    }
+    if (j.contains("orientation")) {
+      const std::string w = where + ".orientation";
+      const json& o = j["orientation"];
+      dmp.orientation.emplace(
+          params, dmp.tau, weights(member(o, "weights", w), w + ".weights", 3, n),
+          quaternion(member(o, "start", w), w + ".start"),
+          quaternion(member(o, "goal", w), w + ".goal"),
+          vector(member(o, "start_angular_velocity", w), w + ".start_angular_velocity", 3));
+    }
+    if (j.contains("gripper")) {
+      const std::string w = where + ".gripper";
+      const json& g = j["gripper"];
+      Eigen::MatrixXd gw(n, 1);
+      gw.col(0) = vector(member(g, "weights", w), w + ".weights", n);
+      dmp.gripper.emplace(params, dmp.tau, gw,
+                          Eigen::VectorXd::Constant(1, number(member(g, "start", w), w + ".start")),
+                          Eigen::VectorXd::Constant(1, number(member(g, "goal", w), w + ".goal")),
+                          Eigen::VectorXd::Constant(
+                              1, number(member(g, "start_velocity", w), w + ".start_velocity")));
+    }
+    if (j.contains("warnings")) {
+      for (const auto& s : j["warnings"]) dmp.warnings.push_back(text(s, where + ".warnings"));
+    }
+    dmp.validate();
+  } catch (const std::invalid_argument& e) {
+    fail(where, e.what());
+  }
+  return dmp;
+}
+
+SkillLibrary skillLibraryFromJson(const json& j) {
+  const std::string root = "skill library";
+  SkillLibrary lib;
+  const std::string format = text(member(j, "format", root), "format");
+  if (format != kSkillLibraryFormat) {
+    fail("format", "expected \"" + std::string(kSkillLibraryFormat) + "\", got \"" + format + "\"");
+  }
+  const double version = number(member(j, "version", root), "version");
+  if (version != kSkillLibraryVersion) {
+    fail("version", "unsupported version " + std::to_string(static_cast<int>(version)) +
+                        " (this build reads version " + std::to_string(kSkillLibraryVersion) + ")");
+  }
+  lib.version = kSkillLibraryVersion;
+  lib.task = text(member(j, "task", root), "task");
+  const json& features = member(j, "features", root);
+  if (!features.is_array()) fail("features", "expected an array of strings");
+  for (size_t i = 0; i < features.size(); ++i) {
+    lib.features.push_back(text(features[i], "features[" + std::to_string(i) + "]"));
+  }
+  lib.generalization_parameters =
+      text(member(j, "generalization_parameters", root), "generalization_parameters");
+  const json& names = member(j, "position_names", root);
+  if (!names.is_array()) fail("position_names", "expected an array of strings");
+  lib.position_names.clear();
+  for (size_t i = 0; i < names.size(); ++i) {
+    lib.position_names.push_back(text(names[i], "position_names[" + std::to_string(i) + "]"));
+  }
+  lib.dmp_parameters = dmpParametersFromJson(member(j, "dmp_parameters", root), "dmp_parameters");
+  const json& segments = member(j, "segments", root);
+  if (!segments.is_array()) fail("segments", "expected an array");
+  for (size_t s = 0; s < segments.size(); ++s) {
+    const std::string ws = "segments[" + std::to_string(s) + "]";
+    SegmentSkills seg;
+    seg.index = static_cast<int>(number(member(segments[s], "index", ws), ws + ".index"));
+    seg.name = text(member(segments[s], "name", ws), ws + ".name");
+    const json& demos = member(segments[s], "demos", ws);
+    if (!demos.is_array()) fail(ws + ".demos", "expected an array");
+    long param_dims = -1;
+    for (size_t d = 0; d < demos.size(); ++d) {
+      const std::string wd = ws + ".demos[" + std::to_string(d) + "]";
+      DemoSkill demo;
+      demo.demo_id = text(member(demos[d], "demo_id", wd), wd + ".demo_id");
+      demo.start_time = number(member(demos[d], "start_time", wd), wd + ".start_time");
+      demo.end_time = number(member(demos[d], "end_time", wd), wd + ".end_time");
+      demo.parameters = vector(member(demos[d], "parameters", wd), wd + ".parameters", param_dims);
+      param_dims = demo.parameters.size();
+      demo.dmp = segmentDmpFromJson(member(demos[d], "dmp", wd), lib.dmp_parameters, wd + ".dmp");
+      if (demo.dmp.position &&
+          demo.dmp.position->dims() != static_cast<int>(lib.position_names.size())) {
+        fail(wd + ".dmp.position", "has " + std::to_string(demo.dmp.position->dims()) +
+                                       " dimensions but position_names has " +
+                                       std::to_string(lib.position_names.size()));
+      }
+      if (!seg.demos.empty()) {
+        const auto& ref = seg.demos.front().dmp;
+        if (ref.position.has_value() != demo.dmp.position.has_value() ||
+            ref.orientation.has_value() != demo.dmp.orientation.has_value() ||
+            ref.gripper.has_value() != demo.dmp.gripper.has_value()) {
+          fail(wd + ".dmp", "has different parts (position/orientation/gripper) than demos[0]");
+        }
+      }
+      seg.demos.push_back(std::move(demo));
+    }
+    lib.segments.push_back(std::move(seg));
+  }
+  return lib;
+}
+
+void saveSkillLibrary(const SkillLibrary& library, const std::string& path) {
+  const std::string tmp = path + ".tmp";
+  {
+    std::ofstream out(tmp);
+    if (!out) throw std::runtime_error("cannot write skill library " + tmp);
+    out << toJson(library).dump(2) << "\n";
+    if (!out) throw std::runtime_error("failed writing skill library " + tmp);
+  }
+  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
+    std::remove(tmp.c_str());
+    throw std::runtime_error("cannot move " + tmp + " to " + path);
+  }
+}
+
+SkillLibrary loadSkillLibrary(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw std::runtime_error("cannot open skill library " + path);
+  json j;
+  try {
+    in >> j;
+  } catch (const json::parse_error& e) {
+    throw std::runtime_error(path + ": not valid JSON: " + e.what());
+  }
+  try {
+    return skillLibraryFromJson(j);
+  } catch (const std::runtime_error& e) {
+    throw std::runtime_error(path + ": " + e.what());
+  }
+}
+
+}  // namespace lfd_dmp

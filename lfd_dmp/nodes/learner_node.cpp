@@ -1,0 +1,98 @@
+// learner_node: service /learner/learn (lfd_msgs/LearnSkills). Reads the demonstration bags, cuts
+// them at the validated changepoints, learns one DMP set per segment per demo and writes the
+// skill library. Thin adapter over lfd_dmp::learnSkillLibrary / readDemoBag.
+// Private parameters: ~pose_topic, ~gripper_topic, ~gripper_joint, ~num_basis.
+#include "lfd_dmp/demo_bag.hpp"
+#include "lfd_dmp/skill_learner.hpp"
+
+#include <lfd_msgs/LearnSkills.h>
+#include <ros/ros.h>
+
+#include <chrono>
+
+namespace {
+
+class Learner {
+ public:
+  explicit Learner(ros::NodeHandle& pnh) {
+    pnh.param<std::string>("pose_topic", topics_.pose, topics_.pose);
+    pnh.param<std::string>("gripper_topic", topics_.gripper, topics_.gripper);
+    pnh.param<std::string>("gripper_joint", topics_.gripper_joint, topics_.gripper_joint);
+    pnh.param<int>("num_basis", num_basis_, num_basis_);
+  }
+
+  bool learn(lfd_msgs::LearnSkills::Request& req, lfd_msgs::LearnSkills::Response& res) {
+    const auto t0 = std::chrono::steady_clock::now();
+    try {
+      if (req.output_path.empty()) throw std::invalid_argument("output_path is empty");
+      std::vector<std::string> bags;
+      std::vector<std::vector<double>> cps;
+      if (!req.segmentations.empty()) {
+        for (const auto& s : req.segmentations) {
+          bags.push_back(s.source);
+          cps.push_back(s.changepoint_times);
+        }
+      } else {
+        if (req.changepoint_counts.size() != req.bag_paths.size()) {
+          throw std::invalid_argument("changepoint_counts needs one entry per bag");
+        }
+        size_t k = 0;
+        for (size_t i = 0; i < req.bag_paths.size(); ++i) {
+          bags.push_back(req.bag_paths[i]);
+          std::vector<double> c;
+          for (uint32_t j = 0; j < req.changepoint_counts[i]; ++j) {
+            if (k >= req.changepoint_times.size()) {
+              throw std::invalid_argument("changepoint_times has fewer entries than the counts");
+            }
+            c.push_back(req.changepoint_times[k++]);
+          }
+          cps.push_back(c);
+        }
+        if (k != req.changepoint_times.size()) {
+          throw std::invalid_argument("changepoint_times has more entries than the counts");
+        }
+      }
+      if (bags.empty()) throw std::invalid_argument("no demonstrations given");
+      std::vector<lfd_dmp::DemoRecording> demos;
+      for (const auto& b : bags) demos.push_back(lfd_dmp::readDemoBag(b, topics_));
+      lfd_dmp::LearnOptions opt;
+      opt.task = req.task;
+      opt.features = req.selected_features;
+      opt.segment_names = req.segment_names;
+      opt.params.num_basis = req.num_basis > 0 ? req.num_basis : num_basis_;
+      const lfd_dmp::LearnOutcome out = lfd_dmp::learnSkillLibrary(demos, cps, opt);
+      lfd_dmp::saveSkillLibrary(out.library, req.output_path);
+      res.success = true;
+      res.warnings = out.warnings;
+      res.library_path = req.output_path;
+      res.num_segments = static_cast<uint32_t>(out.library.segments.size());
+      res.num_demos = static_cast<uint32_t>(out.demos_used);
+      for (const auto& w : out.warnings) ROS_WARN("learner: %s", w.c_str());
+      ROS_INFO("learner: %u segments x %u demos -> %s", res.num_segments, res.num_demos,
+               req.output_path.c_str());
+    } catch (const std::exception& e) {
+      res.success = false;
+      res.error = e.what();
+      ROS_ERROR("learner: %s", e.what());
+    }
+    res.elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    return true;  // failures are reported in the response, not as a transport error
+  }
+
+ private:
+  lfd_dmp::DemoBagTopics topics_;
+  int num_basis_ = lfd::DmpParameters().num_basis;
+};
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  ros::init(argc, argv, "learner");
+  ros::NodeHandle nh;
+  ros::NodeHandle pnh("~");
+  Learner learner(pnh);
+  ros::ServiceServer srv = nh.advertiseService("/learner/learn", &Learner::learn, &learner);
+  ROS_INFO("learner: ready on /learner/learn");
+  ros::spin();
+  return 0;
+}

@@ -1,0 +1,179 @@
+// dmp_tool CLI path: learn from a temp CSV, roll out to CSV with a new goal, generalize, errors.
+#include "lfd_dmp/dmp_tool.hpp"
+#include "lfd_dmp/skill_library.hpp"
+#include "lfd_dmp/trajectory_csv.hpp"
+
+#include <gtest/gtest.h>
+
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <sstream>
+
+namespace {
+
+std::string tempPath(const std::string& name) {
+  return ::testing::TempDir() + "/lfd_dmp_tool_" + std::to_string(::getpid()) + "_" + name;
+}
+
+// t, x, y, z, qw, qx, qy, qz, gripper; reach toward goal_x.
+std::string writeDemoCsv(const std::string& name, double goal_x, int rows = 400) {
+  const std::string path = tempPath(name);
+  std::ofstream out(path);
+  out << "t,x,y,z,qw,qx,qy,qz,gripper\n";
+  for (int i = 0; i < rows; ++i) {
+    const double t = 2.0 * i / (rows - 1);
+    const double s = t / 2.0;
+    const double mj = 10 * std::pow(s, 3) - 15 * std::pow(s, 4) + 6 * std::pow(s, 5);
+    const Eigen::Quaterniond q(Eigen::AngleAxisd(0.5 * mj, Eigen::Vector3d::UnitY()));
+    out << t << "," << 0.3 + (goal_x - 0.3) * mj << "," << 0.05 * std::sin(M_PI * s) << ","
+        << 0.8 + 0.1 * std::pow(std::sin(M_PI * mj), 2) << "," << q.w() << "," << q.x() << ","
+        << q.y() << "," << q.z() << "," << 0.08 - 0.08 * mj << "\n";
+  }
+  return path;
+}
+
+int run(const std::vector<std::string>& args, std::string* out_text = nullptr,
+        std::string* err_text = nullptr) {
+  std::ostringstream out, err;
+  const int rc = lfd_dmp::runDmpTool(args, out, err);
+  if (out_text) *out_text = out.str();
+  if (err_text) *err_text = err.str();
+  return rc;
+}
+
+TEST(DmpTool, LearnThenRolloutToANewGoal) {
+  const std::string csv = writeDemoCsv("demo.csv", 0.6);
+  const std::string json = tempPath("skill.json");
+  const std::string traj_csv = tempPath("traj.csv");
+  std::string out, err;
+  ASSERT_EQ(run({"learn", "--csv", csv, "--out", json, "--task", "reach"}, &out, &err), 0) << err;
+  const lfd_dmp::SkillLibrary lib = lfd_dmp::loadSkillLibrary(json);
+  EXPECT_EQ(lib.task, "reach");
+  EXPECT_EQ(lib.position_names, (std::vector<std::string>{"x", "y", "z"}));
+  ASSERT_EQ(lib.segments.size(), 1u);
+  ASSERT_TRUE(lib.segments[0].demos[0].dmp.orientation.has_value());
+  ASSERT_TRUE(lib.segments[0].demos[0].dmp.gripper.has_value());
+
+  ASSERT_EQ(run({"rollout", "--library", json, "--out", traj_csv, "--goal", "0.7,0.02,0.85",
+                 "--goal-gripper", "0.01", "--dt", "0.005", "--duration", "3.0"},
+                &out, &err),
+            0)
+      << err;
+  const lfd_dmp::CsvTrajectory traj = lfd_dmp::readTrajectoryCsv(traj_csv);
+  EXPECT_EQ(traj.position_names, (std::vector<std::string>{"x", "y", "z"}));
+  EXPECT_EQ(traj.demo.times.size(), 601);
+  EXPECT_NEAR(traj.demo.times[600], 3.0, 1e-9);
+  const Eigen::Vector3d end = traj.demo.positions.bottomRows(1).transpose();
+  EXPECT_LT((end - Eigen::Vector3d(0.7, 0.02, 0.85)).norm(), 1e-3);
+  EXPECT_NEAR(traj.demo.gripper[600], 0.01, 1e-3);
+  EXPECT_EQ(traj.demo.quaternions.cols(), 4);
+  // Reproducing the demo itself: the rolled-out CSV matches the input CSV.
+  std::ostringstream dt;
+  dt.precision(17);
+  dt << 2.0 / 399;
+  ASSERT_EQ(run({"rollout", "--library", json, "--out", traj_csv, "--dt", dt.str()}), 0);
+  const lfd_dmp::CsvTrajectory again = lfd_dmp::readTrajectoryCsv(traj_csv);
+  const lfd_dmp::CsvTrajectory demo = lfd_dmp::readTrajectoryCsv(csv);
+  ASSERT_EQ(again.demo.positions.rows(), demo.demo.positions.rows());
+  EXPECT_LT((again.demo.positions - demo.demo.positions).cwiseAbs().maxCoeff(), 1e-3);
+  for (const auto& p : {csv, json, traj_csv}) std::remove(p.c_str());
+}
+
+TEST(DmpTool, GeneralizesAcrossDemosOfALibrary) {
+  lfd_dmp::SkillLibrary lib;
+  for (double gx : {0.5, 0.8}) {
+    const std::string csv = writeDemoCsv("g.csv", gx);
+    const std::string json = tempPath("g.json");
+    ASSERT_EQ(run({"learn", "--csv", csv, "--out", json}), 0);
+    lfd_dmp::SkillLibrary one = lfd_dmp::loadSkillLibrary(json);
+    if (lib.segments.empty()) {
+      lib = one;
+    } else {
+      lib.segments[0].demos.push_back(one.segments[0].demos[0]);
+    }
+    std::remove(csv.c_str());
+    std::remove(json.c_str());
+  }
+  const std::string json = tempPath("two.json");
+  const std::string traj_csv = tempPath("gen.csv");
+  lfd_dmp::saveSkillLibrary(lib, json);
+  std::string out, err;
+  ASSERT_EQ(run({"rollout", "--library", json, "--out", traj_csv, "--generalize", "--goal",
+                 "0.65,0.0,0.8", "--start", "0.3,0,0.8"},
+                &out, &err),
+            0)
+      << err;
+  EXPECT_EQ(out.find("warning"), std::string::npos) << out;
+  const auto traj = lfd_dmp::readTrajectoryCsv(traj_csv);
+  EXPECT_LT((traj.demo.positions.bottomRows(1).transpose() - Eigen::Vector3d(0.65, 0, 0.8)).norm(),
+            2e-3);
+  // The lift (0.1 m) is kept.
+  EXPECT_NEAR(traj.demo.positions.col(2).maxCoeff(), 0.9, 0.01);
+  // Far outside the demos: still rolls out but warns.
+  ASSERT_EQ(run({"rollout", "--library", json, "--out", traj_csv, "--generalize", "--goal",
+                 "1.5,0.4,0.8"},
+                &out, &err),
+            0);
+  EXPECT_NE(out.find("warning"), std::string::npos);
+  for (const auto& p : {json, traj_csv}) std::remove(p.c_str());
+}
+
+TEST(DmpTool, BadInputGivesClearErrors) {
+  std::string out, err;
+  EXPECT_EQ(run({}, &out, &err), 2);
+  EXPECT_EQ(run({"explode"}, &out, &err), 2);
+  EXPECT_NE(err.find("unknown command"), std::string::npos);
+  EXPECT_EQ(run({"learn", "--csv", "x.csv"}, &out, &err), 2);
+  EXPECT_NE(err.find("missing --out"), std::string::npos);
+
+  // NaN in a CSV row: line and column in the message, nothing written.
+  const std::string csv = tempPath("nan.csv");
+  const std::string json = tempPath("nan.json");
+  {
+    std::ofstream f(csv);
+    f << "t,x,y\n0,0,0\n0.1,0.1,0\n0.2,nan,0\n";
+  }
+  EXPECT_EQ(run({"learn", "--csv", csv, "--out", json}, &out, &err), 1);
+  EXPECT_NE(err.find("line 4, column \"x\""), std::string::npos) << err;
+  EXPECT_FALSE(std::ifstream(json).good());
+
+  // Too short for a DMP.
+  {
+    std::ofstream f(csv);
+    f << "t,x,y\n0,0,0\n0.1,0.1,0\n0.2,0.2,0\n";
+  }
+  EXPECT_EQ(run({"learn", "--csv", csv, "--out", json}, &out, &err), 1);
+  EXPECT_NE(err.find("at least"), std::string::npos) << err;
+
+  // Partial quaternion columns.
+  {
+    std::ofstream f(csv);
+    f << "t,x,qw,qx\n0,0,1,0\n";
+  }
+  EXPECT_EQ(run({"learn", "--csv", csv, "--out", json}, &out, &err), 1);
+  EXPECT_NE(err.find("qw,qx,qy,qz"), std::string::npos) << err;
+
+  // Wrong goal dimension at rollout.
+  const std::string good_csv = writeDemoCsv("ok.csv", 0.6, 100);
+  ASSERT_EQ(run({"learn", "--csv", good_csv, "--out", json}), 0);
+  EXPECT_EQ(
+      run({"rollout", "--library", json, "--out", tempPath("o.csv"), "--goal", "1,2"}, &out, &err),
+      2);
+  EXPECT_NE(err.find("goal_position has 2 dims"), std::string::npos) << err;
+  EXPECT_EQ(
+      run({"rollout", "--library", json, "--out", tempPath("o.csv"), "--segment", "3"}, &out, &err),
+      2);
+  for (const auto& p : {csv, json, good_csv}) std::remove(p.c_str());
+}
+
+}  // namespace
+
+// catkin_add_gtest links gtest without gtest_main (and the static gtest_main archive is then simply
+// not pulled in by the standalone build).
+int main(int argc, char** argv) {
+  ::testing::InitGoogleTest(&argc, argv);
+  return RUN_ALL_TESTS();
+}

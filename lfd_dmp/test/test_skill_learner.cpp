@@ -1,0 +1,145 @@
+// Learner: cutting demos at changepoints into per-segment DMPs, and reading demo bags.
+#include "lfd_dmp/demo_bag.hpp"
+#include "lfd_dmp/skill_learner.hpp"
+
+#include <geometry_msgs/PoseStamped.h>
+#include <rosbag/bag.h>
+#include <sensor_msgs/JointState.h>
+
+#include <gtest/gtest.h>
+
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdio>
+
+namespace {
+
+// Approach (0..2 s), grasp-and-lift (2..4 s), return (4..5 s); gripper closes around 2 s.
+lfd_dmp::DemoRecording recording(const std::string& id, double object_x, double hz = 100.0) {
+  lfd_dmp::DemoRecording rec;
+  rec.id = id;
+  const int m = static_cast<int>(5.0 * hz) + 1;
+  rec.times = Eigen::VectorXd::LinSpaced(m, 10.0, 15.0);  // bag time does not start at 0
+  rec.positions.resize(m, 3);
+  rec.quaternions.resize(m, 4);
+  rec.gripper.resize(m);
+  auto mj = [](double s) {
+    s = std::clamp(s, 0.0, 1.0);
+    return 10 * std::pow(s, 3) - 15 * std::pow(s, 4) + 6 * std::pow(s, 5);
+  };
+  for (int i = 0; i < m; ++i) {
+    const double t = rec.times[i] - 10.0;
+    const Eigen::Vector3d home(0.3, -0.2, 0.9), object(object_x, 0.0, 0.8), lifted(object_x, 0.1, 1.0);
+    Eigen::Vector3d p = home + (object - home) * mj(t / 2.0);
+    if (t > 2.0) p = object + (lifted - object) * mj((t - 2.0) / 2.0);
+    if (t > 4.0) p = lifted + (home - lifted) * mj(t - 4.0);
+    rec.positions.row(i) = p.transpose();
+    const Eigen::Quaterniond q(Eigen::AngleAxisd(0.4 * mj(t / 5.0), Eigen::Vector3d::UnitZ()));
+    rec.quaternions.row(i) << q.w(), q.x(), q.y(), q.z();
+    rec.gripper[i] = 0.08 - 0.06 * mj((t - 1.8) / 0.4);
+  }
+  return rec;
+}
+
+TEST(SkillLearner, CutsDemosAtChangepointsIntoSegmentDmps) {
+  std::vector<lfd_dmp::DemoRecording> demos = {recording("a.bag", 0.6), recording("b.bag", 0.7),
+                                               recording("c.bag", 0.65)};
+  std::vector<std::vector<double>> cps = {{12.0, 14.0}, {12.0, 14.0}, {13.0}};  // c: inconsistent
+  lfd_dmp::LearnOptions opt;
+  opt.task = "grasp";
+  opt.segment_names = {"approach", "move"};
+  opt.features = {"gripper", "speed"};
+  const auto out = lfd_dmp::learnSkillLibrary(demos, cps, opt);
+  EXPECT_EQ(out.demos_used, 2u);
+  ASSERT_EQ(out.warnings.size(), 1u);
+  EXPECT_NE(out.warnings[0].find("c.bag skipped"), std::string::npos);
+  const auto& lib = out.library;
+  ASSERT_EQ(lib.segments.size(), 3u);
+  EXPECT_EQ(lib.segments[0].name, "approach");
+  EXPECT_EQ(lib.segments[2].name, "segment_2");
+  EXPECT_EQ(lib.features, opt.features);
+  for (const auto& seg : lib.segments) ASSERT_EQ(seg.demos.size(), 2u);
+  // Segment 0 of demo b ends at its object; its goal parameters are that position.
+  const auto& s0 = lib.segments[0].demos[1];
+  EXPECT_NEAR(s0.start_time, 10.0, 1e-9);
+  EXPECT_NEAR(s0.end_time, 12.0, 1e-9);
+  EXPECT_LT((s0.parameters - Eigen::Vector3d(0.7, 0.0, 0.8)).norm(), 1e-9);
+  // Each segment DMP reproduces its piece of the demo, including the gripper closing.
+  const auto& s1 = lib.segments[1].demos[0];
+  lfd::SegmentRolloutOptions o;
+  o.dt = 0.01;
+  const auto traj = s1.dmp.rollout(o);
+  const Eigen::MatrixXd truth = demos[0].positions.middleRows(200, 201);
+  EXPECT_LT((traj.positions - truth).rowwise().norm().maxCoeff(), 1e-3);
+  EXPECT_NEAR(traj.gripper[traj.gripper.size() - 1], 0.02, 1e-3);
+  // Consecutive segments join at the same sample.
+  EXPECT_EQ(lib.segments[0].demos[0].end_time, lib.segments[1].demos[0].start_time);
+}
+
+TEST(SkillLearner, RejectsUnusableInput) {
+  std::vector<lfd_dmp::DemoRecording> demos = {recording("a.bag", 0.6)};
+  lfd_dmp::LearnOptions opt;
+  EXPECT_THROW(lfd_dmp::learnSkillLibrary({}, {}, opt), std::invalid_argument);
+  EXPECT_THROW(lfd_dmp::learnSkillLibrary(demos, {}, opt), std::invalid_argument);
+  try {
+    lfd_dmp::learnSkillLibrary(demos, {{16.0}}, opt);
+    FAIL();
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("outside the recording"), std::string::npos) << e.what();
+  }
+  // A changepoint 2 samples after the start leaves a segment too short for a DMP.
+  try {
+    lfd_dmp::learnSkillLibrary(demos, {{10.02}}, opt);
+    FAIL();
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("segment 0"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("at least"), std::string::npos) << e.what();
+  }
+}
+
+TEST(DemoBag, ReadsPosesAndInterpolatesTheGripper) {
+  const std::string path =
+      ::testing::TempDir() + "/lfd_dmp_demo_" + std::to_string(::getpid()) + ".bag";
+  const lfd_dmp::DemoRecording rec = recording(path, 0.6, 50.0);
+  {
+    rosbag::Bag bag(path, rosbag::bagmode::Write);
+    for (Eigen::Index i = 0; i < rec.times.size(); ++i) {
+      geometry_msgs::PoseStamped p;
+      p.header.stamp = ros::Time(rec.times[i]);
+      p.header.frame_id = "base_link";
+      p.pose.position.x = rec.positions(i, 0);
+      p.pose.position.y = rec.positions(i, 1);
+      p.pose.position.z = rec.positions(i, 2);
+      p.pose.orientation.w = rec.quaternions(i, 0);
+      p.pose.orientation.x = rec.quaternions(i, 1);
+      p.pose.orientation.y = rec.quaternions(i, 2);
+      p.pose.orientation.z = rec.quaternions(i, 3);
+      bag.write("/ee_pose", p.header.stamp, p);
+      if (i % 2 == 0) {  // gripper at half the rate: interpolated onto the pose stamps
+        sensor_msgs::JointState js;
+        js.header.stamp = p.header.stamp;
+        js.name = {"R_GRIPPER"};
+        js.position = {rec.gripper[i]};
+        bag.write("/gripper/state", js.header.stamp, js);
+      }
+    }
+    bag.close();
+  }
+  const lfd_dmp::DemoRecording back = lfd_dmp::readDemoBag(path);
+  ASSERT_EQ(back.times.size(), rec.times.size());
+  EXPECT_LT((back.times - rec.times).cwiseAbs().maxCoeff(), 1e-6);
+  EXPECT_LT((back.positions - rec.positions).cwiseAbs().maxCoeff(), 1e-12);
+  EXPECT_LT((back.quaternions - rec.quaternions).cwiseAbs().maxCoeff(), 1e-12);
+  ASSERT_EQ(back.gripper.size(), rec.gripper.size());
+  EXPECT_LT((back.gripper - rec.gripper).cwiseAbs().maxCoeff(), 2e-3);
+  std::remove(path.c_str());
+  EXPECT_THROW(lfd_dmp::readDemoBag(path), std::runtime_error);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  ::testing::InitGoogleTest(&argc, argv);
+  return RUN_ALL_TESTS();
+}

@@ -1,0 +1,164 @@
+// Skill library JSON: round trip and validation errors.
+#include "lfd_dmp/skill_library.hpp"
+
+#include <gtest/gtest.h>
+
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <limits>
+
+namespace {
+
+using lfd_dmp::SkillLibrary;
+
+lfd::SegmentDmp learnDemo(double goal_x) {
+  lfd::SegmentDemo demo;
+  demo.times = Eigen::VectorXd::LinSpaced(200, 0.0, 1.5);
+  demo.positions.resize(200, 3);
+  demo.quaternions.resize(200, 4);
+  demo.gripper.resize(200);
+  for (int i = 0; i < 200; ++i) {
+    const double s = demo.times[i] / 1.5;
+    const double mj = 10 * std::pow(s, 3) - 15 * std::pow(s, 4) + 6 * std::pow(s, 5);
+    demo.positions.row(i) << 0.3 + (goal_x - 0.3) * mj, 0.1 * std::sin(M_PI * s), 0.8 + 0.05 * mj;
+    const Eigen::Quaterniond q(Eigen::AngleAxisd(0.7 * mj, Eigen::Vector3d::UnitZ()));
+    demo.quaternions.row(i) << q.w(), q.x(), q.y(), q.z();
+    demo.gripper[i] = 0.08 - 0.07 * mj;
+  }
+  return lfd::SegmentDmp::learn(demo);
+}
+
+SkillLibrary makeLibrary() {
+  SkillLibrary lib;
+  lib.task = "grasp";
+  lib.features = {"gripper_opening", "ee_speed", "ee_x"};
+  for (int s = 0; s < 2; ++s) {
+    lfd_dmp::SegmentSkills seg;
+    seg.index = s;
+    seg.name = s == 0 ? "approach" : "move";
+    for (int d = 0; d < 2; ++d) {
+      lfd_dmp::DemoSkill skill;
+      skill.demo_id = "demo_" + std::to_string(d) + ".bag";
+      skill.start_time = 1.5 * s;
+      skill.end_time = 1.5 * (s + 1);
+      skill.dmp = learnDemo(0.5 + 0.1 * d + 0.2 * s);
+      skill.parameters = skill.dmp.position->goal();
+      seg.demos.push_back(skill);
+    }
+    lib.segments.push_back(seg);
+  }
+  return lib;
+}
+
+std::string tempPath(const std::string& name) {
+  return ::testing::TempDir() + "/lfd_dmp_test_" + std::to_string(::getpid()) + "_" + name;
+}
+
+std::string loadError(const nlohmann::json& j) {
+  const std::string path = tempPath("bad.json");
+  std::ofstream(path) << j.dump();
+  try {
+    lfd_dmp::loadSkillLibrary(path);
+  } catch (const std::runtime_error& e) {
+    std::remove(path.c_str());
+    return e.what();
+  }
+  std::remove(path.c_str());
+  return "";
+}
+
+TEST(SkillLibrary, RoundTripKeepsEverything) {
+  const SkillLibrary lib = makeLibrary();
+  const std::string path = tempPath("lib.json");
+  lfd_dmp::saveSkillLibrary(lib, path);
+  const SkillLibrary back = lfd_dmp::loadSkillLibrary(path);
+  EXPECT_EQ(lfd_dmp::toJson(back), lfd_dmp::toJson(lib));
+  EXPECT_EQ(back.task, "grasp");
+  EXPECT_EQ(back.features, lib.features);
+  ASSERT_EQ(back.segments.size(), 2u);
+  EXPECT_EQ(back.segments[1].name, "move");
+  const auto& a = lib.segments[1].demos[1].dmp;
+  const auto& b = back.segments[1].demos[1].dmp;
+  EXPECT_EQ(a.position->weights(), b.position->weights());  // bit-exact doubles
+  EXPECT_EQ(a.orientation->weights(), b.orientation->weights());
+  EXPECT_EQ(a.gripper->weights(), b.gripper->weights());
+  // Same rollouts.
+  lfd::SegmentRolloutOptions o;
+  o.goal_position = Eigen::Vector3d(0.7, 0.05, 0.85);
+  const auto ta = a.rollout(o);
+  const auto tb = b.rollout(o);
+  EXPECT_LT((ta.positions - tb.positions).cwiseAbs().maxCoeff(), 1e-12);
+  EXPECT_LT((ta.quaternions - tb.quaternions).cwiseAbs().maxCoeff(), 1e-12);
+  EXPECT_LT((ta.gripper - tb.gripper).cwiseAbs().maxCoeff(), 1e-12);
+  std::remove(path.c_str());
+}
+
+TEST(SkillLibrary, ValidationNamesTheProblem) {
+  const nlohmann::json good = lfd_dmp::toJson(makeLibrary());
+  EXPECT_EQ(loadError(good), "");
+
+  nlohmann::json j = good;
+  j["version"] = 2;
+  EXPECT_NE(loadError(j).find("unsupported version 2"), std::string::npos) << loadError(j);
+
+  j = good;
+  j["format"] = "something_else";
+  EXPECT_NE(loadError(j).find("format"), std::string::npos);
+
+  j = good;
+  j["segments"][0]["demos"][1]["dmp"]["position"]["weights"][1].erase(3);
+  EXPECT_NE(loadError(j).find(
+                "segments[0].demos[1].dmp.position.weights[1]: expected 50 numbers, got 49"),
+            std::string::npos)
+      << loadError(j);
+
+  j = good;
+  j["segments"][1]["demos"][0]["dmp"]["gripper"]["weights"][7] =
+      std::numeric_limits<double>::quiet_NaN();  // serialized as null
+  EXPECT_NE(loadError(j).find("segments[1].demos[0].dmp.gripper.weights[7]: expected a number"),
+            std::string::npos)
+      << loadError(j);
+
+  j = good;
+  j["segments"][0]["demos"][0]["dmp"].erase("tau");
+  EXPECT_NE(loadError(j).find("missing field \"tau\""), std::string::npos);
+
+  j = good;
+  j["segments"][0]["demos"][0]["dmp"]["orientation"]["goal"] = {0, 0, 0, 0};
+  EXPECT_NE(loadError(j).find("zero norm"), std::string::npos);
+
+  j = good;
+  j["segments"][0]["demos"][1]["dmp"].erase("orientation");
+  EXPECT_NE(loadError(j).find("different parts"), std::string::npos);
+
+  j = good;
+  j["dmp_parameters"]["num_basis"] = 1;
+  EXPECT_NE(loadError(j).find("num_basis"), std::string::npos);
+
+  j = good;
+  j["segments"][0]["demos"][1]["parameters"] = {1.0, 2.0};
+  EXPECT_NE(loadError(j).find("parameters: expected 3 numbers"), std::string::npos) << loadError(j);
+
+  const std::string path = tempPath("notjson.json");
+  std::ofstream(path) << "{ not json";
+  try {
+    lfd_dmp::loadSkillLibrary(path);
+    FAIL();
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("not valid JSON"), std::string::npos);
+  }
+  std::remove(path.c_str());
+  EXPECT_THROW(lfd_dmp::loadSkillLibrary(tempPath("missing.json")), std::runtime_error);
+}
+
+}  // namespace
+
+// catkin_add_gtest links gtest without gtest_main (and the static gtest_main archive is then simply
+// not pulled in by the standalone build).
+int main(int argc, char** argv) {
+  ::testing::InitGoogleTest(&argc, argv);
+  return RUN_ALL_TESTS();
+}

@@ -1,0 +1,19 @@
+// CSV -> feature matrix for the `segment` CLI: a header row names the columns, one row per
+// sample, comma separated. An optional time column (seconds) becomes the clock; without one the
+// samples are taken as uniformly spaced at `rate` Hz (or indices when rate <= 0).
+#pragma once
+
+#include <string>
+
+#include "lfd_core/time_series.hpp"
+
+namespace lfd_segmentation {
+
+/// `time_column`: a column name, or "" to use a column named time, t, timestamp or stamp when
+/// present. Throws std::invalid_argument (file, line and column named) for an unreadable file,
+/// a missing header, ragged rows, unparsable cells or a missing time column that was asked for.
+/// NaN/Inf cells are kept so that the pipeline can report them by feature.
+lfd::FeatureMatrix read_csv_features(const std::string& path, const std::string& time_column = "",
+                                     double rate = 0.0);
+
+}  // namespace lfd_segmentation

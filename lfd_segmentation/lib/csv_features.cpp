@@ -1,0 +1,121 @@
+#include "lfd_segmentation/csv_features.hpp"
+
+#include <cerrno>
+#include <cstdlib>
+#include <fstream>
+#include <stdexcept>
+#include <vector>
+
+namespace lfd_segmentation {
+
+namespace {
+
+std::string trim(const std::string& s) {
+  const auto begin = s.find_first_not_of(" \t\r\"");
+  if (begin == std::string::npos) return "";
+  const auto end = s.find_last_not_of(" \t\r\"");
+  return s.substr(begin, end - begin + 1);
+}
+
+std::vector<std::string> split(const std::string& line) {
+  std::vector<std::string> cells;
+  std::size_t start = 0;
+  while (true) {
+    const auto comma = line.find(',', start);
+    cells.push_back(trim(line.substr(start, comma == std::string::npos ? comma : comma - start)));
+    if (comma == std::string::npos) break;
+    start = comma + 1;
+  }
+  return cells;
+}
+
+}  // namespace
+
+lfd::FeatureMatrix read_csv_features(const std::string& path, const std::string& time_column,
+                                     double rate) {
+  std::ifstream in(path);
+  if (!in) throw std::invalid_argument("cannot open CSV file '" + path + "'");
+  std::string line;
+  std::size_t line_number = 0;
+  while (std::getline(in, line)) {
+    ++line_number;
+    if (!trim(line).empty()) break;
+  }
+  if (trim(line).empty()) throw std::invalid_argument("CSV file '" + path + "' is empty");
+  const std::vector<std::string> header = split(line);
+  int time_index = -1;
+  for (std::size_t c = 0; c < header.size(); ++c) {
+    if (header[c].empty()) {
+      throw std::invalid_argument("CSV file '" + path + "': column " + std::to_string(c + 1) +
+                                  " of the header has no name");
+    }
+    const bool is_time = time_column.empty() ? (header[c] == "time" || header[c] == "t" ||
+                                                header[c] == "timestamp" || header[c] == "stamp")
+                                             : header[c] == time_column;
+    if (is_time && time_index < 0) time_index = static_cast<int>(c);
+  }
+  if (!time_column.empty() && time_index < 0) {
+    throw std::invalid_argument("CSV file '" + path + "' has no time column '" + time_column + "'");
+  }
+  lfd::FeatureMatrix m;
+  for (std::size_t c = 0; c < header.size(); ++c) {
+    if (static_cast<int>(c) != time_index) m.names.push_back(header[c]);
+  }
+  if (m.names.empty()) throw std::invalid_argument("CSV file '" + path + "' has no feature column");
+
+  std::vector<double> values;  // row-major while reading
+  std::vector<double> time;
+  while (std::getline(in, line)) {
+    ++line_number;
+    if (trim(line).empty()) continue;
+    const char* p = line.c_str();
+    std::size_t column = 0;
+    while (true) {
+      while (*p == ' ' || *p == '\t' || *p == '"') ++p;
+      char* end = nullptr;
+      errno = 0;
+      const double v = std::strtod(p, &end);
+      if (end == p) {
+        throw std::invalid_argument("CSV file '" + path + "' line " + std::to_string(line_number) +
+                                    ": column " + std::to_string(column + 1) + " ('" +
+                                    (column < header.size() ? header[column] : "?") +
+                                    "') is not a number");
+      }
+      if (column >= header.size()) {
+        throw std::invalid_argument("CSV file '" + path + "' line " + std::to_string(line_number) +
+                                    " has more than " + std::to_string(header.size()) + " columns");
+      }
+      (static_cast<int>(column) == time_index ? time : values).push_back(v);
+      ++column;
+      p = end;
+      while (*p == ' ' || *p == '\t' || *p == '\r' || *p == '"') ++p;
+      if (*p == ',') {
+        ++p;
+        continue;
+      }
+      if (*p != '\0') {
+        throw std::invalid_argument("CSV file '" + path + "' line " + std::to_string(line_number) +
+                                    ": unexpected '" + std::string(1, *p) + "'");
+      }
+      break;
+    }
+    if (column != header.size()) {
+      throw std::invalid_argument("CSV file '" + path + "' line " + std::to_string(line_number) +
+                                  " has " + std::to_string(column) + " columns, the header " +
+                                  std::to_string(header.size()));
+    }
+  }
+  const std::size_t rows = values.size() / m.names.size();
+  if (rows == 0) throw std::invalid_argument("CSV file '" + path + "' has no data rows");
+  m.data = Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(
+      values.data(), rows, m.names.size());
+  if (time_index >= 0) {
+    m.time = std::move(time);
+  } else if (rate > 0) {
+    m.time.resize(rows);
+    for (std::size_t r = 0; r < rows; ++r) m.time[r] = r / rate;
+  }
+  return m;
+}
+
+}  // namespace lfd_segmentation

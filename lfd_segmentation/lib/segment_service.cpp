@@ -1,0 +1,119 @@
+#include "lfd_segmentation/segment_service.hpp"
+
+#include <chrono>
+#include <stdexcept>
+
+#include "lfd_segmentation/bag_features.hpp"
+
+namespace lfd_segmentation {
+
+SegmentationParams apply_overrides(const SegmentationParams& params,
+                                   const lfd_msgs::Segment::Request& request) {
+  SegmentationParams p = params;
+  if (!request.combination.empty()) {
+    p.pipeline.segmentation.combination = lfd::parse_profile_combination(request.combination);
+  }
+  if (request.threshold > 0) {
+    if (request.threshold > 1) {
+      throw std::invalid_argument("threshold T must be in (0,1], got " +
+                                  std::to_string(request.threshold));
+    }
+    p.pipeline.relevance.threshold = request.threshold;
+  }
+  if (request.min_segment_seconds > 0) p.min_segment_seconds = request.min_segment_seconds;
+  if (request.window_seconds > 0) p.window_seconds = request.window_seconds;
+  if (request.num_changepoints > 0)
+    p.pipeline.segmentation.num_changepoints = request.num_changepoints;
+  return p;
+}
+
+namespace {
+
+lfd_msgs::DemoSegmentation demo_message(const DemoFeatures& demo,
+                                        const lfd::DemoSegmentationResult& r, double rate) {
+  lfd_msgs::DemoSegmentation m;
+  const lfd::FeatureMatrix& x = demo.matrix;
+  m.source = demo.source;
+  m.num_samples = static_cast<uint32_t>(r.num_samples);
+  m.sample_rate = rate;
+  m.start_time = x.time_at(0);
+  m.min_segment_length = static_cast<uint32_t>(r.min_segment_length);
+  m.changepoints.assign(r.changepoints.begin(), r.changepoints.end());
+  m.changepoint_times = r.changepoint_times;
+  m.rejected.assign(r.rejected.begin(), r.rejected.end());
+  m.rejected_times = r.rejected_times;
+  for (const lfd::SplitCandidate& c : r.clasp.candidates) {
+    m.candidates.push_back(static_cast<uint32_t>(c.index));
+    m.candidate_scores.push_back(c.score);
+  }
+  m.sensory_events.assign(r.events.begin(), r.events.end());
+  const Eigen::Index last = x.rows() - 1;
+  for (const lfd::Interval& z : r.zones) {
+    lfd_msgs::ConfidenceZone zone;
+    zone.begin_index = static_cast<uint32_t>(z.begin);
+    zone.end_index = static_cast<uint32_t>(z.end);
+    zone.begin_time = x.time_at(std::min<Eigen::Index>(z.begin, last));
+    zone.end_time = x.time_at(std::min<Eigen::Index>(z.end, last));
+    m.zones.push_back(zone);
+  }
+  return m;
+}
+
+}  // namespace
+
+void handle_segment_request(const SegmentationParams& params,
+                            const lfd_msgs::Segment::Request& request,
+                            lfd_msgs::Segment::Response& response) {
+  const auto start = std::chrono::steady_clock::now();
+  response = lfd_msgs::Segment::Response();
+  try {
+    if (request.bag_paths.empty()) {
+      throw std::invalid_argument("empty request: give at least one bag path");
+    }
+    const SegmentationParams p = apply_overrides(params, request);
+    std::vector<DemoFeatures> demos;
+    std::vector<lfd::FeatureMatrix> matrices;
+    for (const std::string& path : request.bag_paths) {
+      demos.push_back(read_bag_features(path, p.topics, p.rate));
+      matrices.push_back(demos.back().matrix);
+    }
+    const lfd::SegmentationPipelineResult result = lfd::run_segmentation_pipeline(
+        matrices, demos[0].sensor_features, p.pipeline_config(), demos[0].state_features);
+    response.warnings = result.warnings;
+    response.selected_features = result.selected_features;
+    response.selected_weights = result.feature_weights;
+    response.sensor_features = result.sensor_features;
+    for (std::size_t d = 0; d < demos.size(); ++d) {
+      response.demos.push_back(demo_message(demos[d], result.demos[d], p.rate));
+    }
+    if (result.relevance_computed) {
+      for (const lfd::FeatureRelevance& f : result.relevance.features) {
+        lfd_msgs::FeatureScore s;
+        s.name = f.name;
+        s.mean_correlation = f.mean_correlation;
+        s.mean_distance = f.mean_distance;
+        s.normalized_distance = f.normalized_distance;
+        s.score = f.score;
+        s.constant = f.constant;
+        s.selected = f.selected;
+        s.selected_correlation_only = f.selected_correlation_only;
+        s.num_demos = static_cast<uint32_t>(f.correlation.rows());
+        for (Eigen::Index r = 0; r < f.correlation.rows(); ++r) {
+          for (Eigen::Index c = 0; c < f.correlation.cols(); ++c) {
+            s.correlation.push_back(f.correlation(r, c));
+          }
+        }
+        response.features.push_back(s);
+      }
+    }
+    response.success = true;
+  } catch (const std::exception& e) {
+    response = lfd_msgs::Segment::Response();
+    response.success = false;
+    response.error = e.what();
+  }
+  response.elapsed =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+}  // namespace lfd_segmentation

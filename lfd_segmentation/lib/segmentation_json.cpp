@@ -1,0 +1,138 @@
+#include "lfd_segmentation/segmentation_json.hpp"
+
+#include <cmath>
+
+namespace lfd_segmentation {
+
+namespace {
+
+using nlohmann::json;
+
+json vector_json(const Eigen::VectorXd& v) {
+  json out = json::array();
+  for (Eigen::Index k = 0; k < v.size(); ++k) {
+    out.push_back(std::isfinite(v[k]) ? json(v[k]) : json(nullptr));
+  }
+  return out;
+}
+
+json matrix_json(const Eigen::MatrixXd& m) {
+  json out = json::array();
+  for (Eigen::Index r = 0; r < m.rows(); ++r) out.push_back(vector_json(m.row(r).transpose()));
+  return out;
+}
+
+json times_json(const std::vector<std::size_t>& indices, const lfd::FeatureMatrix& demo) {
+  json out = json::array();
+  for (std::size_t i : indices) out.push_back(demo.time_at(static_cast<Eigen::Index>(i)));
+  return out;
+}
+
+json clasp_json(const lfd::MultivariateSegmentation& s, const lfd::FeatureMatrix& demo,
+                const std::vector<std::string>& features, const JsonOptions& options) {
+  json out;
+  out["clasp_changepoints"] = s.changepoints;
+  out["clasp_changepoint_times"] = times_json(s.changepoints, demo);
+  json candidates = json::array();
+  for (const lfd::SplitCandidate& c : s.candidates) {
+    candidates.push_back(
+        {{"index", c.index},
+         {"time", demo.time_at(static_cast<Eigen::Index>(c.index))},
+         {"range", {c.range_begin, c.range_end}},
+         {"score", std::isfinite(c.score) ? json(c.score) : json(nullptr)},
+         {"log10_p_value", std::isfinite(c.log10_p_value) ? json(c.log10_p_value) : json(nullptr)},
+         {"accepted_by_clasp", c.accepted}});
+  }
+  out["candidates"] = candidates;
+  json windows = json::object();
+  for (std::size_t f = 0; f < features.size() && f < s.window_sizes.size(); ++f) {
+    windows[features[f]] = s.window_sizes[f];
+  }
+  out["window_sizes"] = windows;
+  out["min_segment_length"] = s.min_segment_length;
+  if (options.profiles) {
+    out["profile"] = vector_json(s.first_profile);
+    out["profile_penalized"] = vector_json(s.first_profile_penalized);
+  }
+  if (options.feature_profiles) {
+    json profiles = json::object();
+    for (std::size_t f = 0; f < features.size() && f < s.first_feature_profiles.size(); ++f) {
+      profiles[features[f]] = vector_json(s.first_feature_profiles[f]);
+    }
+    out["feature_profiles"] = profiles;
+  }
+  return out;
+}
+
+}  // namespace
+
+json to_json(const lfd::SegmentationPipelineResult& r, const std::vector<lfd::FeatureMatrix>& demos,
+             const std::vector<std::string>& sources, const JsonOptions& options) {
+  json out;
+  out["warnings"] = r.warnings;
+  out["state_features"] = r.state_features;
+  out["sensor_features"] = r.sensor_features;
+  out["selected_features"] = r.selected_features;
+  out["feature_weights"] = r.feature_weights;
+  out["relevance_computed"] = r.relevance_computed;
+  out["stage_seconds"] = {{"relevance", r.relevance_seconds},
+                          {"segmentation", r.segmentation_seconds}};
+  if (r.relevance_computed) {
+    json features = json::array();
+    for (const lfd::FeatureRelevance& f : r.relevance.features) {
+      features.push_back({{"name", f.name},
+                          {"mean_correlation", f.mean_correlation},
+                          {"mean_distance", f.mean_distance},
+                          {"normalized_distance", f.normalized_distance},
+                          {"score", f.score},
+                          {"constant", f.constant},
+                          {"selected", f.selected},
+                          {"selected_correlation_only", f.selected_correlation_only},
+                          {"correlation", matrix_json(f.correlation)},
+                          {"distance", matrix_json(f.distance)}});
+    }
+    out["relevance"] = {{"features", features},
+                        {"selected", r.relevance.selected},
+                        {"selected_correlation_only", r.relevance.selected_correlation_only}};
+  }
+  json demo_list = json::array();
+  for (std::size_t d = 0; d < r.demos.size(); ++d) {
+    const lfd::DemoSegmentationResult& s = r.demos[d];
+    json zones = json::array();
+    for (const lfd::Interval& z : s.zones) {
+      zones.push_back({{"begin", z.begin},
+                       {"end", z.end},
+                       {"begin_time", demos[d].time_at(static_cast<Eigen::Index>(z.begin))},
+                       {"end_time", demos[d].time_at(static_cast<Eigen::Index>(
+                                        std::min<std::size_t>(z.end, demos[d].rows() - 1)))}});
+    }
+    json demo = clasp_json(s.clasp, demos[d], r.selected_features, options);
+    demo["source"] = d < sources.size() ? sources[d] : "";
+    demo["num_samples"] = s.num_samples;
+    demo["changepoints"] = s.changepoints;
+    demo["changepoint_times"] = s.changepoint_times;
+    demo["rejected"] = s.rejected;
+    demo["rejected_times"] = s.rejected_times;
+    demo["events"] = s.events;
+    demo["zones"] = zones;
+    demo_list.push_back(demo);
+  }
+  out["demos"] = demo_list;
+  return out;
+}
+
+json to_json(const lfd::MultivariateSegmentation& s, const lfd::FeatureMatrix& demo,
+             const std::string& source, const JsonOptions& options) {
+  json out;
+  out["selected_features"] = demo.names;
+  json d = clasp_json(s, demo, demo.names, options);
+  d["source"] = source;
+  d["num_samples"] = demo.rows();
+  d["changepoints"] = s.changepoints;
+  d["changepoint_times"] = times_json(s.changepoints, demo);
+  out["demos"] = json::array({d});
+  out["warnings"] = json::array();
+  return out;
+}
+
+}  // namespace lfd_segmentation

@@ -1,0 +1,140 @@
+#include "lfd_segmentation/segmentation_params.hpp"
+
+#include <cmath>
+#include <stdexcept>
+
+namespace lfd_segmentation {
+
+namespace {
+
+template <typename T>
+T get(const YAML::Node& node, const std::string& key, T fallback) {
+  if (!node || !node[key]) return fallback;
+  try {
+    return node[key].as<T>();
+  } catch (const YAML::Exception& e) {
+    throw std::invalid_argument("segmentation parameter '" + key +
+                                "' has a bad value: " + e.what());
+  }
+}
+
+double non_negative(double value, const std::string& key) {
+  if (!(value >= 0) || !std::isfinite(value)) {
+    throw std::invalid_argument("segmentation parameter '" + key + "' must be >= 0, got " +
+                                std::to_string(value));
+  }
+  return value;
+}
+
+TopicConfig parse_topic(const YAML::Node& node, std::size_t index) {
+  const std::string where = "topics[" + std::to_string(index) + "]";
+  if (!node.IsMap()) throw std::invalid_argument(where + " must be a map");
+  TopicConfig topic;
+  topic.topic = get<std::string>(node, "topic", "");
+  if (topic.topic.empty()) throw std::invalid_argument(where + " has no 'topic'");
+  if (topic.topic == kGroundTruthTopic) {
+    throw std::invalid_argument(where + ": " + kGroundTruthTopic +
+                                " is ground truth for evaluation and must not be segmented");
+  }
+  const std::string role = get<std::string>(node, "role", "state");
+  if (role == "state") {
+    topic.role = FeatureRole::kState;
+  } else if (role == "sensor") {
+    topic.role = FeatureRole::kSensor;
+  } else {
+    throw std::invalid_argument(where + ": role must be 'state' or 'sensor', got '" + role + "'");
+  }
+  const std::string interpolation = get<std::string>(node, "interpolation", "linear");
+  if (interpolation == "linear") {
+    topic.interpolation = lfd::Interpolation::kLinear;
+  } else if (interpolation == "zoh" || interpolation == "zero_order_hold") {
+    topic.interpolation = lfd::Interpolation::kZeroOrderHold;
+  } else {
+    throw std::invalid_argument(where + ": interpolation must be 'linear' or 'zoh'");
+  }
+  topic.fields = get<std::vector<std::string>>(node, "fields", {});
+  if (topic.fields.empty())
+    throw std::invalid_argument(where + " (" + topic.topic + ") has no fields");
+  return topic;
+}
+
+}  // namespace
+
+lfd::SegmentationPipelineConfig SegmentationParams::pipeline_config() const {
+  lfd::SegmentationPipelineConfig config = pipeline;
+  config.segmentation.min_segment_length =
+      min_segment_seconds > 0 ? static_cast<std::size_t>(std::lround(min_segment_seconds * rate))
+                              : 0;
+  config.window_size =
+      window_seconds > 0 ? std::max<std::size_t>(2, std::lround(window_seconds * rate)) : 0;
+  return config;
+}
+
+SegmentationParams params_from_yaml(const YAML::Node& root) {
+  SegmentationParams p;
+  p.rate = get<double>(root, "rate", p.rate);
+  if (!(p.rate > 0) || !std::isfinite(p.rate)) {
+    throw std::invalid_argument("segmentation parameter 'rate' must be > 0");
+  }
+  auto& relevance = p.pipeline.relevance;
+  relevance.threshold = get<double>(root, "threshold", relevance.threshold);
+  if (!(relevance.threshold > 0 && relevance.threshold <= 1)) {
+    throw std::invalid_argument("segmentation parameter 'threshold' must be in (0,1]");
+  }
+  relevance.band_fraction = get<double>(root, "dtw_band_fraction", relevance.band_fraction);
+  relevance.normalize_per_demo =
+      get<bool>(root, "normalize_per_demo", relevance.normalize_per_demo);
+
+  auto& seg = p.pipeline.segmentation;
+  seg.combination = lfd::parse_profile_combination(
+      get<std::string>(root, "combination", lfd::to_string(seg.combination)));
+  p.min_segment_seconds =
+      non_negative(get<double>(root, "min_segment_seconds", 0.0), "min_segment_seconds");
+  p.window_seconds = non_negative(get<double>(root, "window_seconds", 0.0), "window_seconds");
+  seg.num_changepoints = get<int>(root, "num_changepoints", seg.num_changepoints);
+  seg.max_changepoints = get<std::size_t>(root, "max_changepoints", seg.max_changepoints);
+  seg.kaiser_beta = non_negative(get<double>(root, "kaiser_beta", seg.kaiser_beta), "kaiser_beta");
+  p.pipeline.validate_with_sensors =
+      get<bool>(root, "validate_with_sensors", p.pipeline.validate_with_sensors);
+  p.pipeline.threads = get<int>(root, "threads", p.pipeline.threads);
+
+  const YAML::Node clasp = root["clasp"];
+  auto& cc = seg.clasp;
+  cc.window_selection = lfd::parse_window_selection(
+      get<std::string>(clasp, "window_selection", lfd::to_string(cc.window_selection)));
+  cc.min_window = get<std::size_t>(clasp, "min_window", cc.min_window);
+  cc.k = get<std::size_t>(clasp, "k", cc.k);
+  cc.distance =
+      lfd::parse_clasp_distance(get<std::string>(clasp, "distance", lfd::to_string(cc.distance)));
+  cc.score = lfd::parse_clasp_score(get<std::string>(clasp, "score", lfd::to_string(cc.score)));
+  cc.p_value_threshold = get<double>(clasp, "p_value_threshold", cc.p_value_threshold);
+
+  const YAML::Node events = root["events"];
+  auto& ev = p.pipeline.events;
+  ev.threshold_ratio = get<double>(events, "threshold_ratio", ev.threshold_ratio);
+  ev.median_window = get<std::size_t>(events, "median_window", ev.median_window);
+  ev.noise_floor_sigmas = get<double>(events, "noise_floor_sigmas", ev.noise_floor_sigmas);
+  ev.hysteresis = get<double>(events, "hysteresis", ev.hysteresis);
+  ev.min_active_samples = get<std::size_t>(events, "min_active_samples", ev.min_active_samples);
+  ev.merge_gap = get<std::size_t>(events, "merge_gap", ev.merge_gap);
+
+  const YAML::Node topics = root["topics"];
+  if (topics) {
+    if (!topics.IsSequence())
+      throw std::invalid_argument("segmentation parameter 'topics' must be a list");
+    for (std::size_t k = 0; k < topics.size(); ++k) p.topics.push_back(parse_topic(topics[k], k));
+  }
+  return p;
+}
+
+SegmentationParams load_params_file(const std::string& path) {
+  YAML::Node root;
+  try {
+    root = YAML::LoadFile(path);
+  } catch (const YAML::Exception& e) {
+    throw std::invalid_argument("cannot read segmentation parameters '" + path + "': " + e.what());
+  }
+  return params_from_yaml(root);
+}
+
+}  // namespace lfd_segmentation

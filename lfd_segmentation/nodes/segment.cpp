@@ -1,0 +1,245 @@
+// segment: master-free command-line segmentation of bags or CSV files; prints JSON.
+//   segment [options] FILE...
+// One CSV file without --sensor-columns: plain parameter-free multivariate ClaSP over all columns.
+// Otherwise the full pipeline across the files (feature relevance, weighted ClaSP, sensor
+// validation). Bags use the topics/roles of --config; CSV columns are state features except the
+// --sensor-columns.
+#include <chrono>
+#include <fstream>
+#include <iostream>
+#include <sstream>
+#include <stdexcept>
+
+#include "lfd_segmentation/bag_features.hpp"
+#include "lfd_segmentation/csv_features.hpp"
+#include "lfd_segmentation/segmentation_json.hpp"
+#include "lfd_segmentation/segmentation_params.hpp"
+
+#ifndef LFD_CONFIG_DIR
+#define LFD_CONFIG_DIR "config"
+#endif
+
+namespace {
+
+const char* kUsage = R"(usage: segment [options] FILE...
+  FILE                      demonstration bags (*.bag) or CSV files (header row, one row per sample)
+  --config PATH             parameters (default: )" LFD_CONFIG_DIR R"(/segmentation.yaml)
+  --sensor-columns a,b,c    CSV columns used only for the confidence zones
+  --state-columns a,b,c     CSV columns considered for segmentation (default: all other columns)
+  --time-column NAME        CSV time column (default: time, t, timestamp or stamp if present)
+  --rate HZ                 bag resampling rate / CSV sample rate without a time column
+  --combination NAME        average | product | weighted_average | weighted_product
+  --threshold T             relevance threshold in (0,1]
+  --min-s N                 min segment length in samples (--min-segment-seconds S in seconds)
+  --window N                fixed ClaSP window in samples (--window-seconds S in seconds)
+  --num-changepoints N      exact number of ClaSP changepoints (default: significance test)
+  --threads N               worker threads (default: parameter 'threads')
+  --feature-profiles        include every selected feature's ClaSP profile
+  --no-profiles             omit the combined profiles
+  --timing                  report the stage timings (stderr and "timing" in the JSON)
+  --output PATH             write the JSON there instead of stdout
+)";
+
+std::vector<std::string> split_list(const std::string& s) {
+  std::vector<std::string> out;
+  std::stringstream in(s);
+  std::string item;
+  while (std::getline(in, item, ',')) {
+    if (!item.empty()) out.push_back(item);
+  }
+  return out;
+}
+
+bool ends_with(const std::string& s, const std::string& suffix) {
+  return s.size() >= suffix.size() &&
+         s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
+}
+
+double seconds_since(std::chrono::steady_clock::time_point t) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+}
+
+struct Options {
+  std::string config = std::string(LFD_CONFIG_DIR) + "/segmentation.yaml";
+  std::vector<std::string> files, sensors, states;
+  std::string time_column, combination, output;
+  double rate = 0, threshold = 0, min_seconds = 0, window_seconds = 0;
+  long min_s = 0, window = 0, num_changepoints = 0, threads = -1;
+  bool timing = false, feature_profiles = false, profiles = true;
+};
+
+Options parse_args(int argc, char** argv) {
+  Options o;
+  for (int k = 1; k < argc; ++k) {
+    const std::string arg = argv[k];
+    auto value = [&]() -> std::string {
+      if (k + 1 >= argc) throw std::invalid_argument(arg + " needs a value");
+      return argv[++k];
+    };
+    auto number = [&]() -> double {
+      const std::string v = value();
+      try {
+        std::size_t used = 0;
+        const double x = std::stod(v, &used);
+        if (used != v.size()) throw std::invalid_argument("");
+        return x;
+      } catch (const std::exception&) {
+        throw std::invalid_argument(arg + " expects a number, got '" + v + "'");
+      }
+    };
+    if (arg == "-h" || arg == "--help") {
+      std::cout << kUsage;
+      std::exit(0);
+    } else if (arg == "--config") {
+      o.config = value();
+    } else if (arg == "--sensor-columns") {
+      o.sensors = split_list(value());
+    } else if (arg == "--state-columns") {
+      o.states = split_list(value());
+    } else if (arg == "--time-column") {
+      o.time_column = value();
+    } else if (arg == "--rate") {
+      o.rate = number();
+    } else if (arg == "--combination") {
+      o.combination = value();
+    } else if (arg == "--threshold") {
+      o.threshold = number();
+    } else if (arg == "--min-s") {
+      o.min_s = static_cast<long>(number());
+    } else if (arg == "--min-segment-seconds") {
+      o.min_seconds = number();
+    } else if (arg == "--window") {
+      o.window = static_cast<long>(number());
+    } else if (arg == "--window-seconds") {
+      o.window_seconds = number();
+    } else if (arg == "--num-changepoints") {
+      o.num_changepoints = static_cast<long>(number());
+    } else if (arg == "--threads") {
+      o.threads = static_cast<long>(number());
+    } else if (arg == "--timing") {
+      o.timing = true;
+    } else if (arg == "--feature-profiles") {
+      o.feature_profiles = true;
+    } else if (arg == "--no-profiles") {
+      o.profiles = false;
+    } else if (arg == "--output") {
+      o.output = value();
+    } else if (!arg.empty() && arg[0] == '-') {
+      throw std::invalid_argument("unknown option " + arg + "\n" + kUsage);
+    } else {
+      o.files.push_back(arg);
+    }
+  }
+  if (o.files.empty()) throw std::invalid_argument(std::string("no input files\n") + kUsage);
+  if (o.min_s < 0 || o.window < 0 || o.min_seconds < 0 || o.window_seconds < 0) {
+    throw std::invalid_argument("min-s and window must be >= 0");
+  }
+  return o;
+}
+
+nlohmann::json run(const Options& o) {
+  const auto start = std::chrono::steady_clock::now();
+  lfd_segmentation::SegmentationParams params = lfd_segmentation::load_params_file(o.config);
+  if (o.rate > 0) params.rate = o.rate;
+  if (!o.combination.empty()) {
+    params.pipeline.segmentation.combination = lfd::parse_profile_combination(o.combination);
+  }
+  if (o.threshold != 0) {
+    if (!(o.threshold > 0 && o.threshold <= 1))
+      throw std::invalid_argument("--threshold must be in (0,1]");
+    params.pipeline.relevance.threshold = o.threshold;
+  }
+  if (o.min_seconds > 0) params.min_segment_seconds = o.min_seconds;
+  if (o.window_seconds > 0) params.window_seconds = o.window_seconds;
+  if (o.threads >= 0) params.pipeline.threads = static_cast<int>(o.threads);
+  lfd::SegmentationPipelineConfig config = params.pipeline_config();
+  if (o.min_s > 0) config.segmentation.min_segment_length = static_cast<std::size_t>(o.min_s);
+  if (o.window > 0) config.window_size = static_cast<std::size_t>(o.window);
+  if (o.num_changepoints > 0)
+    config.segmentation.num_changepoints = static_cast<int>(o.num_changepoints);
+
+  // Load every file (all bags or all CSV).
+  std::size_t bags = 0;
+  for (const std::string& f : o.files) bags += ends_with(f, ".bag") ? 1 : 0;
+  if (bags != 0 && bags != o.files.size())
+    throw std::invalid_argument("do not mix bags and CSV files");
+  std::vector<lfd::FeatureMatrix> demos;
+  std::vector<std::string> sensors = o.sensors, states = o.states;
+  for (const std::string& f : o.files) {
+    if (bags) {
+      lfd_segmentation::DemoFeatures demo =
+          lfd_segmentation::read_bag_features(f, params.topics, params.rate);
+      if (demos.empty() && o.sensors.empty()) sensors = demo.sensor_features;
+      if (demos.empty() && o.states.empty()) states = demo.state_features;
+      demos.push_back(std::move(demo.matrix));
+    } else {
+      demos.push_back(lfd_segmentation::read_csv_features(f, o.time_column, o.rate));
+    }
+  }
+  const double load_time = seconds_since(start);
+  lfd_segmentation::JsonOptions json_options;
+  json_options.profiles = o.profiles;
+  json_options.feature_profiles = o.feature_profiles;
+
+  nlohmann::json out;
+  const auto compute_start = std::chrono::steady_clock::now();
+  if (!bags && demos.size() == 1 && o.sensors.empty()) {
+    // Plain parameter-free multivariate ClaSP over the chosen columns, equal weights.
+    lfd::FeatureMatrix demo = states.empty() ? demos[0] : demos[0].select(states);
+    lfd::check_finite(demo, o.files[0]);
+    lfd::MultivariateSegmentationConfig seg = config.segmentation;
+    if (config.window_size > 0) seg.window_sizes.assign(demo.cols(), config.window_size);
+    const lfd::MultivariateSegmentation s = lfd::segment_multivariate(demo.data, {}, seg);
+    out = lfd_segmentation::to_json(s, demo, o.files[0], json_options);
+    out["mode"] = "clasp";
+  } else {
+    const lfd::SegmentationPipelineResult r =
+        lfd::run_segmentation_pipeline(demos, sensors, config, states);
+    out = lfd_segmentation::to_json(r, demos, o.files, json_options);
+    out["mode"] = "pipeline";
+  }
+  const double compute_time = seconds_since(compute_start);
+  if (o.timing) {
+    std::size_t samples = 0;
+    for (const auto& d : demos) samples += d.rows();
+    out["timing"] = {{"load_s", load_time},
+                     {"segmentation_s", compute_time},
+                     {"total_s", seconds_since(start)},
+                     {"demos", demos.size()},
+                     {"features", demos[0].cols()},
+                     {"samples", samples}};
+    std::cerr << "segment: " << demos.size() << " demo(s), " << demos[0].cols() << " features, "
+              << samples << " samples: load " << load_time << " s, segmentation " << compute_time
+              << " s, total " << seconds_since(start) << " s\n";
+  }
+  out["success"] = true;
+  return out;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  Options options;
+  nlohmann::json out;
+  int status = 0;
+  try {
+    options = parse_args(argc, argv);
+    out = run(options);
+  } catch (const std::exception& e) {
+    std::cerr << "segment: error: " << e.what() << "\n";
+    out = {{"success", false}, {"error", e.what()}};
+    status = 1;
+  }
+  const std::string text = out.dump(1);
+  if (!options.output.empty()) {
+    std::ofstream file(options.output);
+    file << text << "\n";
+    if (!file) {
+      std::cerr << "segment: cannot write " << options.output << "\n";
+      return 1;
+    }
+  } else {
+    std::cout << text << "\n";
+  }
+  return status;
+}

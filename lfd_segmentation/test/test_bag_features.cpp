@@ -1,0 +1,146 @@
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+
+#include "demo_bag_writer.hpp"
+#include "lfd_segmentation/bag_features.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+using lfd_segmentation::FeatureRole;
+using lfd_segmentation::TopicConfig;
+
+fs::path temp_dir() {
+  const fs::path dir = fs::temp_directory_path() / ("lfd_seg_test_" + std::to_string(getpid()));
+  fs::create_directories(dir);
+  return dir;
+}
+
+std::vector<TopicConfig> default_topics() {
+  return lfd_segmentation::load_params_file(std::string(LFD_CONFIG_DIR) + "/segmentation.yaml")
+      .topics;
+}
+
+TEST(BagFeatures, ReadsConfiguredFieldsOnOneClock) {
+  const std::string bag = (temp_dir() / "good.bag").string();
+  lfd_segmentation_test::DemoBagOptions o;
+  lfd_segmentation_test::write_demo_bag(bag, o);
+  const auto demo = lfd_segmentation::read_bag_features(bag, default_topics(), 50.0);
+  const lfd::FeatureMatrix& m = demo.matrix;
+  EXPECT_GE(m.index_of("/ee_twist/twist/linear/x"), 0);
+  EXPECT_GE(m.index_of("/ee_pose/pose/orientation/w"), 0);
+  EXPECT_GE(m.index_of("/gripper/state/position/R_GRIPPER"), 0);
+  EXPECT_GE(m.index_of("/touch/values/r_touch_left"), 0);  // values/* expanded
+  EXPECT_GE(m.index_of("/touch/values/r_touch_right"), 0);
+  EXPECT_GE(m.index_of("/wrist_ft/wrench/force/z"), 0);
+  for (const std::string& name : m.names) EXPECT_EQ(name.find("/lfd/phase"), std::string::npos);
+  EXPECT_EQ(demo.state_features.size(), 14u);
+  EXPECT_EQ(demo.sensor_features.size(), 8u);
+  EXPECT_EQ(demo.state_features.size() + demo.sensor_features.size(), std::size_t(m.cols()));
+  // 50 Hz over the common span of 100 Hz and 50 Hz streams (~7.98 s).
+  ASSERT_GT(m.rows(), 390);
+  EXPECT_LT(m.rows(), 402);
+  EXPECT_NEAR(m.time[1] - m.time[0], 0.02, 1e-9);
+  EXPECT_NEAR(m.time[0], o.start_time, 1e-6);
+  const int gripper = m.require("/gripper/state/position/R_GRIPPER");
+  EXPECT_NEAR(m.data(10, gripper), 0.08, 0.005);
+  EXPECT_NEAR(m.data(m.rows() - 10, gripper), 0.02, 0.005);
+  const int touch = m.require("/touch/values/r_touch_left");
+  EXPECT_NEAR(m.data(10, touch), 0.0, 0.2);
+  EXPECT_NEAR(m.data(m.rows() - 10, touch), 4.0, 0.2);
+}
+
+TEST(BagFeatures, ZeroOrderHoldKeepsDiscreteValues) {
+  const std::string bag = (temp_dir() / "zoh.bag").string();
+  lfd_segmentation_test::write_demo_bag(bag);
+  std::vector<TopicConfig> topics{{"/gripper/state",
+                                   FeatureRole::kState,
+                                   {"effort/R_GRIPPER"},
+                                   lfd::Interpolation::kZeroOrderHold}};
+  const auto demo = lfd_segmentation::read_bag_features(bag, topics, 33.0);
+  for (Eigen::Index r = 0; r < demo.matrix.rows(); ++r) {
+    const double v = demo.matrix.data(r, 0);
+    EXPECT_TRUE(v == 0.0 || v == 5.0) << v;
+  }
+}
+
+void expect_invalid(const std::string& bag, const std::vector<TopicConfig>& topics,
+                    const std::string& needle) {
+  try {
+    lfd_segmentation::read_bag_features(bag, topics, 50.0);
+    FAIL() << "expected an error mentioning " << needle;
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
+  }
+}
+
+TEST(BagFeatures, MissingTopicOrFieldIsAClearError) {
+  const std::string bag = (temp_dir() / "missing.bag").string();
+  lfd_segmentation_test::DemoBagOptions o;
+  o.with_touch = false;
+  lfd_segmentation_test::write_demo_bag(bag, o);
+  expect_invalid(bag, default_topics(), "no messages on topic /touch");
+  expect_invalid(bag, {{"/ee_twist", FeatureRole::kState, {"twist/linear/w"}}},
+                 "no field 'twist/linear/w'");
+  expect_invalid(bag, {{"/gripper/state", FeatureRole::kState, {"position/L_GRIPPER"}}},
+                 "no data for field 'position/L_GRIPPER'");
+  expect_invalid(bag, {{"/gripper/state", FeatureRole::kState, {"speed/R_GRIPPER"}}}, "bad field");
+  expect_invalid(bag, {{"/lfd/phase", FeatureRole::kState, {"index"}}}, "ground truth");
+}
+
+TEST(BagFeatures, NaNSampleIsReportedWithItsFeature) {
+  const std::string bag = (temp_dir() / "nan.bag").string();
+  lfd_segmentation_test::DemoBagOptions o;
+  o.nan_in_twist = true;
+  lfd_segmentation_test::write_demo_bag(bag, o);
+  expect_invalid(bag, default_topics(), "/ee_twist/twist/linear/x");
+}
+
+TEST(BagFeatures, UnreadableOrTruncatedBagIsARuntimeError) {
+  EXPECT_THROW(lfd_segmentation::read_bag_features("/nonexistent/demo.bag", default_topics(), 50),
+               std::runtime_error);
+  const std::string bag = (temp_dir() / "truncated.bag").string();
+  lfd_segmentation_test::write_demo_bag(bag);
+  fs::resize_file(bag, fs::file_size(bag) / 2);
+  EXPECT_THROW(lfd_segmentation::read_bag_features(bag, default_topics(), 50), std::runtime_error);
+  const std::string garbage = (temp_dir() / "garbage.bag").string();
+  std::ofstream(garbage) << "this is not a bag";
+  EXPECT_THROW(lfd_segmentation::read_bag_features(garbage, default_topics(), 50),
+               std::runtime_error);
+}
+
+TEST(SegmentationParams, LoadsTheShippedConfigAndRejectsBadValues) {
+  const auto p =
+      lfd_segmentation::load_params_file(std::string(LFD_CONFIG_DIR) + "/segmentation.yaml");
+  EXPECT_DOUBLE_EQ(p.pipeline.relevance.threshold, 0.9);
+  EXPECT_EQ(p.pipeline.segmentation.combination, lfd::ProfileCombination::kWeightedProduct);
+  EXPECT_DOUBLE_EQ(p.pipeline.events.threshold_ratio, 0.4);
+  EXPECT_EQ(p.topics.size(), 5u);
+  EXPECT_THROW(lfd_segmentation::params_from_yaml(YAML::Load("threshold: 1.5")),
+               std::invalid_argument);
+  EXPECT_THROW(lfd_segmentation::params_from_yaml(YAML::Load("combination: median")),
+               std::invalid_argument);
+  EXPECT_THROW(lfd_segmentation::params_from_yaml(YAML::Load("rate: -1")), std::invalid_argument);
+  EXPECT_THROW(lfd_segmentation::params_from_yaml(
+                   YAML::Load("topics: [{topic: /lfd/phase, fields: [index]}]")),
+               std::invalid_argument);
+  EXPECT_THROW(lfd_segmentation::params_from_yaml(
+                   YAML::Load("topics: [{topic: /x, role: actuator, fields: [a]}]")),
+               std::invalid_argument);
+  lfd_segmentation::SegmentationParams s;
+  s.rate = 50;
+  s.min_segment_seconds = 1.0;
+  s.window_seconds = 0.4;
+  EXPECT_EQ(s.pipeline_config().segmentation.min_segment_length, 50u);
+  EXPECT_EQ(s.pipeline_config().window_size, 20u);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  testing::InitGoogleTest(&argc, argv);
+  return RUN_ALL_TESTS();
+}

@@ -1,0 +1,141 @@
+// The `segment` CLI's CSV path (run as a subprocess, JSON parsed back) and the CSV reader.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <random>
+
+#include "lfd_segmentation/csv_features.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+
+fs::path temp_dir() {
+  const fs::path dir = fs::temp_directory_path() / ("lfd_cli_test_" + std::to_string(getpid()));
+  fs::create_directories(dir);
+  return dir;
+}
+
+// A grasp-like CSV: time, gripper (step), speed (texture changes), noise, touch (sensor).
+std::size_t write_demo_csv(const std::string& path, int n, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> noise(0.0, 1.0);
+  const std::size_t grasp = static_cast<std::size_t>(0.4 * n);
+  std::ofstream out(path);
+  out << "time,gripper,speed,noise,touch\n";
+  for (int i = 0; i < n; ++i) {
+    const double t = double(i) / (n - 1);
+    const bool closed = i >= int(grasp);
+    const double phase = closed ? (t - 0.4) / 0.6 : t / 0.4;
+    out << 0.02 * i << "," << (closed ? 0.02 : 0.08) + 0.0005 * noise(rng) << ","
+        << std::sin(M_PI * phase) * (closed ? 0.2 : 0.3) +
+               0.05 * std::sin(2 * M_PI * i / (closed ? 9.0 : 23.0)) + 0.003 * noise(rng)
+        << "," << noise(rng) << "," << (closed ? 4.0 : 0.0) + 0.02 * noise(rng) << "\n";
+  }
+  return grasp;
+}
+
+nlohmann::json run_cli(const std::string& args, int* status) {
+  const std::string out = (temp_dir() / "out.json").string();
+  const std::string cmd =
+      std::string(SEGMENT_CLI) + " " + args + " --output " + out + " 2>/dev/null";
+  const int rc = std::system(cmd.c_str());
+  *status = WEXITSTATUS(rc);
+  std::ifstream in(out);
+  return nlohmann::json::parse(in);
+}
+
+TEST(SegmentCli, SingleCsvRunsPlainMultivariateClasp) {
+  const std::string csv = (temp_dir() / "one.csv").string();
+  const std::size_t grasp = write_demo_csv(csv, 500, 1);
+  int status = -1;
+  const auto j = run_cli("--state-columns gripper,speed " + csv, &status);
+  ASSERT_EQ(status, 0) << j.dump();
+  EXPECT_EQ(j["mode"], "clasp");
+  ASSERT_EQ(j["demos"].size(), 1u);
+  const auto& cps = j["demos"][0]["changepoints"];
+  ASSERT_GE(cps.size(), 1u);
+  bool near = false;
+  // Tests the CLI plumbing; ClaSP places a step within about one window (50 samples) of it.
+  for (const auto& cp : cps) near = near || std::abs(cp.get<double>() - double(grasp)) < 75;
+  EXPECT_TRUE(near) << cps.dump();
+  EXPECT_EQ(j["demos"][0]["profile"].size(), 500u);
+  EXPECT_NEAR(j["demos"][0]["changepoint_times"][0].get<double>(), 0.02 * cps[0].get<double>(),
+              1e-9);
+}
+
+TEST(SegmentCli, SeveralCsvRunThePipelineWithSensorValidation) {
+  std::string files;
+  std::vector<std::size_t> grasps;
+  for (int d = 0; d < 3; ++d) {
+    const std::string csv = (temp_dir() / ("demo" + std::to_string(d) + ".csv")).string();
+    grasps.push_back(write_demo_csv(csv, 450 + 30 * d, 10 + d));
+    files += " " + csv;
+  }
+  int status = -1;
+  const auto j = run_cli("--sensor-columns touch --timing" + files, &status);
+  ASSERT_EQ(status, 0) << j.dump();
+  EXPECT_EQ(j["mode"], "pipeline");
+  EXPECT_TRUE(j["relevance_computed"].get<bool>());
+  EXPECT_EQ(j["sensor_features"], nlohmann::json::array({"touch"}));
+  ASSERT_EQ(j["relevance"]["features"].size(), 3u);  // gripper, speed, noise
+  for (const auto& f : j["relevance"]["features"]) {
+    EXPECT_EQ(f["correlation"].size(), 3u);
+    if (f["name"] == "noise") EXPECT_FALSE(f["selected"].get<bool>());
+  }
+  ASSERT_EQ(j["demos"].size(), 3u);
+  for (int d = 0; d < 3; ++d) {
+    const auto& demo = j["demos"][d];
+    ASSERT_EQ(demo["changepoints"].size(), 1u) << demo.dump();
+    EXPECT_NEAR(demo["changepoints"][0].get<double>(), double(grasps[d]), 0.1 * (450 + 30 * d));
+    EXPECT_FALSE(demo["zones"].empty());
+  }
+  EXPECT_TRUE(j.contains("timing"));
+}
+
+TEST(SegmentCli, BadInputFailsWithAnErrorInTheJson) {
+  const std::string csv = (temp_dir() / "bad.csv").string();
+  std::ofstream(csv) << "time,a,b\n0,1,2\n0.1,nan,3\n0.2,1,4\n";
+  int status = -1;
+  auto j = run_cli(csv + " " + csv + " --sensor-columns b", &status);
+  EXPECT_EQ(status, 1);
+  EXPECT_FALSE(j["success"].get<bool>());
+  EXPECT_NE(j["error"].get<std::string>().find("'a' has NaN"), std::string::npos) << j.dump();
+  j = run_cli("/nonexistent.csv", &status);
+  EXPECT_EQ(status, 1);
+  EXPECT_NE(j["error"].get<std::string>().find("cannot open"), std::string::npos);
+  j = run_cli("--bogus x " + csv, &status);
+  EXPECT_EQ(status, 1);
+}
+
+TEST(CsvFeatures, ParsesHeaderTimeAndRejectsRaggedRows) {
+  const std::string csv = (temp_dir() / "parse.csv").string();
+  std::ofstream(csv) << "a, t ,b\n1,0.0,2\n3,0.5,4\n\n";
+  const auto m = lfd_segmentation::read_csv_features(csv);
+  EXPECT_EQ(m.names, (std::vector<std::string>{"a", "b"}));
+  ASSERT_EQ(m.rows(), 2);
+  EXPECT_EQ(m.time, (std::vector<double>{0.0, 0.5}));
+  EXPECT_EQ(m.data(1, 0), 3.0);
+  EXPECT_EQ(m.data(1, 1), 4.0);
+  const auto no_time = lfd_segmentation::read_csv_features(csv, "b", 0.0);
+  EXPECT_EQ(no_time.names, (std::vector<std::string>{"a", "t"}));
+  std::ofstream(csv) << "a,b\n1,2\n3\n";
+  EXPECT_THROW(lfd_segmentation::read_csv_features(csv), std::invalid_argument);
+  std::ofstream(csv) << "a,b\n1,x\n";
+  EXPECT_THROW(lfd_segmentation::read_csv_features(csv), std::invalid_argument);
+  std::ofstream(csv) << "a,b\n1,2\n";
+  EXPECT_THROW(lfd_segmentation::read_csv_features(csv, "time"), std::invalid_argument);
+  const auto rated = lfd_segmentation::read_csv_features(csv, "", 10.0);
+  EXPECT_EQ(rated.time, (std::vector<double>{0.0}));
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  testing::InitGoogleTest(&argc, argv);
+  return RUN_ALL_TESTS();
+}

@@ -1,0 +1,172 @@
+// The service body (handle_segment_request) on bags written by the test: every bad input ends in
+// success=false + a precise error (or a warning), and a good request finds the grasp.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "demo_bag_writer.hpp"
+#include "lfd_segmentation/segment_service.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+using lfd_segmentation_test::DemoBagOptions;
+
+class SegmentService : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    dir_ = fs::temp_directory_path() / ("lfd_service_test_" + std::to_string(getpid()));
+    fs::create_directories(dir_);
+    params_ =
+        lfd_segmentation::load_params_file(std::string(LFD_CONFIG_DIR) + "/segmentation.yaml");
+  }
+  static void TearDownTestSuite() { fs::remove_all(dir_); }
+
+  static std::string bag(const std::string& name, DemoBagOptions o = {}) {
+    const std::string path = (dir_ / (name + ".bag")).string();
+    if (!fs::exists(path)) lfd_segmentation_test::write_demo_bag(path, o);
+    return path;
+  }
+  static std::vector<std::string> good_bags(int count) {
+    std::vector<std::string> bags;
+    for (int d = 0; d < count; ++d) {
+      DemoBagOptions o;
+      o.seed = 100 + d;
+      o.duration = 7.0 + 0.5 * d;
+      o.start_time = 50.0 + 20 * d;
+      bags.push_back(bag("good" + std::to_string(d), o));
+    }
+    return bags;
+  }
+  lfd_msgs::Segment::Response call(const std::vector<std::string>& bags,
+                                   lfd_msgs::Segment::Request request = {}) {
+    request.bag_paths = bags;
+    lfd_msgs::Segment::Response response;
+    lfd_segmentation::handle_segment_request(params_, request, response);
+    return response;
+  }
+  void expect_error(const lfd_msgs::Segment::Response& r, const std::string& needle) {
+    EXPECT_FALSE(r.success);
+    EXPECT_NE(r.error.find(needle), std::string::npos) << r.error;
+    EXPECT_TRUE(r.demos.empty());
+  }
+
+  static fs::path dir_;
+  static lfd_segmentation::SegmentationParams params_;
+};
+fs::path SegmentService::dir_;
+lfd_segmentation::SegmentationParams SegmentService::params_;
+
+TEST_F(SegmentService, GoodRequestValidatesTheGraspChangepoint) {
+  const auto bags = good_bags(3);
+  const auto r = call(bags);
+  ASSERT_TRUE(r.success) << r.error;
+  ASSERT_EQ(r.demos.size(), 3u);
+  EXPECT_FALSE(r.selected_features.empty());
+  EXPECT_EQ(r.selected_features.size(), r.selected_weights.size());
+  EXPECT_EQ(r.sensor_features.size(), 8u);
+  EXPECT_FALSE(r.features.empty());
+  for (const auto& f : r.features) EXPECT_EQ(f.correlation.size(), 9u);
+  // Every validated changepoint is the grasp; ClaSP may place a step up to ~one window late, so
+  // one demo may lose it to its zone (ClaSP precision is tested in lfd_core).
+  int validated = 0;
+  for (int d = 0; d < 3; ++d) {
+    const auto& demo = r.demos[d];
+    DemoBagOptions o;
+    o.duration = 7.0 + 0.5 * d;
+    o.start_time = 50.0 + 20 * d;
+    EXPECT_LE(demo.changepoints.size(), 1u) << "demo " << d;
+    EXPECT_FALSE(demo.candidates.empty());
+    for (double t : demo.changepoint_times) {
+      EXPECT_NEAR(t, lfd_segmentation_test::grasp_time(o), 0.1 * o.duration);
+      ++validated;
+    }
+    EXPECT_NEAR(demo.start_time, o.start_time, 0.05);
+    EXPECT_DOUBLE_EQ(demo.sample_rate, params_.rate);
+    EXPECT_FALSE(demo.zones.empty());
+  }
+  EXPECT_GE(validated, 2);
+  EXPECT_GT(r.elapsed, 0.0);
+}
+
+TEST_F(SegmentService, OverridesAreApplied) {
+  lfd_msgs::Segment::Request request;
+  request.combination = "average";
+  request.num_changepoints = 2;
+  request.min_segment_seconds = 1.0;
+  const auto r = call(good_bags(2), request);
+  ASSERT_TRUE(r.success) << r.error;
+  EXPECT_EQ(r.demos[0].min_segment_length, 50u);
+  request.combination = "median";
+  expect_error(call(good_bags(2), request), "median");
+  request.combination = "";
+  request.threshold = 2.0;
+  expect_error(call(good_bags(2), request), "threshold");
+}
+
+TEST_F(SegmentService, EmptyRequest) {
+  expect_error(call({}), "empty request");
+}
+
+TEST_F(SegmentService, SingleDemoFallsBackWithAWarning) {
+  const auto r = call({good_bags(1)[0]});
+  ASSERT_TRUE(r.success) << r.error;
+  ASSERT_FALSE(r.warnings.empty());
+  bool warned = false;
+  for (const auto& w : r.warnings)
+    warned = warned || w.find("single demonstration") != std::string::npos;
+  EXPECT_TRUE(warned);
+  EXPECT_TRUE(r.features.empty());
+}
+
+TEST_F(SegmentService, MissingTopic) {
+  DemoBagOptions o;
+  o.with_touch = false;
+  expect_error(call({good_bags(1)[0], bag("no_touch", o)}), "no messages on topic /touch");
+}
+
+TEST_F(SegmentService, NaNSample) {
+  DemoBagOptions o;
+  o.nan_in_twist = true;
+  expect_error(call({good_bags(1)[0], bag("nan", o)}), "/ee_twist/twist/linear/x");
+}
+
+TEST_F(SegmentService, DemoShorterThanTwiceMinSegment) {
+  lfd_msgs::Segment::Request request;
+  request.min_segment_seconds = 5.0;
+  expect_error(call(good_bags(2), request), "2 * min_s");
+}
+
+TEST_F(SegmentService, ConstantSignalIsIgnoredWithAWarning) {
+  DemoBagOptions o;
+  o.constant_gripper = true;
+  o.seed = 7;
+  const auto r = call({bag("constant_a", o), bag("constant_b", o)});
+  ASSERT_TRUE(r.success) << r.error;
+  bool warned = false;
+  for (const auto& w : r.warnings)
+    warned = warned || w.find("R_GRIPPER' is constant") != std::string::npos;
+  EXPECT_TRUE(warned);
+}
+
+TEST_F(SegmentService, UnreadableAndTruncatedBags) {
+  expect_error(call({"/nonexistent/demo.bag", good_bags(1)[0]}), "cannot open bag");
+  const std::string truncated = (dir_ / "truncated.bag").string();
+  fs::copy_file(good_bags(1)[0], truncated, fs::copy_options::overwrite_existing);
+  fs::resize_file(truncated, fs::file_size(truncated) / 3);
+  expect_error(call({good_bags(1)[0], truncated}), "truncated.bag");
+}
+
+TEST_F(SegmentService, FeaturesThatDifferBetweenDemos) {
+  DemoBagOptions o;
+  o.touch_name = "r_touch_palm";
+  expect_error(call({good_bags(1)[0], bag("other_touch", o)}), "features differ");
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  testing::InitGoogleTest(&argc, argv);
+  return RUN_ALL_TESTS();
+}

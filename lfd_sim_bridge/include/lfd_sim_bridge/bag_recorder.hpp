@@ -1,0 +1,55 @@
+// One demonstration bag: generic (ShapeShifter) messages stamped with their header time, written to
+// `<path>.active` and renamed to `<path>` on close, like `rosbag record` does, so a bag that exists
+// under its final name is always complete.
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <string>
+
+#include <lfd_msgs/DemoMetadata.h>
+#include <ros/message_event.h>
+#include <ros/time.h>
+#include <rosbag/bag.h>
+#include <topic_tools/shape_shifter.h>
+
+namespace lfd_sim_bridge {
+
+// Header stamp of a serialized message whose definition starts with a std_msgs/Header field;
+// returns false when the type has no leading header (e.g. tf2_msgs/TFMessage).
+bool headerStampOf(const topic_tools::ShapeShifter& msg, ros::Time* stamp);
+
+class DemoBag {
+ public:
+  // Opens `<bag_path>.active` (creating parent folders) and writes `metadata` on /lfd/metadata at
+  // `start`. Throws std::runtime_error with the reason when the bag cannot be created.
+  DemoBag(const std::string& bag_path, lfd_msgs::DemoMetadata metadata, const ros::Time& start);
+  ~DemoBag();  // closes (and renames) if still open, so no data is lost on error paths
+
+  DemoBag(const DemoBag&) = delete;
+  DemoBag& operator=(const DemoBag&) = delete;
+
+  // Writes one message at `stamp`. Messages stamped before the start belong to the previous
+  // demonstration and are dropped (returns false).
+  bool write(const std::string& topic, const ros::Time& stamp,
+             const ros::MessageEvent<const topic_tools::ShapeShifter>& event);
+
+  // Closes the bag and renames `<path>.active` to `<path>`.
+  void close();
+
+  const std::string& path() const { return path_; }
+  const ros::Time& start() const { return start_; }
+  uint64_t messagesWritten() const { return written_; }
+  const std::map<std::string, uint64_t>& perTopic() const { return per_topic_; }
+
+ private:
+  std::string path_;
+  ros::Time start_;
+  rosbag::Bag bag_;
+  bool open_ = false;
+  uint64_t written_ = 0;
+  std::map<std::string, uint64_t> per_topic_;
+};
+
+}  // namespace lfd_sim_bridge

@@ -1,0 +1,200 @@
+// ROS-free MuJoCo workcell: loads the MJCF scene, emulates a position-controlled hardware
+// interface (PD tracking of joint targets with position, velocity and effort limits, smooth
+// trajectories, a parallel gripper), steps physics at the model timestep, reads every sensor the
+// pipeline records, and recovers from numerical divergence instead of crashing.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <memory>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "lfd_sim_bridge/trajectory_interpolator.hpp"
+
+struct mjModel_;
+struct mjData_;
+
+namespace lfd_sim {
+
+enum class LogLevel { kInfo, kWarn, kError };
+using LogSink = std::function<void(LogLevel, const std::string&)>;
+
+// Gaussian noise (standard deviations, SI units) added to the readings returned by readState().
+// All zero = exact readings. Control always uses the exact state.
+struct SensorNoise {
+  double joint_position = 0.0;  // rad or m
+  double joint_velocity = 0.0;
+  double joint_effort = 0.0;
+  double force = 0.0;            // N
+  double torque = 0.0;           // N m
+  double touch = 0.0;            // N
+  double gyro = 0.0;             // rad/s
+  double accel = 0.0;            // m/s^2
+  double ee_position = 0.0;      // m
+  double ee_orientation = 0.0;   // rad (small random rotation)
+  double gripper = 0.0;          // m
+  double object_position = 0.0;  // m
+};
+
+struct WorkcellConfig {
+  // Proportional gain per actuated joint. Joints not listed keep the MJCF position actuator's kp,
+  // or default_kp if the actuator has none.
+  std::map<std::string, double> kp;
+  double default_kp = 200.0;
+  // Damping: joint damping is raised to damping_ratio * 2 sqrt(kp * I_eff) (critical at 1) unless
+  // given per joint in `kd`. It is applied as implicit joint damping (unconditionally stable) with
+  // the target velocity fed forward, so it does not slow trajectory tracking.
+  double damping_ratio = 1.0;
+  std::map<std::string, double> kd;
+  // Velocity limits (rad/s or m/s) of the target motion, and effort limits (N m or N).
+  // Effort: per joint here, else URDF (see applyUrdfLimits), else the actuator's forcerange.
+  double default_velocity_limit = 2.0;
+  std::map<std::string, double> velocity_limits;
+  std::map<std::string, double> effort_limits;
+  double default_effort_limit = 200.0;  // when neither config, URDF nor MJCF gives one
+  // Feed forward gravity and Coriolis torques (within the effort limit), as a humanoid's
+  // position controller would; without it the arm sags by g(q)/kp.
+  bool gravity_compensation = true;
+  // Initial posture used by reset(); joints not listed start at the model's qpos0.
+  std::map<std::string, double> initial_posture;
+  // Gripper: actuated joint name, opening between the fingers = scale * joint position.
+  std::string gripper_joint = "R_GRIPPER";
+  double gripper_opening_scale = 2.0;
+  // Frames of the contract.
+  std::string base_body = "base_link";
+  std::string ee_site = "r_gripper_tcp";
+  std::vector<std::string> objects = {"stick", "box"};
+  // Readings noise (teleop-like mode), seeded for reproducible datasets.
+  SensorNoise noise;
+  uint64_t noise_seed = 1;
+  // Divergence: any |qvel| above this (rad/s, m/s) counts as a blow-up and triggers a reset.
+  double max_abs_velocity = 200.0;
+};
+
+struct Pose {
+  std::array<double, 3> position{0, 0, 0};
+  std::array<double, 4> orientation{1, 0, 0, 0};  // quaternion w, x, y, z
+};
+
+struct JointLimit {
+  double lower = -1e300, upper = 1e300;
+  bool position_limited = false;
+  double velocity = 0.0;  // max |target rate|
+  double effort = 0.0;    // max |actuator force|
+};
+
+// One snapshot of everything the bridge publishes, at sim time `time`.
+struct WorkcellState {
+  double time = 0.0;
+  std::vector<std::string> joint_names;  // every hinge/slide joint of the model (no free joints)
+  std::vector<double> joint_positions, joint_velocities, joint_efforts;
+  std::array<double, 3> wrist_force{}, wrist_torque{};  // in the r_wrist_ft site frame
+  std::vector<std::string> touch_names;
+  std::vector<double> touch_values;
+  std::array<double, 3> imu_gyro{}, imu_accel{};      // in the imu site frame
+  std::array<double, 4> imu_orientation{1, 0, 0, 0};  // w, x, y, z, world frame
+  double gripper_opening = 0.0, gripper_velocity = 0.0, gripper_effort = 0.0;
+  Pose ee_pose;                                                       // r_gripper_tcp in base_link
+  std::array<double, 3> ee_linear_velocity{}, ee_angular_velocity{};  // in base_link axes
+  std::vector<std::string> object_names;
+  std::vector<Pose> object_poses;  // world
+};
+
+class WorkcellSim {
+ public:
+  // Loads the MJCF file; throws std::runtime_error with MuJoCo's message if it fails.
+  explicit WorkcellSim(const std::string& mjcf_path, const WorkcellConfig& config = {},
+                       LogSink log = nullptr);
+  ~WorkcellSim();
+  WorkcellSim(const WorkcellSim&) = delete;
+  WorkcellSim& operator=(const WorkcellSim&) = delete;
+
+  // Overrides velocity/effort limits from a URDF string (joint <limit velocity effort>), unless
+  // the config names the joint explicitly. Throws std::invalid_argument if the URDF does not parse.
+  void applyUrdfLimits(const std::string& urdf_xml);
+
+  // --- commands (all throw std::invalid_argument on bad input and then change nothing) ---
+  // Streamed targets; cancels any running trajectory.
+  void setJointTargets(const std::vector<std::string>& names, const std::vector<double>& positions);
+  // Replaces the current trajectory. It starts at max(start_time, now) (start_time <= 0 = now).
+  // A repeat of the running trajectory with the same start_time > 0 is ignored, so senders may
+  // resend a stamped trajectory (ROS can drop the first messages of a new connection).
+  void setTrajectory(const JointTrajectory& trajectory, double start_time = 0.0);
+  // Opening between the fingers (m) and max force (N, <= 0 = the joint's effort limit).
+  void setGripper(double opening, double max_effort);
+
+  // --- simulation ---
+  void step(int n = 1);
+  double time() const;
+  double timestep() const;
+  // Robot to a posture (empty = configured initial posture; unlisted joints take the initial
+  // posture), zero velocities, targets = posture, trajectory cancelled. Objects return to their
+  // initial poses if reset_objects. Sim time keeps running (never goes backwards).
+  void reset(const std::map<std::string, double>& posture = {}, bool reset_objects = false);
+  void setObjectPose(const std::string& object, const Pose& pose_in_world);
+
+  // --- readings ---
+  WorkcellState readState();  // noisy if config.noise is non-zero
+  void readState(WorkcellState* state);
+  Pose basePoseInWorld() const;
+
+  // --- introspection ---
+  const std::vector<std::string>& actuatedJoints() const { return actuated_names_; }
+  const std::vector<std::string>& jointNames() const { return joint_names_; }
+  bool hasJoint(const std::string& name) const;
+  JointLimit jointLimit(const std::string& actuated_joint) const;
+  double jointPosition(const std::string& name) const;
+  double jointTarget(const std::string& actuated_joint) const;  // after clamping & rate limit
+  double actuatorForce(const std::string& actuated_joint) const;
+  bool trajectoryActive() const;     // true until sim time passes the trajectory's last point
+  double trajectoryEndTime() const;  // 0 when none has been set
+  int divergenceCount() const { return divergence_count_; }
+  const mjModel_* model() const { return m_; }
+  mjData_* data() { return d_; }
+  // For tests: write NaN into the velocity of the first dof, as a blow-up would.
+  void injectNaNForTest();
+
+ private:
+  struct Actuated;
+  void configureActuators();
+  void computeControls();
+  bool diverged(std::string* why) const;
+  std::array<int, 4> badNumberWarnings() const;
+  void recoverFromDivergence(const std::string& why);
+  void applyPosture(const std::map<std::string, double>& posture);
+  void log(LogLevel level, const std::string& text) const;
+  double clampTarget(Actuated& a, double target);
+  Pose bodyPose(int body) const;
+  int actuatedIndex(const std::string& name) const;
+  double noise(double std);
+
+  WorkcellConfig config_;
+  LogSink log_;
+  mjModel_* m_ = nullptr;
+  mjData_* d_ = nullptr;
+  std::vector<Actuated> actuated_;
+  std::vector<std::string> actuated_names_;
+  std::map<std::string, int> actuated_index_;
+  std::vector<std::string> joint_names_;
+  std::vector<int> joint_ids_;
+  std::unique_ptr<TrajectoryInterpolator> trajectory_;
+  std::vector<int> trajectory_to_actuated_;
+  JointTrajectory last_trajectory_;
+  double last_trajectory_stamp_ = 0.0;
+  std::vector<double> traj_pos_, traj_vel_;
+  int base_body_ = -1, ee_site_ = -1, gripper_ = -1;
+  int force_adr_ = -1, torque_adr_ = -1, gyro_adr_ = -1, accel_adr_ = -1, quat_adr_ = -1;
+  std::vector<std::pair<std::string, int>> touch_adr_;
+  std::vector<std::pair<std::string, int>> objects_;  // name, body id
+  std::vector<double> initial_qpos_;                  // model qpos0: initial object poses
+  std::vector<double> scene_qpos_;  // object poses last set (divergence recovery restores them)
+  int divergence_count_ = 0;
+  std::mt19937_64 rng_;
+  bool noisy_ = false;
+};
+
+}  // namespace lfd_sim

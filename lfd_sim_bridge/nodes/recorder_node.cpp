@@ -1,0 +1,274 @@
+// recorder_node: one bag per demonstration. Subscribes generically (ShapeShifter) to the topics of
+// config/recorder.yaml from startup, so no subscription latency is paid when a demo starts, and
+// writes them while a recording is active, stamped with their header time (sim time).
+//   /recorder/start (lfd_msgs/StartRecording): open <bag_path>.active, write metadata first
+//   /recorder/stop  (lfd_msgs/StopRecording):  wait for in-flight messages, close, rename
+// SIGINT/SIGTERM close the open bag cleanly before the node exits.
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <csignal>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <vector>
+
+#include <lfd_msgs/StartRecording.h>
+#include <lfd_msgs/StopRecording.h>
+#include <ros/callback_queue.h>
+#include <ros/ros.h>
+#include <rosgraph_msgs/Clock.h>
+#include <topic_tools/shape_shifter.h>
+
+#include "lfd_sim_bridge/bag_recorder.hpp"
+
+namespace {
+
+std::atomic<bool> g_signalled{false};
+void onSignal(int) {
+  g_signalled = true;
+}
+
+struct TopicSpec {
+  std::string name;
+  double rate = 0.0;  // expected rate (Hz, sim time); 0 = event-driven
+};
+
+std::vector<TopicSpec> loadTopics(ros::NodeHandle& pnh) {
+  XmlRpc::XmlRpcValue list;
+  if (!pnh.getParam("topics", list) || list.getType() != XmlRpc::XmlRpcValue::TypeArray)
+    throw std::runtime_error("~topics must be a list of {name, rate} (see config/recorder.yaml)");
+  std::vector<TopicSpec> topics;
+  for (int i = 0; i < list.size(); ++i) {
+    XmlRpc::XmlRpcValue& entry = list[i];
+    TopicSpec spec;
+    if (entry.getType() == XmlRpc::XmlRpcValue::TypeString) {
+      spec.name = static_cast<std::string>(entry);
+    } else if (entry.getType() == XmlRpc::XmlRpcValue::TypeStruct && entry.hasMember("name")) {
+      spec.name = static_cast<std::string>(entry["name"]);
+      if (entry.hasMember("rate")) {
+        XmlRpc::XmlRpcValue& r = entry["rate"];
+        spec.rate = r.getType() == XmlRpc::XmlRpcValue::TypeInt ? static_cast<int>(r)
+                                                                : static_cast<double>(r);
+      }
+    } else {
+      throw std::runtime_error("~topics[" + std::to_string(i) + "] needs a 'name'");
+    }
+    topics.push_back(spec);
+  }
+  return topics;
+}
+
+class Recorder {
+ public:
+  Recorder(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
+    topics_ = loadTopics(pnh);
+    const int queue_size = pnh.param("queue_size", 100000);
+    settle_timeout_ = pnh.param("settle_timeout", 1.0);
+    for (const TopicSpec& spec : topics_) {
+      ros::SubscribeOptions opts;
+      // Full callback type: the connection header (latching, callerid) comes with each message.
+      opts.initByFullCallbackType<const ros::MessageEvent<const topic_tools::ShapeShifter>&>(
+          spec.name, queue_size,
+          [this,
+           name = spec.name](const ros::MessageEvent<const topic_tools::ShapeShifter>& event) {
+            onMessage(name, event);
+          });
+      opts.transport_hints = ros::TransportHints().tcpNoDelay();
+      subscribers_.push_back(nh.subscribe(opts));
+    }
+    // Services run on their own thread so /recorder/stop can wait for in-flight messages while the
+    // main thread keeps writing them.
+    service_nh_.setCallbackQueue(&service_queue_);
+    start_srv_ = service_nh_.advertiseService("/recorder/start", &Recorder::onStart, this);
+    // The newest sim time, read on the service thread: ros::Time::now() is updated on the main
+    // queue, behind any backlog of messages, and would stop a bag too early.
+    clock_sub_ = service_nh_.subscribe("/clock", 10, &Recorder::onClock, this,
+                                       ros::TransportHints().tcpNoDelay());
+    stop_srv_ = service_nh_.advertiseService("/recorder/stop", &Recorder::onStop, this);
+    service_spinner_ = std::make_unique<ros::AsyncSpinner>(1, &service_queue_);
+    service_spinner_->start();
+    ROS_INFO("recorder: %zu topics, queue %d, services /recorder/start and /recorder/stop",
+             topics_.size(), queue_size);
+  }
+
+  // Closes the open bag (if any): used on shutdown so that nothing recorded is lost.
+  void closeOnShutdown() {
+    service_spinner_->stop();
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (bag_) {
+      const std::string path = bag_->path();
+      const uint64_t n = bag_->messagesWritten();
+      closeLocked();
+      ROS_INFO("recorder: shutdown, closed %s (%lu messages)", path.c_str(),
+               static_cast<unsigned long>(n));
+    }
+  }
+
+ private:
+  void onMessage(const std::string& topic,
+                 const ros::MessageEvent<const topic_tools::ShapeShifter>& event) {
+    ros::Time stamp;
+    if (!lfd_sim_bridge::headerStampOf(*event.getConstMessage(), &stamp) || stamp.isZero())
+      stamp = ros::Time::now();
+    const auto& header = event.getConnectionHeader();
+    const auto latch = header.find("latching");
+    const bool latched = latch != header.end() && latch->second == "1";
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      if (latched) latched_[topic] = event;
+      last_stamp_[topic] = stamp;
+      if (bag_ && (stop_time_.isZero() || stamp <= stop_time_)) {
+        try {
+          bag_->write(topic, stamp, event);
+        } catch (const std::exception& e) {
+          ROS_ERROR_THROTTLE(1.0, "recorder: writing %s failed: %s", topic.c_str(), e.what());
+        }
+      }
+    }
+    settled_.notify_all();
+  }
+
+  bool onStart(lfd_msgs::StartRecording::Request& req, lfd_msgs::StartRecording::Response& res) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (bag_) {
+      res.success = false;
+      res.message = "already recording to " + bag_->path();
+      return true;
+    }
+    const ros::Time start =
+        req.metadata.header.stamp.isZero() ? ros::Time::now() : req.metadata.header.stamp;
+    try {
+      bag_ = std::make_unique<lfd_sim_bridge::DemoBag>(req.bag_path, req.metadata, start);
+    } catch (const std::exception& e) {
+      res.success = false;
+      res.message = e.what();
+      ROS_ERROR("recorder: %s", e.what());
+      return true;
+    }
+    stop_time_ = ros::Time();
+    // Latched topics (e.g. /tf_static) were sent once, before this demo: repeat them at its start.
+    for (const auto& [topic, event] : latched_) bag_->write(topic, start, event);
+    res.success = true;
+    res.message = "recording " + req.bag_path;
+    ROS_INFO("recorder: start %s at t=%.3f", req.bag_path.c_str(), start.toSec());
+    return true;
+  }
+
+  bool onStop(lfd_msgs::StopRecording::Request&, lfd_msgs::StopRecording::Response& res) {
+    std::unique_lock<std::mutex> lock(mutex_);
+    if (!bag_) {
+      res.success = false;
+      res.message = "not recording";
+      return true;
+    }
+    stop_time_ = std::max(ros::Time::now(), latest_clock_);
+    // Messages stamped up to the stop time may still be queued: wait until every topic seen in this
+    // bag has delivered past the stop time (or the settle timeout passes, e.g. sim paused).
+    if (!settled_.wait_for(lock, std::chrono::duration<double>(settle_timeout_),
+                           [this] { return allTopicsPast(stop_time_); }))
+      ROS_WARN("recorder: %s", laggingTopics(stop_time_).c_str());
+    res.bag_path = bag_->path();
+    res.messages_written = bag_->messagesWritten();
+    warnAboutRates();
+    try {
+      closeLocked();
+    } catch (const std::exception& e) {
+      res.success = false;
+      res.message = e.what();
+      return true;
+    }
+    res.success = true;
+    res.message = "closed after " + std::to_string(res.messages_written) + " messages";
+    ROS_INFO("recorder: stop %s (%lu messages)", res.bag_path.c_str(),
+             static_cast<unsigned long>(res.messages_written));
+    return true;
+  }
+
+  void onClock(const rosgraph_msgs::Clock::ConstPtr& msg) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    latest_clock_ = std::max(latest_clock_, msg->clock);
+  }
+
+  // True when no message stamped up to t can still be on its way: each periodic topic has
+  // delivered a message less than one period before t (its next one is after t). Event-driven
+  // topics (rate 0) give no such guarantee and are not waited for.
+  bool allTopicsPast(const ros::Time& t) const {
+    for (const TopicSpec& spec : topics_) {
+      if (spec.rate <= 0.0 || !bag_->perTopic().count(spec.name)) continue;
+      const auto it = last_stamp_.find(spec.name);
+      if (it == last_stamp_.end() || it->second + ros::Duration(1.0 / spec.rate) <= t) return false;
+    }
+    return true;
+  }
+
+  std::string laggingTopics(const ros::Time& t) const {
+    std::string text = "stopped before every topic reached t=" + std::to_string(t.toSec()) + ":";
+    for (const TopicSpec& spec : topics_) {
+      if (spec.rate <= 0.0 || !bag_->perTopic().count(spec.name)) continue;
+      const auto it = last_stamp_.find(spec.name);
+      if (it == last_stamp_.end() || it->second + ros::Duration(1.0 / spec.rate) <= t)
+        text += " " + spec.name +
+                (it == last_stamp_.end() ? " (none)"
+                                         : " (last " + std::to_string(it->second.toSec()) + ")");
+    }
+    return text;
+  }
+
+  void warnAboutRates() const {
+    const double duration = (stop_time_ - bag_->start()).toSec();
+    if (duration <= 0.5) return;
+    for (const TopicSpec& spec : topics_) {
+      const auto it = bag_->perTopic().find(spec.name);
+      const double count = it == bag_->perTopic().end() ? 0.0 : static_cast<double>(it->second);
+      if (spec.rate > 0.0 && count < 0.5 * spec.rate * duration)
+        ROS_WARN("recorder: %s has %.0f messages over %.2f s, expected ~%.0f", spec.name.c_str(),
+                 count, duration, spec.rate * duration);
+    }
+  }
+
+  void closeLocked() {
+    std::unique_ptr<lfd_sim_bridge::DemoBag> bag = std::move(bag_);
+    stop_time_ = ros::Time();
+    bag->close();
+  }
+
+  std::vector<TopicSpec> topics_;
+  double settle_timeout_ = 1.0;
+  std::vector<ros::Subscriber> subscribers_;
+  ros::NodeHandle service_nh_;
+  ros::CallbackQueue service_queue_;
+  std::unique_ptr<ros::AsyncSpinner> service_spinner_;
+  ros::ServiceServer start_srv_, stop_srv_;
+
+  std::mutex mutex_;
+  std::condition_variable settled_;
+  std::unique_ptr<lfd_sim_bridge::DemoBag> bag_;
+  ros::Time stop_time_, latest_clock_;
+  ros::Subscriber clock_sub_;
+  std::map<std::string, ros::Time> last_stamp_;
+  std::map<std::string, ros::MessageEvent<const topic_tools::ShapeShifter>> latched_;
+};
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  ros::init(argc, argv, "recorder", ros::init_options::NoSigintHandler);
+  std::signal(SIGINT, onSignal);
+  std::signal(SIGTERM, onSignal);
+  ros::NodeHandle nh, pnh("~");
+  std::unique_ptr<Recorder> recorder;
+  try {
+    recorder = std::make_unique<Recorder>(nh, pnh);
+  } catch (const std::exception& e) {
+    ROS_FATAL("recorder: %s", e.what());
+    return 1;
+  }
+  ros::CallbackQueue* queue = ros::getGlobalCallbackQueue();
+  while (ros::ok() && !g_signalled) queue->callAvailable(ros::WallDuration(0.05));
+  queue->callAvailable();  // messages already received are part of the demonstration: write them
+  recorder->closeOnShutdown();
+  ros::shutdown();
+  return 0;
+}

@@ -1,0 +1,171 @@
+#!/usr/bin/python3
+"""Generate the four demonstration datasets of the paper's evaluation, then summarise them.
+
+  generate_datasets.py --out DIR [--datasets sim_grasp,sim_push,teleop_grasp,teleop_push]
+                       [--seed N] [--tasks-file PATH] [--timeout S] [--force]
+
+Each dataset <DIR>/<mode>_<task> gets one bag per configuration of config/tasks.yaml, produced by
+`roslaunch lfd_launch demonstrate.launch` (bridge as fast as possible + recorder + demonstrator).
+A dataset that already holds every bag is skipped, and the demonstrator skips bags that exist,
+so a rerun resumes where an interrupted one stopped (*.bag.active leftovers are removed first).
+Uses the ROS master of ROS_MASTER_URI when one is running, else starts a private one.
+Prints a table: dataset, demos, mean duration, physical successes, recorded topics.
+Exit status 0 only if every dataset is complete and every demo succeeded physically.
+"""
+import argparse
+import glob
+import os
+import shutil
+import socket
+import subprocess
+import sys
+import time
+
+import rosgraph
+import rospkg
+import yaml
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from check_demo_bag import check_bag  # noqa: E402
+
+DATASETS = ("sim_grasp", "sim_push", "teleop_grasp", "teleop_push")
+
+
+def configurations(tasks_file, task, mode):
+    with open(tasks_file) as f:
+        tasks = yaml.safe_load(f)
+    entries = (tasks.get(task) or {}).get(mode) or []
+    return [e.get("id", i) for i, e in enumerate(entries)]
+
+
+def bag_name(out, task, mode, config):
+    return os.path.join(out, "%s_%s_%02d.bag" % (task, mode, config))
+
+
+def free_port():
+    with socket.socket() as s:
+        s.bind(("localhost", 0))
+        return s.getsockname()[1]
+
+
+class Master:
+    """A private roscore when none is reachable, stopped on exit."""
+
+    def __init__(self):
+        self.proc = None
+
+    def __enter__(self):
+        if rosgraph.is_master_online():
+            return self
+        port = free_port()
+        os.environ["ROS_MASTER_URI"] = "http://localhost:%d" % port
+        self.proc = subprocess.Popen(["roscore", "-p", str(port)], stdout=subprocess.DEVNULL,
+                                     stderr=subprocess.DEVNULL)
+        deadline = time.time() + 30
+        while not rosgraph.is_master_online():
+            if time.time() > deadline or self.proc.poll() is not None:
+                raise RuntimeError("could not start roscore on port %d" % port)
+            time.sleep(0.1)
+        return self
+
+    def __exit__(self, *exc):
+        if self.proc and self.proc.poll() is None:
+            self.proc.send_signal(2)
+            try:
+                self.proc.wait(15)
+            except subprocess.TimeoutExpired:
+                self.proc.kill()
+                self.proc.wait()
+
+
+def generate(name, out_root, args, log_dir):
+    mode, task = name.split("_")
+    out = os.path.join(out_root, name)
+    ids = configurations(args.tasks_file, task, mode)
+    os.makedirs(out, exist_ok=True)
+    for stale in glob.glob(os.path.join(out, "*.bag.active")):
+        os.remove(stale)  # an interrupted demo: recorded again below
+    missing = [i for i in ids if not os.path.exists(bag_name(out, task, mode, i))]
+    if not missing:
+        print("[datasets] %s: complete (%d bags), skipped" % (name, len(ids)), flush=True)
+        return 0.0
+    print("[datasets] %s: recording %d of %d demos" % (name, len(missing), len(ids)), flush=True)
+    cmd = ["roslaunch", "lfd_launch", "demonstrate.launch", "task:=" + task, "mode:=" + mode,
+           "output_dir:=" + out, "seed:=%d" % args.seed, "tasks_file:=" + args.tasks_file,
+           "configurations:=[%s]" % ",".join(str(i) for i in missing)]
+    start = time.time()
+    with open(os.path.join(log_dir, name + ".log"), "w") as log:
+        try:
+            subprocess.run(cmd, stdout=log, stderr=subprocess.STDOUT, timeout=args.timeout,
+                           check=False)
+        except subprocess.TimeoutExpired:
+            print("[datasets] %s: timed out after %.0f s (see %s)" % (name, args.timeout, log.name),
+                  file=sys.stderr)
+    elapsed = time.time() - start
+    print("[datasets] %s: %.1f s wall" % (name, elapsed), flush=True)
+    return elapsed
+
+
+def summarize(out_root, names, args):
+    rows, all_ok, all_topics = [], True, set()
+    for name in names:
+        mode, task = name.split("_")
+        ids = configurations(args.tasks_file, task, mode)
+        bags = [bag_name(os.path.join(out_root, name), task, mode, i) for i in ids]
+        results = [check_bag(b) for b in bags if os.path.exists(b)]
+        ok = sum(bool(r["success"]) for r in results)
+        durations = [r["duration"] for r in results if "duration" in r]
+        topics = sorted({t for r in results for t in r.get("topics", {})})
+        all_topics.update(topics)
+        all_ok &= len(results) == len(ids) and ok == len(ids)
+        rows.append((name, "%d/%d" % (len(results), len(ids)),
+                     "%.1f" % (sum(durations) / len(durations)) if durations else "-",
+                     "%d/%d" % (ok, len(results)), len(topics)))
+        for r in results:
+            if not r["success"]:
+                print("[datasets]   FAIL %s: %s" % (r["bag"], r["reason"]))
+    header = ("dataset", "demos", "mean duration [s]", "physical success", "topics")
+    widths = [max(len(str(x)) for x in col) for col in zip(header, *rows)]
+    line = "  ".join("%-*s" % (w, h) for w, h in zip(widths, header))
+    print(line)
+    print("-" * len(line))
+    for row in rows:
+        print("  ".join("%-*s" % (w, str(c)) for w, c in zip(widths, row)))
+    print("topics recorded: %s" % " ".join(sorted(all_topics)))
+    return all_ok
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("--out", required=True, help="folder receiving one subfolder per dataset")
+    parser.add_argument("--datasets", default=",".join(DATASETS),
+                        help="comma-separated subset of " + ",".join(DATASETS))
+    parser.add_argument("--seed", type=int, default=1)
+    parser.add_argument("--tasks-file", default=None, help="default: lfd_config/tasks.yaml")
+    parser.add_argument("--timeout", type=float, default=600.0, help="s per dataset")
+    parser.add_argument("--force", action="store_true", help="delete and regenerate")
+    args = parser.parse_args()
+    names = [n.strip() for n in args.datasets.split(",") if n.strip()]
+    for n in names:
+        if n not in DATASETS:
+            parser.error("unknown dataset '%s' (choose from %s)" % (n, ", ".join(DATASETS)))
+    if args.tasks_file is None:
+        args.tasks_file = os.path.join(rospkg.RosPack().get_path("lfd_config"), "tasks.yaml")
+    out_root = os.path.abspath(args.out)
+    log_dir = os.path.join(out_root, "logs")
+    os.makedirs(log_dir, exist_ok=True)
+    if args.force:
+        for n in names:
+            shutil.rmtree(os.path.join(out_root, n), ignore_errors=True)
+    start = time.time()
+    with Master():
+        for n in names:
+            generate(n, out_root, args, log_dir)
+    total = time.time() - start
+    print("[datasets] generation took %.1f s wall in total (logs in %s)" % (total, log_dir))
+    ok = summarize(out_root, names, args)
+    return 0 if ok else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,77 @@
+// The whole segmentation stage of the paper for a set of demonstrations of one task:
+//   II-B feature relevance (DTW + correlation) on the state features across demonstrations
+//   -> II-C multivariate ClaSP on the selected features of each demonstration, the per-feature
+//      profiles weighted by their relevance score and penalized by a Kaiser window
+//   -> validation of the changepoints with confidence zones around sensory events (eq. 1),
+//      computed from the sensor features only.
+// Features have a role: "state" features (poses, velocities, gripper opening...) are candidates
+// for segmentation; "sensor" features (touch, wrist force/torque...) only build the zones.
+#pragma once
+
+#include <cstddef>
+#include <string>
+#include <vector>
+
+#include "lfd_core/clasp.hpp"
+#include "lfd_core/feature_relevance.hpp"
+#include "lfd_core/multivariate_segmentation.hpp"
+#include "lfd_core/sensory_events.hpp"
+#include "lfd_core/time_series.hpp"
+
+namespace lfd {
+
+struct SegmentationPipelineConfig {
+  /// II-B threshold T and DTW settings.
+  FeatureRelevanceConfig relevance;
+  /// II-C combination, ClaSP settings, Kaiser beta. Its min_segment_length (min_s, samples; 0 =
+  /// automatic), window_sizes and num_changepoints are the per-request overrides.
+  MultivariateSegmentationConfig segmentation;
+  /// Fixed ClaSP window for every selected feature (0 = automatic per feature).
+  std::size_t window_size = 0;
+  /// Sensory events and eq. (1) zones.
+  SensoryEventConfig events;
+  /// false: every ClaSP changepoint is accepted (no sensor validation).
+  bool validate_with_sensors = true;
+  /// Worker threads for DTW and the per-demonstration segmentations (<= 0 = all cores).
+  int threads = 0;
+};
+
+struct DemoSegmentationResult {
+  std::vector<std::size_t> changepoints;  ///< validated changepoints (row indices, sorted)
+  std::vector<double> changepoint_times;  ///< their times (s, or index without a clock)
+  std::vector<std::size_t> rejected;      ///< ClaSP changepoints outside every zone
+  std::vector<double> rejected_times;
+  std::vector<Interval> zones;         ///< confidence zones (row indices, closed)
+  std::vector<std::size_t> events;     ///< sensory events (row indices)
+  std::size_t min_segment_length = 0;  ///< the min_s used for ClaSP and the zones
+  std::size_t num_samples = 0;
+  MultivariateSegmentation clasp;  ///< candidates, windows, profiles (paper Fig. 5, 8)
+};
+
+struct SegmentationPipelineResult {
+  std::vector<DemoSegmentationResult> demos;   ///< in input order
+  std::vector<std::string> state_features;     ///< features considered for segmentation
+  std::vector<std::string> sensor_features;    ///< features used for the zones
+  std::vector<std::string> selected_features;  ///< used by ClaSP (best first)
+  std::vector<double> feature_weights;         ///< combination weight of each selected feature
+  bool relevance_computed = false;             ///< false with a single demonstration
+  FeatureRelevanceResult relevance;            ///< both variants, per-feature N x N matrices
+  std::vector<std::string> warnings;
+  double relevance_seconds = 0;     ///< wall time of II-B (DTW + correlations)
+  double segmentation_seconds = 0;  ///< wall time of II-C (ClaSP + validation, all demos)
+};
+
+/// Runs the pipeline. `sensor_features` name the sensor columns; `state_features` name the
+/// candidates for segmentation (empty = every column that is not a sensor). Every demonstration
+/// must have the same set of features (any column order).
+/// Throws std::invalid_argument (with the demonstration and feature named) for: no
+/// demonstrations, features that differ between demonstrations, unknown feature names, NaN/Inf
+/// samples, empty demonstrations, demonstrations shorter than 2 * min_s, no state feature, or
+/// only constant state features. A single demonstration falls back to every non-constant state
+/// feature with equal weights (warning); constant features are left out (warning).
+SegmentationPipelineResult run_segmentation_pipeline(
+    const std::vector<FeatureMatrix>& demos, const std::vector<std::string>& sensor_features,
+    const SegmentationPipelineConfig& config = {},
+    const std::vector<std::string>& state_features = {});
+
+}  // namespace lfd

@@ -1,0 +1,26 @@
+// First and second time derivatives of sampled signals by local polynomial least squares
+// (Savitzky-Golay). Works on non-uniform time stamps; uniform sampling takes a fast path that
+// reuses one set of convolution coefficients for the interior. Near the ends the window is
+// shifted inside the signal (asymmetric fit) instead of padding, so no artificial edge effects.
+#pragma once
+
+#include <Eigen/Core>
+
+namespace lfd {
+
+struct SmoothDerivativeOptions {
+  int half_window = 5;  ///< window = 2 * half_window + 1 samples
+  int poly_order = 4;   ///< local polynomial degree (>= 2 for accelerations)
+};
+
+struct SmoothDerivatives {
+  Eigen::MatrixXd velocity;      ///< same shape as the input values (samples x dims)
+  Eigen::MatrixXd acceleration;  ///< same shape
+};
+
+/// times: strictly increasing, length M; values: M x D. Requires M >= poly_order + 1.
+/// The window shrinks to M when the signal is shorter than it. Throws std::invalid_argument.
+SmoothDerivatives smoothDerivatives(const Eigen::VectorXd& times, const Eigen::MatrixXd& values,
+                                    const SmoothDerivativeOptions& options = {});
+
+}  // namespace lfd

@@ -1,0 +1,275 @@
+// Multivariate ClaSP with Kaiser penalization (paper II-C).
+//
+// Recursion: every range [begin, end) between accepted changepoints gets fresh per-feature ClaSP
+// profiles computed on that sub-series only (k-NN restricted to it, labels relative to it), as
+// claspy's binary segmentation does. Slicing the whole-series profile instead would keep
+// neighbours from outside the range and a split score that still "sees" the changepoints already
+// found, so the second-best peak would often sit right next to the first changepoint. Recomputing
+// costs O(L^2) per range of length L, i.e. at most O(n^2) per recursion level.
+//
+// Each range's combined profile is multiplied by a Kaiser window spanning the range, so splits
+// near a range end (which would create short, uninterpretable segments) are penalized, and the
+// argmax is the candidate. It is accepted when the weighted mean of the per-feature log10 p-values
+// of ClaSP's rank-sum test is below log10(p_value_threshold) (or, with a fixed count, always).
+// Ranges are split best-score first (priority queue), as in claspy.
+#include "lfd_core/multivariate_segmentation.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <queue>
+#include <stdexcept>
+#include <string>
+
+namespace lfd {
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr double kMinScoreForLog = 1e-12;
+
+bool is_weighted(ProfileCombination c) {
+  return c == ProfileCombination::kWeightedAverage || c == ProfileCombination::kWeightedProduct;
+}
+
+// Zeroth-order modified Bessel function of the first kind (power series; converges for all x).
+double bessel_i0(double x) {
+  double sum = 1.0, term = 1.0;
+  const double q = 0.25 * x * x;
+  for (int k = 1; k < 500; ++k) {
+    term *= q / (static_cast<double>(k) * static_cast<double>(k));
+    sum += term;
+    if (term < 1e-17 * sum) break;
+  }
+  return sum;
+}
+
+}  // namespace
+
+ProfileCombination parse_profile_combination(const std::string& name) {
+  if (name == "average") return ProfileCombination::kAverage;
+  if (name == "product") return ProfileCombination::kProduct;
+  if (name == "weighted_average") return ProfileCombination::kWeightedAverage;
+  if (name == "weighted_product") return ProfileCombination::kWeightedProduct;
+  throw std::invalid_argument("unknown profile combination '" + name +
+                              "' (average, product, weighted_average, weighted_product)");
+}
+
+std::string to_string(ProfileCombination combination) {
+  switch (combination) {
+    case ProfileCombination::kAverage:
+      return "average";
+    case ProfileCombination::kProduct:
+      return "product";
+    case ProfileCombination::kWeightedAverage:
+      return "weighted_average";
+    case ProfileCombination::kWeightedProduct:
+      return "weighted_product";
+  }
+  return "?";
+}
+
+Eigen::VectorXd combine_profiles(const std::vector<Eigen::VectorXd>& profiles,
+                                 const std::vector<double>& weights,
+                                 ProfileCombination combination) {
+  if (profiles.empty()) throw std::invalid_argument("combine_profiles: no profiles");
+  const Eigen::Index n = profiles.front().size();
+  for (const auto& p : profiles)
+    if (p.size() != n) throw std::invalid_argument("combine_profiles: profiles differ in length");
+  std::vector<double> w(profiles.size(), 1.0);
+  if (is_weighted(combination) && !weights.empty()) {
+    if (weights.size() != profiles.size())
+      throw std::invalid_argument("combine_profiles: " + std::to_string(weights.size()) +
+                                  " weights for " + std::to_string(profiles.size()) + " profiles");
+    w = weights;
+  }
+  double total = 0.0;
+  for (double v : w) {
+    if (!(v >= 0.0) || !std::isfinite(v))
+      throw std::invalid_argument("combine_profiles: weights must be finite and >= 0");
+    total += v;
+  }
+  if (!(total > 0.0)) throw std::invalid_argument("combine_profiles: weights sum to zero");
+  const bool product = combination == ProfileCombination::kProduct ||
+                       combination == ProfileCombination::kWeightedProduct;
+
+  Eigen::VectorXd out(n);
+  for (Eigen::Index t = 0; t < n; ++t) {
+    double acc = 0.0;
+    bool defined = true;
+    for (std::size_t f = 0; f < profiles.size() && defined; ++f) {
+      const double p = profiles[f][t];
+      if (std::isnan(p)) {
+        defined = false;
+      } else if (w[f] > 0.0) {
+        acc += w[f] * (product ? std::log(std::max(p, kMinScoreForLog)) : p);
+      }
+    }
+    out[t] = !defined ? kNaN : product ? std::exp(acc / total) : acc / total;
+  }
+  return out;
+}
+
+Eigen::VectorXd kaiser_window(std::size_t n, double beta) {
+  if (!(beta >= 0.0) || !std::isfinite(beta))
+    throw std::invalid_argument("kaiser_window: beta must be finite and >= 0");
+  Eigen::VectorXd win(static_cast<Eigen::Index>(n));
+  if (n == 1) {
+    win[0] = 1.0;
+    return win;
+  }
+  const double norm = bessel_i0(beta);
+  for (std::size_t k = 0; k < n; ++k) {
+    const double r = 2.0 * static_cast<double>(k) / static_cast<double>(n - 1) - 1.0;
+    win[static_cast<Eigen::Index>(k)] =
+        bessel_i0(beta * std::sqrt(std::max(0.0, 1.0 - r * r))) / norm;
+  }
+  return win;
+}
+
+MultivariateSegmentation segment_multivariate(const Eigen::MatrixXd& features,
+                                              const std::vector<double>& weights,
+                                              const MultivariateSegmentationConfig& config) {
+  const std::size_t n = static_cast<std::size_t>(features.rows());
+  const std::size_t num_features = static_cast<std::size_t>(features.cols());
+  if (num_features == 0) throw std::invalid_argument("segment_multivariate: no feature columns");
+  if (!features.allFinite())
+    throw std::invalid_argument("segment_multivariate: features contain NaN/Inf values");
+  if (!weights.empty() && weights.size() != num_features)
+    throw std::invalid_argument("segment_multivariate: " + std::to_string(weights.size()) +
+                                " weights for " + std::to_string(num_features) + " features");
+  if (!config.window_sizes.empty() && config.window_sizes.size() != num_features)
+    throw std::invalid_argument(
+        "segment_multivariate: window_sizes must have one entry per feature");
+  for (double v : weights)
+    if (!(v >= 0.0) || !std::isfinite(v))
+      throw std::invalid_argument("segment_multivariate: weights must be finite and >= 0");
+  if (!(config.clasp.p_value_threshold > 0.0))
+    throw std::invalid_argument("segment_multivariate: p_value_threshold must be > 0");
+
+  // Weights used both for the combination and to average the features' p-values.
+  std::vector<double> w(num_features, 1.0);
+  if (is_weighted(config.combination) && !weights.empty()) w = weights;
+
+  MultivariateSegmentation out;
+  out.window_sizes.assign(num_features, 0);
+  out.first_profile = Eigen::VectorXd::Constant(static_cast<Eigen::Index>(n), kNaN);
+  out.first_profile_penalized = out.first_profile;
+  out.first_feature_profiles.assign(num_features,
+                                    Eigen::VectorXd::Zero(static_cast<Eigen::Index>(n)));
+
+  // Informative features: varying and with a positive weight.
+  std::vector<std::size_t> active;
+  for (std::size_t f = 0; f < num_features; ++f) {
+    const auto col = features.col(static_cast<Eigen::Index>(f));
+    const double range = n ? col.maxCoeff() - col.minCoeff() : 0.0;
+    if (n < 6 || !(range > 1e-12 * (1.0 + col.cwiseAbs().maxCoeff())) || w[f] <= 0.0) continue;
+    if (!config.window_sizes.empty()) {
+      out.window_sizes[f] = config.window_sizes[f];
+    } else if (config.clasp.window_size) {
+      out.window_sizes[f] = config.clasp.window_size;
+    } else {
+      // Automatic windows are capped at n / 10 so that one slowly varying feature cannot push
+      // the automatic min_s (2 x largest window) past what leaves room for a split.
+      const std::size_t chosen =
+          select_window_size(col, config.clasp.window_selection, config.clasp.min_window);
+      out.window_sizes[f] = std::max<std::size_t>(2, std::min(chosen, n / 10));
+    }
+    if (out.window_sizes[f] < 2)
+      throw std::invalid_argument("segment_multivariate: window size of feature " +
+                                  std::to_string(f) + " must be >= 2");
+    active.push_back(f);
+  }
+  std::size_t max_window = 0;
+  for (std::size_t f : active) max_window = std::max(max_window, out.window_sizes[f]);
+  out.min_segment_length =
+      config.min_segment_length ? config.min_segment_length : std::max(2 * max_window, n / 20);
+  const std::size_t min_s = std::max<std::size_t>(out.min_segment_length, 1);
+  if (active.empty() || n < 2 * min_s + 1) return out;
+
+  const bool learn = config.num_changepoints < 0;
+  const std::size_t max_cps = learn ? std::min(config.max_changepoints, n / min_s)
+                                    : static_cast<std::size_t>(config.num_changepoints);
+  const double log10_threshold = std::log10(config.clasp.p_value_threshold);
+
+  struct Queued {
+    double score;
+    std::size_t candidate_index;  // into out.candidates
+    bool operator<(const Queued& o) const { return score < o.score; }
+  };
+  std::priority_queue<Queued> queue;
+
+  const auto in_candidate_zone = [&](std::size_t t) {
+    if (config.candidate_zones.empty()) return true;
+    return std::any_of(config.candidate_zones.begin(), config.candidate_zones.end(),
+                       [t](const Interval& z) { return z.contains(t); });
+  };
+  const auto evaluate = [&](std::size_t begin, std::size_t end, bool first) {
+    const std::size_t len = end - begin;
+    if (len < 2 * min_s + 1) return;
+    std::vector<Eigen::VectorXd> profiles;
+    std::vector<KnnResult> knns;
+    std::vector<double> used_weights;
+    std::vector<std::size_t> used_features;
+    for (std::size_t f : active) {
+      const std::size_t wf = out.window_sizes[f];
+      if (len < 3 * wf) continue;  // the sub-series is too short for this feature's window
+      ClaspConfig cfg = config.clasp;
+      cfg.window_size = wf;
+      cfg.min_segment_size = min_s;
+      ClaspProfile p = compute_clasp_profile(
+          features.col(static_cast<Eigen::Index>(f))
+              .segment(static_cast<Eigen::Index>(begin), static_cast<Eigen::Index>(len)),
+          cfg);
+      profiles.push_back(std::move(p.profile));
+      knns.push_back(std::move(p.knn));
+      used_weights.push_back(w[f]);
+      used_features.push_back(f);
+    }
+    if (profiles.empty()) return;
+    const Eigen::VectorXd combined = combine_profiles(profiles, used_weights, config.combination);
+    const Eigen::VectorXd penalized = combined.cwiseProduct(kaiser_window(len, config.kaiser_beta));
+    if (first) {
+      out.first_profile = combined;
+      out.first_profile_penalized = penalized;
+      for (std::size_t i = 0; i < used_features.size(); ++i)
+        out.first_feature_profiles[used_features[i]] = profiles[i];
+    }
+    Eigen::Index best = -1;
+    for (Eigen::Index t = 0; t < penalized.size(); ++t) {
+      if (std::isnan(penalized[t]) || (best >= 0 && penalized[t] <= penalized[best])) continue;
+      if (!in_candidate_zone(begin + static_cast<std::size_t>(t))) continue;
+      best = t;
+    }
+    if (best < 0) return;
+    double weighted_log_p = 0.0, weight_sum = 0.0;
+    for (std::size_t i = 0; i < knns.size(); ++i) {
+      weighted_log_p +=
+          used_weights[i] * split_log10_p_value(knns[i], static_cast<std::size_t>(best));
+      weight_sum += used_weights[i];
+    }
+    SplitCandidate c;
+    c.index = begin + static_cast<std::size_t>(best);
+    c.range_begin = begin;
+    c.range_end = end;
+    c.score = penalized[best];
+    c.log10_p_value = weighted_log_p / weight_sum;
+    out.candidates.push_back(c);
+    if (learn && c.log10_p_value > log10_threshold) return;  // not significant: range stays whole
+    queue.push({c.score, out.candidates.size() - 1});
+  };
+
+  evaluate(0, n, true);
+  while (!queue.empty() && out.changepoints.size() < max_cps) {
+    SplitCandidate& c = out.candidates[queue.top().candidate_index];
+    queue.pop();
+    c.accepted = true;
+    out.changepoints.push_back(c.index);
+    const std::size_t cp = c.index, begin = c.range_begin, end = c.range_end;
+    evaluate(begin, cp, false);  // may reallocate out.candidates: `c` is not used below
+    evaluate(cp, end, false);
+  }
+  std::sort(out.changepoints.begin(), out.changepoints.end());
+  return out;
+}
+
+}  // namespace lfd

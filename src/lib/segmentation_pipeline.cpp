@@ -1,0 +1,241 @@
+#include "lfd_core/segmentation_pipeline.hpp"
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <exception>
+#include <set>
+#include <stdexcept>
+#include <thread>
+
+namespace lfd {
+
+namespace {
+
+std::string join(const std::vector<std::string>& names) {
+  std::string out;
+  for (const std::string& n : names) out += (out.empty() ? "'" : ", '") + n + "'";
+  return out;
+}
+
+std::string demo_context(std::size_t d) {
+  return "demonstration " + std::to_string(d);
+}
+
+// Every demonstration must carry the same feature names (in any order).
+void check_same_features(const std::vector<FeatureMatrix>& demos) {
+  const std::set<std::string> reference(demos[0].names.begin(), demos[0].names.end());
+  if (reference.size() != demos[0].names.size()) {
+    throw std::invalid_argument(demo_context(0) + " has duplicate feature names");
+  }
+  for (std::size_t d = 1; d < demos.size(); ++d) {
+    const std::set<std::string> names(demos[d].names.begin(), demos[d].names.end());
+    if (names.size() != demos[d].names.size()) {
+      throw std::invalid_argument(demo_context(d) + " has duplicate feature names");
+    }
+    if (names == reference) continue;
+    std::vector<std::string> missing, extra;
+    std::set_difference(reference.begin(), reference.end(), names.begin(), names.end(),
+                        std::back_inserter(missing));
+    std::set_difference(names.begin(), names.end(), reference.begin(), reference.end(),
+                        std::back_inserter(extra));
+    std::string msg = "features differ between demonstrations: " + demo_context(d);
+    if (!missing.empty()) msg += " lacks " + join(missing);
+    if (!extra.empty()) msg += (missing.empty() ? " has extra " : " and has extra ") + join(extra);
+    throw std::invalid_argument(msg + " (compared with " + demo_context(0) + ")");
+  }
+}
+
+bool is_constant(const FeatureMatrix& demo, int col) {
+  const double lo = demo.data.col(col).minCoeff(), hi = demo.data.col(col).maxCoeff();
+  return !(hi - lo > 1e-12 * (1.0 + std::max(std::abs(hi), std::abs(lo))));
+}
+
+// Runs job(d) for every demonstration on up to `threads` threads; rethrows the first failure (by
+// demonstration index) with the demonstration named.
+template <typename Job>
+void for_each_demo(std::size_t count, int threads, Job job) {
+  std::vector<std::exception_ptr> errors(count);
+  std::atomic<std::size_t> next{0};
+  auto worker = [&]() {
+    for (std::size_t d = next++; d < count; d = next++) {
+      try {
+        job(d);
+      } catch (...) {
+        errors[d] = std::current_exception();
+      }
+    }
+  };
+  if (threads <= 0) threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  threads = static_cast<int>(std::min<std::size_t>(threads, count));
+  if (threads <= 1) {
+    worker();
+  } else {
+    std::vector<std::thread> pool;
+    for (int t = 0; t < threads; ++t) pool.emplace_back(worker);
+    for (std::thread& t : pool) t.join();
+  }
+  for (std::size_t d = 0; d < count; ++d) {
+    if (!errors[d]) continue;
+    try {
+      std::rethrow_exception(errors[d]);
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument(demo_context(d) + ": " + e.what());
+    } catch (const std::exception& e) {
+      throw std::runtime_error(demo_context(d) + ": " + e.what());
+    }
+  }
+}
+
+}  // namespace
+
+SegmentationPipelineResult run_segmentation_pipeline(
+    const std::vector<FeatureMatrix>& demos, const std::vector<std::string>& sensor_features,
+    const SegmentationPipelineConfig& config, const std::vector<std::string>& state_features) {
+  if (demos.empty()) throw std::invalid_argument("no demonstrations to segment");
+  SegmentationPipelineResult result;
+
+  // ---- input checks: shape, same features, roles, finite samples, lengths
+  for (std::size_t d = 0; d < demos.size(); ++d) {
+    try {
+      demos[d].validate_shape();
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument(demo_context(d) + ": " + e.what());
+    }
+    if (demos[d].rows() < 2) {
+      throw std::invalid_argument(demo_context(d) + " has " + std::to_string(demos[d].rows()) +
+                                  " samples; at least 2 are needed");
+    }
+  }
+  check_same_features(demos);
+  const FeatureMatrix& first = demos[0];
+  for (const std::string& s : sensor_features) {
+    if (first.index_of(s) < 0) {
+      throw std::invalid_argument("sensor feature '" + s + "' is not in the demonstrations");
+    }
+  }
+  if (state_features.empty()) {
+    for (const std::string& name : first.names) {
+      if (std::find(sensor_features.begin(), sensor_features.end(), name) == sensor_features.end())
+        result.state_features.push_back(name);
+    }
+  } else {
+    for (const std::string& s : state_features) {
+      if (first.index_of(s) < 0) {
+        throw std::invalid_argument("state feature '" + s + "' is not in the demonstrations");
+      }
+    }
+    result.state_features = state_features;
+  }
+  result.sensor_features = sensor_features;
+  if (result.state_features.empty()) {
+    throw std::invalid_argument("no state feature to segment (every feature is a sensor)");
+  }
+  std::vector<std::string> used = result.state_features;
+  used.insert(used.end(), sensor_features.begin(), sensor_features.end());
+  for (std::size_t d = 0; d < demos.size(); ++d)
+    check_finite(demos[d].select(used), demo_context(d));
+
+  const std::size_t min_s = config.segmentation.min_segment_length;
+  if (min_s > 0) {
+    for (std::size_t d = 0; d < demos.size(); ++d) {
+      if (static_cast<std::size_t>(demos[d].rows()) < 2 * min_s) {
+        throw std::invalid_argument(
+            demo_context(d) + " has " + std::to_string(demos[d].rows()) +
+            " samples, fewer than 2 * min_s = " + std::to_string(2 * min_s));
+      }
+    }
+  }
+
+  // ---- constant state features carry no information
+  std::vector<std::string> informative;
+  for (const std::string& name : result.state_features) {
+    bool constant_everywhere = true;
+    for (const FeatureMatrix& demo : demos) {
+      constant_everywhere = constant_everywhere && is_constant(demo, demo.require(name));
+    }
+    if (constant_everywhere) {
+      result.warnings.push_back("state feature '" + name +
+                                "' is constant in every demonstration and is ignored");
+    } else {
+      informative.push_back(name);
+    }
+  }
+  if (informative.empty()) {
+    throw std::invalid_argument("every state feature is constant: nothing to segment");
+  }
+
+  // ---- II-B feature relevance (needs >= 2 demonstrations)
+  const auto relevance_start = std::chrono::steady_clock::now();
+  if (demos.size() >= 2) {
+    FeatureRelevanceConfig relevance_config = config.relevance;
+    relevance_config.threads = config.threads;
+    result.relevance = compute_feature_relevance(demos, informative, relevance_config);
+    result.relevance_computed = true;
+    for (const std::string& w : result.relevance.warnings) result.warnings.push_back(w);
+    result.selected_features = result.relevance.selected;
+    for (double score : result.relevance.selected_scores()) {
+      // Weights must be positive; a non-positive best score (warned above) keeps weight 1.
+      result.feature_weights.push_back(score > 0 ? score : 1.0);
+    }
+    if (result.selected_features.empty()) {
+      throw std::invalid_argument("feature relevance selected no feature");
+    }
+  } else {
+    result.warnings.push_back(
+        "a single demonstration: feature relevance needs at least 2, so every non-constant "
+        "state feature is used with equal weights");
+    result.selected_features = informative;
+    result.feature_weights.assign(informative.size(), 1.0);
+  }
+
+  const auto segmentation_start = std::chrono::steady_clock::now();
+  result.relevance_seconds =
+      std::chrono::duration<double>(segmentation_start - relevance_start).count();
+
+  // ---- II-C multivariate ClaSP + sensory validation, one demonstration per worker
+  MultivariateSegmentationConfig segmentation_config = config.segmentation;
+  if (config.window_size > 0) {
+    segmentation_config.window_sizes.assign(result.selected_features.size(), config.window_size);
+  }
+  const bool validate = config.validate_with_sensors && !sensor_features.empty();
+  if (!validate) {
+    result.warnings.push_back(sensor_features.empty()
+                                  ? "no sensor features: ClaSP changepoints are not validated"
+                                  : "sensor validation disabled: ClaSP changepoints are accepted");
+  }
+  result.demos.resize(demos.size());
+  for_each_demo(demos.size(), config.threads, [&](std::size_t d) {
+    const FeatureMatrix& demo = demos[d];
+    DemoSegmentationResult& out = result.demos[d];
+    out.num_samples = static_cast<std::size_t>(demo.rows());
+    out.clasp = segment_multivariate(demo.select(result.selected_features).data,
+                                     result.feature_weights, segmentation_config);
+    out.min_segment_length = out.clasp.min_segment_length;
+    if (validate) {
+      const ChangepointValidation v =
+          validate_changepoints(out.clasp.changepoints, demo.select(sensor_features).data,
+                                out.min_segment_length, config.events);
+      out.changepoints = v.accepted;
+      out.rejected = v.rejected;
+      out.zones = v.zones;
+      out.events = v.events;
+    } else {
+      out.changepoints = out.clasp.changepoints;
+    }
+    for (std::size_t cp : out.changepoints) out.changepoint_times.push_back(demo.time_at(cp));
+    for (std::size_t cp : out.rejected) out.rejected_times.push_back(demo.time_at(cp));
+  });
+  result.segmentation_seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - segmentation_start).count();
+  for (std::size_t d = 0; d < demos.size(); ++d) {
+    if (validate && result.demos[d].events.empty()) {
+      result.warnings.push_back(demo_context(d) +
+                                ": no sensory event detected, so no changepoint can be validated");
+    }
+  }
+  return result;
+}
+
+}  // namespace lfd

@@ -1,0 +1,164 @@
+// Sensory events, confidence zones (paper eq. 1) and changepoint validation. The rule and the
+// robustness options are documented in sensory_events.hpp.
+#include "lfd_core/sensory_events.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+namespace lfd {
+namespace {
+
+void check_config(const SensoryEventConfig& c) {
+  if (!(c.threshold_ratio > 0.0 && c.threshold_ratio <= 1.0))
+    throw std::invalid_argument("sensory events: threshold_ratio must be in (0, 1], got " +
+                                std::to_string(c.threshold_ratio));
+  if (!(c.hysteresis > 0.0 && c.hysteresis <= 1.0))
+    throw std::invalid_argument("sensory events: hysteresis must be in (0, 1], got " +
+                                std::to_string(c.hysteresis));
+  if (!(c.noise_floor_sigmas >= 0.0))
+    throw std::invalid_argument("sensory events: noise_floor_sigmas must be >= 0");
+}
+
+double median_of(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  const std::size_t mid = v.size() / 2;
+  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(mid), v.end());
+  double m = v[mid];
+  if (v.size() % 2 == 0) m = 0.5 * (m + *std::max_element(v.begin(), v.begin() + mid));
+  return m;
+}
+
+// Running median with a window shrunk symmetrically at the ends (so edges are not invented).
+std::vector<double> running_median(const Eigen::Ref<const Eigen::VectorXd>& x, std::size_t window) {
+  const std::size_t n = static_cast<std::size_t>(x.size());
+  std::vector<double> out(n);
+  if (window < 2) {
+    for (std::size_t i = 0; i < n; ++i) out[i] = x[static_cast<Eigen::Index>(i)];
+    return out;
+  }
+  const std::size_t half = window / 2;
+  std::vector<double> buf;
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::size_t h = std::min({half, i, n - 1 - i});
+    buf.assign(x.data() + (i - h), x.data() + (i + h + 1));
+    std::nth_element(buf.begin(), buf.begin() + static_cast<std::ptrdiff_t>(h), buf.end());
+    out[i] = buf[h];
+  }
+  return out;
+}
+
+}  // namespace
+
+std::vector<std::size_t> detect_sensory_events(const Eigen::Ref<const Eigen::VectorXd>& signal,
+                                               const SensoryEventConfig& config) {
+  check_config(config);
+  if (!signal.allFinite()) throw std::invalid_argument("sensory events: signal has NaN/Inf values");
+  const std::size_t n = static_cast<std::size_t>(signal.size());
+  if (n < 2) return {};
+  const std::vector<double> y = running_median(signal, config.median_window);
+  std::vector<double> mag(n, 0.0);
+  for (std::size_t t = 1; t < n; ++t) mag[t] = std::abs(y[t] - y[t - 1]);
+  const double peak = *std::max_element(mag.begin(), mag.end());
+  if (!(peak > 0.0)) return {};
+  double on = config.threshold_ratio * peak;
+  if (config.noise_floor_sigmas > 0.0) {
+    // Noise level of the RAW differences: a running median leaves plateaus whose differences are
+    // mostly 0, which would make the robust sigma of the smoothed differences meaningless.
+    std::vector<double> raw(n - 1);
+    for (std::size_t t = 1; t < n; ++t)
+      raw[t - 1] = signal[static_cast<Eigen::Index>(t)] - signal[static_cast<Eigen::Index>(t - 1)];
+    const double med = median_of(raw);
+    for (double& v : raw) v = std::abs(v - med);
+    on = std::max(on, config.noise_floor_sigmas * 1.4826 * median_of(raw));
+  }
+  const double off = config.hysteresis * on;
+
+  struct Burst {
+    std::size_t begin, end;  // end = first quiet sample, or n if still active at the end
+  };
+  std::vector<Burst> bursts;
+  bool active = false;
+  for (std::size_t t = 1; t < n; ++t) {
+    if (!active && mag[t] > on) {
+      bursts.push_back({t, n});
+      active = true;
+    } else if (active && mag[t] <= off) {
+      bursts.back().end = t;
+      active = false;
+    }
+  }
+  std::vector<Burst> merged;
+  for (const Burst& b : bursts) {
+    if (!merged.empty() && merged.back().end != n &&
+        b.begin - merged.back().end <= config.merge_gap)
+      merged.back().end = b.end;
+    else
+      merged.push_back(b);
+  }
+  std::vector<std::size_t> events;
+  for (const Burst& b : merged) {
+    if (b.end != n && b.end - b.begin < config.min_active_samples) continue;
+    events.push_back(b.begin);
+    if (b.end != n) events.push_back(b.end);
+  }
+  return events;
+}
+
+std::vector<Interval> confidence_zones(const std::vector<std::size_t>& events, std::size_t min_s,
+                                       std::size_t length) {
+  const std::size_t half = min_s / 2;
+  std::vector<Interval> raw;
+  raw.reserve(events.size());
+  for (std::size_t s : events) raw.push_back({s > half ? s - half : 0, std::min(s + half, length)});
+  std::sort(raw.begin(), raw.end(),
+            [](const Interval& a, const Interval& b) { return a.begin < b.begin; });
+  std::vector<Interval> zones;
+  for (const Interval& z : raw) {
+    // Integer intervals that overlap or touch ([0,5] and [6,9]) form one contiguous zone.
+    if (!zones.empty() && z.begin <= zones.back().end + 1)
+      zones.back().end = std::max(zones.back().end, z.end);
+    else
+      zones.push_back(z);
+  }
+  return zones;
+}
+
+ChangepointValidation validate_with_zones(const std::vector<std::size_t>& candidates,
+                                          const std::vector<Interval>& zones) {
+  ChangepointValidation out;
+  out.zones = zones;
+  std::vector<std::size_t> sorted = candidates;
+  std::sort(sorted.begin(), sorted.end());
+  for (std::size_t c : sorted) {
+    const bool inside =
+        std::any_of(zones.begin(), zones.end(), [c](const Interval& z) { return z.contains(c); });
+    (inside ? out.accepted : out.rejected).push_back(c);
+  }
+  return out;
+}
+
+ChangepointValidation validate_changepoints(const std::vector<std::size_t>& candidates,
+                                            const Eigen::MatrixXd& sensors, std::size_t min_s,
+                                            const SensoryEventConfig& config) {
+  check_config(config);
+  std::vector<std::vector<std::size_t>> per_sensor;
+  std::vector<std::size_t> all;
+  for (Eigen::Index c = 0; c < sensors.cols(); ++c) {
+    if (!sensors.col(c).allFinite())
+      throw std::invalid_argument("sensory events: sensor column " + std::to_string(c) +
+                                  " has NaN/Inf values");
+    per_sensor.push_back(detect_sensory_events(sensors.col(c), config));
+    all.insert(all.end(), per_sensor.back().begin(), per_sensor.back().end());
+  }
+  std::sort(all.begin(), all.end());
+  all.erase(std::unique(all.begin(), all.end()), all.end());
+  ChangepointValidation out = validate_with_zones(
+      candidates, confidence_zones(all, min_s, static_cast<std::size_t>(sensors.rows())));
+  out.events = std::move(all);
+  out.events_per_sensor = std::move(per_sensor);
+  return out;
+}
+
+}  // namespace lfd

@@ -1,0 +1,258 @@
+// Multivariate ClaSP (paper II-C): profile combination arithmetic, Kaiser window, recovery of a
+// changepoint carried by one feature among noise features, all four combinations, min_s.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+#include <vector>
+
+#include "lfd_core/multivariate_segmentation.hpp"
+
+namespace {
+
+using lfd::ProfileCombination;
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+Eigen::VectorXd vec(std::initializer_list<double> v) {
+  Eigen::VectorXd out(static_cast<Eigen::Index>(v.size()));
+  Eigen::Index i = 0;
+  for (double x : v) out[i++] = x;
+  return out;
+}
+
+TEST(CombineProfiles, AllFourMethodsExact) {
+  const std::vector<Eigen::VectorXd> p{vec({0.5, 0.9, kNaN}), vec({0.8, 0.4, 0.7})};
+  const std::vector<double> w{3.0, 1.0};
+  const auto avg = lfd::combine_profiles(p, w, ProfileCombination::kAverage);
+  EXPECT_DOUBLE_EQ(avg[0], 0.65);
+  EXPECT_DOUBLE_EQ(avg[1], 0.65);
+  EXPECT_TRUE(std::isnan(avg[2]));  // undefined in one feature -> undefined
+  const auto prod = lfd::combine_profiles(p, w, ProfileCombination::kProduct);
+  EXPECT_NEAR(prod[0], std::sqrt(0.5 * 0.8), 1e-12);
+  EXPECT_NEAR(prod[1], std::sqrt(0.9 * 0.4), 1e-12);
+  const auto wavg = lfd::combine_profiles(p, w, ProfileCombination::kWeightedAverage);
+  EXPECT_NEAR(wavg[0], (3 * 0.5 + 0.8) / 4, 1e-12);
+  const auto wprod = lfd::combine_profiles(p, w, ProfileCombination::kWeightedProduct);
+  EXPECT_NEAR(wprod[0], std::pow(0.5, 0.75) * std::pow(0.8, 0.25), 1e-12);
+  EXPECT_NEAR(wprod[1], std::pow(0.9, 0.75) * std::pow(0.4, 0.25), 1e-12);
+  // Unweighted methods ignore the weights; a zero weight removes a feature from weighted ones.
+  EXPECT_DOUBLE_EQ(lfd::combine_profiles(p, {1.0, 0.0}, ProfileCombination::kWeightedProduct)[1],
+                   0.9);
+}
+
+TEST(CombineProfiles, ProductStaysFiniteWithManyFeaturesAndZeros) {
+  std::vector<Eigen::VectorXd> p(200, vec({1e-3, 0.0}));
+  const auto prod = lfd::combine_profiles(p, {}, ProfileCombination::kProduct);
+  EXPECT_NEAR(prod[0], 1e-3, 1e-12);  // a raw product would underflow to 0
+  EXPECT_GT(prod[1], 0.0);            // zeros are clamped, not -inf in log space
+}
+
+TEST(CombineProfiles, RejectsBadInput) {
+  const std::vector<Eigen::VectorXd> p{vec({0.5, 0.6}), vec({0.5})};
+  EXPECT_THROW(lfd::combine_profiles(p, {}, ProfileCombination::kAverage), std::invalid_argument);
+  const std::vector<Eigen::VectorXd> q{vec({0.5}), vec({0.5})};
+  EXPECT_THROW(lfd::combine_profiles(q, {1.0}, ProfileCombination::kWeightedAverage),
+               std::invalid_argument);
+  EXPECT_THROW(lfd::combine_profiles(q, {1.0, -1.0}, ProfileCombination::kWeightedAverage),
+               std::invalid_argument);
+  EXPECT_THROW(lfd::combine_profiles(q, {0.0, 0.0}, ProfileCombination::kWeightedProduct),
+               std::invalid_argument);
+  EXPECT_THROW(lfd::combine_profiles({}, {}, ProfileCombination::kAverage), std::invalid_argument);
+}
+
+TEST(CombineProfiles, ParsesNames) {
+  for (auto name : {"average", "product", "weighted_average", "weighted_product"})
+    EXPECT_EQ(lfd::to_string(lfd::parse_profile_combination(name)), name);
+  EXPECT_THROW(lfd::parse_profile_combination("median"), std::invalid_argument);
+}
+
+TEST(KaiserWindow, ShapeAndKnownValues) {
+  const auto k = lfd::kaiser_window(101, 2.0);
+  EXPECT_NEAR(k[50], 1.0, 1e-12);
+  EXPECT_NEAR(k[0], 1.0 / 2.2795853023360673, 1e-9);  // 1 / I0(2)
+  EXPECT_NEAR(k[100], k[0], 1e-12);
+  for (Eigen::Index i = 0; i < 50; ++i) {
+    EXPECT_LT(k[i], k[i + 1]);
+    EXPECT_NEAR(k[i], k[100 - i], 1e-12);
+  }
+  EXPECT_TRUE(lfd::kaiser_window(10, 0.0).isOnes());
+  EXPECT_THROW(lfd::kaiser_window(10, -1.0), std::invalid_argument);
+}
+
+// Feature with a real changepoint at `cp`: a sine that turns into a square wave.
+Eigen::VectorXd shape_change(std::size_t n, std::size_t cp, std::mt19937& rng) {
+  std::normal_distribution<double> g(0.0, 0.05);
+  Eigen::VectorXd x(static_cast<Eigen::Index>(n));
+  for (std::size_t t = 0; t < n; ++t) {
+    const double s = std::sin(2.0 * M_PI * static_cast<double>(t) / 40.0);
+    x[static_cast<Eigen::Index>(t)] = (t < cp ? s : (s >= 0 ? 1.0 : -1.0)) + g(rng);
+  }
+  return x;
+}
+
+// Feature with a changepoint in level and speed: slow drift, then a faster oscillation.
+Eigen::VectorXd level_change(std::size_t n, std::size_t cp, std::mt19937& rng) {
+  std::normal_distribution<double> g(0.0, 0.05);
+  Eigen::VectorXd x(static_cast<Eigen::Index>(n));
+  for (std::size_t t = 0; t < n; ++t) {
+    const double tt = static_cast<double>(t);
+    x[static_cast<Eigen::Index>(t)] =
+        (t < cp ? std::sin(2.0 * M_PI * tt / 70.0) : 2.0 + 0.5 * std::sin(2.0 * M_PI * tt / 25.0)) +
+        g(rng);
+  }
+  return x;
+}
+
+Eigen::VectorXd noise(std::size_t n, std::mt19937& rng) {
+  std::normal_distribution<double> g(0.0, 1.0);
+  Eigen::VectorXd x(static_cast<Eigen::Index>(n));
+  for (Eigen::Index i = 0; i < x.size(); ++i) x[i] = g(rng);
+  return x;
+}
+
+TEST(MultivariateSegmentation, WeightedProductIgnoresLowWeightNoiseFeatures) {
+  const std::size_t n = 2000, cp = 1100;
+  int correct = 0;
+  for (unsigned seed = 1; seed <= 3; ++seed) {
+    std::mt19937 rng(seed);
+    Eigen::MatrixXd f(n, 4);
+    f.col(0) = shape_change(n, cp, rng);
+    f.col(1) = noise(n, rng);
+    f.col(2) = noise(n, rng);
+    f.col(3) = noise(n, rng);
+    lfd::MultivariateSegmentationConfig config;  // weighted product, significance test
+    const auto seg = lfd::segment_multivariate(f, {1.0, 0.05, 0.05, 0.05}, config);
+    ASSERT_EQ(seg.changepoints.size(), 1u) << "seed " << seed;
+    correct += std::abs(static_cast<double>(seg.changepoints[0]) - cp) <= seg.window_sizes[0];
+  }
+  EXPECT_EQ(correct, 3);
+}
+
+TEST(MultivariateSegmentation, EveryCombinationFindsASharedChangepoint) {
+  const std::size_t n = 2000, cp = 800;
+  std::mt19937 rng(7);
+  Eigen::MatrixXd f(n, 3);
+  f.col(0) = shape_change(n, cp, rng);
+  f.col(1) = level_change(n, cp, rng);
+  f.col(2) = noise(n, rng);
+  const std::vector<double> weights{1.0, 0.8, 0.1};
+  for (auto method : {ProfileCombination::kAverage, ProfileCombination::kProduct,
+                      ProfileCombination::kWeightedAverage, ProfileCombination::kWeightedProduct}) {
+    lfd::MultivariateSegmentationConfig config;
+    config.combination = method;
+    const auto seg = lfd::segment_multivariate(f, weights, config);
+    ASSERT_FALSE(seg.changepoints.empty()) << lfd::to_string(method);
+    ASSERT_FALSE(seg.candidates.empty());
+    EXPECT_TRUE(seg.candidates.front().accepted);
+    EXPECT_NEAR(static_cast<double>(seg.candidates.front().index), static_cast<double>(cp), 40.0)
+        << lfd::to_string(method);
+  }
+}
+
+TEST(MultivariateSegmentation, FirstProfilesArePenalizedByTheKaiserWindow) {
+  const std::size_t n = 1500;
+  std::mt19937 rng(3);
+  Eigen::MatrixXd f(n, 2);
+  f.col(0) = shape_change(n, 700, rng);
+  f.col(1) = level_change(n, 700, rng);
+  lfd::MultivariateSegmentationConfig config;
+  config.kaiser_beta = 3.0;
+  const auto seg = lfd::segment_multivariate(f, {1.0, 1.0}, config);
+  ASSERT_EQ(seg.first_profile.size(), static_cast<Eigen::Index>(n));
+  const Eigen::VectorXd kaiser = lfd::kaiser_window(n, 3.0);
+  const std::size_t min_s = seg.min_segment_length;
+  for (std::size_t t = 0; t < n; ++t) {
+    const auto i = static_cast<Eigen::Index>(t);
+    if (t < min_s || t > n - min_s) {
+      EXPECT_TRUE(std::isnan(seg.first_profile[i])) << t;
+    } else {
+      ASSERT_FALSE(std::isnan(seg.first_profile[i])) << t;
+      EXPECT_NEAR(seg.first_profile_penalized[i], seg.first_profile[i] * kaiser[i], 1e-12);
+    }
+  }
+  EXPECT_EQ(seg.first_feature_profiles.size(), 2u);
+}
+
+TEST(MultivariateSegmentation, MinSegmentLengthIsEnforced) {
+  const std::size_t n = 2000;
+  std::mt19937 rng(5);
+  Eigen::MatrixXd f(n, 2);
+  f.col(0) = shape_change(n, 1000, rng);
+  f.col(1) = noise(n, rng);
+  lfd::MultivariateSegmentationConfig config;
+  config.num_changepoints = 6;  // force more splits than the data holds
+  config.min_segment_length = 300;
+  const auto seg = lfd::segment_multivariate(f, {1.0, 1.0}, config);
+  ASSERT_FALSE(seg.changepoints.empty());
+  EXPECT_LE(seg.changepoints.size(), 6u);
+  std::size_t previous = 0;
+  for (std::size_t cp : seg.changepoints) {
+    EXPECT_GE(cp - previous, 300u);
+    previous = cp;
+  }
+  EXPECT_GE(n - previous, 300u);
+  config.min_segment_length = 1000;  // no split leaves two segments of >= 1000 + 1
+  EXPECT_TRUE(lfd::segment_multivariate(f, {1.0, 1.0}, config).changepoints.empty());
+}
+
+TEST(MultivariateSegmentation, CandidateZonesRestrictTheArgmax) {
+  const std::size_t n = 2000;
+  std::mt19937 rng(4);
+  Eigen::MatrixXd f(n, 2);
+  f.col(0) = shape_change(n, 1300, rng);
+  f.col(1) = level_change(n, 600, rng);
+  lfd::MultivariateSegmentationConfig config;
+  config.num_changepoints = 1;
+  const auto free = lfd::segment_multivariate(f, {1.0, 1.0}, config);
+  ASSERT_EQ(free.changepoints.size(), 1u);
+  // Only allow the zone around the other changepoint: the argmax must come from inside it.
+  const bool first_at_600 = std::abs(static_cast<double>(free.changepoints[0]) - 600.0) < 100.0;
+  const lfd::Interval zone = first_at_600 ? lfd::Interval{1200, 1400} : lfd::Interval{500, 700};
+  config.candidate_zones = {zone};
+  const auto zoned = lfd::segment_multivariate(f, {1.0, 1.0}, config);
+  ASSERT_EQ(zoned.changepoints.size(), 1u);
+  EXPECT_TRUE(zone.contains(zoned.changepoints[0])) << zoned.changepoints[0];
+  Eigen::Index best = static_cast<Eigen::Index>(zone.begin);
+  for (auto t = static_cast<Eigen::Index>(zone.begin); t <= static_cast<Eigen::Index>(zone.end);
+       ++t)
+    if (zoned.first_profile_penalized[t] > zoned.first_profile_penalized[best]) best = t;
+  EXPECT_EQ(zoned.changepoints[0], static_cast<std::size_t>(best));
+}
+
+TEST(MultivariateSegmentation, StationaryFeaturesGiveNoChangepoint) {
+  const std::size_t n = 2000;
+  std::mt19937 rng(9);
+  Eigen::MatrixXd f(n, 2);
+  for (std::size_t t = 0; t < n; ++t)
+    f(static_cast<Eigen::Index>(t), 0) = std::sin(2.0 * M_PI * static_cast<double>(t) / 50.0);
+  f.col(0) += 0.1 * noise(n, rng);
+  f.col(1) = noise(n, rng);
+  const auto seg = lfd::segment_multivariate(f, {1.0, 0.5}, lfd::MultivariateSegmentationConfig{});
+  EXPECT_TRUE(seg.changepoints.empty());
+  ASSERT_EQ(seg.candidates.size(), 1u);
+  EXPECT_FALSE(seg.candidates[0].accepted);
+  EXPECT_GT(seg.candidates[0].log10_p_value, -15.0);
+}
+
+TEST(MultivariateSegmentation, ConstantColumnIsIgnoredAndBadInputRejected) {
+  const std::size_t n = 1500;
+  std::mt19937 rng(2);
+  Eigen::MatrixXd f(n, 2);
+  f.col(0) = shape_change(n, 600, rng);
+  f.col(1).setConstant(3.0);
+  const auto seg = lfd::segment_multivariate(f, {1.0, 1.0}, lfd::MultivariateSegmentationConfig{});
+  ASSERT_EQ(seg.changepoints.size(), 1u);
+  EXPECT_NEAR(static_cast<double>(seg.changepoints[0]), 600.0, 40.0);
+  EXPECT_EQ(seg.window_sizes[1], 0u);
+  EXPECT_TRUE(seg.first_feature_profiles[1].isZero());
+
+  lfd::MultivariateSegmentationConfig config;
+  EXPECT_THROW(lfd::segment_multivariate(f, {1.0}, config), std::invalid_argument);
+  EXPECT_THROW(lfd::segment_multivariate(f, {1.0, -0.1}, config), std::invalid_argument);
+  EXPECT_THROW(lfd::segment_multivariate(Eigen::MatrixXd(n, 0), {}, config), std::invalid_argument);
+  f(10, 0) = std::nan("");
+  EXPECT_THROW(lfd::segment_multivariate(f, {1.0, 1.0}, config), std::invalid_argument);
+}
+
+}  // namespace

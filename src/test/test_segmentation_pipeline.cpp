@@ -1,0 +1,139 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "lfd_core/segmentation_pipeline.hpp"
+
+namespace {
+
+// Grasp-like demonstrations: the gripper closes at `grasp` (40 % of the demo), the speed has one
+// bump per phase, the touch sensor steps up when the fingers close. Noise and a constant column
+// must not disturb the result.
+struct SyntheticDemo {
+  lfd::FeatureMatrix matrix;
+  std::size_t grasp = 0;
+};
+
+std::vector<SyntheticDemo> make_demos(int count, unsigned seed = 1) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> noise(0.0, 1.0);
+  std::vector<SyntheticDemo> demos;
+  for (int d = 0; d < count; ++d) {
+    const int n = 400 + 25 * d;
+    SyntheticDemo demo;
+    demo.grasp = static_cast<std::size_t>(0.4 * n);
+    lfd::FeatureMatrix& m = demo.matrix;
+    m.names = {"gripper", "speed", "noise", "constant", "touch"};
+    m.data.resize(n, m.names.size());
+    for (int i = 0; i < n; ++i) {
+      const double t = double(i) / (n - 1);
+      const bool closed = i >= int(demo.grasp);
+      m.time.push_back(0.01 * i);
+      m.data(i, 0) = (closed ? 0.0 : 0.08) + 0.0005 * noise(rng);
+      const double phase = closed ? (t - 0.4) / 0.6 : t / 0.4;
+      m.data(i, 1) = std::sin(M_PI * phase) * (closed ? 0.2 : 0.3) +
+                     0.05 * std::sin(2 * M_PI * i / (closed ? 9.0 : 23.0)) + 0.003 * noise(rng);
+      m.data(i, 2) = noise(rng);
+      m.data(i, 3) = 2.0;
+      m.data(i, 4) = (closed ? 5.0 : 0.0) + 0.05 * noise(rng);
+    }
+    demos.push_back(std::move(demo));
+  }
+  return demos;
+}
+
+std::vector<lfd::FeatureMatrix> matrices(const std::vector<SyntheticDemo>& demos) {
+  std::vector<lfd::FeatureMatrix> out;
+  for (const auto& d : demos) out.push_back(d.matrix);
+  return out;
+}
+
+TEST(SegmentationPipeline, FindsTheGraspChangepointInEveryDemo) {
+  const auto demos = make_demos(4);
+  const auto result = lfd::run_segmentation_pipeline(matrices(demos), {"touch"});
+  ASSERT_TRUE(result.relevance_computed);
+  ASSERT_FALSE(result.selected_features.empty());
+  EXPECT_EQ(std::find(result.selected_features.begin(), result.selected_features.end(), "noise"),
+            result.selected_features.end());
+  EXPECT_EQ(std::find(result.selected_features.begin(), result.selected_features.end(), "touch"),
+            result.selected_features.end())
+      << "a sensor feature must never be segmented";
+  ASSERT_EQ(result.demos.size(), demos.size());
+  for (std::size_t d = 0; d < demos.size(); ++d) {
+    const auto& r = result.demos[d];
+    ASSERT_EQ(r.changepoints.size(), 1u) << "demo " << d;
+    const double tolerance = 0.1 * r.num_samples;  // ClaSP localizes within ~w/2 of a step
+    EXPECT_NEAR(double(r.changepoints[0]), double(demos[d].grasp), tolerance) << "demo " << d;
+    EXPECT_NEAR(r.changepoint_times[0], 0.01 * r.changepoints[0], 1e-9);
+    ASSERT_FALSE(r.zones.empty());
+    EXPECT_TRUE(r.zones[0].contains(demos[d].grasp));
+  }
+}
+
+TEST(SegmentationPipeline, SingleDemoFallsBackWithAWarning) {
+  const auto demos = make_demos(1);
+  const auto result = lfd::run_segmentation_pipeline(matrices(demos), {"touch"});
+  EXPECT_FALSE(result.relevance_computed);
+  EXPECT_EQ(result.selected_features, (std::vector<std::string>{"gripper", "speed", "noise"}));
+  bool warned = false;
+  for (const auto& w : result.warnings) warned = warned || w.find("single") != std::string::npos;
+  EXPECT_TRUE(warned);
+  ASSERT_EQ(result.demos.size(), 1u);
+}
+
+TEST(SegmentationPipeline, ConstantFeatureIsIgnoredWithAWarning) {
+  const auto result = lfd::run_segmentation_pipeline(matrices(make_demos(2)), {"touch"});
+  bool warned = false;
+  for (const auto& w : result.warnings)
+    warned = warned || w.find("'constant'") != std::string::npos;
+  EXPECT_TRUE(warned);
+  EXPECT_THROW(result.relevance.feature("constant"), std::invalid_argument);
+}
+
+void expect_error(const std::vector<lfd::FeatureMatrix>& demos, const std::string& needle,
+                  const lfd::SegmentationPipelineConfig& config = {},
+                  const std::vector<std::string>& sensors = {"touch"}) {
+  try {
+    lfd::run_segmentation_pipeline(demos, sensors, config);
+    FAIL() << "expected an error mentioning '" << needle << "'";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
+  }
+}
+
+TEST(SegmentationPipeline, BadInputGivesClearErrors) {
+  const auto good = matrices(make_demos(3));
+  expect_error({}, "no demonstrations");
+
+  auto renamed = good;
+  renamed[2].names[1] = "velocity";
+  expect_error(renamed, "features differ");
+
+  auto with_nan = good;
+  with_nan[1].data(7, 0) = std::nan("");
+  expect_error(with_nan, "demonstration 1: feature 'gripper' has NaN");
+
+  auto with_inf = good;
+  with_inf[0].data(3, 4) = INFINITY;
+  expect_error(with_inf, "feature 'touch' has Inf");
+
+  lfd::SegmentationPipelineConfig long_min_s;
+  long_min_s.segmentation.min_segment_length = 300;
+  expect_error(good, "2 * min_s", long_min_s);
+
+  expect_error(good, "sensor feature 'missing'", {}, {"missing"});
+  expect_error(good, "every feature is a sensor", {},
+               {"gripper", "speed", "noise", "constant", "touch"});
+
+  auto all_constant = good;
+  for (auto& m : all_constant) m.data.leftCols(3).setConstant(1.0);
+  expect_error(all_constant, "constant");
+
+  auto empty = good;
+  empty[0].data.resize(0, 5);
+  empty[0].time.clear();
+  expect_error(empty, "demonstration 0");
+}
+
+}  // namespace

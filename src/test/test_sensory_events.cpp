@@ -1,0 +1,154 @@
+// Sensory events and confidence zones (paper eq. 1): exact event indices on hand-made signals,
+// zone clipping and merging, accept/reject, and the noise robustness options.
+#include <gtest/gtest.h>
+
+#include <random>
+#include <vector>
+
+#include "lfd_core/sensory_events.hpp"
+
+namespace {
+
+using lfd::Interval;
+using lfd::SensoryEventConfig;
+using Events = std::vector<std::size_t>;
+using Zones = std::vector<Interval>;
+
+SensoryEventConfig paper_literal() {
+  SensoryEventConfig c;
+  c.median_window = 1;
+  c.noise_floor_sigmas = 0.0;
+  c.hysteresis = 1.0;
+  return c;
+}
+
+Eigen::VectorXd from_diffs(const std::vector<double>& diffs) {
+  Eigen::VectorXd x(static_cast<Eigen::Index>(diffs.size() + 1));
+  x[0] = 0.0;
+  for (std::size_t i = 0; i < diffs.size(); ++i)
+    x[static_cast<Eigen::Index>(i + 1)] = x[static_cast<Eigen::Index>(i)] + diffs[i];
+  return x;
+}
+
+TEST(SensoryEvents, StepGivesOnAndOffEventForBothSigns) {
+  Eigen::VectorXd up = Eigen::VectorXd::Zero(200);
+  up.tail(100).setConstant(1.0);
+  EXPECT_EQ(lfd::detect_sensory_events(up, paper_literal()), (Events{100, 101}));
+  EXPECT_EQ(lfd::detect_sensory_events(up), (Events{100, 101}));  // defaults keep clean steps
+  const Eigen::VectorXd down = -up;                               // high -> low
+  EXPECT_EQ(lfd::detect_sensory_events(down, paper_literal()), (Events{100, 101}));
+}
+
+TEST(SensoryEvents, PulseGivesBeginningAndEndOfBothEdges) {
+  Eigen::VectorXd x = Eigen::VectorXd::Zero(100);
+  x.segment(50, 10).setConstant(2.0);
+  EXPECT_EQ(lfd::detect_sensory_events(x, paper_literal()), (Events{50, 51, 60, 61}));
+}
+
+TEST(SensoryEvents, ThresholdIsARatioOfTheLargestDifference) {
+  // |diff| at t = 1..7: 0.1 0.5 1.0 0.3 0.15 0.0 0.0 -> threshold 0.4.
+  const Eigen::VectorXd x = from_diffs({0.1, 0.5, 1.0, 0.3, 0.15, 0.0, 0.0});
+  EXPECT_EQ(lfd::detect_sensory_events(x, paper_literal()), (Events{2, 4}));
+  SensoryEventConfig hyst = paper_literal();
+  hyst.hysteresis = 0.5;  // stays active until |diff| <= 0.2
+  EXPECT_EQ(lfd::detect_sensory_events(x, hyst), (Events{2, 5}));
+  SensoryEventConfig high = paper_literal();
+  high.threshold_ratio = 0.9;
+  EXPECT_EQ(lfd::detect_sensory_events(x, high), (Events{3, 4}));
+}
+
+TEST(SensoryEvents, ActivityRunningToTheEndHasNoOffEvent) {
+  const Eigen::VectorXd x = from_diffs({0.0, 0.0, 1.0, 1.0, 1.0});
+  EXPECT_EQ(lfd::detect_sensory_events(x, paper_literal()), (Events{3}));
+}
+
+TEST(SensoryEvents, ConstantOrTinySignalsHaveNoEvents) {
+  EXPECT_TRUE(lfd::detect_sensory_events(Eigen::VectorXd::Constant(50, 4.0)).empty());
+  EXPECT_TRUE(lfd::detect_sensory_events(Eigen::VectorXd::Zero(1)).empty());
+}
+
+TEST(SensoryEvents, NoiseFloorAndMedianKeepNoiseFromFloodingEvents) {
+  std::mt19937 rng(1);
+  std::normal_distribution<double> g(0.0, 0.05);
+  Eigen::VectorXd pure(2000), step(2000), spiky(2000);
+  for (Eigen::Index t = 0; t < 2000; ++t) {
+    pure[t] = g(rng);
+    step[t] = (t >= 1000 ? 1.0 : 0.0) + g(rng);
+    spiky[t] = (t >= 1500 ? 1.0 : 0.0) + 0.01 * g(rng);
+  }
+  spiky[400] = 5.0;  // one-sample glitch, larger than the real step
+  // Paper-literal: 0.4 x max of pure noise is crossed everywhere.
+  EXPECT_GT(lfd::detect_sensory_events(pure, paper_literal()).size(), 20u);
+  EXPECT_TRUE(lfd::detect_sensory_events(pure).empty());
+  const Events on_step = lfd::detect_sensory_events(step);
+  ASSERT_FALSE(on_step.empty());
+  for (std::size_t e : on_step) EXPECT_NEAR(static_cast<double>(e), 1000.0, 4.0);
+  // The glitch dominates the literal rule (the real step is below 0.4 x 5) ...
+  const Events literal = lfd::detect_sensory_events(spiky, paper_literal());
+  ASSERT_FALSE(literal.empty());
+  EXPECT_EQ(literal.front(), 400u);
+  // ... while the median filter removes it and finds the step.
+  const Events robust = lfd::detect_sensory_events(spiky);
+  ASSERT_FALSE(robust.empty());
+  for (std::size_t e : robust) EXPECT_NEAR(static_cast<double>(e), 1500.0, 3.0);
+}
+
+TEST(SensoryEvents, MinActiveSamplesAndMergeGap) {
+  // Two bursts (t = 3 and t = 6..7) separated by two quiet samples.
+  const Eigen::VectorXd x = from_diffs({0, 0, 1.0, 0, 0, 1.0, 1.0, 0, 0, 0});
+  EXPECT_EQ(lfd::detect_sensory_events(x, paper_literal()), (Events{3, 4, 6, 8}));
+  SensoryEventConfig merged = paper_literal();
+  merged.merge_gap = 2;
+  EXPECT_EQ(lfd::detect_sensory_events(x, merged), (Events{3, 8}));
+  SensoryEventConfig longer = paper_literal();
+  longer.min_active_samples = 2;
+  EXPECT_EQ(lfd::detect_sensory_events(x, longer), (Events{6, 8}));
+}
+
+TEST(SensoryEvents, RejectsBadConfigAndInput) {
+  SensoryEventConfig c;
+  c.threshold_ratio = 0.0;
+  EXPECT_THROW(lfd::detect_sensory_events(Eigen::VectorXd::Zero(5), c), std::invalid_argument);
+  c = SensoryEventConfig{};
+  c.hysteresis = 1.5;
+  EXPECT_THROW(lfd::detect_sensory_events(Eigen::VectorXd::Zero(5), c), std::invalid_argument);
+  Eigen::VectorXd x = Eigen::VectorXd::Zero(5);
+  x[2] = std::nan("");
+  EXPECT_THROW(lfd::detect_sensory_events(x), std::invalid_argument);
+}
+
+TEST(ConfidenceZones, EquationOneWithClippingAndMerging) {
+  EXPECT_EQ(lfd::confidence_zones({10, 50}, 20, 100), (Zones{{0, 20}, {40, 60}}));
+  EXPECT_EQ(lfd::confidence_zones({3}, 20, 100), (Zones{{0, 13}}));       // clipped at 0
+  EXPECT_EQ(lfd::confidence_zones({95}, 20, 100), (Zones{{85, 100}}));    // clipped at len(T)
+  EXPECT_EQ(lfd::confidence_zones({25, 10}, 20, 100), (Zones{{0, 35}}));  // overlap merges
+  EXPECT_EQ(lfd::confidence_zones({10, 31}, 20, 100), (Zones{{0, 41}}));  // touching merges
+  EXPECT_EQ(lfd::confidence_zones({10, 32}, 20, 100), (Zones{{0, 20}, {22, 42}}));
+  EXPECT_EQ(lfd::confidence_zones({50}, 21, 100), (Zones{{40, 60}}));  // min_s / 2 = 10
+  EXPECT_TRUE(lfd::confidence_zones({}, 20, 100).empty());
+}
+
+TEST(ConfidenceZones, ValidationAcceptsInsideAndRejectsOutside) {
+  const auto v = lfd::validate_with_zones({70, 5, 30, 55, 60, 39}, {{0, 20}, {40, 60}});
+  EXPECT_EQ(v.accepted, (Events{5, 55, 60}));  // zone bounds are inclusive
+  EXPECT_EQ(v.rejected, (Events{30, 39, 70}));
+}
+
+TEST(ConfidenceZones, FullValidationOverSeveralSensors) {
+  Eigen::MatrixXd sensors = Eigen::MatrixXd::Zero(300, 2);
+  sensors.block(100, 0, 200, 1).setConstant(1.0);  // touch from t = 100 on
+  sensors.block(250, 1, 50, 1).setConstant(-3.0);  // force drop at t = 250
+  const auto v = lfd::validate_changepoints({90, 160, 240, 280}, sensors, 40);
+  EXPECT_EQ(v.events_per_sensor[0], (Events{100, 101}));
+  EXPECT_EQ(v.events_per_sensor[1], (Events{250, 251}));
+  EXPECT_EQ(v.events, (Events{100, 101, 250, 251}));
+  EXPECT_EQ(v.zones, (Zones{{80, 121}, {230, 271}}));
+  EXPECT_EQ(v.accepted, (Events{90, 240}));
+  EXPECT_EQ(v.rejected, (Events{160, 280}));
+  // No sensor at all: nothing can be confirmed.
+  const auto none = lfd::validate_changepoints({90}, Eigen::MatrixXd(300, 0), 40);
+  EXPECT_TRUE(none.zones.empty());
+  EXPECT_EQ(none.rejected, (Events{90}));
+}
+
+}  // namespace

@@ -1,0 +1,204 @@
+// rostest: the bridge's services. Pause and step advance sim time by exactly steps x 1 ms and
+// announce it on /clock; set_scene places objects (read back on /objects/<name>/pose) and
+// rejects bad requests atomically; reset restores a posture and, on request, the objects.
+#include <gtest/gtest.h>
+#include <lfd_msgs/ResetSim.h>
+#include <lfd_msgs/SetScene.h>
+#include <lfd_msgs/StepSim.h>
+#include <ros/ros.h>
+#include <sensor_msgs/JointState.h>
+#include <std_srvs/SetBool.h>
+
+#include <cmath>
+
+#include "bridge_test_utils.hpp"
+
+namespace {
+
+using bridge_test::BridgeProbe;
+using bridge_test::waitFor;
+
+template <typename Srv>
+bool call(const std::string& name, Srv* srv) {
+  if (!ros::service::waitForService(name, ros::Duration(30.0))) return false;
+  return ros::service::call(name, *srv);
+}
+
+bool setPaused(bool paused) {
+  std_srvs::SetBool srv;
+  srv.request.data = paused;
+  return call("/bridge/pause", &srv) && srv.response.success;
+}
+
+geometry_msgs::Pose pose(double x, double y, double z, double yaw) {
+  geometry_msgs::Pose p;
+  p.position.x = x;
+  p.position.y = y;
+  p.position.z = z;
+  p.orientation.w = std::cos(yaw / 2);
+  p.orientation.z = std::sin(yaw / 2);
+  return p;
+}
+
+class BridgeServices : public testing::Test {
+ protected:
+  void SetUp() override {
+    ASSERT_TRUE(setPaused(false));
+    // Every subscription connected (one message each) before a test relies on single messages
+    // published while paused.
+    geometry_msgs::PoseStamped p;
+    ASSERT_TRUE(waitFor(
+        [&] {
+          return probe_.hasJointStates() && probe_.objectPose("stick", &p) &&
+                 probe_.objectPose("box", &p);
+        },
+        30.0))
+        << "no /joint_states or /objects/*/pose";
+  }
+  // A failed test must not leave the bridge paused for the next one.
+  void TearDown() override { setPaused(false); }
+  ros::NodeHandle nh_;
+  BridgeProbe probe_{nh_};
+};
+
+TEST_F(BridgeServices, PauseAndStepAdvanceExactly) {
+  ASSERT_TRUE(setPaused(true));
+  lfd_msgs::StepSim step;
+  step.request.steps = 0;
+  ASSERT_TRUE(call("/bridge/step", &step));
+  ASSERT_TRUE(step.response.success) << step.response.message;
+  const double t0 = step.response.sim_time;
+  // Paused: time stands still.
+  ros::WallDuration(0.3).sleep();
+  step.request.steps = 0;
+  ASSERT_TRUE(call("/bridge/step", &step));
+  EXPECT_DOUBLE_EQ(step.response.sim_time, t0);
+  step.request.steps = 250;
+  ASSERT_TRUE(call("/bridge/step", &step));
+  ASSERT_TRUE(step.response.success) << step.response.message;
+  EXPECT_NEAR(step.response.sim_time, t0 + 0.250, 1e-9);
+  // /clock and the sensors announce exactly that time.
+  EXPECT_TRUE(waitFor([&] { return std::abs(probe_.clockTime() - (t0 + 0.25)) < 1e-9; }, 10.0))
+      << "clock " << probe_.clockTime();
+  EXPECT_TRUE(
+      waitFor([&] { return std::abs(probe_.jointStateTime() - (t0 + 0.25)) < 1e-9; }, 10.0));
+  step.request.steps = 1;
+  ASSERT_TRUE(call("/bridge/step", &step));
+  EXPECT_NEAR(step.response.sim_time, t0 + 0.251, 1e-9);
+  EXPECT_TRUE(waitFor([&] { return std::abs(probe_.clockTime() - (t0 + 0.251)) < 1e-9; }, 10.0));
+  EXPECT_EQ(probe_.clockViolations(), 0);
+  // Stepping while running is refused (it would not be exact).
+  ASSERT_TRUE(setPaused(false));
+  step.request.steps = 10;
+  ASSERT_TRUE(call("/bridge/step", &step));
+  EXPECT_FALSE(step.response.success);
+  EXPECT_TRUE(probe_.waitUntilSimTime(t0 + 0.5, 20.0)) << "did not resume";
+}
+
+TEST_F(BridgeServices, SetScenePlacesObjects) {
+  ASSERT_TRUE(setPaused(true));
+  probe_.forgetObjects();
+  lfd_msgs::SetScene scene;
+  scene.request.object_names = {"stick", "box"};
+  scene.request.poses = {pose(0.45, -0.25, 0.815, 0.3), pose(0.6, 0.1, 0.84, 0.0)};
+  ASSERT_TRUE(call("/bridge/set_scene", &scene));
+  ASSERT_TRUE(scene.response.success) << scene.response.message;
+  geometry_msgs::PoseStamped stick, box;
+  // Messages published before the pause may still be in flight: wait for the placed poses.
+  EXPECT_TRUE(waitFor(
+      [&] {
+        return probe_.objectPose("stick", &stick) && probe_.objectPose("box", &box) &&
+               std::abs(stick.pose.position.x - 0.45) < 1e-9 &&
+               std::abs(box.pose.position.x - 0.6) < 1e-9;
+      },
+      10.0));
+  EXPECT_NEAR(stick.pose.position.x, 0.45, 1e-9);
+  EXPECT_NEAR(stick.pose.position.y, -0.25, 1e-9);
+  EXPECT_NEAR(stick.pose.orientation.z, std::sin(0.15), 1e-9);
+  EXPECT_NEAR(box.pose.position.x, 0.6, 1e-9);
+  // Running on, both rest where they were put.
+  ASSERT_TRUE(setPaused(false));
+  const double t = probe_.jointStateTime();
+  ASSERT_TRUE(probe_.waitUntilSimTime(t + 0.5, 20.0));
+  ASSERT_TRUE(waitFor(
+      [&] { return probe_.objectPose("stick", &stick) && stick.header.stamp.toSec() >= t + 0.5; },
+      10.0));
+  EXPECT_NEAR(stick.pose.position.x, 0.45, 0.005);
+  EXPECT_NEAR(stick.pose.position.z, 0.815, 0.003);
+
+  // Bad requests fail and move nothing.
+  lfd_msgs::SetScene bad;
+  bad.request.object_names = {"box", "table"};
+  bad.request.poses = {pose(0.3, 0.0, 0.84, 0.0), pose(0.3, 0.0, 0.84, 0.0)};
+  ASSERT_TRUE(call("/bridge/set_scene", &bad));
+  EXPECT_FALSE(bad.response.success);
+  EXPECT_NE(bad.response.message.find("table"), std::string::npos);
+  bad.request.object_names = {"box"};
+  ASSERT_TRUE(call("/bridge/set_scene", &bad));
+  EXPECT_FALSE(bad.response.success);  // 1 name, 2 poses
+  const double t2 = probe_.jointStateTime();
+  ASSERT_TRUE(waitFor(
+      [&] { return probe_.objectPose("box", &box) && box.header.stamp.toSec() > t2; }, 10.0));
+  EXPECT_NEAR(box.pose.position.x, 0.6, 0.005);
+}
+
+TEST_F(BridgeServices, ResetRestoresPostureAndObjects) {
+  // Objects back to their parked poses first, so the arm moves freely.
+  lfd_msgs::ResetSim park;
+  park.request.reset_objects = true;
+  ASSERT_TRUE(call("/bridge/reset", &park));
+  ASSERT_TRUE(park.response.success) << park.response.message;
+  ASSERT_TRUE(setPaused(false));
+  ros::Publisher cmd = nh_.advertise<sensor_msgs::JointState>("/joint_command", 10);
+  {
+    bridge_test::TargetStream stream(cmd, {"R_SHOULDER_Y"}, {-0.5});
+    EXPECT_TRUE(
+        waitFor([&] { return std::abs(probe_.position("R_SHOULDER_Y") + 0.5) < 0.01; }, 20.0))
+        << "R_SHOULDER_Y at " << probe_.position("R_SHOULDER_Y");
+  }
+
+  ASSERT_TRUE(setPaused(true));
+  lfd_msgs::ResetSim reset;
+  reset.request.joint_names = {"R_SHOULDER_Y"};
+  reset.request.positions = {0.3};
+  reset.request.reset_objects = true;
+  ASSERT_TRUE(call("/bridge/reset", &reset));
+  ASSERT_TRUE(reset.response.success) << reset.response.message;
+  EXPECT_TRUE(
+      waitFor([&] { return std::abs(probe_.position("R_SHOULDER_Y") - 0.3) < 1e-9; }, 10.0));
+  EXPECT_NEAR(probe_.position("R_ELBOW_P"), -1.3, 1e-9);  // configured initial posture
+  geometry_msgs::PoseStamped stick;
+  EXPECT_TRUE(waitFor(
+      [&] {
+        return probe_.objectPose("stick", &stick) && std::abs(stick.pose.position.x - 0.78) < 1e-6;
+      },
+      10.0))
+      << "stick not back at its initial pose: x=" << stick.pose.position.x;
+  // The reset posture is held once running again.
+  ASSERT_TRUE(setPaused(false));
+  const double t2 = probe_.jointStateTime();
+  ASSERT_TRUE(probe_.waitUntilSimTime(t2 + 0.5, 20.0));
+  EXPECT_NEAR(probe_.position("R_SHOULDER_Y"), 0.3, 2e-3);
+
+  lfd_msgs::ResetSim bad;
+  bad.request.joint_names = {"NO_SUCH_JOINT"};
+  bad.request.positions = {0.0};
+  ASSERT_TRUE(call("/bridge/reset", &bad));
+  EXPECT_FALSE(bad.response.success);
+  bad.request.joint_names = {"R_SHOULDER_Y", "R_ELBOW_P"};
+  ASSERT_TRUE(call("/bridge/reset", &bad));
+  EXPECT_FALSE(bad.response.success);
+  EXPECT_EQ(probe_.clockViolations(), 0);  // resets never move time backwards
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  testing::InitGoogleTest(&argc, argv);
+  ros::init(argc, argv, "bridge_services_test");
+  ros::AsyncSpinner spinner(2);
+  spinner.start();
+  const int result = RUN_ALL_TESTS();
+  spinner.stop();
+  return result;
+}

@@ -1,0 +1,50 @@
+#!/usr/bin/python3
+"""rostest: all four datasets are generated and every demonstration in them succeeds physically,
+judged from its bag (metadata goal vs. final object pose)."""
+import glob
+import os
+import shutil
+import subprocess
+import sys
+import unittest
+
+import rospkg
+import rospy
+import rostest
+import yaml
+
+SCRIPTS = os.path.join(rospkg.RosPack().get_path("lfd_sim_bridge"), "scripts")
+sys.path.insert(0, SCRIPTS)
+from check_demo_bag import check_bag  # noqa: E402
+
+
+class DatasetsSucceed(unittest.TestCase):
+    def test_every_demo_succeeds(self):
+        rospy.init_node("datasets_test", anonymous=True)
+        out = rospy.get_param("datasets_test/output_dir")
+        tasks_file = os.path.join(rospkg.RosPack().get_path("lfd_config"), "tasks.yaml")
+        with open(tasks_file) as f:
+            tasks = yaml.safe_load(f)
+        try:
+            gen = subprocess.run([os.path.join(SCRIPTS, "generate_datasets.py"), "--out", out],
+                                 stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+                                 timeout=840)
+            print(gen.stdout)
+            for name in ("sim_grasp", "sim_push", "teleop_grasp", "teleop_push"):
+                mode, task = name.split("_")
+                expected = len(tasks[task][mode])
+                self.assertGreaterEqual(expected, 9 if task == "grasp" else 6, name)
+                bags = sorted(glob.glob(os.path.join(out, name, "*.bag")))
+                self.assertEqual(len(bags), expected, "%s: %d bags\n%s" % (name, len(bags), gen.stdout))
+                for bag in bags:
+                    r = check_bag(bag)
+                    self.assertEqual(r.get("task"), task, bag)
+                    self.assertEqual(r.get("mode"), mode, bag)
+                    self.assertTrue(r["success"], "%s: %s" % (bag, r["reason"]))
+            self.assertEqual(gen.returncode, 0, gen.stdout)
+        finally:
+            shutil.rmtree(out, ignore_errors=True)
+
+
+if __name__ == "__main__":
+    rostest.rosrun("lfd_test", "datasets_succeed", DatasetsSucceed)

@@ -1,0 +1,105 @@
+#!/usr/bin/python3
+"""rostest: the recorder writes every configured topic at its configured rate (+-10 %, no gap over
+two periods), the metadata first, and a recorder interrupted by SIGINT still closes its bag."""
+import os
+import signal
+import subprocess
+import time
+import unittest
+
+import rosbag
+import rospy
+import rostest
+import yaml
+from lfd_msgs.msg import DemoMetadata
+from lfd_msgs.srv import StartRecording, StopRecording  # noqa: F401 (StopRecording: API check)
+
+
+def topic_stamps(bag, topic):
+    return [t.to_sec() for _, _, t in bag.read_messages(topics=[topic])]
+
+
+class RecorderTopics(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        rospy.init_node("recorder_test")
+        cls.output_dir = rospy.get_param("recorder_test/output_dir")
+        with open(rospy.get_param("recorder_test/recorder_config")) as f:
+            cls.config = yaml.safe_load(f)
+
+    def wait_for_file(self, path, timeout):
+        deadline = time.time() + timeout
+        while not os.path.exists(path):
+            self.assertLess(time.time(), deadline, "%s did not appear in %.0f s" % (path, timeout))
+            time.sleep(0.2)
+
+    def test_1_demo_bag_has_every_topic_at_its_rate(self):
+        bag_path = os.path.join(self.output_dir, "push_sim_00.bag")
+        self.wait_for_file(bag_path, 180.0)
+        self.assertFalse(os.path.exists(bag_path + ".active"))
+        with rosbag.Bag(bag_path) as bag:
+            first = next(bag.read_messages())
+            self.assertEqual(first.topic, "/lfd/metadata")
+            self.assertEqual(first.message.task, "push")
+            self.assertEqual(len(topic_stamps(bag, "/lfd/metadata")), 1)
+            start, end = bag.get_start_time(), bag.get_end_time()
+            self.assertAlmostEqual(start, first.message.header.stamp.to_sec(), places=6)
+            self.assertGreater(end - start, 3.0)
+            for spec in self.config["topics"]:
+                name, rate = spec["name"], float(spec.get("rate", 0.0))
+                stamps = topic_stamps(bag, name)
+                self.assertGreater(len(stamps), 1, "%s missing from the bag" % name)
+                if rate <= 0.0:
+                    continue
+                period = 1.0 / rate
+                measured = (len(stamps) - 1) / (stamps[-1] - stamps[0])
+                self.assertAlmostEqual(measured / rate, 1.0, delta=0.10,
+                                       msg="%s at %.1f Hz, configured %.1f Hz" % (name, measured, rate))
+                gaps = [b - a for a, b in zip(stamps, stamps[1:])]
+                self.assertLessEqual(max(gaps), 2.0 * period + 1e-6,
+                                     "%s has a gap of %.3f s" % (name, max(gaps)))
+                # The topic covers the whole demonstration, from its start to its end.
+                self.assertLessEqual(stamps[0] - start, 2.0 * period + 1e-6, name)
+                self.assertLessEqual(end - stamps[-1], 2.0 * period + 1e-6, name)
+
+    def test_2_sigint_closes_the_bag(self):
+        rospy.set_param("/recorder_sigint/topics", self.config["topics"])
+        proc = subprocess.Popen(["rosrun", "lfd_sim_bridge", "recorder_node",
+                                 "__name:=recorder_sigint",
+                                 "/recorder/start:=/recorder_sigint/start",
+                                 "/recorder/stop:=/recorder_sigint/stop"])
+        try:
+            rospy.wait_for_service("/recorder_sigint/start", timeout=30.0)
+            time.sleep(0.5)  # subscriptions connect
+            bag_path = os.path.join(self.output_dir, "sigint", "interrupted.bag")
+            meta = DemoMetadata(task="grasp", configuration=3, mode="sim", speed=1.0,
+                                extra_json="{}")
+            meta.header.stamp = rospy.Time.now()
+            start = rospy.ServiceProxy("/recorder_sigint/start", StartRecording)
+            response = start(bag_path=bag_path, metadata=meta)
+            self.assertTrue(response.success, response.message)
+            rospy.sleep(1.0)  # sim time
+            interrupted_at = rospy.Time.now().to_sec()
+            proc.send_signal(signal.SIGINT)
+            self.assertEqual(proc.wait(timeout=30.0), 0)
+        finally:
+            if proc.poll() is None:
+                proc.kill()
+                proc.wait()
+        self.assertTrue(os.path.exists(bag_path), "the interrupted bag was not renamed")
+        self.assertFalse(os.path.exists(bag_path + ".active"))
+        with rosbag.Bag(bag_path) as bag:  # readable: the index was written on close
+            first = next(bag.read_messages())
+            self.assertEqual(first.topic, "/lfd/metadata")
+            self.assertEqual(first.message.configuration, 3)
+            joints = topic_stamps(bag, "/joint_states")
+            # Everything received before the signal is in the bag: at least the second of sim
+            # time waited, at the configured rate.
+            self.assertGreaterEqual(joints[-1], interrupted_at - 0.05)
+            rate = next(float(t["rate"]) for t in self.config["topics"] if t["name"] == "/joint_states")
+            self.assertGreaterEqual(len(joints),
+                                    0.9 * rate * (interrupted_at - meta.header.stamp.to_sec()))
+
+
+if __name__ == "__main__":
+    rostest.rosrun("lfd_test", "recorder_topics", RecorderTopics)
