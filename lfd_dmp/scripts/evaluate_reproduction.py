@@ -108,17 +108,16 @@ class Session:
         self.log = open(log_path, "w")
         self.proc = subprocess.Popen(["roslaunch", "-p", str(self.port), launch.name],
                                      stdout=self.log, stderr=subprocess.STDOUT)
+        import rosgraph
         import rospy
         self.rospy = rospy
         deadline = time.time() + 120
-        while True:
-            try:
-                rospy.init_node("evaluate_reproduction", anonymous=True)
-                break
-            except Exception:
-                if time.time() > deadline:
-                    raise
-                time.sleep(1)
+        while not rosgraph.is_master_online():  # roslaunch starts the master first
+            if time.time() > deadline or self.proc.poll() is not None:
+                raise RuntimeError("roslaunch did not start a master (see %s)" % log_path)
+            time.sleep(0.5)
+        time.sleep(1.0)  # /use_sim_time is set once the launch file is loaded
+        rospy.init_node("evaluate_reproduction", anonymous=True)
         from lfd_msgs.srv import ExecuteTask, LearnSkills, ResetSim, SetScene
         services = {"/executor/execute": ExecuteTask, "/learner/learn": LearnSkills,
                     "/bridge/reset": ResetSim, "/bridge/set_scene": SetScene}

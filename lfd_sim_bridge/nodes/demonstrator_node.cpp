@@ -5,9 +5,13 @@
 // and judge physical success from the simulated object pose. Exits when every demo is done.
 // The motion logic is ROS-free (lib/demo_*.cpp); this node only times and sends it.
 //
+// Timing: in lockstep mode (default) the node pauses the bridge and advances it with /bridge/step,
+// so commands, phase stamps and recorded samples line up exactly in sim time and nothing is
+// dropped however loaded the machine is; the sim then runs exactly as fast as the nodes keep up.
+//
 // Private parameters (config/demonstrator.yaml): task, mode, configurations, output_dir, seed,
 // tasks_file, speed_min/max, sample_period, contact_threshold, lead_in, tail, phase_rate,
-// skip_existing, geometry/*, timing/*, teleop/*.
+// skip_existing, lockstep, lockstep_chunk, geometry/*, timing/*, teleop/*.
 #include <atomic>
 #include <cmath>
 #include <fstream>

@@ -12,7 +12,7 @@ import rospy
 import rostest
 import yaml
 from lfd_msgs.msg import DemoMetadata
-from lfd_msgs.srv import StartRecording, StopRecording  # noqa: F401 (StopRecording: API check)
+from lfd_msgs.srv import StartRecording
 
 
 def topic_stamps(bag, topic):
