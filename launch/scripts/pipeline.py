@@ -31,6 +31,17 @@ def say(msg):
     print("[pipeline] %s" % msg, flush=True)
 
 
+def stop_group(proc, timeout):
+    """SIGINT a process group (roslaunch/roscore shut down cleanly on it), SIGKILL if it hangs."""
+    with contextlib.suppress(ProcessLookupError):
+        os.killpg(proc.pid, signal.SIGINT)
+    try:
+        proc.wait(timeout=timeout)
+    except subprocess.TimeoutExpired:
+        os.killpg(proc.pid, signal.SIGKILL)
+        proc.wait()
+
+
 def free_port():
     with socket.socket() as s:
         s.bind(("localhost", 0))
@@ -53,18 +64,13 @@ def private_master():
             raise RuntimeError("roscore exited at start (port %d)" % port)
         time.sleep(0.2)
     else:
-        os.killpg(core.pid, signal.SIGINT)
+        stop_group(core, 15)
         raise RuntimeError("roscore did not come up on port %d" % port)
     time.sleep(1.0)  # the parameter server answers a little after the port opens
     try:
         yield env
     finally:
-        with contextlib.suppress(ProcessLookupError):
-            os.killpg(core.pid, signal.SIGINT)
-        try:
-            core.wait(timeout=15)
-        except subprocess.TimeoutExpired:
-            os.killpg(core.pid, signal.SIGKILL)
+        stop_group(core, 15)
 
 
 def run(cmd, env=None):
@@ -73,9 +79,7 @@ def run(cmd, env=None):
     try:
         return proc.wait()
     except KeyboardInterrupt:
-        with contextlib.suppress(ProcessLookupError):
-            os.killpg(proc.pid, signal.SIGINT)
-        proc.wait()
+        stop_group(proc, 30)
         raise
 
 
@@ -87,12 +91,7 @@ def background_launch(cmd, env):
     try:
         yield proc
     finally:
-        with contextlib.suppress(ProcessLookupError):
-            os.killpg(proc.pid, signal.SIGINT)
-        try:
-            proc.wait(timeout=20)
-        except subprocess.TimeoutExpired:
-            os.killpg(proc.pid, signal.SIGKILL)
+        stop_group(proc, 20)
 
 
 def count_bags(folder):
