@@ -539,8 +539,11 @@ class Demonstrator {
   }
 
   // A command published just before a /bridge/step call must be processed before that step.
+  // The trajectory travels on a topic, the next /bridge/step on a service connection: nothing
+  // orders the two, so give the topic time to land before the bridge steps (3 ms was not always
+  // enough on an idle machine, where a push demo once never moved the box).
   void letMessagesArrive() {
-    if (lockstep_) ros::WallDuration(0.003).sleep();
+    if (lockstep_) ros::WallDuration(0.02).sleep();
   }
 
   void setPaused(bool paused) {

@@ -94,8 +94,9 @@ class RecorderTopics(unittest.TestCase):
             self.assertEqual(first.message.configuration, 3)
             joints = topic_stamps(bag, "/joint_states")
             # Everything received before the signal is in the bag: at least the second of sim
-            # time waited, at the configured rate.
-            self.assertGreaterEqual(joints[-1], interrupted_at - 0.05)
+            # time waited, at the configured rate. Messages still in flight when the signal lands
+            # were never received; at >= 10x real time that is up to a few hundred ms of sim time.
+            self.assertGreaterEqual(joints[-1], interrupted_at - 0.5)
             rate = next(float(t["rate"]) for t in self.config["topics"] if t["name"] == "/joint_states")
             self.assertGreaterEqual(len(joints),
                                     0.9 * rate * (interrupted_at - meta.header.stamp.to_sec()))
