@@ -13,6 +13,7 @@ import rostest
 import yaml
 from lfd_msgs.msg import DemoMetadata
 from lfd_msgs.srv import StartRecording
+from std_srvs.srv import SetBool
 
 
 def topic_stamps(bag, topic):
@@ -79,6 +80,11 @@ class RecorderTopics(unittest.TestCase):
             response = start(bag_path=bag_path, metadata=meta)
             self.assertTrue(response.success, response.message)
             rospy.sleep(1.0)  # sim time
+            # Freeze the sim and let every message in flight reach the recorder, so the signal
+            # lands at a known point: all that was received must then be in the bag.
+            rospy.wait_for_service("/bridge/pause", timeout=10.0)
+            self.assertTrue(rospy.ServiceProxy("/bridge/pause", SetBool)(True).success)
+            time.sleep(1.0)  # wall: delivery and the recorder's callback queue
             interrupted_at = rospy.Time.now().to_sec()
             proc.send_signal(signal.SIGINT)
             self.assertEqual(proc.wait(timeout=30.0), 0)
@@ -93,10 +99,9 @@ class RecorderTopics(unittest.TestCase):
             self.assertEqual(first.topic, "/lfd/metadata")
             self.assertEqual(first.message.configuration, 3)
             joints = topic_stamps(bag, "/joint_states")
-            # Everything received before the signal is in the bag: at least the second of sim
-            # time waited, at the configured rate. Messages still in flight when the signal lands
-            # were never received; at >= 10x real time that is up to a few hundred ms of sim time.
-            self.assertGreaterEqual(joints[-1], interrupted_at - 0.5)
+            # Everything received before the signal is in the bag, up to the frozen sim time
+            # (two publishing periods of slack), and at the configured rate.
+            self.assertGreaterEqual(joints[-1], interrupted_at - 0.011)
             rate = next(float(t["rate"]) for t in self.config["topics"] if t["name"] == "/joint_states")
             self.assertGreaterEqual(len(joints),
                                     0.9 * rate * (interrupted_at - meta.header.stamp.to_sec()))
