@@ -9,6 +9,7 @@
 // The logic is lfd_dmp::TaskPlanner (lib/executor.cpp); this file is ROS I/O and sim-time pacing.
 // Parameters: config/executor.yaml (loaded by launch/reproduce.launch).
 #include "lfd_dmp/executor.hpp"
+#include "lfd_sim_bridge/pose_msg.hpp"
 
 #include <lfd_msgs/ExecuteTask.h>
 #include <lfd_msgs/GripperCommand.h>
@@ -33,18 +34,6 @@ namespace {
 
 double yawOf(const geometry_msgs::Quaternion& q) {
   return std::atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z));
-}
-
-geometry_msgs::Pose toMsg(const lfd_dmp::TcpPose& p) {
-  geometry_msgs::Pose m;
-  m.position.x = p.position.x();
-  m.position.y = p.position.y();
-  m.position.z = p.position.z();
-  m.orientation.w = p.orientation.w();
-  m.orientation.x = p.orientation.x();
-  m.orientation.y = p.orientation.y();
-  m.orientation.z = p.orientation.z();
-  return m;
 }
 
 // YAML numbers may be ints or doubles; anything else is a configuration error.
@@ -368,7 +357,7 @@ class Executor {
     for (size_t k = 0; k < plan.poses.size(); k += 10) {
       geometry_msgs::PoseStamped ps;
       ps.header = path.header;
-      ps.pose = toMsg(plan.poses[k]);
+      ps.pose = lfd_sim_bridge::toPoseMsg(plan.poses[k]);
       path.poses.push_back(ps);
     }
     planned_pub_.publish(path);
@@ -385,7 +374,8 @@ class Executor {
         m.id = id++;
         m.type = which == 1 ? visualization_msgs::Marker::TEXT_VIEW_FACING
                             : visualization_msgs::Marker::SPHERE;
-        m.pose = which == 2 ? toMsg(plan.poses[s.begin]) : toMsg(s.goal);
+        m.pose = which == 2 ? lfd_sim_bridge::toPoseMsg(plan.poses[s.begin])
+                            : lfd_sim_bridge::toPoseMsg(s.goal);
         if (which == 1) m.pose.position.z += 0.05;
         m.scale.x = m.scale.y = m.scale.z = which == 1 ? 0.03 : which == 0 ? 0.025 : 0.015;
         m.color.a = 1.0;

@@ -43,6 +43,7 @@
 #include "lfd_sim_bridge/demo_ik.hpp"
 #include "lfd_sim_bridge/demo_plan.hpp"
 #include "lfd_sim_bridge/demo_tasks.hpp"
+#include "lfd_sim_bridge/pose_msg.hpp"
 
 namespace {
 
@@ -64,18 +65,6 @@ Eigen::Quaterniond quaternionParam(const ros::NodeHandle& pnh, const std::string
   if (!pnh.getParam(name, wxyz)) return fallback;
   if (wxyz.size() != 4) throw std::invalid_argument("~" + name + " must be [w, x, y, z]");
   return Eigen::Quaterniond(wxyz[0], wxyz[1], wxyz[2], wxyz[3]).normalized();
-}
-
-geometry_msgs::Pose toMsg(const demo::Pose& p) {
-  geometry_msgs::Pose m;
-  m.position.x = p.position.x();
-  m.position.y = p.position.y();
-  m.position.z = p.position.z();
-  m.orientation.w = p.orientation.w();
-  m.orientation.x = p.orientation.x();
-  m.orientation.y = p.orientation.y();
-  m.orientation.z = p.orientation.z();
-  return m;
 }
 
 demo::Pose fromMsg(const geometry_msgs::Pose& m) {
@@ -327,11 +316,11 @@ class Demonstrator {
     call(reset_client_, lfd_msgs::ResetSim());
     lfd_msgs::SetScene scene;
     scene.request.object_names.push_back(setup_.object);
-    scene.request.poses.push_back(toMsg(c.object_start));
+    scene.request.poses.push_back(lfd_sim_bridge::toPoseMsg(c.object_start));
     for (const auto& [object, pose] : setup_.park) {
       if (object == setup_.object) continue;
       scene.request.object_names.push_back(object);
-      scene.request.poses.push_back(toMsg(pose));
+      scene.request.poses.push_back(lfd_sim_bridge::toPoseMsg(pose));
     }
     call(scene_client_, scene);
     advanceTo(now() + ros::Duration(settle_before_));
