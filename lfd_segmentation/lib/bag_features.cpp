@@ -266,8 +266,9 @@ DemoFeatures read_bag_features(const std::string& path, const std::vector<TopicC
     throw std::invalid_argument("bag '" + path + "': " + e.what());
   }
   for (std::size_t k = 0; k < streams.size(); ++k) {
-    (roles[k] == FeatureRole::kSensor ? demo.sensor_features : demo.state_features)
-        .push_back(streams[k].name);
+    if (roles[k] == FeatureRole::kSensor) demo.sensor_features.push_back(streams[k].name);
+    if (roles[k] == FeatureRole::kState) demo.state_features.push_back(streams[k].name);
+    if (roles[k] == FeatureRole::kContext) demo.context_features.push_back(streams[k].name);
   }
   return demo;
 }

@@ -41,8 +41,11 @@ TopicConfig parse_topic(const YAML::Node& node, std::size_t index) {
     topic.role = FeatureRole::kState;
   } else if (role == "sensor") {
     topic.role = FeatureRole::kSensor;
+  } else if (role == "context") {
+    topic.role = FeatureRole::kContext;
   } else {
-    throw std::invalid_argument(where + ": role must be 'state' or 'sensor', got '" + role + "'");
+    throw std::invalid_argument(where + ": role must be 'state', 'sensor' or 'context', got '" +
+                                role + "'");
   }
   const std::string interpolation = get<std::string>(node, "interpolation", "linear");
   if (interpolation == "linear") {
@@ -96,6 +99,7 @@ SegmentationParams params_from_yaml(const YAML::Node& root) {
   seg.kaiser_beta = non_negative(get<double>(root, "kaiser_beta", seg.kaiser_beta), "kaiser_beta");
   p.pipeline.validate_with_sensors =
       get<bool>(root, "validate_with_sensors", p.pipeline.validate_with_sensors);
+  p.pipeline.search_in_zones = get<bool>(root, "search_in_zones", p.pipeline.search_in_zones);
   p.pipeline.threads = get<int>(root, "threads", p.pipeline.threads);
 
   const YAML::Node clasp = root["clasp"];
@@ -108,6 +112,7 @@ SegmentationParams params_from_yaml(const YAML::Node& root) {
       lfd::parse_clasp_distance(get<std::string>(clasp, "distance", lfd::to_string(cc.distance)));
   cc.score = lfd::parse_clasp_score(get<std::string>(clasp, "score", lfd::to_string(cc.score)));
   cc.p_value_threshold = get<double>(clasp, "p_value_threshold", cc.p_value_threshold);
+  cc.tie_jitter = non_negative(get<double>(clasp, "tie_jitter", cc.tie_jitter), "clasp/tie_jitter");
 
   const YAML::Node events = root["events"];
   auto& ev = p.pipeline.events;

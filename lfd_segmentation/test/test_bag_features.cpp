@@ -38,8 +38,10 @@ TEST(BagFeatures, ReadsConfiguredFieldsOnOneClock) {
   EXPECT_GE(m.index_of("/wrist_ft/wrench/force/z"), 0);
   for (const std::string& name : m.names) EXPECT_EQ(name.find("/lfd/phase"), std::string::npos);
   EXPECT_EQ(demo.state_features.size(), 14u);
-  EXPECT_EQ(demo.sensor_features.size(), 8u);
-  EXPECT_EQ(demo.state_features.size() + demo.sensor_features.size(), std::size_t(m.cols()));
+  EXPECT_EQ(demo.sensor_features.size(), 2u);   // the touch pads
+  EXPECT_EQ(demo.context_features.size(), 6u);  // the wrist F/T: read, used by neither
+  EXPECT_EQ(demo.state_features.size() + demo.sensor_features.size() + demo.context_features.size(),
+            std::size_t(m.cols()));
   // 50 Hz over the common span of 100 Hz and 50 Hz streams (~7.98 s).
   ASSERT_GT(m.rows(), 390);
   EXPECT_LT(m.rows(), 402);

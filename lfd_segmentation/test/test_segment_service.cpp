@@ -65,7 +65,7 @@ TEST_F(SegmentService, GoodRequestValidatesTheGraspChangepoint) {
   ASSERT_EQ(r.demos.size(), 3u);
   EXPECT_FALSE(r.selected_features.empty());
   EXPECT_EQ(r.selected_features.size(), r.selected_weights.size());
-  EXPECT_EQ(r.sensor_features.size(), 8u);
+  EXPECT_EQ(r.sensor_features.size(), 2u);  // touch pads; the wrist F/T is context
   EXPECT_FALSE(r.features.empty());
   for (const auto& f : r.features) EXPECT_EQ(f.correlation.size(), 9u);
   // Every validated changepoint is the grasp; ClaSP may place a step up to ~one window late, so

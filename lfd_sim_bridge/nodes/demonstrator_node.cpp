@@ -132,6 +132,7 @@ class Demonstrator {
     contact_chunk_ = param(pnh, "lockstep_contact_chunk", 0.01);
     physics_dt_ = param(pnh, "physics_dt", 0.001);
     publish_period_ = 1.0 / nh.param("/bridge/publish_rate", 200.0);
+    gripper_joint_ = nh.param<std::string>("/bridge/gripper_joint", "R_GRIPPER");
     grasp_offset_ = param(pnh, "grasp_offset_range", 0.015);
     grasp_yaw_ = param(pnh, "grasp_yaw_range", 0.08);
     criteria_.tolerance = param(pnh, "success_tolerance", 0.03);
@@ -313,7 +314,15 @@ class Demonstrator {
     variation.grasp_yaw = grasp_yaw_ * (2.0 * unit(rng) - 1.0);
 
     // Scene: the robot in its ready posture, the task's object at its start, the other parked.
-    call(reset_client_, lfd_msgs::ResetSim());
+    lfd_msgs::ResetSim reset;
+    if (task_ == "push") {
+      // The pushing fist is closed before recording starts: the gripper carries no information
+      // about the push's phases, and a closing transient at the start would only mislead the
+      // feature selection.
+      reset.request.joint_names.push_back(gripper_joint_);
+      reset.request.positions.push_back(0.0);
+    }
+    call(reset_client_, reset);
     lfd_msgs::SetScene scene;
     scene.request.object_names.push_back(setup_.object);
     scene.request.poses.push_back(lfd_sim_bridge::toPoseMsg(c.object_start));
@@ -637,6 +646,7 @@ class Demonstrator {
   ros::Publisher trajectory_pub_, gripper_pub_, phase_pub_;
   ros::Subscriber joint_sub_, touch_sub_, object_sub_;
   ros::ServiceClient reset_client_, scene_client_, start_client_, stop_client_;
+  std::string gripper_joint_;
 
   std::mutex mutex_;
   sensor_msgs::JointState joints_;

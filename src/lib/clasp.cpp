@@ -2,17 +2,21 @@
 //
 // Labels follow claspy: at split s, subsequence i is truly "right" (1) iff i >= s, and predicted by
 // the majority label of its k neighbours. The w subsequences [s - w, s) straddle the split (they
-// start left of it but reach into the right part); claspy forces their prediction to 1 so that they
-// cannot reward a split, and we do the same.
-// Score kRocAuc is the ROC-AUC of these hard predictions against the truth, i.e. the balanced
-// accuracy (TPR + TNR) / 2. (claspy passes the two label vectors to its AUC routine in swapped
-// order, which yields (PPV + NPV) / 2; we use the textbook definition.)
+// start left of it but reach into the right part), so neither label is true for them. claspy forces
+// their prediction to 1; that charges every split w false positives, a penalty of w / s on the
+// true-negative rate that makes the profile lean towards the end of the series (and, with claspy's
+// swapped AUC arguments, w / (n - s) towards its start). We leave them out of the score and of the
+// significance test instead, so a clean change scores 1 wherever it lies.
+// Score kRocAuc is the ROC-AUC of the hard predictions against the truth, i.e. the balanced
+// accuracy (TPR + TNR) / 2 (the textbook definition; claspy's argument order yields
+// (PPV + NPV) / 2).
 #include "lfd_core/clasp.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <queue>
+#include <random>
 #include <stdexcept>
 #include <string>
 
@@ -31,7 +35,9 @@ double score_from_confusion(const std::size_t cm[2][2], ClaspScore score) {
   return 0.5 * (f1_pos + f1_neg);
 }
 
-// Predicted labels (with the straddling subsequences forced to 1) at one split.
+constexpr unsigned char kStraddles = 2;
+
+// Predicted labels at one split (kStraddles for the subsequences that straddle it).
 std::vector<unsigned char> predicted_labels(const KnnResult& knn, std::size_t split) {
   const std::size_t m = knn.num_subsequences, k = knn.k, w = knn.window;
   std::vector<unsigned char> pred(m, 0);
@@ -44,7 +50,7 @@ std::vector<unsigned char> predicted_labels(const KnnResult& knn, std::size_t sp
       ones += static_cast<std::size_t>(j) >= split;
     }
     pred[i] = 2 * ones > valid;
-    if (i < split && i + w >= split) pred[i] = 1;
+    if (i < split && i + w >= split) pred[i] = kStraddles;
   }
   return pred;
 }
@@ -99,12 +105,16 @@ Eigen::VectorXd classification_score_profile(const KnnResult& knn, std::size_t m
       ones[i] += static_cast<std::size_t>(j) >= s;
     }
   const auto truth = [](std::size_t i, std::size_t split) { return i >= split ? 1 : 0; };
-  const auto pred = [&](std::size_t i, std::size_t split) {
-    if (i < split && i + w >= split) return 1;  // straddles the split
-    return 2 * ones[i] > valid[i] ? 1 : 0;
+  const auto straddles = [w](std::size_t i, std::size_t split) {
+    return i < split && i + w >= split;
   };
+  const auto pred = [&](std::size_t i) { return 2 * ones[i] > valid[i] ? 1 : 0; };
   std::size_t cm[2][2] = {{0, 0}, {0, 0}};
-  for (std::size_t i = 0; i < m; ++i) ++cm[truth(i, s)][pred(i, s)];
+  // Straddling subsequences belong to neither side: they are left out of the confusion matrix.
+  const auto add = [&](std::size_t i, std::size_t split, int delta) {
+    if (!straddles(i, split)) cm[truth(i, split)][pred(i)] += static_cast<std::size_t>(delta);
+  };
+  for (std::size_t i = 0; i < m; ++i) add(i, s, 1);
 
   std::vector<std::size_t> stamp(m, 0);
   std::vector<std::size_t> affected;
@@ -123,9 +133,9 @@ Eigen::VectorXd classification_score_profile(const KnnResult& knn, std::size_t m
     touch(s);
     if (s >= w) touch(s - w);
     for (std::size_t e = start[s]; e < start[s + 1]; ++e) touch(referrers[e]);
-    for (std::size_t a : affected) --cm[truth(a, s)][pred(a, s)];
+    for (std::size_t a : affected) add(a, s, -1);
     for (std::size_t e = start[s]; e < start[s + 1]; ++e) --ones[referrers[e]];
-    for (std::size_t a : affected) ++cm[truth(a, s + 1)][pred(a, s + 1)];
+    for (std::size_t a : affected) add(a, s + 1, 1);
   }
   return profile;
 }
@@ -135,14 +145,18 @@ double split_log10_p_value(const KnnResult& knn, std::size_t split) {
   if (split == 0 || split >= m) return 0.0;  // one side empty: no evidence
   const std::vector<unsigned char> pred = predicted_labels(knn, split);
   // Wilcoxon rank-sum on binary data: all zeros share one mid-rank, all ones another.
-  double zeros = 0.0, left_zeros = 0.0;
-  for (std::size_t i = 0; i < m; ++i)
+  double zeros = 0.0, left_zeros = 0.0, left = 0.0, total = 0.0;
+  for (std::size_t i = 0; i < m; ++i) {
+    if (pred[i] == kStraddles) continue;
+    total += 1.0;
+    left += i < split;
     if (!pred[i]) {
       zeros += 1.0;
       if (i < split) left_zeros += 1.0;
     }
-  const double total = static_cast<double>(m);
-  const double n1 = static_cast<double>(split), n2 = total - n1;
+  }
+  const double n1 = left, n2 = total - n1;
+  if (n1 < 1.0 || n2 < 1.0) return 0.0;
   const double ones = total - zeros;
   const double rank_zero = (zeros + 1.0) / 2.0;
   const double rank_one = zeros + (ones + 1.0) / 2.0;
@@ -159,6 +173,8 @@ ClaspProfile compute_clasp_profile(const Eigen::Ref<const Eigen::VectorXd>& seri
   if (config.k < 1 || config.k > 255) throw std::invalid_argument("ClaSP: k must be in [1, 255]");
   if (!(config.exclusion_radius >= 0.0))
     throw std::invalid_argument("ClaSP: exclusion_radius must be >= 0");
+  if (!(config.tie_jitter >= 0.0) || !std::isfinite(config.tie_jitter))
+    throw std::invalid_argument("ClaSP: tie_jitter must be finite and >= 0");
   ClaspProfile out;
   out.window_size = config.window_size
                         ? config.window_size
@@ -170,7 +186,16 @@ ClaspProfile compute_clasp_profile(const Eigen::Ref<const Eigen::VectorXd>& seri
         "ClaSP: series of " + std::to_string(n) + " samples is too short for window " +
         std::to_string(w) + " and minimum segment size " + std::to_string(out.min_segment_size));
   const auto exclusion = static_cast<std::size_t>(config.exclusion_radius * static_cast<double>(w));
-  out.knn = self_join_knn(series, w, config.k, exclusion, config.distance);
+  if (config.tie_jitter > 0.0) {
+    const double range = series.maxCoeff() - series.minCoeff();
+    std::mt19937 rng(0x5eed);  // fixed: the same series always gets the same profile
+    std::normal_distribution<double> gauss(0.0, config.tie_jitter * (range > 0.0 ? range : 1.0));
+    Eigen::VectorXd jittered = series;
+    for (Eigen::Index i = 0; i < jittered.size(); ++i) jittered[i] += gauss(rng);
+    out.knn = self_join_knn(jittered, w, config.k, exclusion, config.distance);
+  } else {
+    out.knn = self_join_knn(series, w, config.k, exclusion, config.distance);
+  }
   out.profile = classification_score_profile(out.knn, out.min_segment_size, config.score);
   return out;
 }

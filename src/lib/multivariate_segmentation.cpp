@@ -198,10 +198,21 @@ MultivariateSegmentation segment_multivariate(const Eigen::MatrixXd& features,
   };
   std::priority_queue<Queued> queue;
 
+  // Zone-guided search: a zone marks one sensory interaction, hence at most one changepoint; once
+  // a zone holds a changepoint it is closed to later candidates.
+  const std::vector<Interval> zones =
+      config.candidate_zones_for ? config.candidate_zones_for(min_s) : config.candidate_zones;
+  const bool restricted = config.candidate_zones_for || !zones.empty();  // no zone: no candidate
+  std::vector<bool> zone_used(zones.size(), false);
+  const auto zone_of = [&](std::size_t t) -> int {
+    for (std::size_t z = 0; z < zones.size(); ++z)
+      if (zones[z].contains(t)) return static_cast<int>(z);
+    return -1;
+  };
   const auto in_candidate_zone = [&](std::size_t t) {
-    if (config.candidate_zones.empty()) return true;
-    return std::any_of(config.candidate_zones.begin(), config.candidate_zones.end(),
-                       [t](const Interval& z) { return z.contains(t); });
+    if (!restricted) return true;
+    const int z = zone_of(t);
+    return z >= 0 && !zone_used[static_cast<std::size_t>(z)];
   };
   const auto evaluate = [&](std::size_t begin, std::size_t end, bool first) {
     const std::size_t len = end - begin;
@@ -262,6 +273,14 @@ MultivariateSegmentation segment_multivariate(const Eigen::MatrixXd& features,
   while (!queue.empty() && out.changepoints.size() < max_cps) {
     SplitCandidate& c = out.candidates[queue.top().candidate_index];
     queue.pop();
+    if (restricted) {
+      const int z = zone_of(c.index);
+      if (zone_used[static_cast<std::size_t>(z)]) {
+        evaluate(c.range_begin, c.range_end, false);  // its zone was taken meanwhile: search again
+        continue;
+      }
+      zone_used[static_cast<std::size_t>(z)] = true;
+    }
     c.accepted = true;
     out.changepoints.push_back(c.index);
     const std::size_t cp = c.index, begin = c.range_begin, end = c.range_end;

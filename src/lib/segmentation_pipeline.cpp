@@ -210,8 +210,15 @@ SegmentationPipelineResult run_segmentation_pipeline(
     const FeatureMatrix& demo = demos[d];
     DemoSegmentationResult& out = result.demos[d];
     out.num_samples = static_cast<std::size_t>(demo.rows());
-    out.clasp = segment_multivariate(demo.select(result.selected_features).data,
-                                     result.feature_weights, segmentation_config);
+    const Eigen::MatrixXd state = demo.select(result.selected_features).data;
+    MultivariateSegmentationConfig demo_config = segmentation_config;
+    if (validate && config.search_in_zones) {
+      demo_config.candidate_zones_for = [&](std::size_t min_s) {
+        return validate_changepoints({}, demo.select(sensor_features).data, min_s, config.events)
+            .zones;
+      };
+    }
+    out.clasp = segment_multivariate(state, result.feature_weights, demo_config);
     out.min_segment_length = out.clasp.min_segment_length;
     if (validate) {
       const ChangepointValidation v =

@@ -135,8 +135,8 @@ double direct_score(const lfd::KnnResult& knn, std::size_t s, ClaspScore score) 
   for (std::size_t i = 0; i < m; ++i) {
     int ones = 0;
     for (std::size_t r = 0; r < k; ++r) ones += static_cast<std::size_t>(knn.neighbour(i, r)) >= s;
-    int pred = 2 * ones > static_cast<int>(k);
-    if (i < s && i + w >= s) pred = 1;
+    const int pred = 2 * ones > static_cast<int>(k);
+    if (i < s && i + w >= s) continue;  // straddles the split: neither label is true
     const int truth = i >= s;
     tp += truth && pred;
     tn += !truth && !pred;
@@ -211,8 +211,18 @@ TEST(ClaspSegment, FindsThreePlantedChangepoints) {
   expect_planted({{Shape::kSine, 40, 0.05, 800},
                   {Shape::kSquare, 60, 0.05, 800},
                   {Shape::kSine, 20, 0.05, 800},
-                  {Shape::kSine, 20, 0.6, 800}},
+                  {Shape::kSaw, 30, 0.05, 800}},
                  13);
+}
+
+// A change of noise level alone is found, but k-NN cannot place it sharply (noisy windows find
+// clean neighbours): the profile has a broad plateau, hence the wider tolerance.
+TEST(ClaspSegment, FindsANoiseLevelChange) {
+  const std::vector<Regime> regimes = {{Shape::kSine, 20, 0.05, 1200},
+                                       {Shape::kSine, 20, 0.6, 1200}};
+  const auto seg = lfd::clasp_segment(piecewise(regimes, 13), ClaspConfig{});
+  ASSERT_EQ(seg.changepoints.size(), 1u);
+  EXPECT_NEAR(static_cast<double>(seg.changepoints[0]), 1200.0, 10.0 * seg.window_size);
 }
 
 TEST(ClaspSegment, StationarySeriesHasNoChangepoint) {
@@ -236,6 +246,45 @@ TEST(ClaspSegment, FixedCountReturnsThatManyChangepoints) {
   EXPECT_NEAR(static_cast<double>(seg.changepoints[0]), 1000.0,
               static_cast<double>(seg.window_size));
   EXPECT_TRUE(lfd::clasp_segment(x, ClaspConfig{}, 0).changepoints.empty());
+}
+
+// A perfectly separable change scores (almost) 1 wherever it lies: the straddling subsequences
+// do not charge early splits more than late ones (claspy's forced labels would cap a change at
+// 20% of the series near 1 - w / (2 s)).
+TEST(ClaspProfile, CleanChangeIsNotPulledTowardsEitherEnd) {
+  for (const std::size_t first : {400u, 1600u}) {
+    const Eigen::VectorXd x =
+        piecewise({{Shape::kSine, 25, 0.02, first}, {Shape::kSquare, 50, 0.02, 2000 - first}}, 31);
+    ClaspConfig config;
+    config.window_size = 25;
+    const lfd::ClaspProfile p = lfd::compute_clasp_profile(x, config);
+    Eigen::Index best = -1;
+    for (Eigen::Index i = 0; i < p.profile.size(); ++i)
+      if (!std::isnan(p.profile[i]) && (best < 0 || p.profile[i] > p.profile[best])) best = i;
+    EXPECT_NEAR(static_cast<double>(best), static_cast<double>(first), 25.0) << first;
+    EXPECT_GT(p.profile[best], 0.97) << first;
+  }
+}
+
+// A held signal (e.g. a gripper that closes once) has near-identical subsequences on each side of
+// its step; without jitter their neighbours follow rounding-level drift, i.e. time proximity, and
+// splits well inside the held stretch score as high as the step. Jitter puts the peak on the step.
+TEST(ClaspProfile, TieJitterPutsThePeakOnTheStepOfAHeldSignal) {
+  const Eigen::Index n = 1000, step = 400;
+  Eigen::VectorXd x(n);
+  for (Eigen::Index i = 0; i < n; ++i) x[i] = (i < step ? 0.08 : 0.01) + 1e-9 * double(i);
+  ClaspConfig config;
+  config.window_size = 20;
+  config.distance = ClaspDistance::kEuclidean;
+  config.tie_jitter = 0.01;
+  const lfd::ClaspProfile p = lfd::compute_clasp_profile(x, config);
+  Eigen::Index best = -1;
+  for (Eigen::Index i = 0; i < n; ++i)
+    if (!std::isnan(p.profile[i]) && (best < 0 || p.profile[i] > p.profile[best])) best = i;
+  EXPECT_NEAR(static_cast<double>(best), static_cast<double>(step), 20.0);
+  EXPECT_LT(p.profile[700], p.profile[best] - 0.05);  // deep inside the held stretch
+  config.tie_jitter = -1.0;
+  EXPECT_THROW(lfd::compute_clasp_profile(x, config), std::invalid_argument);
 }
 
 TEST(ClaspSignificance, SeparatesRealFromRandomSplit) {

@@ -220,6 +220,35 @@ TEST(MultivariateSegmentation, CandidateZonesRestrictTheArgmax) {
   EXPECT_EQ(zoned.changepoints[0], static_cast<std::size_t>(best));
 }
 
+// A zone marks one sensory interaction: however many changepoints are asked for, a zone holds at
+// most one, and a zone-less demonstration (callback returning nothing) gets none.
+TEST(MultivariateSegmentation, EachZoneHoldsAtMostOneChangepoint) {
+  const std::size_t n = 2000;
+  std::mt19937 rng(4);
+  Eigen::MatrixXd f(n, 2);
+  f.col(0) = shape_change(n, 1300, rng);
+  f.col(1) = level_change(n, 600, rng);
+  lfd::MultivariateSegmentationConfig config;
+  config.num_changepoints = 4;
+  config.min_segment_length = 100;
+  const std::vector<lfd::Interval> zones{{450, 750}, {1150, 1450}};
+  std::size_t seen_min_s = 0;
+  config.candidate_zones_for = [&](std::size_t min_s) {
+    seen_min_s = min_s;
+    return zones;
+  };
+  const auto seg = lfd::segment_multivariate(f, {1.0, 1.0}, config);
+  EXPECT_EQ(seen_min_s, 100u);
+  ASSERT_EQ(seg.changepoints.size(), 2u);
+  EXPECT_TRUE(zones[0].contains(seg.changepoints[0])) << seg.changepoints[0];
+  EXPECT_TRUE(zones[1].contains(seg.changepoints[1])) << seg.changepoints[1];
+
+  config.candidate_zones_for = [](std::size_t) { return std::vector<lfd::Interval>{}; };
+  const auto none = lfd::segment_multivariate(f, {1.0, 1.0}, config);
+  EXPECT_TRUE(none.changepoints.empty());
+  EXPECT_FALSE(std::isnan(none.first_profile[1000]));  // profiles are still reported
+}
+
 TEST(MultivariateSegmentation, StationaryFeaturesGiveNoChangepoint) {
   const std::size_t n = 2000;
   std::mt19937 rng(9);

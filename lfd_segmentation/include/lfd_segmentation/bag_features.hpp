@@ -18,6 +18,7 @@ struct DemoFeatures {
   lfd::FeatureMatrix matrix;  ///< resampled features, times = bag times (s)
   std::vector<std::string> state_features;
   std::vector<std::string> sensor_features;
+  std::vector<std::string> context_features;  ///< role context: in the matrix, used by neither
 };
 
 /// Raw (not resampled) streams of the configured fields of one bag. Throws std::runtime_error for

@@ -12,7 +12,9 @@
 
 namespace lfd_segmentation {
 
-enum class FeatureRole { kState, kSensor };
+/// kState: candidate for feature selection and ClaSP; kSensor: builds the confidence zones only;
+/// kContext: read and resampled with the others (bad data is still reported) but used by neither.
+enum class FeatureRole { kState, kSensor, kContext };
 
 /// One topic of the bags: its fields become features named "<topic>/<field>".
 struct TopicConfig {

@@ -57,6 +57,13 @@ struct ClaspConfig {
   std::size_t min_segment_size = 0;
   /// A changepoint is accepted when the rank-sum test on the predicted labels gives p below this.
   double p_value_threshold = 1e-15;
+  /// Resolution of the k-NN as a fraction of the series' range: deterministic Gaussian jitter of
+  /// this std is added before the k-NN (0 = off). Robot signals hold still for long stretches
+  /// (gripper closed, arm at rest) whose subsequences are all but identical; their neighbours
+  /// are then decided by rounding-level drift, i.e. by time proximity, and every split inside the
+  /// stretch scores ~1. Jitter makes neighbours within such a stretch random, as they should be,
+  /// so only the stretch's edges (the real changes) score high.
+  double tie_jitter = 0.0;
 };
 
 /// The k nearest neighbours of every subsequence (self-join, trivial matches excluded).

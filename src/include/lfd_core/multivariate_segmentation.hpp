@@ -8,6 +8,7 @@
 
 #include <Eigen/Core>
 #include <cstddef>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -67,8 +68,12 @@ struct MultivariateSegmentationConfig {
   /// Optional extension (empty = the paper: candidates anywhere, validated afterwards). When
   /// given, e.g. the confidence zones of sensory_events.hpp, each recursion step takes the argmax
   /// of its penalized profile only inside these intervals, so a strong peak outside every zone
-  /// cannot hide a weaker in-zone changepoint of the same range.
+  /// cannot hide a weaker in-zone changepoint of the same range. Each zone then holds at most one
+  /// changepoint (a zone marks one sensory interaction).
   std::vector<Interval> candidate_zones;
+  /// Alternative to candidate_zones for zones that depend on min_s (eq. 1): called once min_s is
+  /// known, its result replaces candidate_zones. Empty result = no zone, hence no changepoint.
+  std::function<std::vector<Interval>(std::size_t min_s)> candidate_zones_for;
   int num_changepoints = -1;          ///< < 0: stop with the significance test; >= 0: exact count
   std::size_t max_changepoints = 16;  ///< safety cap when the test decides
 };

@@ -32,6 +32,11 @@ struct SegmentationPipelineConfig {
   SensoryEventConfig events;
   /// false: every ClaSP changepoint is accepted (no sensor validation).
   bool validate_with_sensors = true;
+  /// true: the zones are computed first and ClaSP searches its candidates only inside them, one
+  /// changepoint per zone (MultivariateSegmentationConfig::candidate_zones). false: the paper's
+  /// order, candidates anywhere and then validated, where a strong out-of-zone peak can hide the
+  /// in-zone change of its range. Needs validate_with_sensors.
+  bool search_in_zones = true;
   /// Worker threads for DTW and the per-demonstration segmentations (<= 0 = all cores).
   int threads = 0;
 };
