@@ -8,6 +8,7 @@
 #include <rosbag/view.h>
 #include <sensor_msgs/Imu.h>
 #include <sensor_msgs/JointState.h>
+#include <cmath>
 
 #include <algorithm>
 #include <functional>
@@ -26,8 +27,17 @@ using FieldMap = std::map<std::string, std::function<double(const Msg&)>>;
   {                                                    \
     path, [](const auto& m) { return double(m.expr); } \
   }
-#define LFD_XYZ(prefix, expr) \
-  LFD_FIELD(prefix "/x", expr.x), LFD_FIELD(prefix "/y", expr.y), LFD_FIELD(prefix "/z", expr.z)
+// "<vector>/norm" is the magnitude, e.g. the hand's speed, which keeps its shape whatever the
+// direction of the motion (pushes toward +x and toward +y look alike).
+#define LFD_NORM(path, expr)                                                             \
+  {                                                                                      \
+    path, [](const auto& m) {                                                            \
+      return std::sqrt(m.expr.x * m.expr.x + m.expr.y * m.expr.y + m.expr.z * m.expr.z); \
+    }                                                                                    \
+  }
+#define LFD_XYZ(prefix, expr)                                                                     \
+  LFD_FIELD(prefix "/x", expr.x), LFD_FIELD(prefix "/y", expr.y), LFD_FIELD(prefix "/z", expr.z), \
+      LFD_NORM(prefix "/norm", expr)
 
 const FieldMap<geometry_msgs::PoseStamped>& pose_fields() {
   static const FieldMap<geometry_msgs::PoseStamped> f{
@@ -53,6 +63,7 @@ const FieldMap<sensor_msgs::Imu>& imu_fields() {
   return f;
 }
 #undef LFD_XYZ
+#undef LFD_NORM
 #undef LFD_FIELD
 
 template <typename Msg>

@@ -97,6 +97,9 @@ SegmentationParams params_from_yaml(const YAML::Node& root) {
   seg.num_changepoints = get<int>(root, "num_changepoints", seg.num_changepoints);
   seg.max_changepoints = get<std::size_t>(root, "max_changepoints", seg.max_changepoints);
   seg.kaiser_beta = non_negative(get<double>(root, "kaiser_beta", seg.kaiser_beta), "kaiser_beta");
+  seg.zone_p_value_threshold =
+      non_negative(get<double>(root, "zone_p_value_threshold", seg.zone_p_value_threshold),
+                   "zone_p_value_threshold");
   p.pipeline.validate_with_sensors =
       get<bool>(root, "validate_with_sensors", p.pipeline.validate_with_sensors);
   p.pipeline.search_in_zones = get<bool>(root, "search_in_zones", p.pipeline.search_in_zones);
@@ -122,6 +125,7 @@ SegmentationParams params_from_yaml(const YAML::Node& root) {
   ev.hysteresis = get<double>(events, "hysteresis", ev.hysteresis);
   ev.min_active_samples = get<std::size_t>(events, "min_active_samples", ev.min_active_samples);
   ev.merge_gap = get<std::size_t>(events, "merge_gap", ev.merge_gap);
+  ev.difference_lag = get<std::size_t>(events, "difference_lag", ev.difference_lag);
 
   const YAML::Node topics = root["topics"];
   if (topics) {

@@ -37,7 +37,8 @@ TEST(BagFeatures, ReadsConfiguredFieldsOnOneClock) {
   EXPECT_GE(m.index_of("/touch/values/r_touch_right"), 0);
   EXPECT_GE(m.index_of("/wrist_ft/wrench/force/z"), 0);
   for (const std::string& name : m.names) EXPECT_EQ(name.find("/lfd/phase"), std::string::npos);
-  EXPECT_EQ(demo.state_features.size(), 14u);
+  EXPECT_EQ(demo.state_features.size(), 16u);  // 7 pose, 6 twist + 2 speed norms, gripper
+  EXPECT_GE(m.index_of("/ee_twist/twist/linear/norm"), 0);
   EXPECT_EQ(demo.sensor_features.size(), 2u);   // the touch pads
   EXPECT_EQ(demo.context_features.size(), 6u);  // the wrist F/T: read, used by neither
   EXPECT_EQ(demo.state_features.size() + demo.sensor_features.size() + demo.context_features.size(),

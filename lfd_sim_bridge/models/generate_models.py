@@ -166,13 +166,13 @@ def arm_links(side):
              (0.0, 0.0, -0.035), 0.05,
              [geom('box', (0.012, 0.006, 0.03), (0.0, 0.006, -0.03), collide=True, color=FINGER_COLOR,
                    name='r_finger_l_pad')],
-             [('r_touch_left_site', (0.0, 0.0, -0.03), (0.013, 0.003, 0.031))]),
+             [('r_touch_left_site', (0.0, 0.006, -0.03), (0.013, 0.007, 0.031))]),
         Link('r_gripper_finger_r', 'r_gripper_palm',
              prismatic('R_GRIPPER_MIMIC', NY, 0.0, 0.045, 'gripper', mimic='R_GRIPPER'),
              (0.0, 0.0, -0.035), 0.05,
              [geom('box', (0.012, 0.006, 0.03), (0.0, -0.006, -0.03), collide=True, color=FINGER_COLOR,
                    name='r_finger_r_pad')],
-             [('r_touch_right_site', (0.0, 0.0, -0.03), (0.013, 0.003, 0.031))]),
+             [('r_touch_right_site', (0.0, -0.006, -0.03), (0.013, 0.007, 0.031))]),
         # Tool centre point: between the pads, 12 mm above the finger tips.
         Link('r_gripper_tcp', 'r_gripper_palm', fixed('R_GRIPPER_TCP_JOINT'), (0.0, 0.0, -0.083)),
     ]

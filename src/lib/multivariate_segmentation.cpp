@@ -145,6 +145,8 @@ MultivariateSegmentation segment_multivariate(const Eigen::MatrixXd& features,
       throw std::invalid_argument("segment_multivariate: weights must be finite and >= 0");
   if (!(config.clasp.p_value_threshold > 0.0))
     throw std::invalid_argument("segment_multivariate: p_value_threshold must be > 0");
+  if (!(config.zone_p_value_threshold >= 0.0 && config.zone_p_value_threshold < 1.0))
+    throw std::invalid_argument("segment_multivariate: zone_p_value_threshold must be in [0, 1)");
 
   // Weights used both for the combination and to average the features' p-values.
   std::vector<double> w(num_features, 1.0);
@@ -265,7 +267,10 @@ MultivariateSegmentation segment_multivariate(const Eigen::MatrixXd& features,
     c.score = penalized[best];
     c.log10_p_value = weighted_log_p / weight_sum;
     out.candidates.push_back(c);
-    if (learn && c.log10_p_value > log10_threshold) return;  // not significant: range stays whole
+    const double needed = restricted && config.zone_p_value_threshold > 0.0
+                              ? std::log10(config.zone_p_value_threshold)
+                              : log10_threshold;
+    if (learn && c.log10_p_value > needed) return;  // not significant: range stays whole
     queue.push({c.score, out.candidates.size() - 1});
   };
 

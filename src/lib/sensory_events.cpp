@@ -19,6 +19,8 @@ void check_config(const SensoryEventConfig& c) {
                                 std::to_string(c.hysteresis));
   if (!(c.noise_floor_sigmas >= 0.0))
     throw std::invalid_argument("sensory events: noise_floor_sigmas must be >= 0");
+  if (c.difference_lag < 1)
+    throw std::invalid_argument("sensory events: difference_lag must be >= 1");
 }
 
 double median_of(std::vector<double> v) {
@@ -58,12 +60,19 @@ std::vector<std::size_t> detect_sensory_events(const Eigen::Ref<const Eigen::Vec
   const std::size_t n = static_cast<std::size_t>(signal.size());
   if (n < 2) return {};
   const std::vector<double> y = running_median(signal, config.median_window);
+  const std::size_t lag = config.difference_lag, ahead = lag / 2, behind = lag - ahead;
   std::vector<double> mag(n, 0.0);
-  for (std::size_t t = 1; t < n; ++t) mag[t] = std::abs(y[t] - y[t - 1]);
+  for (std::size_t t = behind; t + ahead < n; ++t) mag[t] = std::abs(y[t + ahead] - y[t - behind]);
   const double peak = *std::max_element(mag.begin(), mag.end());
   if (!(peak > 0.0)) return {};
   double on = config.threshold_ratio * peak;
-  if (config.noise_floor_sigmas > 0.0) {
+  if (config.noise_floor_sigmas > 0.0 && lag > 1) {
+    // Lagged differences of a smoothed signal are noise-dominated wherever nothing happens, so
+    // their own robust spread is the noise level.
+    std::vector<double> lagged(mag.begin() + static_cast<std::ptrdiff_t>(behind),
+                               mag.end() - static_cast<std::ptrdiff_t>(ahead));
+    on = std::max(on, config.noise_floor_sigmas * 1.4826 * median_of(lagged));
+  } else if (config.noise_floor_sigmas > 0.0) {
     // Noise level of the RAW differences: a running median leaves plateaus whose differences are
     // mostly 0, which would make the robust sigma of the smoothed differences meaningless.
     std::vector<double> raw(n - 1);

@@ -249,6 +249,30 @@ TEST(MultivariateSegmentation, EachZoneHoldsAtMostOneChangepoint) {
   EXPECT_FALSE(std::isnan(none.first_profile[1000]));  // profiles are still reported
 }
 
+// A noisy change whose ClaSP evidence (p ~ 1e-9) misses the strict threshold is kept inside a
+// sensory zone when the zone threshold is looser, and never outside a zone.
+TEST(MultivariateSegmentation, ZoneThresholdAcceptsWeakerInZoneEvidence) {
+  std::mt19937 rng(11);
+  std::normal_distribution<double> g(0.0, 1.0);
+  const int n = 600, cp = 300;
+  Eigen::MatrixXd f(n, 1);
+  for (int t = 0; t < n; ++t) {
+    const double s = std::sin(2.0 * M_PI * t / 40.0);
+    f(t, 0) = (t < cp ? s : (s >= 0 ? 1.0 : -1.0)) + g(rng);
+  }
+  lfd::MultivariateSegmentationConfig config;
+  config.window_sizes = {20};
+  config.min_segment_length = 60;
+  config.candidate_zones = {{250, 350}};
+  EXPECT_TRUE(lfd::segment_multivariate(f, {1.0}, config).changepoints.empty());
+  config.zone_p_value_threshold = 1e-5;
+  const auto seg = lfd::segment_multivariate(f, {1.0}, config);
+  ASSERT_EQ(seg.changepoints.size(), 1u);
+  EXPECT_NEAR(static_cast<double>(seg.changepoints[0]), cp, 25.0);
+  config.zone_p_value_threshold = 1.0;
+  EXPECT_THROW(lfd::segment_multivariate(f, {1.0}, config), std::invalid_argument);
+}
+
 TEST(MultivariateSegmentation, StationaryFeaturesGiveNoChangepoint) {
   const std::size_t n = 2000;
   std::mt19937 rng(9);

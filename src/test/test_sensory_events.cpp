@@ -105,7 +105,35 @@ TEST(SensoryEvents, MinActiveSamplesAndMergeGap) {
   EXPECT_EQ(lfd::detect_sensory_events(x, longer), (Events{6, 8}));
 }
 
+// A contact seen by a chattering sensor: quiet, then 0..3 noise-like chatter for 150 samples with
+// a short inertial spike before it. The lagged level difference ignores the spike, and merging
+// bursts within 50 samples turns the chatter into one burst: events at contact on and off only.
+TEST(SensoryEvents, LaggedLevelDifferenceSeesContactNotSpikesOrChatter) {
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> chatter(0.0, 3.0);
+  Eigen::VectorXd x = Eigen::VectorXd::Zero(400);
+  x[60] = 6.0;  // one-sample inertial spike, larger than any chatter step
+  for (Eigen::Index i = 150; i < 300; ++i) x[i] = (i % 4 == 0) ? 0.0 : chatter(rng);
+  SensoryEventConfig paper;  // lag 1: the spike and every chatter edge are events
+  paper.median_window = 1;
+  paper.noise_floor_sigmas = 0.0;
+  EXPECT_GT(lfd::detect_sensory_events(x, paper).size(), 6u);
+  SensoryEventConfig level;
+  level.median_window = 13;
+  level.difference_lag = 13;
+  level.merge_gap = 50;
+  const Events events = lfd::detect_sensory_events(x, level);
+  ASSERT_EQ(events.size(), 2u) << ::testing::PrintToString(events);
+  EXPECT_NEAR(static_cast<double>(events[0]), 150.0, 13.0);
+  EXPECT_NEAR(static_cast<double>(events[1]), 300.0, 13.0);
+}
+
 TEST(SensoryEvents, RejectsBadConfigAndInput) {
+  {
+    SensoryEventConfig c;
+    c.difference_lag = 0;
+    EXPECT_THROW(lfd::detect_sensory_events(Eigen::VectorXd::Zero(10), c), std::invalid_argument);
+  }
   SensoryEventConfig c;
   c.threshold_ratio = 0.0;
   EXPECT_THROW(lfd::detect_sensory_events(Eigen::VectorXd::Zero(5), c), std::invalid_argument);

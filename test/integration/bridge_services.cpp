@@ -166,7 +166,9 @@ TEST_F(BridgeServices, ResetRestoresPostureAndObjects) {
   ASSERT_TRUE(reset.response.success) << reset.response.message;
   EXPECT_TRUE(
       waitFor([&] { return std::abs(probe_.position("R_SHOULDER_Y") - 0.3) < 1e-9; }, 10.0));
-  EXPECT_NEAR(probe_.position("R_ELBOW_P"), -1.3, 1e-9);  // configured initial posture
+  double configured = 0.0;  // the bridge's configured initial posture (config/bridge.yaml)
+  ASSERT_TRUE(ros::param::get("/bridge/initial_posture/R_ELBOW_P", configured));
+  EXPECT_NEAR(probe_.position("R_ELBOW_P"), configured, 1e-9);
   geometry_msgs::PoseStamped stick;
   EXPECT_TRUE(waitFor(
       [&] {

@@ -74,6 +74,10 @@ struct MultivariateSegmentationConfig {
   /// Alternative to candidate_zones for zones that depend on min_s (eq. 1): called once min_s is
   /// known, its result replaces candidate_zones. Empty result = no zone, hence no changepoint.
   std::function<std::vector<Interval>(std::size_t min_s)> candidate_zones_for;
+  /// Significance needed by an in-zone candidate (zone-guided search only; 0 = the ClaSP
+  /// threshold). The sensory event is independent evidence of a change there, so ClaSP's own
+  /// evidence may be weaker than for a candidate anywhere.
+  double zone_p_value_threshold = 0.0;
   int num_changepoints = -1;          ///< < 0: stop with the significance test; >= 0: exact count
   std::size_t max_changepoints = 16;  ///< safety cap when the test decides
 };

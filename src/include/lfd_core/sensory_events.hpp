@@ -13,7 +13,8 @@
 //   - noise_floor_sigmas: thr is raised to at least that many robust noise sigmas (1.4826 * MAD)
 //     of the raw first difference, so a sensor carrying only noise produces no event at all;
 //   - hysteresis: activity switches off below hysteresis * thr (1 = the paper's single threshold);
-//   - min_active_samples / merge_gap: drop one-sample blips, merge bursts closer than merge_gap.
+//   - min_active_samples / merge_gap: drop one-sample blips, merge bursts closer than merge_gap;
+//   - difference_lag: level change over a lag instead of the sample-to-sample difference.
 #pragma once
 
 #include <Eigen/Core>
@@ -29,6 +30,12 @@ struct SensoryEventConfig {
   double hysteresis = 0.5;             ///< in (0, 1]; 1 = paper-literal single threshold
   std::size_t min_active_samples = 1;  ///< bursts shorter than this are ignored
   std::size_t merge_gap = 0;           ///< bursts separated by <= merge_gap quiet samples merge
+  /// Lag L of the difference (1 = the paper's first difference). With L > 1 the difference is
+  /// y[t + L/2] - y[t - L + L/2] of the median-smoothed y: with median_window ~ L it compares the
+  /// sensor's level just before and just after t, so a spike (inertia of a starting move) or a
+  /// zero-mean vibration (a swinging load, chattering contact) is not an event, while contact
+  /// made or lost is. The noise floor then comes from these lagged differences themselves.
+  std::size_t difference_lag = 1;
 };
 
 /// A closed interval of sample indices [begin, end] (eq. 1 uses closed intervals).
