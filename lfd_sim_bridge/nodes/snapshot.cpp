@@ -1,0 +1,458 @@
+// snapshot: offscreen MuJoCo pictures of a recorded demonstration or reproduction, one PNG per
+// requested time (by default the end of every ground-truth segment and the end of the bag).
+//
+//   snapshot --bag B [--times 8.3,12.9,end [--relative]] --out DIR [--model workcell.xml]
+//            [--width 960] [--height 720] [--camera overview|free] [--lookat x,y,z]
+//            [--distance d] [--azimuth deg] [--elevation deg]
+//
+// For each time the scene is rebuilt from the bag, not simulated: the robot joints by name from
+// /joint_states, the free objects from /objects/<body>/pose (the latest message at or before the
+// time), then mj_forward and one offscreen render. Times are bag time (the recorded stamps, as
+// the `segment` CLI reports changepoint_times), or seconds from the bag's start with --relative.
+// Writes DIR/snapshot_<k>_<t>s.png and prints one "t file" line per picture.
+//
+// Rendering needs no display: an OSMesa context (libOSMesa, loaded at run time so the package
+// does not link it; MuJoCo's GL loader then finds OSMesaGetProcAddress in the process).
+#include <GL/osmesa.h>
+#include <dlfcn.h>
+#include <mujoco/mujoco.h>
+#include <rosbag/bag.h>
+#include <rosbag/view.h>
+
+#include <geometry_msgs/PoseStamped.h>
+#include <lfd_msgs/Phase.h>
+#include <sensor_msgs/JointState.h>
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <map>
+#include <memory>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace {
+
+struct Options {
+  std::string bag;
+  std::string out;
+  // The package's own scene: this source file sits in <package>/nodes/.
+  std::string model =
+      (std::filesystem::path(__FILE__).parent_path().parent_path() / "models" / "workcell.xml")
+          .string();
+  std::string times;  // empty: segment ends
+  bool relative = false;
+  int width = 960;
+  int height = 720;
+  std::string camera = "free";
+  std::array<double, 3> lookat{0.4, -0.15, 0.95};
+  double distance = 2.4;
+  double azimuth = 215.0;
+  double elevation = -28.0;
+};
+
+[[noreturn]] void usage(const std::string& error) {
+  std::cerr
+      << "snapshot: " << error << "\n"
+      << "usage: snapshot --bag B [--times t1,t2,...|end [--relative]] --out DIR\n"
+         "                [--model MJCF]\n"
+         "                [--width W] [--height H] [--camera overview|free|<MJCF camera>]\n"
+         "                [--lookat x,y,z] [--distance d] [--azimuth deg] [--elevation deg]\n";
+  std::exit(2);
+}
+
+double parse_number(const std::string& text, const std::string& what) {
+  try {
+    std::size_t used = 0;
+    double v = std::stod(text, &used);
+    if (used != text.size() || !std::isfinite(v)) throw std::invalid_argument(text);
+    return v;
+  } catch (const std::exception&) {
+    usage(what + ": '" + text + "' is not a number");
+  }
+}
+
+std::vector<std::string> split(const std::string& text, char sep) {
+  std::vector<std::string> parts;
+  std::stringstream ss(text);
+  std::string part;
+  while (std::getline(ss, part, sep))
+    if (!part.empty()) parts.push_back(part);
+  return parts;
+}
+
+Options parse_options(int argc, char** argv) {
+  Options o;
+  for (int i = 1; i < argc; ++i) {
+    std::string key = argv[i];
+    if (key == "-h" || key == "--help") usage("help");
+    if (key == "--relative") {
+      o.relative = true;
+      continue;
+    }
+    if (i + 1 >= argc) usage(key + " needs a value");
+    std::string value = argv[++i];
+    if (key == "--bag")
+      o.bag = value;
+    else if (key == "--out")
+      o.out = value;
+    else if (key == "--model")
+      o.model = value;
+    else if (key == "--times")
+      o.times = value;
+    else if (key == "--width")
+      o.width = static_cast<int>(parse_number(value, key));
+    else if (key == "--height")
+      o.height = static_cast<int>(parse_number(value, key));
+    else if (key == "--camera")
+      o.camera = value;
+    else if (key == "--distance")
+      o.distance = parse_number(value, key);
+    else if (key == "--azimuth")
+      o.azimuth = parse_number(value, key);
+    else if (key == "--elevation")
+      o.elevation = parse_number(value, key);
+    else if (key == "--lookat") {
+      auto parts = split(value, ',');
+      if (parts.size() != 3) usage("--lookat needs x,y,z");
+      for (int k = 0; k < 3; ++k) o.lookat[k] = parse_number(parts[k], key);
+    } else {
+      usage("unknown option " + key);
+    }
+  }
+  if (o.bag.empty()) usage("--bag is required");
+  if (o.out.empty()) usage("--out is required");
+  if (o.width < 16 || o.height < 16 || o.width > 4096 || o.height > 4096)
+    usage("--width and --height must be within [16, 4096]");
+  if (o.distance <= 0) usage("--distance must be positive");
+  return o;
+}
+
+// ---- the bag's states -------------------------------------------------------------------------
+
+template <typename Msg>
+struct Stamped {
+  double t;
+  Msg msg;
+};
+
+struct Recording {
+  double start = 0, end = 0;
+  std::vector<Stamped<sensor_msgs::JointState>> joints;
+  std::map<std::string, std::vector<Stamped<geometry_msgs::PoseStamped>>> objects;
+  std::vector<double>
+      segment_ends;  // last /lfd/phase message of each ground-truth phase but the last
+};
+
+Recording read_recording(const std::string& path) {
+  if (!std::filesystem::is_regular_file(path))
+    throw std::runtime_error("bag '" + path + "' does not exist");
+  rosbag::Bag bag(path, rosbag::bagmode::Read);
+  rosbag::View view(bag);
+  if (view.size() == 0) throw std::runtime_error("bag '" + path + "' is empty");
+  Recording r;
+  r.start = view.getBeginTime().toSec();
+  r.end = view.getEndTime().toSec();
+  std::string phase;
+  double phase_time = 0;
+  for (const rosbag::MessageInstance& m : view) {
+    const std::string& topic = m.getTopic();
+    double t = m.getTime().toSec();
+    if (topic == "/joint_states") {
+      if (auto js = m.instantiate<sensor_msgs::JointState>()) r.joints.push_back({t, *js});
+    } else if (topic.rfind("/objects/", 0) == 0 && topic.size() > 14 &&
+               topic.compare(topic.size() - 5, 5, "/pose") == 0) {
+      if (auto p = m.instantiate<geometry_msgs::PoseStamped>())
+        r.objects[topic.substr(9, topic.size() - 14)].push_back({t, *p});
+    } else if (topic == "/lfd/phase") {
+      if (auto p = m.instantiate<lfd_msgs::Phase>()) {
+        if (!phase.empty() && p->name != phase) r.segment_ends.push_back(phase_time);
+        phase = p->name;
+        phase_time = t;
+      }
+    }
+  }
+  if (r.joints.empty()) throw std::runtime_error("bag '" + path + "' has no /joint_states");
+  return r;
+}
+
+// The latest sample at or before t (the first one if t precedes them all).
+template <typename Msg>
+const Msg& latest(const std::vector<Stamped<Msg>>& samples, double t) {
+  auto it = std::upper_bound(samples.begin(), samples.end(), t,
+                             [](double v, const Stamped<Msg>& s) { return v < s.t; });
+  return it == samples.begin() ? it->msg : std::prev(it)->msg;
+}
+
+std::vector<double> requested_times(const Options& o, const Recording& r) {
+  std::vector<double> times;
+  if (o.times.empty()) {
+    times = r.segment_ends;
+    times.push_back(r.end);
+    return times;
+  }
+  for (const std::string& part : split(o.times, ',')) {
+    double t = part == "end" ? r.end : parse_number(part, "--times");
+    if (o.relative && part != "end") t += r.start;
+    if (t < r.start - 1e-6 || t > r.end + 1e-6) {
+      std::ostringstream msg;
+      msg << "time " << part << " is outside the bag [" << r.start << ", " << r.end
+          << "] s of bag time" << (o.relative ? "" : " (--relative: from the bag's start)");
+      throw std::invalid_argument(msg.str());
+    }
+    times.push_back(t);
+  }
+  if (times.empty()) usage("--times lists no time");
+  return times;
+}
+
+// ---- scene ------------------------------------------------------------------------------------
+
+void apply_state(const mjModel* m, mjData* d, const Recording& r, double t) {
+  const sensor_msgs::JointState& js = latest(r.joints, t);
+  for (std::size_t k = 0; k < js.name.size() && k < js.position.size(); ++k) {
+    int id = mj_name2id(m, mjOBJ_JOINT, js.name[k].c_str());
+    if (id < 0) continue;  // a joint of the robot's description unknown to the scene
+    if (m->jnt_type[id] != mjJNT_HINGE && m->jnt_type[id] != mjJNT_SLIDE) continue;
+    d->qpos[m->jnt_qposadr[id]] = js.position[k];
+  }
+  for (const auto& [name, samples] : r.objects) {
+    int id = mj_name2id(m, mjOBJ_JOINT, (name + "_free").c_str());
+    if (id < 0 || m->jnt_type[id] != mjJNT_FREE) continue;
+    const geometry_msgs::Pose& p = latest(samples, t).pose;
+    mjtNum* q = d->qpos + m->jnt_qposadr[id];
+    q[0] = p.position.x;
+    q[1] = p.position.y;
+    q[2] = p.position.z;
+    q[3] = p.orientation.w;
+    q[4] = p.orientation.x;
+    q[5] = p.orientation.y;
+    q[6] = p.orientation.z;
+    mju_normalize4(q + 3);
+  }
+  mj_forward(m, d);
+}
+
+// ---- PNG -------------------------------------------------------------------------------------
+
+std::uint32_t crc32(const std::uint8_t* data, std::size_t n, std::uint32_t crc = 0) {
+  static const auto table = [] {
+    std::array<std::uint32_t, 256> t{};
+    for (std::uint32_t i = 0; i < 256; ++i) {
+      std::uint32_t c = i;
+      for (int k = 0; k < 8; ++k) c = (c & 1) ? 0xEDB88320u ^ (c >> 1) : c >> 1;
+      t[i] = c;
+    }
+    return t;
+  }();
+  crc = ~crc;
+  for (std::size_t i = 0; i < n; ++i) crc = table[(crc ^ data[i]) & 0xFF] ^ (crc >> 8);
+  return ~crc;
+}
+
+void put_u32(std::vector<std::uint8_t>& out, std::uint32_t v) {
+  for (int s = 24; s >= 0; s -= 8) out.push_back(static_cast<std::uint8_t>(v >> s));
+}
+
+// A zlib stream of data: compressed by the system's libz when it loads (dlopen: no link-time
+// dependency), else stored deflate blocks (valid PNG data, ~4x larger).
+std::vector<std::uint8_t> zlib_compress(const std::vector<std::uint8_t>& data) {
+  using Compress2 =
+      int (*)(unsigned char*, unsigned long*, const unsigned char*, unsigned long, int);
+  using CompressBound = unsigned long (*)(unsigned long);
+  static void* libz = dlopen("libz.so.1", RTLD_NOW | RTLD_LOCAL);
+  if (libz) {
+    auto compress2 = reinterpret_cast<Compress2>(dlsym(libz, "compress2"));
+    auto bound = reinterpret_cast<CompressBound>(dlsym(libz, "compressBound"));
+    if (compress2 && bound) {
+      unsigned long size = bound(data.size());
+      std::vector<std::uint8_t> out(size);
+      if (compress2(out.data(), &size, data.data(), data.size(), 6) == 0) {  // Z_OK
+        out.resize(size);
+        return out;
+      }
+    }
+  }
+  std::vector<std::uint8_t> z = {0x78, 0x01};  // zlib header, stored blocks
+  for (std::size_t pos = 0; pos < data.size() || pos == 0; pos += 65535) {
+    std::size_t len = std::min<std::size_t>(65535, data.size() - pos);
+    z.push_back(pos + len >= data.size() ? 1 : 0);
+    z.push_back(static_cast<std::uint8_t>(len & 0xFF));
+    z.push_back(static_cast<std::uint8_t>(len >> 8));
+    z.push_back(static_cast<std::uint8_t>(~len & 0xFF));
+    z.push_back(static_cast<std::uint8_t>((~len >> 8) & 0xFF));
+    z.insert(z.end(), data.begin() + static_cast<std::ptrdiff_t>(pos),
+             data.begin() + static_cast<std::ptrdiff_t>(pos + len));
+    if (len == 0) break;
+  }
+  std::uint32_t a = 1, b = 0;  // adler32 of the uncompressed data
+  for (std::uint8_t v : data) {
+    a = (a + v) % 65521;
+    b = (b + a) % 65521;
+  }
+  put_u32(z, (b << 16) | a);
+  return z;
+}
+
+void write_chunk(std::ofstream& f, const char* type, const std::vector<std::uint8_t>& data) {
+  std::vector<std::uint8_t> chunk;
+  put_u32(chunk, static_cast<std::uint32_t>(data.size()));
+  chunk.insert(chunk.end(), type, type + 4);
+  chunk.insert(chunk.end(), data.begin(), data.end());
+  std::uint32_t crc = crc32(chunk.data() + 4, chunk.size() - 4);
+  put_u32(chunk, crc);
+  f.write(reinterpret_cast<const char*>(chunk.data()), static_cast<std::streamsize>(chunk.size()));
+}
+
+// rgb: width*height*3 bytes, top row first.
+void write_png(const std::string& path, const std::vector<std::uint8_t>& rgb, int width,
+               int height) {
+  std::vector<std::uint8_t> raw;  // each row: filter byte 0, then the pixels
+  raw.reserve(static_cast<std::size_t>(height) * (3 * width + 1));
+  for (int y = 0; y < height; ++y) {
+    raw.push_back(0);
+    raw.insert(raw.end(), rgb.begin() + static_cast<std::ptrdiff_t>(y) * 3 * width,
+               rgb.begin() + static_cast<std::ptrdiff_t>(y + 1) * 3 * width);
+  }
+  std::vector<std::uint8_t> z = zlib_compress(raw);
+
+  std::ofstream f(path, std::ios::binary);
+  if (!f) throw std::runtime_error("cannot write '" + path + "'");
+  const std::uint8_t signature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n'};
+  f.write(reinterpret_cast<const char*>(signature), 8);
+  std::vector<std::uint8_t> header;
+  put_u32(header, static_cast<std::uint32_t>(width));
+  put_u32(header, static_cast<std::uint32_t>(height));
+  header.insert(header.end(), {8, 2, 0, 0, 0});  // 8-bit RGB, no interlace
+  write_chunk(f, "IHDR", header);
+  write_chunk(f, "IDAT", z);
+  write_chunk(f, "IEND", {});
+  if (!f) throw std::runtime_error("cannot write '" + path + "'");
+}
+
+// ---- offscreen GL -----------------------------------------------------------------------------
+
+// An OSMesa context with its own pixel buffer, loaded with dlopen.
+class OffscreenGL {
+ public:
+  OffscreenGL(int width, int height) : buffer_(static_cast<std::size_t>(width) * height * 4) {
+    for (const char* name : {"libOSMesa.so.8", "libOSMesa.so"}) {
+      lib_ = dlopen(name, RTLD_NOW | RTLD_GLOBAL);
+      if (lib_) break;
+    }
+    if (!lib_) throw std::runtime_error("cannot load libOSMesa (apt install libosmesa6)");
+    auto create = reinterpret_cast<OSMesaContext (*)(GLenum, GLint, GLint, GLint, OSMesaContext)>(
+        dlsym(lib_, "OSMesaCreateContextExt"));
+    auto make_current =
+        reinterpret_cast<GLboolean (*)(OSMesaContext, void*, GLenum, GLsizei, GLsizei)>(
+            dlsym(lib_, "OSMesaMakeCurrent"));
+    destroy_ = reinterpret_cast<void (*)(OSMesaContext)>(dlsym(lib_, "OSMesaDestroyContext"));
+    if (!create || !make_current || !destroy_)
+      throw std::runtime_error("libOSMesa lacks OSMesaCreateContextExt/MakeCurrent/Destroy");
+    context_ = create(OSMESA_RGBA, 24, 8, 0, nullptr);
+    if (!context_) throw std::runtime_error("OSMesaCreateContextExt failed");
+    if (!make_current(context_, buffer_.data(), GL_UNSIGNED_BYTE, width, height))
+      throw std::runtime_error("OSMesaMakeCurrent failed");
+  }
+  ~OffscreenGL() {
+    if (context_) destroy_(context_);
+    // lib_ stays loaded: MuJoCo keeps GL function pointers into it until exit.
+  }
+  OffscreenGL(const OffscreenGL&) = delete;
+  OffscreenGL& operator=(const OffscreenGL&) = delete;
+
+ private:
+  void* lib_ = nullptr;
+  OSMesaContext context_ = nullptr;
+  void (*destroy_)(OSMesaContext) = nullptr;
+  std::vector<std::uint8_t> buffer_;
+};
+
+struct ModelDeleter {
+  void operator()(mjModel* m) const { mj_deleteModel(m); }
+};
+struct DataDeleter {
+  void operator()(mjData* d) const { mj_deleteData(d); }
+};
+
+int run(const Options& o) {
+  Recording rec = read_recording(o.bag);
+  std::vector<double> times = requested_times(o, rec);
+
+  char error[1000] = "";
+  std::unique_ptr<mjModel, ModelDeleter> model(mj_loadXML(o.model.c_str(), nullptr, error, 1000));
+  if (!model) throw std::runtime_error("cannot load '" + o.model + "': " + error);
+  mjModel* m = model.get();
+  std::unique_ptr<mjData, DataDeleter> data(mj_makeData(m));
+  m->vis.global.offwidth = std::max(m->vis.global.offwidth, o.width);
+  m->vis.global.offheight = std::max(m->vis.global.offheight, o.height);
+
+  mjvCamera cam;
+  mjv_defaultCamera(&cam);
+  if (o.camera == "free") {
+    cam.type = mjCAMERA_FREE;
+    for (int k = 0; k < 3; ++k) cam.lookat[k] = o.lookat[k];
+    cam.distance = o.distance;
+    cam.azimuth = o.azimuth;
+    cam.elevation = o.elevation;
+  } else {
+    cam.type = mjCAMERA_FIXED;
+    cam.fixedcamid = mj_name2id(m, mjOBJ_CAMERA, o.camera.c_str());
+    if (cam.fixedcamid < 0)
+      throw std::invalid_argument("--camera: '" + o.camera +
+                                  "' is neither 'free' nor a camera of " + o.model);
+  }
+
+  OffscreenGL gl(m->vis.global.offwidth, m->vis.global.offheight);
+  mjvOption opt;
+  mjv_defaultOption(&opt);
+  mjvScene scene;
+  mjv_defaultScene(&scene);
+  mjv_makeScene(m, &scene, 2000);
+  mjrContext con;
+  mjr_defaultContext(&con);
+  mjr_makeContext(m, &con, mjFONTSCALE_100);
+  mjr_setBuffer(mjFB_OFFSCREEN, &con);
+  if (con.currentBuffer != mjFB_OFFSCREEN) throw std::runtime_error("no offscreen buffer");
+
+  std::filesystem::create_directories(o.out);
+  const mjrRect viewport{0, 0, o.width, o.height};
+  std::vector<std::uint8_t> bottom_up(static_cast<std::size_t>(o.width) * o.height * 3);
+  std::vector<std::uint8_t> rgb(bottom_up.size());
+  for (std::size_t k = 0; k < times.size(); ++k) {
+    apply_state(m, data.get(), rec, times[k]);
+    mjv_updateScene(m, data.get(), &opt, nullptr, &cam, mjCAT_ALL, &scene);
+    mjr_render(viewport, &scene, &con);
+    mjr_readPixels(bottom_up.data(), nullptr, viewport, &con);
+    const std::size_t row = static_cast<std::size_t>(o.width) * 3;
+    for (int y = 0; y < o.height; ++y)
+      std::memcpy(rgb.data() + y * row, bottom_up.data() + (o.height - 1 - y) * row, row);
+    char name[64];
+    std::snprintf(name, sizeof(name), "snapshot_%02zu_%.2fs.png", k, times[k] - rec.start);
+    std::string file = (std::filesystem::path(o.out) / name).string();
+    write_png(file, rgb, o.width, o.height);
+    std::printf("%.3f %s\n", times[k] - rec.start, file.c_str());
+  }
+  mjr_freeContext(&con);
+  mjv_freeScene(&scene);
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  Options o = parse_options(argc, argv);
+  try {
+    return run(o);
+  } catch (const std::exception& e) {
+    std::cerr << "snapshot: " << e.what() << "\n";
+    return 1;
+  }
+}
