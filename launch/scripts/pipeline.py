@@ -1,15 +1,43 @@
 #!/usr/bin/python3
 """The headless lfd pipeline: README's first command (`./lfd pipeline --out DIR`).
 
-Stages, each through roslaunch on a private ROS master of its own (so one stage's /use_sim_time
-never leaks into the next):
-  datasets  generate the four demonstration datasets (resumes: existing bags are kept)
-  segment   segment every dataset through the segmentation service, for all four combination
-            methods, and score it against the demonstrator's ground truth
+Stages (`--stages`, default all, in this order), each through roslaunch on a private ROS master of
+its own (so one stage's /use_sim_time never leaks into the next):
+  datasets   generate the demonstration datasets (resumes: existing bags are kept)
+  segment    segment every dataset through the segmentation service, for all four combination
+             methods, and score it against the demonstrator's ground truth
+  learn      launch/learn.launch: per dataset, segment its bags (/segmentation/segment, the paper's
+             method of config/segmentation.yaml; never the ground truth) and learn the skill
+             library from the validated changepoints (/learner/learn) -> DIR/skills/<task>_<mode>.json
+  reproduce  launch/reproduce.launch: per learned library, reproduce every unseen goal of
+             config/tasks.yaml (`unseen.<mode>`) in MuJoCo through /executor/execute and judge the
+             object's final pose with config/evaluation.yaml `reproduction`
+             (lfd_dmp/scripts/evaluate_reproduction.py) -> DIR/reproduction/<task>_<mode>.json
 
-Writes DIR/report.json (stable keys: datasets.<name>.demos, segmentation.<name>.success_rate,
-segmentation.<name>.methods.<method>, timings.<stage>_s) and DIR/report.md, and prints the time of
-each stage. Ctrl-C stops cleanly; a rerun picks up the datasets that already exist.
+Writes DIR/report.json and DIR/report.md, and prints the time of each stage. Stable report.json keys:
+  datasets.<dataset>.demos
+  segmentation.<dataset>.success_rate, segmentation.<dataset>.methods.<method>
+  learning.<dataset>.segments            segments in the learned library (expected_segments beside)
+  learning.<dataset>.changepoint_counts  validated changepoints per demo, warnings, error (if any)
+  reproduction.<task>.success_rate       sim library on the sim unseen goals (successes / goals)
+  reproduction.<task>.execution_time_ratio  mean executed time / mean demonstration duration
+  reproduction.<task>.goals              per goal: id, success, object_position_error_m,
+                                         object_yaw_error_rad, tcp_position_error_m,
+                                         tcp_orientation_error_rad, time_ratio, error
+  reproduction_teleop.<task>.*           the same for the teleop library on the teleop goals
+  timings.<stage>_s                      wall time of the stage's last run (datasets_s, segment_s,
+                                         learn_s, reproduce_s; total_s their sum; a stage with
+                                         nothing to redo keeps its previous time)
+A task that cannot be learned or reproduced (e.g. push while its segmentation finds another number of
+changepoints than the task has transitions) is recorded with its error and listed under `problems`;
+the other tasks go on. <dataset> is <mode>_<task> (sim_grasp, sim_push, teleop_grasp, teleop_push).
+
+Resumable: the datasets stage keeps existing bags, learn keeps existing libraries and reproduce
+keeps results newer than their library for the same goals; `--force` redoes learn and reproduce.
+`--stages learn,reproduce` reruns stages alone on an existing output folder. Ctrl-C stops cleanly,
+keeping everything recorded so far (reproduction results include the goals done).
+Reduced runs (CI): `--demos N` records N configurations per dataset (spread over tasks.yaml's list;
+later stages use the bags present), `--goals N` reproduces N unseen goals per task (spread).
 """
 import argparse
 import contextlib
@@ -21,9 +49,13 @@ import subprocess
 import sys
 import time
 
+import yaml
+
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.abspath(os.path.join(HERE, "..", ".."))
 DATASETS = ("sim_grasp", "sim_push", "teleop_grasp", "teleop_push")
+TASKS_FILE = os.path.join(ROOT, "config", "tasks.yaml")
+EVALUATE_REPRODUCTION = os.path.join(ROOT, "lfd_dmp", "scripts", "evaluate_reproduction.py")
 PAPER_METHOD = "weighted_product"
 
 
@@ -100,10 +132,37 @@ def count_bags(folder):
     return len([f for f in os.listdir(folder) if f.endswith(".bag")])
 
 
+def spread(items, n):
+    """n items evenly spread over the list (all of them when n <= 0 or n >= len)."""
+    if n <= 0 or n >= len(items):
+        return list(items)
+    if n == 1:
+        return [items[len(items) // 2]]
+    return [items[round(i * (len(items) - 1) / (n - 1))] for i in range(n)]
+
+
+def reduced_tasks_file(out, demos):
+    """tasks.yaml with `demos` configurations per demonstrated dataset (--demos), or the original."""
+    if demos <= 0:
+        return TASKS_FILE
+    with open(TASKS_FILE) as f:
+        tasks = yaml.safe_load(f)
+    for task in ("grasp", "push"):
+        for mode in ("sim", "teleop"):
+            tasks[task][mode] = spread(tasks[task][mode], demos)
+    path = os.path.join(out, "tasks_%d_demos.yaml" % demos)
+    with open(path, "w") as f:
+        f.write("# config/tasks.yaml reduced by `pipeline.py --demos %d` (written by the pipeline)\n"
+                % demos)
+        yaml.safe_dump(tasks, f, default_flow_style=None, sort_keys=False)
+    return path
+
+
 def stage_datasets(out, args, report):
     data = os.path.join(out, "datasets")
     cmd = ["/usr/bin/python3", os.path.join(ROOT, "lfd_sim_bridge", "scripts", "generate_datasets.py"),
-           "--out", data, "--datasets", ",".join(args.datasets)]
+           "--out", data, "--datasets", ",".join(args.datasets),
+           "--tasks-file", reduced_tasks_file(out, args.demos)]
     with private_master() as env:
         rc = run(cmd, env)
     report["datasets"] = {n: {"demos": count_bags(os.path.join(data, n)), "path": os.path.join(data, n)}
@@ -112,11 +171,18 @@ def stage_datasets(out, args, report):
         raise RuntimeError("dataset generation failed (exit %d); see the table above" % rc)
 
 
+def require_bags(data, names):
+    if not os.path.isdir(data):
+        raise RuntimeError("no dataset folder %s: run the datasets stage first" % data)
+    missing = [n for n in names if count_bags(os.path.join(data, n)) == 0]
+    if missing:
+        raise RuntimeError("no bags for %s under %s: run the datasets stage first"
+                           % (",".join(missing), data))
+
+
 def stage_segment(out, args, report):
     data = os.path.join(out, "datasets")
-    missing = [n for n in args.datasets if count_bags(os.path.join(data, n)) == 0]
-    if missing:
-        raise RuntimeError("no bags for %s under %s: run the datasets stage first" % (",".join(missing), data))
+    require_bags(data, args.datasets)
     result = os.path.join(out, "segmentation.json")
     with private_master() as env:
         with background_launch(["roslaunch", "lfd_launch", "segment.launch"], env):
@@ -139,12 +205,212 @@ def stage_segment(out, args, report):
         raise RuntimeError("segmentation evaluation reported errors (exit %d)" % rc)
 
 
-STAGES = {"datasets": stage_datasets, "segment": stage_segment}
+def by_mode(datasets):
+    """{"sim": ["grasp", "push"], ...} from dataset names <mode>_<task>, in a stable order."""
+    modes = {}
+    for name in datasets:
+        mode, task = name.split("_", 1)
+        modes.setdefault(mode, []).append(task)
+    return modes
+
+
+def load_json(path):
+    with contextlib.suppress(OSError, ValueError):
+        with open(path) as f:
+            return json.load(f)
+    return None
+
+
+def learning_entry(task_result, library):
+    """report.json learning.<dataset> from one task of evaluate_reproduction.py --learn-only."""
+    lr = task_result.get("learning") or {}
+    entry = {"library": library if os.path.exists(library) else None,
+             "segments": task_result.get("segments") if os.path.exists(library) else 0,
+             "expected_segments": lr.get("expected_segments"),
+             "demos_used": lr.get("num_demos"), "bags": lr.get("bags"),
+             "changepoint_counts": lr.get("changepoint_counts", []),
+             "selected_features": lr.get("selected_features", []),
+             "changepoint_source": lr.get("changepoint_source"),
+             "warnings": lr.get("warnings", [])}
+    if task_result.get("error"):
+        entry["error"] = task_result["error"]
+    return entry
+
+
+def stage_learn(out, args, report):
+    data = os.path.join(out, "datasets")
+    require_bags(data, args.datasets)
+    skills = os.path.join(out, "skills")
+    os.makedirs(skills, exist_ok=True)
+    learning = report.setdefault("learning", {})
+    todo = {}
+    for mode, tasks in by_mode(args.datasets).items():
+        for task in tasks:
+            library = os.path.join(skills, "%s_%s.json" % (task, mode))
+            record = os.path.join(skills, "%s_%s.learning.json" % (task, mode))
+            done = load_json(record)
+            if not args.force and done is not None and os.path.exists(library):
+                say("learn %s_%s: library exists, kept (--force relearns)" % (mode, task))
+                learning["%s_%s" % (mode, task)] = done
+                continue
+            for stale in (library, record):  # never reproduce an old library after a failure
+                with contextlib.suppress(FileNotFoundError):
+                    os.remove(stale)
+            todo.setdefault(mode, []).append(task)
+    if not todo:
+        return "skipped"
+    with private_master() as env:
+        with background_launch(["roslaunch", "lfd_launch", "learn.launch", "output:=log"], env):
+            for mode, tasks in todo.items():
+                result = os.path.join(skills, "learning_%s.json" % mode)
+                with contextlib.suppress(FileNotFoundError):
+                    os.remove(result)
+                rc = run(["/usr/bin/python3", EVALUATE_REPRODUCTION, "--attach", "--learn-only",
+                          "--dataset", data, "--mode", mode, "--tasks", ",".join(tasks),
+                          "--library-dir", skills, "--library-name", "{task}_{mode}.json",
+                          "--out", result], env)
+                res = load_json(result)
+                if res is None:
+                    raise RuntimeError("learning %s produced no result (exit %d)" % (mode, rc))
+                for task in tasks:
+                    library = os.path.join(skills, "%s_%s.json" % (task, mode))
+                    tr = res["tasks"].get(task, {"error": "not reached (interrupted?)"})
+                    entry = learning_entry(tr, library)
+                    learning["%s_%s" % (mode, task)] = entry
+                    if tr.get("error") is None and os.path.exists(library):
+                        with open(os.path.join(skills, "%s_%s.learning.json" % (task, mode)), "w") as f:
+                            json.dump(entry, f, indent=1, sort_keys=True)
+    return None
+
+
+def goal_ids(task, mode, n):
+    with open(TASKS_FILE) as f:
+        unseen = yaml.safe_load(f)[task]["unseen"][mode]
+    return [e["id"] for e in spread(unseen, n)]
+
+
+def nan_to_none(v):
+    return None if v is None or v != v else v
+
+
+def reproduction_entry(task_result, result_path):
+    runs = task_result.get("runs", [])
+    entry = {"success_rate": task_result.get("success_rate"),
+             "successes": task_result.get("successes", 0), "goals_total": len(runs),
+             "execution_time_ratio": task_result.get("mean_time_ratio"),
+             "mean_object_position_error_m": nan_to_none(task_result.get("mean_object_position_error")),
+             "mean_tcp_position_error_m": task_result.get("mean_tcp_final_error"),
+             "segments": task_result.get("segments"), "library": task_result.get("library"),
+             "result": result_path,
+             "goals": [{"id": r["id"], "success": r["success"],
+                        "object_position_error_m": nan_to_none(r.get("object_position_error")),
+                        "object_yaw_error_rad": nan_to_none(r.get("object_yaw_error")),
+                        "tcp_position_error_m":
+                            r.get("tcp_final_position_error") if r["executed"] else None,
+                        "tcp_orientation_error_rad":
+                            r.get("tcp_final_orientation_error") if r["executed"] else None,
+                        "time_ratio": r.get("time_ratio"), "execution_time_s": r.get("execution_time"),
+                        "error": r.get("error", "")} for r in runs]}
+    if task_result.get("error"):
+        entry["error"] = task_result["error"]
+    errors = sorted({g["error"] for g in entry["goals"] if g["error"]})
+    if errors and not entry.get("error") and not entry["successes"]:
+        entry["error"] = "; ".join(errors)
+    return entry
+
+
+def reproduction_key(mode):
+    return "reproduction" if mode == "sim" else "reproduction_%s" % mode
+
+
+def stage_reproduce(out, args, report):
+    skills = os.path.join(out, "skills")
+    results = os.path.join(out, "reproduction")
+    os.makedirs(results, exist_ok=True)
+    todo = {}
+    for mode, tasks in by_mode(args.datasets).items():
+        section = report.setdefault(reproduction_key(mode), {})
+        for task in tasks:
+            library = os.path.join(skills, "%s_%s.json" % (task, mode))
+            path = os.path.join(results, "%s_%s.json" % (task, mode))
+            ids = goal_ids(task, mode, args.goals)
+            if not os.path.exists(library):
+                err = (report.get("learning", {}).get("%s_%s" % (mode, task), {}).get("error")
+                       or "no skill library %s: run the learn stage" % library)
+                section[task] = {"success_rate": None, "execution_time_ratio": None, "goals": [],
+                                 "error": "not reproduced: " + err}
+                say("reproduce %s_%s: %s" % (mode, task, section[task]["error"]))
+                continue
+            done = load_json(path)
+            runs = ((done or {}).get("tasks", {}).get(task) or {}).get("runs", [])
+            if (not args.force and done and done.get("complete") and [r["id"] for r in runs] == ids
+                    and os.path.getmtime(path) > os.path.getmtime(library)):
+                say("reproduce %s_%s: results newer than the library kept (--force reruns)"
+                    % (mode, task))
+                section[task] = reproduction_entry(done["tasks"][task], path)
+                continue
+            todo.setdefault(mode, []).append((task, ids))
+    if not todo:
+        return "skipped"
+    with private_master() as env:
+        with background_launch(["roslaunch", "lfd_launch", "reproduce.launch",
+                                "library_dir:=" + skills], env):
+            for mode, items in todo.items():
+                for task, ids in items:
+                    path = os.path.join(results, "%s_%s.json" % (task, mode))
+                    with contextlib.suppress(FileNotFoundError):
+                        os.remove(path)
+                    say("reproduce %s_%s: %d unseen goals %s" % (mode, task, len(ids), ids))
+                    try:
+                        rc = run(["/usr/bin/python3", EVALUATE_REPRODUCTION, "--attach", "--no-learn",
+                                  "--dataset", os.path.join(out, "datasets"), "--mode", mode,
+                                  "--tasks", task, "--goals", ",".join(map(str, ids)),
+                                  "--library-dir", skills, "--library-name", "{task}_{mode}.json",
+                                  "--out", path], env)
+                    except KeyboardInterrupt:  # report the goals done; a rerun redoes the task
+                        res = load_json(path)
+                        if res and task in res["tasks"]:
+                            entry = reproduction_entry(res["tasks"][task], path)
+                            entry["interrupted"] = True
+                            report[reproduction_key(mode)][task] = entry
+                        raise
+                    res = load_json(path)
+                    if res is None or task not in res["tasks"]:
+                        raise RuntimeError("reproduction %s_%s produced no result (exit %d)"
+                                           % (mode, task, rc))
+                    entry = reproduction_entry(res["tasks"][task], path)
+                    report[reproduction_key(mode)][task] = entry
+                    say("reproduce %s_%s: %d/%d goals reached, time ratio %s" % (
+                        mode, task, entry["successes"], len(ids),
+                        "-" if entry["execution_time_ratio"] is None
+                        else "%.2f" % entry["execution_time_ratio"]))
+    return None
+
+
+STAGES = {"datasets": stage_datasets, "segment": stage_segment, "learn": stage_learn,
+          "reproduce": stage_reproduce}
+
+
+def problems(report):
+    """Human-readable list of what did not work (learning errors, failed reproductions)."""
+    out = []
+    for name, e in sorted(report.get("learning", {}).items()):
+        if e.get("error"):
+            out.append("learn %s: %s" % (name, e["error"]))
+        elif e.get("expected_segments") and e.get("segments") != e["expected_segments"]:
+            out.append("learn %s: %s segment(s) learned, the task has %d (changepoints per demo %s)"
+                       % (name, e.get("segments"), e["expected_segments"], e.get("changepoint_counts")))
+    for key in ("reproduction", "reproduction_teleop"):
+        for task, e in sorted(report.get(key, {}).items()):
+            if e.get("error"):
+                out.append("%s %s: %s" % (key, task, e["error"]))
+            if e.get("interrupted"):
+                out.append("%s %s: interrupted after %d goal(s); rerun to complete"
+                           % (key, task, len(e.get("goals", []))))
+    return out
 
 
 def write_report(out, report):
-    with open(os.path.join(out, "report.json"), "w") as f:
-        json.dump(report, f, indent=1, sort_keys=True)
     lines = ["# lfd pipeline report", ""]
     if "datasets" in report:
         lines += ["## Datasets", "", "| dataset | demos |", "| --- | --- |"]
@@ -161,6 +427,51 @@ def write_report(out, report):
             lines.append("| %s | %s | %s |" % (name, " | ".join(cells), ", ".join(e["selected_features"])))
         tol = next(iter(report["segmentation"].values()))["tolerance_s"]
         lines += ["", "A changepoint counts when it lies within %.2f s of its ground-truth transition." % tol, ""]
+    if report.get("learning"):
+        lines += ["## Learning (skill libraries from the validated changepoints)", "",
+                  "| dataset | segments (task's) | demos used | changepoints per demo | warnings / error |",
+                  "| --- | --- | --- | --- | --- |"]
+        for name, e in sorted(report["learning"].items()):
+            notes = e.get("error") or ("%d warning(s)" % len(e["warnings"]) if e.get("warnings") else "")
+            lines.append("| %s | %s (%s) | %s | %s | %s |" % (
+                name, e.get("segments"), e.get("expected_segments"), e.get("demos_used"),
+                " ".join(str(c) for c in e.get("changepoint_counts", [])), notes))
+        lines.append("")
+    for key, title in (("reproduction", "sim"), ("reproduction_teleop", "teleop")):
+        if not report.get(key):
+            continue
+        lines += ["## Reproduction toward unseen goals (%s)" % title, "",
+                  "| task | success | time ratio | mean object error | mean TCP error | note |",
+                  "| --- | --- | --- | --- | --- | --- |"]
+        mm = lambda v: "-" if v is None else "%.1f mm" % (v * 1e3)  # noqa: E731
+        for task, e in sorted(report[key].items()):
+            goals = e.get("goals", [])
+            lines.append("| %s | %s | %s | %s | %s | %s |" % (
+                task, "%d/%d" % (sum(g["success"] for g in goals), len(goals)) if goals else "-",
+                "-" if e.get("execution_time_ratio") is None else "%.2f" % e["execution_time_ratio"],
+                mm(e.get("mean_object_position_error_m")), mm(e.get("mean_tcp_position_error_m")),
+                (e.get("error") or "").replace("|", "/")))
+        lines += ["", "Success: the stick ends lifted >= 10 cm within 3 cm of its goal; the box within "
+                  "3 cm of its target (config/evaluation.yaml). Time ratio: executed / mean "
+                  "demonstrated duration.", ""]
+        for task, e in sorted(report[key].items()):
+            if not e.get("goals"):
+                continue
+            lines += ["%s, per goal:" % task, "",
+                      "| goal | result | object error | yaw error | TCP error | time ratio |",
+                      "| --- | --- | --- | --- | --- | --- |"]
+            for g in e["goals"]:
+                lines.append("| %d | %s | %s | %s | %s | %s |" % (
+                    g["id"], "ok" if g["success"] else "FAILED", mm(g["object_position_error_m"]),
+                    "-" if g["object_yaw_error_rad"] is None else "%.3f rad" % g["object_yaw_error_rad"],
+                    mm(g["tcp_position_error_m"]),
+                    "-" if g["time_ratio"] is None else "%.2f" % g["time_ratio"]))
+            lines.append("")
+    report["problems"] = problems(report)
+    if report["problems"]:
+        lines += ["## Problems", ""] + ["- " + p for p in report["problems"]] + [""]
+    with open(os.path.join(out, "report.json"), "w") as f:
+        json.dump(report, f, indent=1, sort_keys=True)
     lines += ["## Timings", ""] + ["- %s: %.1f s" % (k, v) for k, v in sorted(report["timings"].items())]
     with open(os.path.join(out, "report.md"), "w") as f:
         f.write("\n".join(lines) + "\n")
@@ -171,8 +482,19 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--out", default=os.path.join(ROOT, "lfd_output"), help="report and data folder")
     ap.add_argument("--stages", default=",".join(STAGES), help="comma list of " + ",".join(STAGES))
-    ap.add_argument("--datasets", default=",".join(DATASETS), type=lambda s: [x for x in s.split(",") if x])
+    ap.add_argument("--datasets", default=",".join(DATASETS), type=lambda s: [x for x in s.split(",") if x],
+                    help="comma list of " + ",".join(DATASETS))
+    ap.add_argument("--demos", type=int, default=0,
+                    help="datasets stage: record N configurations per dataset (0 = all of tasks.yaml)")
+    ap.add_argument("--goals", type=int, default=0,
+                    help="reproduce stage: N unseen goals per task (0 = all of tasks.yaml)")
+    ap.add_argument("--force", action="store_true",
+                    help="learn and reproduce again even where results exist")
     args = ap.parse_args()
+    bad = [d for d in args.datasets if d not in DATASETS]
+    if bad:
+        say("error: unknown dataset(s) %s; known: %s" % (",".join(bad), ",".join(DATASETS)))
+        return 2
 
     out = os.path.abspath(args.out)
     try:
@@ -189,6 +511,7 @@ def main():
     if unknown:
         say("error: unknown stage(s) %s; known: %s" % (",".join(unknown), ",".join(STAGES)))
         return 2
+    stages = [s for s in STAGES if s in stages]  # always in data-flow order
 
     report_path = os.path.join(out, "report.json")
     report = {}
@@ -201,11 +524,15 @@ def main():
         for stage in stages:
             say("stage %s ..." % stage)
             start = time.time()
+            outcome = None
             try:
-                STAGES[stage](out, args, report)
+                outcome = STAGES[stage](out, args, report)
             except RuntimeError as exc:
                 say("error in stage %s: %s" % (stage, exc))
                 status = 1
+            if outcome == "skipped":  # everything was already there: keep the measured time
+                say("stage %s: nothing to do (--force redoes it)" % stage)
+                continue
             report["timings"]["%s_s" % stage] = round(time.time() - start, 2)
             say("stage %s took %.1f s" % (stage, report["timings"]["%s_s" % stage]))
             if status:
@@ -215,6 +542,8 @@ def main():
         status = 130
     report["timings"]["total_s"] = round(sum(v for k, v in report["timings"].items() if k != "total_s"), 2)
     print(write_report(out, report))
+    for p in report["problems"]:
+        say("problem: " + p)
     say("report: %s and %s" % (report_path, os.path.join(out, "report.md")))
     return status
 

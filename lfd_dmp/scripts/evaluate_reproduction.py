@@ -3,7 +3,9 @@
 simulated dataset, then reproduce every unseen goal of config/tasks.yaml in the MuJoCo sim.
 
   evaluate_reproduction.py --dataset DIR [--tasks grasp,push] [--changepoints segmentation|ground_truth]
-                           [--library-dir DIR] [--reuse-libraries] [--goals 100,101] [--out FILE.json]
+                           [--library-dir DIR] [--library-name '{task}.json'] [--reuse-libraries]
+                           [--learn-only | --no-learn] [--attach] [--mode sim|teleop]
+                           [--goals 100,101] [--out FILE.json]
 
 DIR holds <DIR>/sim_grasp/*.bag and <DIR>/sim_push/*.bag (lfd_sim_bridge/scripts/generate_datasets.py).
 Changepoints: `segmentation` (default) calls /segmentation/segment (lfd_segmentation's node) on the
@@ -16,7 +18,15 @@ other object parked), /executor/execute toward the goal, then the object's final
 grasp = stick >= 0.10 m above the table and within 0.03 m (3-D) of its goal; push = box within
 0.03 m (horizontal) of its target. Time ratio = executed time / mean demonstrated duration of the
 learned segments (same span). Starts its own roslaunch (reproduce.launch + learner
-[+ segmentation]) on a private master port. Writes JSON and prints a table.
+[+ segmentation]) on a private master port, or with --attach uses the nodes already running at
+ROS_MASTER_URI (launch/learn.launch for --learn-only, launch/reproduce.launch for --no-learn: the
+headless pipeline's stages). Writes JSON (also after an error or Ctrl-C, with what was done) and
+prints a table. A task whose learning fails is reported with its error; the other tasks still run.
+
+Segment names are given to the learner only when the segmentation yields the task's expected
+number of segments; otherwise the library's segments are named segment_<i> and the executor
+refuses it with a clear error (its goal rules need the expected segments). Boundaries are never
+made up.
 """
 import argparse
 import glob
@@ -90,45 +100,66 @@ def mean_demo_duration(library_path):
 
 
 class Session:
-    """A private roslaunch (reproduce.launch + learner [+ segmentation]) and a rospy node."""
+    """The ROS side: either a private roslaunch (reproduce.launch + learner [+ segmentation]) or,
+    with attach, the graph already running at ROS_MASTER_URI; and a rospy node."""
 
-    def __init__(self, library_dir, with_segmentation, log_path):
-        self.port = free_port()
-        os.environ["ROS_MASTER_URI"] = "http://localhost:%d" % self.port
-        launch = tempfile.NamedTemporaryFile("w", suffix=".launch", delete=False)
-        seg = ""
-        if with_segmentation:
-            seg = ('<node pkg="lfd_segmentation" type="segmentation_node" name="segmentation">'
-                   '<rosparam command="load" file="$(find lfd_config)/segmentation.yaml"/></node>')
-        launch.write('<launch><include file="$(find lfd_launch)/reproduce.launch">'
-                     '<arg name="library_dir" value="%s"/></include>'
-                     '<node pkg="lfd_dmp" type="learner_node" name="learner"/>%s</launch>'
-                     % (library_dir, seg))
-        launch.close()
-        self.log = open(log_path, "w")
-        self.proc = subprocess.Popen(["roslaunch", "-p", str(self.port), launch.name],
-                                     stdout=self.log, stderr=subprocess.STDOUT)
+    def __init__(self, library_dir, with_segmentation, log_path, attach=False, learning=True,
+                 executing=True):
+        self.proc = None
+        self.log = None
         import rosgraph
-        import rospy
-        self.rospy = rospy
+        if not attach:
+            self.port = free_port()
+            os.environ["ROS_MASTER_URI"] = "http://localhost:%d" % self.port
+            launch = tempfile.NamedTemporaryFile("w", suffix=".launch", delete=False)
+            seg = ""
+            if with_segmentation:
+                seg = ('<node pkg="lfd_segmentation" type="segmentation_node" name="segmentation">'
+                       '<rosparam command="load" file="$(find lfd_config)/segmentation.yaml"/></node>')
+            launch.write('<launch><include file="$(find lfd_launch)/reproduce.launch">'
+                         '<arg name="library_dir" value="%s"/></include>'
+                         '<node pkg="lfd_dmp" type="learner_node" name="learner"/>%s</launch>'
+                         % (library_dir, seg))
+            launch.close()
+            self.log = open(log_path, "w")
+            self.proc = subprocess.Popen(["roslaunch", "-p", str(self.port), launch.name],
+                                         stdout=self.log, stderr=subprocess.STDOUT)
         deadline = time.time() + 120
         while not rosgraph.is_master_online():  # roslaunch starts the master first
-            if time.time() > deadline or self.proc.poll() is not None:
-                raise RuntimeError("roslaunch did not start a master (see %s)" % log_path)
+            if time.time() > deadline or (self.proc and self.proc.poll() is not None):
+                raise RuntimeError("no ROS master at %s (see %s)"
+                                   % (os.environ.get("ROS_MASTER_URI"), log_path))
             time.sleep(0.5)
-        time.sleep(1.0)  # /use_sim_time is set once the launch file is loaded
-        rospy.init_node("evaluate_reproduction", anonymous=True)
+        if executing:  # rospy reads /use_sim_time once, at init: wait for the launch to set it
+            master = rosgraph.Master("/evaluate_reproduction_probe")
+            while not master.hasParam("/use_sim_time"):
+                if time.time() > deadline:
+                    raise RuntimeError("/use_sim_time never set: is the simulation launched?")
+                time.sleep(0.2)
+        time.sleep(1.0)
+        import rospy
+        self.rospy = rospy
+        # Ctrl-C must raise KeyboardInterrupt here (results so far are written, nothing more is
+        # judged), not just shut rospy down and turn the remaining goals into failed calls.
+        rospy.init_node("evaluate_reproduction", anonymous=True, disable_signals=True)
         from lfd_msgs.srv import ExecuteTask, LearnSkills, ResetSim, SetScene
-        services = {"/executor/execute": ExecuteTask, "/learner/learn": LearnSkills,
-                    "/bridge/reset": ResetSim, "/bridge/set_scene": SetScene}
-        if with_segmentation:
+        services = {}
+        if learning:
+            services["/learner/learn"] = LearnSkills
+        if executing:
+            services.update({"/executor/execute": ExecuteTask, "/bridge/reset": ResetSim,
+                             "/bridge/set_scene": SetScene})
+        if learning and with_segmentation:
             from lfd_msgs.srv import Segment
             services["/segmentation/segment"] = Segment
         self.srv = {}
         for name, typ in services.items():
-            rospy.wait_for_service(name, timeout=120)
+            try:
+                rospy.wait_for_service(name, timeout=120)
+            except rospy.ROSException:
+                raise RuntimeError("service %s did not come up within 120 s" % name)
             self.srv[name] = rospy.ServiceProxy(name, typ)
-        while rospy.Time.now().is_zero():
+        while executing and rospy.Time.now().is_zero():
             time.sleep(0.05)
 
     def sleep_sim(self, seconds):
@@ -142,20 +173,22 @@ class Session:
 
     def close(self):
         self.rospy.signal_shutdown("done")
-        self.proc.terminate()
-        try:
-            self.proc.wait(timeout=30)
-        except subprocess.TimeoutExpired:
-            self.proc.kill()
-        self.log.close()
+        if self.proc:
+            self.proc.terminate()
+            try:
+                self.proc.wait(timeout=30)
+            except subprocess.TimeoutExpired:
+                self.proc.kill()
+        if self.log:
+            self.log.close()
 
 
 def learn(session, task, bags, changepoints, library_path):
     from lfd_msgs.msg import DemoSegmentation
     from lfd_msgs.srv import LearnSkillsRequest
-    req = LearnSkillsRequest(task=task, output_path=library_path,
-                             segment_names=SEGMENT_NAMES[task])
-    report = {"changepoint_source": changepoints}
+    req = LearnSkillsRequest(task=task, output_path=library_path)
+    report = {"changepoint_source": changepoints, "bags": len(bags),
+              "expected_segments": len(SEGMENT_NAMES[task]), "warnings": []}
     if changepoints == "segmentation":
         seg = session.srv["/segmentation/segment"](bag_paths=bags)
         if not seg.success:
@@ -163,16 +196,30 @@ def learn(session, task, bags, changepoints, library_path):
         req.segmentations = seg.demos
         req.selected_features = seg.selected_features
         report["selected_features"] = list(seg.selected_features)
-        report["changepoint_counts"] = [len(d.changepoint_times) for d in seg.demos]
+        report["segmentation_time"] = seg.elapsed
     else:
         for b in bags:
             req.segmentations.append(DemoSegmentation(
                 source=b, changepoint_times=ground_truth_changepoints(b, task)))
+    counts = [len(d.changepoint_times) for d in req.segmentations]
+    report["changepoint_counts"] = counts
+    report["changepoint_times"] = [list(d.changepoint_times) for d in req.segmentations]
+    # The learner keeps the majority count (ties: fewer); name the segments only if it is the
+    # task's, so a 1-segment library of a 3-segment task is not called "approach".
+    majority = min(set(counts), key=lambda c: (-counts.count(c), c)) if counts else 0
+    if majority + 1 == len(SEGMENT_NAMES[task]):
+        req.segment_names = SEGMENT_NAMES[task]
+    else:
+        report["warnings"].append(
+            "segmentation gives %d segment(s) (majority of changepoint counts %s), the task has %d:"
+            " segments left unnamed; the executor will refuse this library"
+            % (majority + 1, counts, len(SEGMENT_NAMES[task])))
     res = session.srv["/learner/learn"](req)
     if not res.success:
         raise RuntimeError("learning %s failed: %s" % (task, res.error))
     report.update({"num_segments": res.num_segments, "num_demos": res.num_demos,
-                   "warnings": list(res.warnings)})
+                   "learn_time": res.elapsed})
+    report["warnings"] += list(res.warnings)
     return report
 
 
@@ -213,6 +260,24 @@ def reproduce(session, task, entry, tasks_cfg, library, tol, min_lift, duration_
     return out
 
 
+def summarize(task, learn_report, library, rows):
+    ok = [r for r in rows if r["success"]]
+    ex = [r for r in rows if r["executed"]]
+    mean = lambda xs: sum(xs) / len(xs) if xs else None  # noqa: E731
+    demo_mean, n_demos, n_segments = (mean_demo_duration(library) if os.path.exists(library)
+                                      else (None, 0, 0))
+    return {"learning": learn_report, "library": library, "demos": n_demos,
+            "segments": n_segments, "mean_demo_duration": demo_mean,
+            "goals": len(rows), "successes": len(ok),
+            "success_rate": len(ok) / len(rows) if rows else None,
+            "mean_object_position_error": mean([r["object_position_error"] for r in rows]),
+            "mean_object_yaw_error": mean([r["object_yaw_error"] for r in rows]),
+            "mean_tcp_final_error": mean([r["tcp_final_position_error"] for r in ex]),
+            "mean_time_ratio": mean([r["time_ratio"] for r in ex]),
+            "mean_overhead_ratio": mean([r["overhead_ratio"] for r in ex]),
+            "runs": rows}
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawTextHelpFormatter)
     ap.add_argument("--dataset", required=True)
@@ -220,14 +285,23 @@ def main():
     ap.add_argument("--changepoints", choices=["segmentation", "ground_truth"],
                     default="segmentation")
     ap.add_argument("--library-dir", default=None, help="default: <dataset>/skills_<changepoints>")
+    ap.add_argument("--library-name", default="{task}.json",
+                    help="library file name in --library-dir ({task}, {mode} are replaced)")
     ap.add_argument("--reuse-libraries", action="store_true", help="skip learning if present")
+    ap.add_argument("--learn-only", action="store_true", help="learn the libraries, reproduce nothing")
+    ap.add_argument("--no-learn", action="store_true",
+                    help="reproduce with the existing libraries (an error if one is missing)")
+    ap.add_argument("--attach", action="store_true",
+                    help="use the nodes running at ROS_MASTER_URI instead of starting roslaunch")
     ap.add_argument("--goals", default="", help="comma-separated unseen ids (default all)")
-    ap.add_argument("--mode", default="sim", help="unseen goal set of tasks.yaml (sim | teleop)")
+    ap.add_argument("--mode", default="sim", help="dataset and unseen goal set (sim | teleop)")
     ap.add_argument("--tolerance", type=float, default=0.03)
     ap.add_argument("--min-lift", type=float, default=0.10)
     ap.add_argument("--duration-scale", type=float, default=1.0)
     ap.add_argument("--out", default=None, help="default: <library-dir>/reproduction.json")
     args = ap.parse_args()
+    if args.learn_only and args.no_learn:
+        ap.error("--learn-only and --no-learn exclude each other")
 
     config_dir = rospkg.RosPack().get_path("lfd_config")
     with open(os.path.join(config_dir, "tasks.yaml")) as f:
@@ -235,7 +309,7 @@ def main():
     dataset = os.path.abspath(args.dataset)
     lib_dir = os.path.abspath(args.library_dir or os.path.join(dataset, "skills_" + args.changepoints))
     os.makedirs(lib_dir, exist_ok=True)
-    with_seg = args.changepoints == "segmentation"
+    with_seg = args.changepoints == "segmentation" and not args.no_learn
     if with_seg:
         try:
             rospkg.RosPack().get_path("lfd_segmentation")
@@ -244,55 +318,88 @@ def main():
                      "--changepoints ground_truth to use the demonstrator's phase boundaries "
                      "(reported as such).")
     tasks = [t for t in args.tasks.split(",") if t]
+    unknown = [t for t in tasks if t not in TASK_OBJECT]
+    if unknown:
+        ap.error("unknown task(s) %s (grasp | push)" % ",".join(unknown))
     wanted = {int(g) for g in args.goals.split(",") if g}
-    session = Session(lib_dir, with_seg, os.path.join(lib_dir, "evaluate_reproduction.log"))
+    out = args.out or os.path.join(lib_dir, "reproduction.json")
     results = {"changepoint_source": args.changepoints, "tolerance": args.tolerance,
-               "min_lift": args.min_lift, "dataset": dataset, "tasks": {}}
+               "min_lift": args.min_lift, "dataset": dataset, "mode": args.mode, "tasks": {},
+               "complete": False}
+    session = None
+    status = 0
     try:
+        session = Session(lib_dir, with_seg, os.path.join(lib_dir, "evaluate_reproduction.log"),
+                          attach=args.attach, learning=not args.no_learn,
+                          executing=not args.learn_only)
         for task in tasks:
-            bags = sorted(glob.glob(os.path.join(dataset, "%s_%s" % (args.mode, task), "*.bag")))
-            if not bags:
-                raise RuntimeError("no bags in %s/%s_%s" % (dataset, args.mode, task))
-            library = os.path.join(lib_dir, task + ".json")
+            library = os.path.join(lib_dir, args.library_name.format(task=task, mode=args.mode))
+            entry = results["tasks"][task] = summarize(task, {}, library, [])
             learn_report = {"reused": True}
-            if not (args.reuse_libraries and os.path.exists(library)):
-                learn_report = learn(session, task, bags, args.changepoints, library)
-            demo_mean, n_demos, n_segments = mean_demo_duration(library)
+            try:
+                if args.no_learn:
+                    if not os.path.exists(library):
+                        raise RuntimeError("no skill library %s: learn it first" % library)
+                elif not (args.reuse_libraries and os.path.exists(library)):
+                    bags = sorted(glob.glob(os.path.join(dataset, "%s_%s" % (args.mode, task),
+                                                         "*.bag")))
+                    if not bags:
+                        raise RuntimeError("no bags in %s/%s_%s" % (dataset, args.mode, task))
+                    learn_report = learn(session, task, bags, args.changepoints, library)
+                    for w in learn_report["warnings"]:
+                        print("%-5s learn: warning: %s" % (task, w), flush=True)
+                    print("%-5s learn: %d segment(s) x %d demo(s), changepoints per demo %s -> %s"
+                          % (task, learn_report["num_segments"], learn_report["num_demos"],
+                             learn_report["changepoint_counts"], library), flush=True)
+            except RuntimeError as exc:
+                print("%-5s: ERROR %s" % (task, exc), flush=True)
+                entry.update({"error": str(exc), "learning": learn_report})
+                status = 1
+                continue
+            entry.update(summarize(task, learn_report, library, []))
+            if args.learn_only:
+                continue
+            demo_mean = entry["mean_demo_duration"]
             goals = [e for e in tasks_cfg[task]["unseen"][args.mode]
                      if not wanted or e["id"] in wanted]
             rows = []
-            for entry in goals:
-                r = reproduce(session, task, entry, tasks_cfg, library, args.tolerance,
-                              args.min_lift, args.duration_scale)
+            for n, goal_entry in enumerate(goals, 1):
+                try:
+                    r = reproduce(session, task, goal_entry, tasks_cfg, library, args.tolerance,
+                                  args.min_lift, args.duration_scale)
+                except (RuntimeError, session.rospy.ServiceException) as exc:
+                    if session.rospy.is_shutdown():
+                        raise
+                    # The bridge (or executor) failed on this goal: record it, try the next.
+                    r = {"id": goal_entry["id"], "executed": False, "success": False,
+                         "error": str(exc), "warnings": [], "execution_time": 0.0,
+                         "planned_duration": 0.0, "segment_durations": [],
+                         "tcp_final_position_error": None, "tcp_final_orientation_error": None,
+                         "planning_time": None, "object_position_error": float("nan"),
+                         "object_height": float("nan"), "object_yaw_error": float("nan")}
                 r["time_ratio"] = r["execution_time"] / demo_mean if r["executed"] else None
                 r["overhead_ratio"] = (r["execution_time"] / r["planned_duration"]
                                        if r["executed"] and r["planned_duration"] > 0 else None)
                 rows.append(r)
-                print("%-5s goal %3d: %-7s obj err %5.1f mm  h %5.1f cm  yaw err %.3f  time %.2f s "
-                      "(x%.2f) %s" % (task, r["id"], "OK" if r["success"] else "FAILED",
-                                      r["object_position_error"] * 1e3, r["object_height"] * 100,
-                                      r["object_yaw_error"], r["execution_time"],
-                                      r["time_ratio"] or 0.0, r["error"]), flush=True)
-            ok = [r for r in rows if r["success"]]
-            ex = [r for r in rows if r["executed"]]
-            mean = lambda xs: sum(xs) / len(xs) if xs else None  # noqa: E731
-            results["tasks"][task] = {
-                "learning": learn_report, "library": library, "demos": n_demos,
-                "segments": n_segments, "mean_demo_duration": demo_mean,
-                "goals": len(rows), "successes": len(ok),
-                "success_rate": len(ok) / len(rows) if rows else None,
-                "mean_object_position_error": mean([r["object_position_error"] for r in rows]),
-                "mean_object_yaw_error": mean([r["object_yaw_error"] for r in rows]),
-                "mean_tcp_final_error": mean([r["tcp_final_position_error"] for r in ex]),
-                "mean_time_ratio": mean([r["time_ratio"] for r in ex]),
-                "mean_overhead_ratio": mean([r["overhead_ratio"] for r in ex]),
-                "runs": rows}
+                entry.update(summarize(task, learn_report, library, rows))
+                print("%-5s goal %3d (%d/%d): %-7s obj err %5.1f mm  h %5.1f cm  yaw err %.3f  "
+                      "time %.2f s (x%.2f) %s" % (
+                          task, r["id"], n, len(goals), "OK" if r["success"] else "FAILED",
+                          r["object_position_error"] * 1e3, r["object_height"] * 100,
+                          r["object_yaw_error"], r["execution_time"], r["time_ratio"] or 0.0,
+                          r["error"]), flush=True)
+            if not rows or entry["successes"] < len(rows):
+                status = status or 1
+        results["complete"] = True
     finally:
-        session.close()
-        out = args.out or os.path.join(lib_dir, "reproduction.json")
+        if session:
+            session.close()
         with open(out, "w") as f:
             json.dump(results, f, indent=2)
 
+    if args.learn_only:
+        print("JSON: %s" % out)
+        return status
     print("\nReproduction on unseen goals (changepoints: %s%s), tolerance %.0f mm"
           % (args.changepoints, " -- GROUND TRUTH phase boundaries, not segmentation"
              if args.changepoints == "ground_truth" else "", args.tolerance * 1e3))
@@ -307,9 +414,12 @@ def main():
             fmt(r["mean_tcp_final_error"], 1e3), fmt(r["mean_time_ratio"]),
             fmt(r["mean_overhead_ratio"])))
     print("JSON: %s" % out)
-    all_ok = all(r["successes"] == r["goals"] for r in results["tasks"].values())
-    return 0 if all_ok else 1
+    return status
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    try:
+        sys.exit(main())
+    except KeyboardInterrupt:
+        print("interrupted: the results so far are written (\"complete\": false)", file=sys.stderr)
+        sys.exit(130)
