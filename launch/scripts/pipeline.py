@@ -13,6 +13,10 @@ its own (so one stage's /use_sim_time never leaks into the next):
              config/tasks.yaml (`unseen.<mode>`) in MuJoCo through /executor/execute and judge the
              object's final pose with config/evaluation.yaml `reproduction`
              (lfd_dmp/scripts/evaluate_reproduction.py) -> DIR/reproduction/<task>_<mode>.json
+  figures    no master: the paper's figures per dataset (skill map, correlation matrix, relevance
+             histograms, ClaSP profile with the Kaiser filter, segmentation with its zones; from
+             the first demonstration), the success-rate bars per method and dataset, and MuJoCo
+             snapshots (OSMesa) of the first demonstration at the end of each phase -> DIR/figures
 
 Writes DIR/report.json and DIR/report.md, and prints the time of each stage. Stable report.json keys:
   datasets.<dataset>.demos
@@ -25,6 +29,7 @@ Writes DIR/report.json and DIR/report.md, and prints the time of each stage. Sta
                                          object_yaw_error_rad, tcp_position_error_m,
                                          tcp_orientation_error_rad, time_ratio, error
   reproduction_teleop.<task>.*           the same for the teleop library on the teleop goals
+  figures.<dataset|success_rates>        PNG paths relative to DIR
   timings.<stage>_s                      wall time of the stage's last run (datasets_s, segment_s,
                                          learn_s, reproduce_s; total_s their sum; a stage with
                                          nothing to redo keeps its previous time)
@@ -387,8 +392,45 @@ def stage_reproduce(out, args, report):
     return None
 
 
+def run_quiet(cmd, env=None):
+    """Runs a figure tool; returns its stdout lines (PNG paths) or raises with its last words."""
+    proc = subprocess.run(cmd, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                          universal_newlines=True)
+    if proc.returncode != 0:
+        last = (proc.stderr.strip().splitlines() or ["no message"])[-1]
+        raise RuntimeError("%s failed (exit %d): %s" % (" ".join(cmd[:3]), proc.returncode, last))
+    return [line.split()[-1] for line in proc.stdout.splitlines() if line.strip().endswith(".png")]
+
+
+def stage_figures(out, args, report):
+    """The paper's figures per dataset (Fig. 3, 4, 5, 7, 8), the success bars (Fig. 9) and MuJoCo
+    snapshots of the first demonstration of each dataset at the end of each of its phases."""
+    data, figs = os.path.join(out, "datasets"), os.path.join(out, "figures")
+    require_bags(data, args.datasets)
+    os.makedirs(figs, exist_ok=True)
+    plot = os.path.join(ROOT, "lfd_segmentation", "scripts", "plot_segmentation.py")
+    made = {}
+    for name in args.datasets:
+        say("figures %s ..." % name)
+        made[name] = run_quiet(["/usr/bin/python3", plot, "--dataset", os.path.join(data, name),
+                                "--config", os.path.join(ROOT, "config", "segmentation.yaml"),
+                                "--out", figs, "--prefix", name + "_", "--demo", "0"])
+        bags = sorted(b for b in os.listdir(os.path.join(data, name)) if b.endswith(".bag"))
+        snap_dir = os.path.join(figs, "snapshots", name)
+        with contextlib.suppress(RuntimeError):  # snapshots need OSMesa; the plots do not
+            made[name] += run_quiet(["rosrun", "lfd_sim_bridge", "snapshot", "--bag",
+                                     os.path.join(data, name, bags[0]), "--out", snap_dir])
+            made[name] += sorted(os.path.join(snap_dir, f) for f in os.listdir(snap_dir)
+                                 if f.endswith(".png") and os.path.join(snap_dir, f) not in made[name])
+    write_report(out, report)  # the bars read this run's rates from report.json
+    if report.get("segmentation"):
+        made["success_rates"] = run_quiet(["/usr/bin/python3", plot, "--report",
+                                           os.path.join(out, "report.json"), "--out", figs])
+    report["figures"] = {k: [os.path.relpath(p, out) for p in v] for k, v in made.items()}
+
+
 STAGES = {"datasets": stage_datasets, "segment": stage_segment, "learn": stage_learn,
-          "reproduce": stage_reproduce}
+          "reproduce": stage_reproduce, "figures": stage_figures}
 
 
 def problems(report):
@@ -467,6 +509,10 @@ def write_report(out, report):
                     mm(g["tcp_position_error_m"]),
                     "-" if g["time_ratio"] is None else "%.2f" % g["time_ratio"]))
             lines.append("")
+    if report.get("figures"):
+        lines += ["## Figures", ""]
+        for name, paths in sorted(report["figures"].items()):
+            lines += ["### %s" % name, ""] + ["![%s](%s)" % (os.path.basename(p), p) for p in paths] + [""]
     report["problems"] = problems(report)
     if report["problems"]:
         lines += ["## Problems", ""] + ["- " + p for p in report["problems"]] + [""]

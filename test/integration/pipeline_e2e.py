@@ -56,13 +56,25 @@ class PipelineE2E(unittest.TestCase):
 
     def test_1_every_stage_ran(self):
         self.assertEqual(self.status, 0, self.log[-3000:])
-        for stage in ("datasets", "segment", "learn", "reproduce"):
+        for stage in ("datasets", "segment", "learn", "reproduce", "figures"):
             self.assertGreater(self.report["timings"].get(stage + "_s", 0), 0, stage)
         self.assertEqual(self.report["datasets"]["sim_grasp"]["demos"], DEMOS)
         with open(os.path.join(self.out, "report.md")) as f:
             md = f.read()
         self.assertIn("## Reproduction toward unseen goals (sim)", md)
         self.assertIn("## Learning", md)
+
+    def test_1b_figures_and_snapshots(self):
+        figures = self.report.get("figures", {})
+        names = [os.path.basename(p) for p in figures.get("sim_grasp", [])]
+        for kind in ("skill_map", "correlation_best", "relevance", "clasp_profile", "segmentation"):
+            self.assertTrue(any(kind in n for n in names), "%s missing in %s" % (kind, names))
+        snapshots = [n for n in names if n.startswith("snapshot_")]
+        self.assertGreaterEqual(len(snapshots), 3, names)  # end of approach, grasp, move
+        self.assertEqual(len(figures.get("success_rates", [])), 1)
+        for rel in figures["sim_grasp"] + figures["success_rates"]:
+            path = os.path.join(self.out, rel)
+            self.assertGreater(os.path.getsize(path), 10000, path)  # a real picture, not an empty file
 
     def test_2_segmentation(self):
         rate = self.report["segmentation"]["sim_grasp"]["success_rate"]
