@@ -16,7 +16,9 @@ its own (so one stage's /use_sim_time never leaks into the next):
   figures    no master: the paper's figures per dataset (skill map, correlation matrix, relevance
              histograms, ClaSP profile with the Kaiser filter, segmentation with its zones; from
              the first demonstration), the success-rate bars per method and dataset, and MuJoCo
-             snapshots (OSMesa) of the first demonstration at the end of each phase -> DIR/figures
+             snapshots (OSMesa) of the first demonstration at the end of each phase and of the
+             first reproduction of each task (recorded by the reproduce stage) at the end of each
+             segment -> DIR/figures
 
 Writes DIR/report.json and DIR/report.md, and prints the time of each stage. Stable report.json keys:
   datasets.<dataset>.demos
@@ -46,6 +48,7 @@ later stages use the bags present), `--goals N` reproduces N unseen goals per ta
 """
 import argparse
 import contextlib
+import glob
 import json
 import os
 import signal
@@ -371,7 +374,7 @@ def stage_reproduce(out, args, report):
                                   "--dataset", os.path.join(out, "datasets"), "--mode", mode,
                                   "--tasks", task, "--goals", ",".join(map(str, ids)),
                                   "--library-dir", skills, "--library-name", "{task}_{mode}.json",
-                                  "--out", path], env)
+                                  "--record-dir", results, "--out", path], env)
                     except KeyboardInterrupt:  # report the goals done; a rerun redoes the task
                         res = load_json(path)
                         if res and task in res["tasks"]:
@@ -422,6 +425,18 @@ def stage_figures(out, args, report):
                                      os.path.join(data, name, bags[0]), "--out", snap_dir])
             made[name] += sorted(os.path.join(snap_dir, f) for f in os.listdir(snap_dir)
                                  if f.endswith(".png") and os.path.join(snap_dir, f) not in made[name])
+    # The first reproduction of each task was recorded: snapshots at the end of each segment.
+    for result in sorted(glob.glob(os.path.join(out, "reproduction", "*_*.json"))):
+        for task, entry in (load_json(result) or {}).get("tasks", {}).items():
+            for run in entry.get("runs", []):
+                if not (run.get("bag") and run.get("segment_end_times")):
+                    continue
+                key = "reproduction_" + os.path.basename(result)[:-len(".json")]
+                snap_dir = os.path.join(figs, "snapshots", key)
+                times = ",".join("%.3f" % t for t in run["segment_end_times"])
+                with contextlib.suppress(RuntimeError, OSError):
+                    made[key] = run_quiet(["rosrun", "lfd_sim_bridge", "snapshot", "--bag",
+                                           run["bag"], "--times", times, "--out", snap_dir])
     write_report(out, report)  # the bars read this run's rates from report.json
     if report.get("segmentation"):
         made["success_rates"] = run_quiet(["/usr/bin/python3", plot, "--report",

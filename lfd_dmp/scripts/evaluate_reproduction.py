@@ -223,7 +223,35 @@ def learn(session, task, bags, changepoints, library_path):
     return report
 
 
-def reproduce(session, task, entry, tasks_cfg, library, tol, min_lift, duration_scale):
+RECORDED_TOPICS = ["/joint_states", "/ee_pose", "/gripper/state", "/objects/stick/pose",
+                   "/objects/box/pose", "/executor/planned_path", "/executor/executed_path",
+                   "/executor/segment_markers"]
+
+
+class BagRecording(object):
+    """`rosbag record` of one reproduction (for snapshots and rviz replay); stopped by SIGINT so
+    the bag is closed properly."""
+
+    def __init__(self, path):
+        self.path = path
+        self.proc = subprocess.Popen(["rosbag", "record", "-q", "-O", path] + RECORDED_TOPICS,
+                                     stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+                                     start_new_session=True)
+        time.sleep(1.5)  # wall time for rosbag to subscribe before anything moves
+
+    def stop(self):
+        import signal
+        try:
+            os.killpg(self.proc.pid, signal.SIGINT)
+            self.proc.wait(timeout=20)
+        except (ProcessLookupError, subprocess.TimeoutExpired):
+            os.killpg(self.proc.pid, signal.SIGKILL)
+            self.proc.wait()
+        return self.path if os.path.exists(self.path) else None
+
+
+def reproduce(session, task, entry, tasks_cfg, library, tol, min_lift, duration_scale,
+              record_path=None):
     obj = TASK_OBJECT[task]
     other = [o for o in TASK_OBJECT.values() if o != obj][0]
     start = entry["stick"] if task == "grasp" else entry["box"]
@@ -236,9 +264,15 @@ def reproduce(session, task, entry, tasks_cfg, library, tol, min_lift, duration_
     if not s.success:
         raise RuntimeError("set_scene failed: " + s.message)
     session.sleep_sim(0.3)
-    res = session.srv["/executor/execute"](library=library, object_pose=pose_of(start),
-                                           goal=pose_of(goal), duration_scale=duration_scale,
-                                           dry_run=False)
+    recording = BagRecording(record_path) if record_path else None
+    started = session.rospy.get_time()
+    try:
+        res = session.srv["/executor/execute"](library=library, object_pose=pose_of(start),
+                                               goal=pose_of(goal), duration_scale=duration_scale,
+                                               dry_run=False)
+        session.sleep_sim(1.0)  # objects come to rest
+    finally:
+        bag = recording.stop() if recording else None
     out = {"id": entry["id"], "executed": res.success, "error": res.error,
            "warnings": list(res.warnings), "execution_time": res.execution_time,
            "planned_duration": res.planned_duration,
@@ -246,7 +280,13 @@ def reproduce(session, task, entry, tasks_cfg, library, tol, min_lift, duration_
            "tcp_final_position_error": res.final_position_error,
            "tcp_final_orientation_error": res.final_orientation_error,
            "planning_time": res.planning_time}
-    session.sleep_sim(1.0)  # objects come to rest
+    if bag:
+        # Sim times at which each segment's streaming ended (snapshots at the end of each segment).
+        ends, t = [], started + max(0.0, res.execution_time - sum(res.segment_durations))
+        for d in res.segment_durations:
+            t += d
+            ends.append(t)
+        out.update({"bag": bag, "segment_end_times": ends})
     p = session.object_pose(obj)
     table_top = tasks_cfg["table_top"]
     d = [p.position.x - goal[0], p.position.y - goal[1], p.position.z - goal[2]]
@@ -298,6 +338,8 @@ def main():
     ap.add_argument("--tolerance", type=float, default=0.03)
     ap.add_argument("--min-lift", type=float, default=0.10)
     ap.add_argument("--duration-scale", type=float, default=1.0)
+    ap.add_argument("--record-dir", default=None,
+                    help="record the first goal of each task into a bag there (snapshots, rviz)")
     ap.add_argument("--out", default=None, help="default: <library-dir>/reproduction.json")
     args = ap.parse_args()
     if args.learn_only and args.no_learn:
@@ -365,8 +407,11 @@ def main():
             rows = []
             for n, goal_entry in enumerate(goals, 1):
                 try:
+                    record = (os.path.join(args.record_dir, "%s_%s_%d.bag"
+                                           % (task, args.mode, goal_entry["id"]))
+                              if args.record_dir and n == 1 else None)
                     r = reproduce(session, task, goal_entry, tasks_cfg, library, args.tolerance,
-                                  args.min_lift, args.duration_scale)
+                                  args.min_lift, args.duration_scale, record)
                 except (RuntimeError, session.rospy.ServiceException) as exc:
                     if session.rospy.is_shutdown():
                         raise
