@@ -31,6 +31,7 @@ Writes DIR/report.json and DIR/report.md, and prints the time of each stage. Sta
                                          object_yaw_error_rad, tcp_position_error_m,
                                          tcp_orientation_error_rad, time_ratio, error
   reproduction_teleop.<task>.*           the same for the teleop library on the teleop goals
+                                         (with --reproduce-modes sim,teleop; default sim only)
   figures.<dataset|success_rates>        PNG paths relative to DIR
   timings.<stage>_s                      wall time of the stage's last run (datasets_s, segment_s,
                                          learn_s, reproduce_s; total_s their sum; a stage with
@@ -337,6 +338,8 @@ def stage_reproduce(out, args, report):
     os.makedirs(results, exist_ok=True)
     todo = {}
     for mode, tasks in by_mode(args.datasets).items():
+        if mode not in args.reproduce_modes:
+            continue
         section = report.setdefault(reproduction_key(mode), {})
         for task in tasks:
             library = os.path.join(skills, "%s_%s.json" % (task, mode))
@@ -549,9 +552,13 @@ def main():
                     help="datasets stage: record N configurations per dataset (0 = all of tasks.yaml)")
     ap.add_argument("--goals", type=int, default=0,
                     help="reproduce stage: N unseen goals per task (0 = all of tasks.yaml)")
+    ap.add_argument("--reproduce-modes", default="sim", type=lambda s: [x for x in s.split(",") if x],
+                    help="reproduce stage: libraries of these modes (sim, teleop); the paper "
+                         "reproduces the simulated tasks; teleop adds ~3.5 min")
     ap.add_argument("--force", action="store_true",
                     help="learn and reproduce again even where results exist")
-    args = ap.parse_args()
+    # roslaunch (launch/pipeline.launch) appends __name:= / __log:= remappings: not ours.
+    args = ap.parse_args([a for a in sys.argv[1:] if not a.startswith("__")])
     bad = [d for d in args.datasets if d not in DATASETS]
     if bad:
         say("error: unknown dataset(s) %s; known: %s" % (",".join(bad), ",".join(DATASETS)))
