@@ -11,12 +11,14 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <set>
 #include <string>
 #include <vector>
 
 #include <lfd_msgs/StartRecording.h>
 #include <lfd_msgs/StopRecording.h>
 #include <ros/callback_queue.h>
+#include <ros/master.h>
 #include <ros/ros.h>
 #include <rosgraph_msgs/Clock.h>
 #include <topic_tools/shape_shifter.h>
@@ -66,6 +68,7 @@ class Recorder {
     topics_ = loadTopics(pnh);
     const int queue_size = pnh.param("queue_size", 100000);
     settle_timeout_ = pnh.param("settle_timeout", 1.0);
+    connect_timeout_ = pnh.param("connect_timeout", 5.0);
     for (const TopicSpec& spec : topics_) {
       ros::SubscribeOptions opts;
       // Full callback type: the connection header (latching, callerid) comes with each message.
@@ -78,6 +81,8 @@ class Recorder {
       opts.transport_hints = ros::TransportHints().tcpNoDelay();
       subscribers_.push_back(nh.subscribe(opts));
     }
+    // The services appear only once the subscriptions are connected: clients wait for them.
+    waitForConnections();
     // Services run on their own thread so /recorder/stop can wait for in-flight messages while the
     // main thread keeps writing them.
     service_nh_.setCallbackQueue(&service_queue_);
@@ -128,6 +133,31 @@ class Recorder {
       }
     }
     settled_.notify_all();
+  }
+
+  // A subscription may still be connecting when the first demo starts (seen on a loaded CI
+  // machine: /wrist_ft joined 4 s of sim time late). Wait, in wall time and bounded, until every
+  // topic that the master knows a publisher of is connected. Topics nobody publishes yet (e.g.
+  // the demonstrator's /lfd/phase when the recorder starts first) are not waited for.
+  void waitForConnections() {
+    ros::master::V_TopicInfo advertised;
+    if (!ros::master::getTopics(advertised)) return;
+    std::set<std::string> published;
+    for (const ros::master::TopicInfo& t : advertised) published.insert(t.name);
+    const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(connect_timeout_);
+    std::vector<std::string> missing;
+    do {
+      missing.clear();
+      for (std::size_t i = 0; i < subscribers_.size(); ++i)
+        if (published.count(subscribers_[i].getTopic()) && subscribers_[i].getNumPublishers() == 0)
+          missing.push_back(topics_[i].name);
+      if (missing.empty()) return;
+      ros::WallDuration(0.01).sleep();
+    } while (ros::WallTime::now() < deadline && ros::ok());
+    std::string names;
+    for (const std::string& m : missing) names += " " + m;
+    ROS_WARN("recorder: no publisher connected after %.1f s on:%s (going on)", connect_timeout_,
+             names.c_str());
   }
 
   bool onStart(lfd_msgs::StartRecording::Request& req, lfd_msgs::StartRecording::Response& res) {
@@ -237,6 +267,7 @@ class Recorder {
   std::vector<TopicSpec> topics_;
   double settle_timeout_ = 1.0;
   std::vector<ros::Subscriber> subscribers_;
+  double connect_timeout_ = 5.0;  // s of wall time, at start-up
   ros::NodeHandle service_nh_;
   ros::CallbackQueue service_queue_;
   std::unique_ptr<ros::AsyncSpinner> service_spinner_;
