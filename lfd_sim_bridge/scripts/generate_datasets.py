@@ -78,7 +78,30 @@ class Master:
                 self.proc.wait()
 
 
+def demo_errors(out):
+    """{configuration: error} of the demos the demonstrator could not record (its summary)."""
+    errors = {}
+    for summary in glob.glob(os.path.join(out, "demonstrator_summary_*.yaml")):
+        with open(summary) as f:
+            for demo in (yaml.safe_load(f) or {}).get("demos", []):
+                if demo.get("error"):
+                    errors[demo["configuration"]] = demo["error"]
+    return errors
+
+
 def generate(name, out_root, args, log_dir):
+    """Records the missing demos of one dataset; a demo that fails is tried once more (a fresh
+    scene), as a demonstrator redoes a botched demonstration."""
+    elapsed = 0.0
+    for attempt in (1, 2):
+        done, took = record_missing(name, out_root, args, log_dir, attempt)
+        elapsed += took
+        if done:
+            break
+    return elapsed
+
+
+def record_missing(name, out_root, args, log_dir, attempt):
     mode, task = name.split("_")
     out = os.path.join(out_root, name)
     ids = configurations(args.tasks_file, task, mode)
@@ -87,14 +110,20 @@ def generate(name, out_root, args, log_dir):
         os.remove(stale)  # an interrupted demo: recorded again below
     missing = [i for i in ids if not os.path.exists(bag_name(out, task, mode, i))]
     if not missing:
-        print("[datasets] %s: complete (%d bags), skipped" % (name, len(ids)), flush=True)
-        return 0.0
+        if attempt == 1:
+            print("[datasets] %s: complete (%d bags), skipped" % (name, len(ids)), flush=True)
+        return True, 0.0
+    if attempt > 1:
+        errors = demo_errors(out)
+        for i in missing:
+            print("[datasets] %s: configuration %d was not recorded (%s); trying again"
+                  % (name, i, errors.get(i, "no error reported")), flush=True)
     print("[datasets] %s: recording %d of %d demos" % (name, len(missing), len(ids)), flush=True)
     cmd = ["roslaunch", "lfd_launch", "demonstrate.launch", "task:=" + task, "mode:=" + mode,
            "output_dir:=" + out, "seed:=%d" % args.seed, "tasks_file:=" + args.tasks_file,
            "configurations:=[%s]" % ",".join(str(i) for i in missing)]
     start = time.time()
-    with open(os.path.join(log_dir, name + ".log"), "w") as log:
+    with open(os.path.join(log_dir, name + ".log"), "w" if attempt == 1 else "a") as log:
         try:
             subprocess.run(cmd, stdout=log, stderr=subprocess.STDOUT, timeout=args.timeout,
                            check=False)
@@ -103,7 +132,7 @@ def generate(name, out_root, args, log_dir):
                   file=sys.stderr)
     elapsed = time.time() - start
     print("[datasets] %s: %.1f s wall" % (name, elapsed), flush=True)
-    return elapsed
+    return False, elapsed
 
 
 def summarize(out_root, names, args):
