@@ -413,6 +413,7 @@ def stage_figures(out, args, report):
     snapshots of the first demonstration of each dataset at the end of each of its phases."""
     data, figs = os.path.join(out, "datasets"), os.path.join(out, "figures")
     require_bags(data, args.datasets)
+    report["figure_problems"] = []  # this run's
     os.makedirs(figs, exist_ok=True)
     plot = os.path.join(ROOT, "lfd_segmentation", "scripts", "plot_segmentation.py")
     made = {}
@@ -423,11 +424,13 @@ def stage_figures(out, args, report):
                                 "--out", figs, "--prefix", name + "_", "--demo", "0"])
         bags = sorted(b for b in os.listdir(os.path.join(data, name)) if b.endswith(".bag"))
         snap_dir = os.path.join(figs, "snapshots", name)
-        with contextlib.suppress(RuntimeError):  # snapshots need OSMesa; the plots do not
+        try:  # snapshots need OSMesa; the plots do not
             made[name] += run_quiet(["rosrun", "lfd_sim_bridge", "snapshot", "--bag",
                                      os.path.join(data, name, bags[0]), "--out", snap_dir])
             made[name] += sorted(os.path.join(snap_dir, f) for f in os.listdir(snap_dir)
                                  if f.endswith(".png") and os.path.join(snap_dir, f) not in made[name])
+        except (RuntimeError, OSError) as exc:
+            report.setdefault("figure_problems", []).append("%s snapshots: %s" % (name, exc))
     # The first reproduction of each task was recorded: snapshots at the end of each segment.
     for result in sorted(glob.glob(os.path.join(out, "reproduction", "*_*.json"))):
         for task, entry in (load_json(result) or {}).get("tasks", {}).items():
@@ -437,14 +440,18 @@ def stage_figures(out, args, report):
                 key = "reproduction_" + os.path.basename(result)[:-len(".json")]
                 snap_dir = os.path.join(figs, "snapshots", key)
                 times = ",".join("%.3f" % t for t in run["segment_end_times"])
-                with contextlib.suppress(RuntimeError, OSError):
+                try:
                     made[key] = run_quiet(["rosrun", "lfd_sim_bridge", "snapshot", "--bag",
                                            run["bag"], "--times", times, "--out", snap_dir])
+                except (RuntimeError, OSError) as exc:
+                    report.setdefault("figure_problems", []).append("%s: %s" % (key, exc))
     write_report(out, report)  # the bars read this run's rates from report.json
     if report.get("segmentation"):
         made["success_rates"] = run_quiet(["/usr/bin/python3", plot, "--report",
                                            os.path.join(out, "report.json"), "--out", figs])
     report["figures"] = {k: [os.path.relpath(p, out) for p in v] for k, v in made.items()}
+    for problem in report.get("figure_problems", []):
+        say("figures: " + problem)
 
 
 STAGES = {"datasets": stage_datasets, "segment": stage_segment, "learn": stage_learn,
@@ -531,7 +538,7 @@ def write_report(out, report):
         lines += ["## Figures", ""]
         for name, paths in sorted(report["figures"].items()):
             lines += ["### %s" % name, ""] + ["![%s](%s)" % (os.path.basename(p), p) for p in paths] + [""]
-    report["problems"] = problems(report)
+    report["problems"] = problems(report) + report.get("figure_problems", [])
     if report["problems"]:
         lines += ["## Problems", ""] + ["- " + p for p in report["problems"]] + [""]
     with open(os.path.join(out, "report.json"), "w") as f:

@@ -82,7 +82,7 @@ class Recorder {
       subscribers_.push_back(nh.subscribe(opts));
     }
     // The services appear only once the subscriptions are connected: clients wait for them.
-    waitForConnections();
+    waitForConnections(connect_timeout_);
     // Services run on their own thread so /recorder/stop can wait for in-flight messages while the
     // main thread keeps writing them.
     service_nh_.setCallbackQueue(&service_queue_);
@@ -139,14 +139,18 @@ class Recorder {
   // machine: /wrist_ft joined 4 s of sim time late). Wait, in wall time and bounded, until every
   // topic that the master knows a publisher of is connected. Topics nobody publishes yet (e.g.
   // the demonstrator's /lfd/phase when the recorder starts first) are not waited for.
-  void waitForConnections() {
+  // paused_only: give up as soon as sim time moves (a running sim would lose data meanwhile);
+  // the lockstep demonstrator keeps the sim paused while it starts a recording.
+  void waitForConnections(double timeout, bool paused_only = false) {
     ros::master::V_TopicInfo advertised;
     if (!ros::master::getTopics(advertised)) return;
     std::set<std::string> published;
     for (const ros::master::TopicInfo& t : advertised) published.insert(t.name);
-    const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(connect_timeout_);
+    const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(timeout);
+    const ros::Time sim_start = ros::Time::now();
     std::vector<std::string> missing;
     do {
+      if (paused_only && ros::Time::now() != sim_start) return;
       missing.clear();
       for (std::size_t i = 0; i < subscribers_.size(); ++i)
         if (published.count(subscribers_[i].getTopic()) && subscribers_[i].getNumPublishers() == 0)
@@ -156,11 +160,14 @@ class Recorder {
     } while (ros::WallTime::now() < deadline && ros::ok());
     std::string names;
     for (const std::string& m : missing) names += " " + m;
-    ROS_WARN("recorder: no publisher connected after %.1f s on:%s (going on)", connect_timeout_,
-             names.c_str());
+    if (!paused_only)
+      ROS_WARN("recorder: no publisher connected after %.1f s on:%s (going on)", timeout,
+               names.c_str());
   }
 
   bool onStart(lfd_msgs::StartRecording::Request& req, lfd_msgs::StartRecording::Response& res) {
+    // Publishers that appeared after start-up (e.g. the bridge started after the recorder).
+    waitForConnections(2.0, true);
     std::lock_guard<std::mutex> lock(mutex_);
     if (bag_) {
       res.success = false;
