@@ -408,6 +408,20 @@ def run_quiet(cmd, env=None):
     return [line.split()[-1] for line in proc.stdout.splitlines() if line.strip().endswith(".png")]
 
 
+def snapshots(report, key, bag, figs, times=None):
+    """MuJoCo snapshots of a bag into figs/snapshots/<key> (default times: the end of each of its
+    ground-truth phases). They need OSMesa, the plots do not: a failure is a reported problem."""
+    cmd = ["rosrun", "lfd_sim_bridge", "snapshot", "--bag", bag,
+           "--out", os.path.join(figs, "snapshots", key)]
+    if times:
+        cmd += ["--times", ",".join("%.3f" % t for t in times)]
+    try:
+        return run_quiet(cmd)
+    except (RuntimeError, OSError) as exc:
+        report.setdefault("figure_problems", []).append("%s snapshots: %s" % (key, exc))
+        return []
+
+
 def stage_figures(out, args, report):
     """The paper's figures per dataset (Fig. 3, 4, 5, 7, 8), the success bars (Fig. 9) and MuJoCo
     snapshots of the first demonstration of each dataset at the end of each of its phases."""
@@ -423,14 +437,7 @@ def stage_figures(out, args, report):
                                 "--config", os.path.join(ROOT, "config", "segmentation.yaml"),
                                 "--out", figs, "--prefix", name + "_", "--demo", "0"])
         bags = sorted(b for b in os.listdir(os.path.join(data, name)) if b.endswith(".bag"))
-        snap_dir = os.path.join(figs, "snapshots", name)
-        try:  # snapshots need OSMesa; the plots do not
-            made[name] += run_quiet(["rosrun", "lfd_sim_bridge", "snapshot", "--bag",
-                                     os.path.join(data, name, bags[0]), "--out", snap_dir])
-            made[name] += sorted(os.path.join(snap_dir, f) for f in os.listdir(snap_dir)
-                                 if f.endswith(".png") and os.path.join(snap_dir, f) not in made[name])
-        except (RuntimeError, OSError) as exc:
-            report.setdefault("figure_problems", []).append("%s snapshots: %s" % (name, exc))
+        made[name] += snapshots(report, name, os.path.join(data, name, bags[0]), figs)
     # The first reproduction of each task was recorded: snapshots at the end of each segment.
     for result in sorted(glob.glob(os.path.join(out, "reproduction", "*_*.json"))):
         for task, entry in (load_json(result) or {}).get("tasks", {}).items():
@@ -438,13 +445,7 @@ def stage_figures(out, args, report):
                 if not (run.get("bag") and run.get("segment_end_times")):
                     continue
                 key = "reproduction_" + os.path.basename(result)[:-len(".json")]
-                snap_dir = os.path.join(figs, "snapshots", key)
-                times = ",".join("%.3f" % t for t in run["segment_end_times"])
-                try:
-                    made[key] = run_quiet(["rosrun", "lfd_sim_bridge", "snapshot", "--bag",
-                                           run["bag"], "--times", times, "--out", snap_dir])
-                except (RuntimeError, OSError) as exc:
-                    report.setdefault("figure_problems", []).append("%s: %s" % (key, exc))
+                made[key] = snapshots(report, key, run["bag"], figs, run["segment_end_times"])
     write_report(out, report)  # the bars read this run's rates from report.json
     if report.get("segmentation"):
         made["success_rates"] = run_quiet(["/usr/bin/python3", plot, "--report",

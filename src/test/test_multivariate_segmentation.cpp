@@ -196,12 +196,18 @@ TEST(MultivariateSegmentation, MinSegmentLengthIsEnforced) {
   EXPECT_TRUE(lfd::segment_multivariate(f, {1.0, 1.0}, config).changepoints.empty());
 }
 
-TEST(MultivariateSegmentation, CandidateZonesRestrictTheArgmax) {
+// Two features, each with its own changepoint: a level change at 600, a shape change at 1300.
+Eigen::MatrixXd changes_at_600_and_1300() {
   const std::size_t n = 2000;
   std::mt19937 rng(4);
   Eigen::MatrixXd f(n, 2);
   f.col(0) = shape_change(n, 1300, rng);
   f.col(1) = level_change(n, 600, rng);
+  return f;
+}
+
+TEST(MultivariateSegmentation, CandidateZonesRestrictTheArgmax) {
+  const Eigen::MatrixXd f = changes_at_600_and_1300();
   lfd::MultivariateSegmentationConfig config;
   config.num_changepoints = 1;
   const auto free = lfd::segment_multivariate(f, {1.0, 1.0}, config);
@@ -223,11 +229,7 @@ TEST(MultivariateSegmentation, CandidateZonesRestrictTheArgmax) {
 // A zone marks one sensory interaction: however many changepoints are asked for, a zone holds at
 // most one, and a zone-less demonstration (callback returning nothing) gets none.
 TEST(MultivariateSegmentation, EachZoneHoldsAtMostOneChangepoint) {
-  const std::size_t n = 2000;
-  std::mt19937 rng(4);
-  Eigen::MatrixXd f(n, 2);
-  f.col(0) = shape_change(n, 1300, rng);
-  f.col(1) = level_change(n, 600, rng);
+  const Eigen::MatrixXd f = changes_at_600_and_1300();
   lfd::MultivariateSegmentationConfig config;
   config.num_changepoints = 4;
   config.min_segment_length = 100;
