@@ -41,7 +41,9 @@ json clasp_json(const lfd::MultivariateSegmentation& s, const lfd::FeatureMatrix
          {"range", {c.range_begin, c.range_end}},
          {"score", std::isfinite(c.score) ? json(c.score) : json(nullptr)},
          {"log10_p_value", std::isfinite(c.log10_p_value) ? json(c.log10_p_value) : json(nullptr)},
-         {"accepted_by_clasp", c.accepted}});
+         {"accepted_by_clasp", c.accepted},
+         {"anchored_to_event", c.anchored},
+         {"profile_argmax", c.profile_argmax}});
   }
   out["candidates"] = candidates;
   json windows = json::object();

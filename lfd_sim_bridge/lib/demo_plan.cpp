@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 
 namespace lfd_sim_bridge {
@@ -31,6 +32,34 @@ Segment hold(const std::string& label, const Pose& at, double duration) {
   Segment s = move(label, at, duration);
   s.is_move = false;
   return s;
+}
+
+// How far behind the centre of a square (half size `half`, rotated by `yaw`) a flat pusher of
+// half width `pusher_half` first touches it, moving along the horizontal unit `dir` through the
+// centre. Off the square's axes the contact is an edge or a corner, farther out than `half`; a
+// pusher narrower than the square may still miss the corner and meet the face.
+double contactDistance(const Eigen::Vector3d& dir, double half, double yaw, double pusher_half) {
+  const double angle = std::atan2(dir.y(), dir.x()) - yaw;
+  const Eigen::Vector2d d(std::cos(angle), std::sin(angle));  // in the square's frame
+  const Eigen::Vector2d n(-d.y(), d.x());
+  // Depth of the square behind the centre along the line at lateral offset l: the largest s with
+  // -s d + l n inside, i.e. the tighter of the two axes' bounds; concave and piecewise linear in l.
+  const auto depth = [&](double l) {
+    double s = std::numeric_limits<double>::infinity();
+    for (int k = 0; k < 2; ++k)
+      if (std::abs(d[k]) > 1e-12)
+        s = std::min(s, (half + l * n[k] * (d[k] > 0 ? 1 : -1)) / std::abs(d[k]));
+    return s;
+  };
+  double best = std::max(depth(-pusher_half), depth(pusher_half));
+  // The axes' bounds cross at l* (the corner's line): the maximum of a concave function there.
+  const double a0 = n[0] * (d[0] > 0 ? 1 : -1) / std::abs(d[0]);
+  const double a1 = n[1] * (d[1] > 0 ? 1 : -1) / std::abs(d[1]);
+  if (std::abs(d[0]) > 1e-12 && std::abs(d[1]) > 1e-12 && std::abs(a0 - a1) > 1e-12) {
+    const double corner = (half / std::abs(d[1]) - half / std::abs(d[0])) / (a0 - a1);
+    if (std::abs(corner) <= pusher_half) best = std::max(best, depth(corner));
+  }
+  return best;
 }
 
 Pose poseAt(const Eigen::Vector3d& position, const Eigen::Quaterniond& orientation) {
@@ -150,10 +179,18 @@ DemoPlan planPush(const TaskInstance& inst, const Pose& start, const Geometry& g
   const Eigen::Quaterniond hand =
       yawRotation(std::atan2(dir.y(), dir.x())) * g.push_orientation.normalized();
   const Eigen::Vector3d height(0, 0, g.push_height);
-  const double face = g.box_half_length + g.tcp_to_face;
+  // TCP-to-box-centre distance along the push when the fist touches the box.
+  // The fist is a square block of half size tcp_to_face, squarely facing the push.
+  const double face =
+      contactDistance(dir, g.box_half_length, yawOf(inst.object_start.orientation), g.tcp_to_face) +
+      g.tcp_to_face;
   const Pose behind =
       poseAt(inst.object_start.position + height - (face + g.push_clearance) * dir, hand);
   const Pose above = poseAt(behind.position + Eigen::Vector3d(0, 0, g.push_prelift), hand);
+  // The paper's push phase is the time in contact: the approach ends with the fist on the face,
+  // so the box starts moving (and the touch sensors fire) as the push phase starts.
+  const Pose touching =
+      poseAt(inst.object_start.position + height - (face - g.push_contact_depth) * dir, hand);
   const Pose pushed = poseAt(inst.goal.position + height - face * dir, hand);
   const Pose retreated =
       poseAt(pushed.position - g.retreat * dir + Eigen::Vector3d(0, 0, g.retreat), hand);
@@ -167,9 +204,10 @@ DemoPlan planPush(const TaskInstance& inst, const Pose& start, const Geometry& g
   approach.segments.push_back(fist);
   timer.addMove(&approach.segments, start, "prepush", above, tm.to_prepush);
   timer.addMove(&approach.segments, above, "lower", behind, tm.lower);
+  timer.addMove(&approach.segments, behind, "touch", touching, tm.touch);
 
   Phase push{"push", 1, {}};
-  timer.addMove(&push.segments, behind, "push", pushed, tm.push);
+  timer.addMove(&push.segments, touching, "push", pushed, tm.push);
 
   Phase back{"return", 2, {}};
   timer.addMove(&back.segments, pushed, "retreat", retreated, tm.retreat);

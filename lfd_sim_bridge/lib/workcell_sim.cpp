@@ -417,6 +417,7 @@ void WorkcellSim::step(int n) {
     // controls of the next step and readState() see the state the integrator just produced.
     mj_step2(m_, d_);
     mj_step1(m_, d_);
+    updateTouch();
     std::string why;
     if (badNumberWarnings() != warnings_before) {
       why = "MuJoCo flagged a bad qpos/qvel/qacc/ctrl (it reset the data)";
@@ -431,6 +432,14 @@ void WorkcellSim::step(int n) {
       d_->time = t_before + m_->opt.timestep;
     }
   }
+}
+
+void WorkcellSim::updateTouch() {
+  touch_filtered_.resize(touch_adr_.size(), 0.0);
+  const double tau = config_.touch_time_constant;
+  const double alpha = tau > 0.0 ? 1.0 - std::exp(-m_->opt.timestep / tau) : 1.0;
+  for (size_t i = 0; i < touch_adr_.size(); ++i)
+    touch_filtered_[i] += alpha * (d_->sensordata[touch_adr_[i].second] - touch_filtered_[i]);
 }
 
 std::array<int, 4> WorkcellSim::badNumberWarnings() const {
@@ -467,6 +476,7 @@ void WorkcellSim::recoverFromDivergence(const std::string& why) {
   log(LogLevel::kError, s.str());
   const double t = d_->time;
   mj_resetData(m_, d_);
+  touch_filtered_.assign(touch_adr_.size(), 0.0);
   for (const auto& [name, body] : objects_) {
     const int adr = m_->jnt_qposadr[m_->body_jntadr[body]];
     std::copy(scene_qpos_.begin() + adr, scene_qpos_.begin() + adr + 7, d_->qpos + adr);
@@ -512,6 +522,7 @@ void WorkcellSim::reset(const std::map<std::string, double>& posture, bool reset
   const double t = d_->time;
   std::vector<mjtNum> qpos(d_->qpos, d_->qpos + m_->nq), qvel(d_->qvel, d_->qvel + m_->nv);
   mj_resetData(m_, d_);
+  touch_filtered_.assign(touch_adr_.size(), 0.0);
   for (const auto& [name, body] : objects_) {
     const int jnt = m_->body_jntadr[body];
     const int qadr = m_->jnt_qposadr[jnt], vadr = m_->jnt_dofadr[jnt];
@@ -621,7 +632,9 @@ void WorkcellSim::readState(WorkcellState* s) {
   for (size_t i = 0; i < touch_adr_.size(); ++i) {
     s->touch_names[i] = touch_adr_[i].first;
     // Touch is a non-negative normal force; noise must not make it negative.
-    s->touch_values[i] = std::max(0.0, d_->sensordata[touch_adr_[i].second] + noise(n.touch));
+    const double force =
+        i < touch_filtered_.size() ? touch_filtered_[i] : d_->sensordata[touch_adr_[i].second];
+    s->touch_values[i] = std::max(0.0, force + noise(n.touch));
   }
   if (gripper_ >= 0) {
     const Actuated& g = actuated_[gripper_];

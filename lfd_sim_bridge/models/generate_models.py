@@ -25,7 +25,7 @@ TABLE_TOP = 0.80  # world z of the table surface
 TABLE_CENTER = (0.50, -0.10)  # world xy of the table centre
 TABLE_HALF = (0.35, 0.50, 0.02)  # half sizes of the table top
 STICK_HALF, STICK_MASS = (0.125, 0.015, 0.015), 0.12  # square bar 25 x 3 x 3 cm
-BOX_HALF, BOX_MASS = (0.04, 0.04, 0.04), 0.3  # 8 cm cube
+BOX_HALF, BOX_MASS = (0.04, 0.04, 0.04), 1.0  # 8 cm cube
 
 # Per-joint-group actuation: (kp, damping, armature, velocity limit, effort limit).
 # Gains are stiff, like a high-ratio position-controlled humanoid servo, so that gravity sag stays
@@ -413,7 +413,7 @@ def write_workcell(path):
       <geom name="stick_geom" type="box" size="{fmt(STICK_HALF)}" rgba="0.85 0.55 0.15 1"
             contype="1" conaffinity="1" condim="4" friction="1.2 0.02 0.001"/>
     </body>
-    <!-- Pushable 8 cm cube, 300 g; table friction 0.4 lets it slide under a push and stop on release. -->
+    <!-- Pushable 8 cm cube, 1 kg; table friction 0.4 lets it slide under a push and stop on release. -->
     <body name="box" pos="0.78 0.14 {TABLE_TOP + 0.04:.4f}">
       <joint name="box_free" type="free" damping="0.0005"/>
       <inertial pos="0 0 0" mass="{BOX_MASS}" diaginertia="{box_i}"/>

@@ -14,7 +14,8 @@
 //   rtf_report_period     wall seconds between "real-time factor" INFO lines (0 = never)
 //   initial_posture, kp, kd, damping_ratio, velocity_limits, default_velocity_limit,
 //   effort_limits, default_effort_limit, gravity_compensation, gripper_opening_scale,
-//   objects, max_abs_velocity, noise/{joint_position,...}, noise_seed (see WorkcellConfig)
+//   objects, max_abs_velocity, touch_time_constant, noise/{joint_position,...}, noise_seed (see
+//   WorkcellConfig)
 #include <geometry_msgs/PoseStamped.h>
 #include <geometry_msgs/TransformStamped.h>
 #include <geometry_msgs/TwistStamped.h>
@@ -82,6 +83,7 @@ lfd_sim::WorkcellConfig loadConfig(ros::NodeHandle& pnh) {
   c.ee_site = param(pnh, "ee_site", c.ee_site);
   c.objects = param(pnh, "objects", c.objects);
   c.max_abs_velocity = param(pnh, "max_abs_velocity", c.max_abs_velocity);
+  c.touch_time_constant = param(pnh, "touch_time_constant", c.touch_time_constant);
   c.noise_seed = static_cast<uint64_t>(param(pnh, "noise_seed", 1));
   lfd_sim::SensorNoise& n = c.noise;
   n.joint_position = param(pnh, "noise/joint_position", 0.0);

@@ -102,12 +102,41 @@ TEST(DemoPlan, PushGeometryEndsBehindTheTarget) {
   const demo::DemoPlan p = plan(inst);
   const double face = g.box_half_length + g.tcp_to_face;
   const demo::Pose contact = phaseEnd(p, 0);
-  EXPECT_NEAR(contact.position.x(), 0.40 - face - g.push_clearance, 1e-12);
+  // The approach ends with the fist on the box face (the push phase is the time in contact),
+  // after lowering behind it with a clearance.
+  EXPECT_NEAR(contact.position.x(), 0.40 - face + g.push_contact_depth, 1e-12);
+  EXPECT_NEAR(segment(p, "lower").target.position.x(), 0.40 - face - g.push_clearance, 1e-12);
   EXPECT_NEAR(contact.position.y(), -0.10, 1e-12);
   const demo::Pose pushed = phaseEnd(p, 1);
   EXPECT_NEAR(pushed.position.x(), 0.50 - face, 1e-12);
   EXPECT_NEAR(pushed.position.z(), contact.position.z(), 1e-12);  // along the table
   EXPECT_THROW(plan({"push", pose(0.4, 0, 0), pose(0.4, 0, 0)}), std::invalid_argument);
+}
+
+TEST(DemoPlan, DiagonalPushTouchesTheBoxCorner) {
+  // Pushed along its diagonal, the cube meets the fist with a corner, half * sqrt(2) from its
+  // centre: the approach must end there, not at the face distance (which is inside the box).
+  const demo::Geometry g;
+  const demo::TaskInstance inst{"push", pose(0.40, -0.10, -0.01), pose(0.50, 0.0, -0.01)};
+  const demo::DemoPlan p = plan(inst);
+  const demo::Pose contact = phaseEnd(p, 0);
+  const Eigen::Vector3d offset = inst.object_start.position - contact.position;
+  EXPECT_NEAR(offset.head<2>().norm(), g.box_half_length * std::sqrt(2.0) + g.tcp_to_face, 1e-9);
+  EXPECT_NEAR(offset.x(), offset.y(), 1e-12);  // straight behind, along the push
+}
+
+TEST(DemoPlan, SlightlyOffAxisPushMeetsTheFaceNotTheCorner) {
+  // 16 degrees off the box's axis, the corner lies beside the push line, out of the fist's
+  // reach: the fist's trailing edge (lateral offset -tcp_to_face) touches the face first.
+  const demo::Geometry g;
+  const double angle = 16.0 * M_PI / 180.0;
+  const demo::TaskInstance inst{
+      "push", pose(0.40, -0.10, -0.01),
+      pose(0.40 + 0.1 * std::cos(angle), -0.10 + 0.1 * std::sin(angle), -0.01)};
+  const Eigen::Vector3d offset = inst.object_start.position - phaseEnd(plan(inst), 0).position;
+  const double face_depth = (g.box_half_length + g.tcp_to_face * std::sin(angle)) / std::cos(angle);
+  ASSERT_LT(face_depth, g.box_half_length * (std::cos(angle) + std::sin(angle)));  // not the corner
+  EXPECT_NEAR(offset.head<2>().norm(), face_depth + g.tcp_to_face, 1e-9);
 }
 
 TEST(DemoPlan, SpeedScalesEveryDuration) {

@@ -216,6 +216,20 @@ MultivariateSegmentation segment_multivariate(const Eigen::MatrixXd& features,
     const int z = zone_of(t);
     return z >= 0 && !zone_used[static_cast<std::size_t>(z)];
   };
+  // The anchor (sensory event) of t's zone nearest to t, relative to `begin`; -1 = none.
+  const auto anchor_for = [&](const Eigen::VectorXd& profile, std::size_t begin,
+                              Eigen::Index t) -> Eigen::Index {
+    if (!restricted) return -1;
+    const int zone = zone_of(begin + static_cast<std::size_t>(t));
+    Eigen::Index nearest = -1;
+    for (std::size_t a : config.zone_anchors) {
+      if (a < begin || a >= begin + static_cast<std::size_t>(profile.size())) continue;
+      const Eigen::Index rel = static_cast<Eigen::Index>(a - begin);
+      if (zone_of(a) != zone || std::isnan(profile[rel])) continue;
+      if (nearest < 0 || std::abs(rel - t) < std::abs(nearest - t)) nearest = rel;
+    }
+    return nearest;
+  };
   const auto evaluate = [&](std::size_t begin, std::size_t end, bool first) {
     const std::size_t len = end - begin;
     if (len < 2 * min_s + 1) return;
@@ -254,6 +268,8 @@ MultivariateSegmentation segment_multivariate(const Eigen::MatrixXd& features,
       best = t;
     }
     if (best < 0) return;
+    // ClaSP's own evidence (the significance at its argmax) decides whether the zone holds a
+    // changepoint; the zone's sensory event then says when (zone_anchors).
     double weighted_log_p = 0.0, weight_sum = 0.0;
     for (std::size_t i = 0; i < knns.size(); ++i) {
       weighted_log_p +=
@@ -261,7 +277,10 @@ MultivariateSegmentation segment_multivariate(const Eigen::MatrixXd& features,
       weight_sum += used_weights[i];
     }
     SplitCandidate c;
-    c.index = begin + static_cast<std::size_t>(best);
+    const Eigen::Index anchor = anchor_for(penalized, begin, best);
+    c.index = begin + static_cast<std::size_t>(anchor >= 0 ? anchor : best);
+    c.profile_argmax = begin + static_cast<std::size_t>(best);
+    c.anchored = anchor >= 0;
     c.range_begin = begin;
     c.range_end = end;
     c.score = penalized[best];

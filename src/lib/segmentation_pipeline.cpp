@@ -212,18 +212,23 @@ SegmentationPipelineResult run_segmentation_pipeline(
     out.num_samples = static_cast<std::size_t>(demo.rows());
     const Eigen::MatrixXd state = demo.select(result.selected_features).data;
     MultivariateSegmentationConfig demo_config = segmentation_config;
+    Eigen::MatrixXd sensors;
+    std::vector<std::size_t> events;  // independent of min_s: detected once
+    if (validate) {
+      sensors = demo.select(sensor_features).data;
+      events = validate_changepoints({}, sensors, 1, config.events).events;
+    }
     if (validate && config.search_in_zones) {
       demo_config.candidate_zones_for = [&](std::size_t min_s) {
-        return validate_changepoints({}, demo.select(sensor_features).data, min_s, config.events)
-            .zones;
+        return confidence_zones(events, min_s, static_cast<std::size_t>(sensors.rows()));
       };
+      if (config.anchor_to_events) demo_config.zone_anchors = events;
     }
     out.clasp = segment_multivariate(state, result.feature_weights, demo_config);
     out.min_segment_length = out.clasp.min_segment_length;
     if (validate) {
-      const ChangepointValidation v =
-          validate_changepoints(out.clasp.changepoints, demo.select(sensor_features).data,
-                                out.min_segment_length, config.events);
+      const ChangepointValidation v = validate_changepoints(out.clasp.changepoints, sensors,
+                                                            out.min_segment_length, config.events);
       out.changepoints = v.accepted;
       out.rejected = v.rejected;
       out.zones = v.zones;

@@ -66,7 +66,8 @@ struct Geometry {
   double grasp_effort = 20.0;         // N
   double teleop_close_opening = 0.0;  // m, the operator closes fully (overshoot)
   double box_half_length = 0.05;      // m, box half extent along the push direction
-  double push_clearance = 0.02;       // m, TCP to box face at the end of the approach
+  double push_clearance = 0.02;       // m, fingers to box face when lowered behind the box
+  double push_contact_depth = 0.0;    // m past the face the approach ends (0 = just touching)
   double tcp_to_face = 0.015;         // m, TCP centre to the gripper's pushing face
   double push_height = 0.0;           // TCP height above the box centre while pushing
   double push_prelift = 0.08;         // m, approach from above before lowering behind the box
@@ -77,7 +78,7 @@ struct Geometry {
 struct Timing {
   double to_pregrasp = 2.0, descend = 1.2, close = 1.0, settle = 0.3, lift = 1.2, carry = 2.0,
          hold = 0.6;
-  double to_prepush = 2.0, lower = 1.0, push = 2.5, retreat = 1.0, go_home = 2.0;
+  double to_prepush = 2.0, lower = 1.0, touch = 0.8, push = 2.5, retreat = 1.0, go_home = 2.0;
   double open = 0.5;  // opening the gripper at the start
 };
 

@@ -68,6 +68,10 @@ struct WorkcellConfig {
   std::string base_body = "base_link";
   std::string ee_site = "r_gripper_tcp";
   std::vector<std::string> objects = {"stick", "box"};
+  // Touch pads: first-order response (s) of the reported normal force. A rigid simulated contact
+  // pushed by a stiff position controller chatters at the physics rate (impacts of 0-5 N); a real
+  // pad's elastomer and readout report their mean. 0 = the raw per-step MuJoCo reading.
+  double touch_time_constant = 0.0;
   // Readings noise (teleop-like mode), seeded for reproducible datasets.
   SensorNoise noise;
   uint64_t noise_seed = 1;
@@ -189,6 +193,8 @@ class WorkcellSim {
   int base_body_ = -1, ee_site_ = -1, gripper_ = -1;
   int force_adr_ = -1, torque_adr_ = -1, gyro_adr_ = -1, accel_adr_ = -1, quat_adr_ = -1;
   std::vector<std::pair<std::string, int>> touch_adr_;
+  std::vector<double> touch_filtered_;  // the pads' response (touch_time_constant)
+  void updateTouch();
   std::vector<std::pair<std::string, int>> objects_;  // name, body id
   std::vector<double> initial_qpos_;                  // model qpos0: initial object poses
   std::vector<double> scene_qpos_;  // object poses last set (divergence recovery restores them)

@@ -78,6 +78,13 @@ struct MultivariateSegmentationConfig {
   /// threshold). The sensory event is independent evidence of a change there, so ClaSP's own
   /// evidence may be weaker than for a candidate anywhere.
   double zone_p_value_threshold = 0.0;
+  /// Sensory events that anchor the zones (zone-guided search only; empty = off). ClaSP still
+  /// decides whether a zone holds a changepoint (its in-zone argmax and that argmax's
+  /// significance), but the changepoint is placed at the zone's event nearest to the argmax. The
+  /// features kept for their consistency across demos (II-B) are smooth kinematics whose profile
+  /// peaks up to a window away from the interaction, often on the zone's edge and at a different
+  /// point of the skill in every demo; the sensors time an interaction to a few samples.
+  std::vector<std::size_t> zone_anchors;
   int num_changepoints = -1;          ///< < 0: stop with the significance test; >= 0: exact count
   std::size_t max_changepoints = 16;  ///< safety cap when the test decides
 };
@@ -90,6 +97,10 @@ struct SplitCandidate {
   double score = 0.0;          ///< penalized combined score at the candidate
   double log10_p_value = 0.0;  ///< weighted mean of the per-feature log10 p-values
   bool accepted = false;
+  /// Placed at a sensory event of its zone instead of the profile's in-zone argmax
+  /// (profile_argmax, where score and log10_p_value are taken); see zone_anchors.
+  bool anchored = false;
+  std::size_t profile_argmax = 0;
 };
 
 struct MultivariateSegmentation {

@@ -37,6 +37,9 @@ struct SegmentationPipelineConfig {
   /// order, candidates anywhere and then validated, where a strong out-of-zone peak can hide the
   /// in-zone change of its range. Needs validate_with_sensors.
   bool search_in_zones = true;
+  /// With search_in_zones: each changepoint sits on the sensory event of its zone nearest to
+  /// ClaSP's in-zone argmax (MultivariateSegmentationConfig::zone_anchors).
+  bool anchor_to_events = true;
   /// Worker threads for DTW and the per-demonstration segmentations (<= 0 = all cores).
   int threads = 0;
 };
