@@ -3,8 +3,10 @@
 #include <gtest/gtest.h>
 #include <mujoco/mujoco.h>
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
+#include <vector>
 
 #include "lfd_sim_bridge/trajectory_interpolator.hpp"
 #include "lfd_sim_bridge/workcell_sim.hpp"
@@ -225,6 +227,38 @@ TEST(WorkcellSim, GripperOpensClosesAndRespectsMaxEffort) {
   }
   EXPECT_LE(max_force, 5.0 + 1e-9);
   EXPECT_NEAR(sim.readState().gripper_opening, 0.0, 2e-3);
+}
+
+// Closing the fingers on the stick gives a step of pad force. With a response time the pads
+// report it as a first-order rise (63 % after one time constant) that ends at the same level.
+TEST(WorkcellSim, TouchPadsRespondWithTheirTimeConstant) {
+  lfd_sim::WorkcellConfig raw_config = readyConfig(), pad_config = readyConfig();
+  pad_config.touch_time_constant = 0.05;
+  lfd_sim::WorkcellSim raw(kModel, raw_config), pad(kModel, pad_config);
+  for (lfd_sim::WorkcellSim* sim : {&raw, &pad}) {
+    // The stick between the open fingers, its long axis across the closing direction (TCP y).
+    lfd_sim::Pose stick = sim->readState().ee_pose;
+    stick.position[2] += 0.85;  // base_link -> world
+    sim->setObjectPose("stick", stick);
+    sim->setGripper(0.0, 20.0);
+  }
+  std::vector<double> raw_left, pad_left;
+  for (int k = 0; k < 1500; ++k) {  // 1.5 s at 1 kHz
+    raw.step();
+    pad.step();
+    raw_left.push_back(raw.readState().touch_values.at(0));
+    pad_left.push_back(pad.readState().touch_values.at(0));
+  }
+  const auto onset =
+      std::find_if(raw_left.begin(), raw_left.end(), [](double v) { return v > 1.0; });
+  ASSERT_NE(onset, raw_left.end()) << "the closed fingers never touch";
+  const std::size_t k0 = static_cast<std::size_t>(onset - raw_left.begin());
+  ASSERT_LT(k0 + 400, raw_left.size());
+  const double level = raw_left.back();
+  ASSERT_GT(level, 1.0);
+  EXPECT_NEAR(pad_left.back(), level, 0.02 * level);           // same force once settled
+  EXPECT_LT(pad_left[k0 + 5], 0.3 * raw_left[k0 + 5]);         // 5 ms: barely started
+  EXPECT_NEAR(pad_left[k0 + 50], 0.63 * level, 0.15 * level);  // one time constant
 }
 
 TEST(WorkcellSim, EndEffectorVelocityMatchesFiniteDifference) {

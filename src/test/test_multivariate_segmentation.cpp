@@ -2,6 +2,7 @@
 // changepoint carried by one feature among noise features, all four combinations, min_s.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 #include <vector>
@@ -273,6 +274,38 @@ TEST(MultivariateSegmentation, ZoneThresholdAcceptsWeakerInZoneEvidence) {
   EXPECT_NEAR(static_cast<double>(seg.changepoints[0]), cp, 25.0);
   config.zone_p_value_threshold = 1.0;
   EXPECT_THROW(lfd::segment_multivariate(f, {1.0}, config), std::invalid_argument);
+}
+
+// Over the whole series the Kaiser-penalized profile peaks between the two changes, outside
+// every zone: without anchors the in-zone argmax is the zone's edge (the flank of that peak).
+// With anchors ClaSP still decides which zones hold a changepoint, but each one sits on its
+// zone's event nearest to the argmax, and a zone ClaSP leaves empty stays empty.
+TEST(MultivariateSegmentation, AnchorsPlaceChangepointsOnTheZoneEvents) {
+  const Eigen::MatrixXd f = changes_at_600_and_1300();
+  lfd::MultivariateSegmentationConfig config;
+  config.min_segment_length = 100;
+  const std::vector<lfd::Interval> zones{{450, 760}, {1150, 1450}, {1700, 1800}};
+  config.candidate_zones = zones;
+  const auto plain = lfd::segment_multivariate(f, {1.0, 1.0}, config);
+  ASSERT_EQ(plain.changepoints.size(), 2u);
+  EXPECT_EQ(plain.changepoints[1], zones[1].begin);  // pinned to the edge, 150 before the change
+  for (const lfd::SplitCandidate& c : plain.candidates) EXPECT_FALSE(c.anchored);
+
+  // Events 80 samples after each change, one more farther inside the first zone, and one in the
+  // zone where nothing changes.
+  config.zone_anchors = {680, 740, 1380, 1750};
+  const auto seg = lfd::segment_multivariate(f, {1.0, 1.0}, config);
+  ASSERT_EQ(seg.changepoints.size(), 2u);
+  EXPECT_EQ(seg.changepoints[0], 680u);  // nearer to the argmax than 740
+  EXPECT_EQ(seg.changepoints[1], 1380u);
+  for (const lfd::SplitCandidate& c : seg.candidates) {
+    EXPECT_TRUE(c.anchored);
+    const auto zone = std::find_if(zones.begin(), zones.end(),
+                                   [&](const lfd::Interval& z) { return z.contains(c.index); });
+    ASSERT_NE(zone, zones.end());
+    EXPECT_TRUE(zone->contains(c.profile_argmax)) << c.profile_argmax;
+    EXPECT_EQ(c.accepted, zone != zones.end() - 1);  // nothing changes in the last zone
+  }
 }
 
 TEST(MultivariateSegmentation, StationaryFeaturesGiveNoChangepoint) {
