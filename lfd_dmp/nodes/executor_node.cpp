@@ -72,6 +72,8 @@ class Executor {
     pnh.param("gripper/close_effort", close_effort_, close_effort_);
     pnh.param("gripper/joint", gripper_joint_, gripper_joint_);
     pnh.param("generalization/bandwidth", options_.generalization.bandwidth, 0.0);
+    pnh.param("generalization/local_linear", options_.generalization.local_linear,
+              options_.generalization.local_linear);
     pnh.param("generalization/range_margin", options_.generalization.range_margin,
               options_.generalization.range_margin);
     pnh.param("ik_tolerance/position", tolerance_.position, tolerance_.position);
