@@ -52,13 +52,9 @@ double contactDistance(const Eigen::Vector3d& dir, double half, double yaw, doub
     return s;
   };
   double best = std::max(depth(-pusher_half), depth(pusher_half));
-  // The axes' bounds cross at l* (the corner's line): the maximum of a concave function there.
-  const double a0 = n[0] * (d[0] > 0 ? 1 : -1) / std::abs(d[0]);
-  const double a1 = n[1] * (d[1] > 0 ? 1 : -1) / std::abs(d[1]);
-  if (std::abs(d[0]) > 1e-12 && std::abs(d[1]) > 1e-12 && std::abs(a0 - a1) > 1e-12) {
-    const double corner = (half / std::abs(d[1]) - half / std::abs(d[0])) / (a0 - a1);
-    if (std::abs(corner) <= pusher_half) best = std::max(best, depth(corner));
-  }
+  // The depth is concave in l and peaks on the line through the square's rearmost corner.
+  const Eigen::Vector2d corner = -half * d.cwiseSign();
+  if (std::abs(corner.dot(n)) <= pusher_half) best = std::max(best, -corner.dot(d));
   return best;
 }
 

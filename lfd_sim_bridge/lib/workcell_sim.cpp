@@ -145,6 +145,7 @@ WorkcellSim::WorkcellSim(const std::string& mjcf_path, const WorkcellConfig& con
     const int adr = sensorAddress(m_, name);
     if (adr >= 0) touch_adr_.emplace_back(name, adr);
   }
+  touch_filtered_.assign(touch_adr_.size(), 0.0);
   const std::pair<const char*, int> expected[] = {{"r_wrist_force", force_adr_},
                                                   {"r_wrist_torque", torque_adr_},
                                                   {"imu_gyro", gyro_adr_},
@@ -435,7 +436,6 @@ void WorkcellSim::step(int n) {
 }
 
 void WorkcellSim::updateTouch() {
-  touch_filtered_.resize(touch_adr_.size(), 0.0);
   const double tau = config_.touch_time_constant;
   const double alpha = tau > 0.0 ? 1.0 - std::exp(-m_->opt.timestep / tau) : 1.0;
   for (size_t i = 0; i < touch_adr_.size(); ++i)
@@ -632,9 +632,7 @@ void WorkcellSim::readState(WorkcellState* s) {
   for (size_t i = 0; i < touch_adr_.size(); ++i) {
     s->touch_names[i] = touch_adr_[i].first;
     // Touch is a non-negative normal force; noise must not make it negative.
-    const double force =
-        i < touch_filtered_.size() ? touch_filtered_[i] : d_->sensordata[touch_adr_[i].second];
-    s->touch_values[i] = std::max(0.0, force + noise(n.touch));
+    s->touch_values[i] = std::max(0.0, touch_filtered_[i] + noise(n.touch));
   }
   if (gripper_ >= 0) {
     const Actuated& g = actuated_[gripper_];

@@ -212,27 +212,26 @@ SegmentationPipelineResult run_segmentation_pipeline(
     out.num_samples = static_cast<std::size_t>(demo.rows());
     const Eigen::MatrixXd state = demo.select(result.selected_features).data;
     MultivariateSegmentationConfig demo_config = segmentation_config;
-    Eigen::MatrixXd sensors;
-    std::vector<std::size_t> events;  // independent of min_s: detected once
-    if (validate) {
-      sensors = demo.select(sensor_features).data;
-      events = validate_changepoints({}, sensors, 1, config.events).events;
-    }
+    // Events do not depend on min_s: detected once, for the zone-guided search and validation.
+    const SensorEvents events =
+        validate ? detect_sensor_events(demo.select(sensor_features).data, config.events)
+                 : SensorEvents{};
+    const auto zones = [&](std::size_t min_s) {
+      return confidence_zones(events.all, min_s, static_cast<std::size_t>(demo.rows()));
+    };
     if (validate && config.search_in_zones) {
-      demo_config.candidate_zones_for = [&](std::size_t min_s) {
-        return confidence_zones(events, min_s, static_cast<std::size_t>(sensors.rows()));
-      };
-      if (config.anchor_to_events) demo_config.zone_anchors = events;
+      demo_config.candidate_zones_for = zones;
+      if (config.anchor_to_events) demo_config.zone_anchors = events.all;
     }
     out.clasp = segment_multivariate(state, result.feature_weights, demo_config);
     out.min_segment_length = out.clasp.min_segment_length;
     if (validate) {
-      const ChangepointValidation v = validate_changepoints(out.clasp.changepoints, sensors,
-                                                            out.min_segment_length, config.events);
+      const ChangepointValidation v =
+          validate_with_zones(out.clasp.changepoints, zones(out.min_segment_length));
       out.changepoints = v.accepted;
       out.rejected = v.rejected;
       out.zones = v.zones;
-      out.events = v.events;
+      out.events = events.all;
     } else {
       out.changepoints = out.clasp.changepoints;
     }

@@ -148,25 +148,30 @@ ChangepointValidation validate_with_zones(const std::vector<std::size_t>& candid
   return out;
 }
 
-ChangepointValidation validate_changepoints(const std::vector<std::size_t>& candidates,
-                                            const Eigen::MatrixXd& sensors, std::size_t min_s,
-                                            const SensoryEventConfig& config) {
+SensorEvents detect_sensor_events(const Eigen::MatrixXd& sensors,
+                                  const SensoryEventConfig& config) {
   check_config(config);
-  std::vector<std::vector<std::size_t>> per_sensor;
-  std::vector<std::size_t> all;
+  SensorEvents out;
   for (Eigen::Index c = 0; c < sensors.cols(); ++c) {
     if (!sensors.col(c).allFinite())
       throw std::invalid_argument("sensory events: sensor column " + std::to_string(c) +
                                   " has NaN/Inf values");
-    per_sensor.push_back(detect_sensory_events(sensors.col(c), config));
-    all.insert(all.end(), per_sensor.back().begin(), per_sensor.back().end());
+    out.per_sensor.push_back(detect_sensory_events(sensors.col(c), config));
+    out.all.insert(out.all.end(), out.per_sensor.back().begin(), out.per_sensor.back().end());
   }
-  std::sort(all.begin(), all.end());
-  all.erase(std::unique(all.begin(), all.end()), all.end());
+  std::sort(out.all.begin(), out.all.end());
+  out.all.erase(std::unique(out.all.begin(), out.all.end()), out.all.end());
+  return out;
+}
+
+ChangepointValidation validate_changepoints(const std::vector<std::size_t>& candidates,
+                                            const Eigen::MatrixXd& sensors, std::size_t min_s,
+                                            const SensoryEventConfig& config) {
+  SensorEvents events = detect_sensor_events(sensors, config);
   ChangepointValidation out = validate_with_zones(
-      candidates, confidence_zones(all, min_s, static_cast<std::size_t>(sensors.rows())));
-  out.events = std::move(all);
-  out.events_per_sensor = std::move(per_sensor);
+      candidates, confidence_zones(events.all, min_s, static_cast<std::size_t>(sensors.rows())));
+  out.events = std::move(events.all);
+  out.events_per_sensor = std::move(events.per_sensor);
   return out;
 }
 

@@ -65,6 +65,16 @@ struct ChangepointValidation {
   std::vector<std::vector<std::size_t>> events_per_sensor;  ///< per column of `sensors`
 };
 
+struct SensorEvents {
+  std::vector<std::size_t> all;                      ///< every sensor's events (sorted, unique)
+  std::vector<std::vector<std::size_t>> per_sensor;  ///< per column of `sensors`
+};
+
+/// Events of every sensor column (rows = samples); they do not depend on min_s. Throws
+/// std::invalid_argument on non-finite sensor values or bad config.
+SensorEvents detect_sensor_events(const Eigen::MatrixXd& sensors,
+                                  const SensoryEventConfig& config = {});
+
 /// Keeps the candidates that lie in a zone. Candidates are a sample index each.
 ChangepointValidation validate_with_zones(const std::vector<std::size_t>& candidates,
                                           const std::vector<Interval>& zones);
