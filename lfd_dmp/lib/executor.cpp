@@ -59,7 +59,61 @@ std::map<std::string, Eigen::VectorXd> allSegmentParameters(const SkillLibrary& 
   return out;
 }
 
+// A shorter stroke does not fix its direction: 1 mm of tremor at 2 cm is already 3 degrees.
+constexpr double kMinHeadingLength = 0.02;  // m
+
+Eigen::Matrix3d yawMatrix(double yaw) {
+  return Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+}
+
+// The task frame of a plan: the new heading and, per demo id, the demo's own heading of the frame
+// segment (demos whose heading is undefined are left out with a warning).
+struct TaskFrame {
+  double yaw = 0.0;
+  std::map<std::string, double> demo_yaw;
+};
+
+TaskFrame taskFrame(const SkillLibrary& library, const std::vector<SegmentTarget>& targets,
+                    const Eigen::Vector3d& tcp_start, const std::string& segment,
+                    std::vector<std::string>* warnings) {
+  size_t k = 0;
+  while (k < targets.size() && targets[k].name != segment) ++k;
+  if (k == targets.size())
+    throw std::invalid_argument("task frame segment '" + segment +
+                                "' is not a segment of the task goal model");
+  TaskFrame frame;
+  const Eigen::Vector3d from = k == 0 ? tcp_start : targets[k - 1].position;
+  try {
+    frame.yaw = headingYaw(from, targets[k].position, kMinHeadingLength);
+  } catch (const std::invalid_argument& e) {
+    throw std::invalid_argument("task frame: the new '" + segment + "' segment: " + e.what());
+  }
+  for (const DemoSkill& d : library.segments[k].demos) {
+    if (!d.dmp.position || d.dmp.position->dims() != 3) continue;
+    try {
+      const Eigen::Vector3d a = d.dmp.position->start(), b = d.dmp.position->goal();
+      frame.demo_yaw[d.demo_id] = headingYaw(a, b, kMinHeadingLength);
+    } catch (const std::invalid_argument& e) {
+      warnings->push_back("demo " + d.demo_id + " left out of the task frame: " + e.what());
+    }
+  }
+  if (frame.demo_yaw.empty())
+    throw std::invalid_argument("task frame: no demo has a defined '" + segment + "' heading");
+  return frame;
+}
+
 }  // namespace
+
+double headingYaw(const Eigen::Vector3d& from, const Eigen::Vector3d& to, double min_length) {
+  const Eigen::Vector2d d = (to - from).head<2>();
+  if (!d.allFinite() || !(d.norm() >= min_length)) {
+    std::ostringstream m;
+    m << "its start and goal are " << d.norm() << " m apart in xy (heading needs >= " << min_length
+      << " m)";
+    throw std::invalid_argument(m.str());
+  }
+  return std::atan2(d.y(), d.x());
+}
 
 GoalReference parseGoalReference(const std::string& s) {
   if (s == "object") return GoalReference::kObject;
@@ -86,6 +140,7 @@ std::vector<SegmentTarget> segmentTargets(const TaskGoalModel& model,
   for (const SegmentGoalRule& rule : model.segments) {
     SegmentTarget t;
     t.name = rule.name;
+    t.frame = rule.frame;
     switch (rule.reference) {
       case GoalReference::kObject:
         t.position = situation.object_position;
@@ -185,6 +240,10 @@ ExecutionPlan TaskPlanner::plan(const SkillLibrary& library,
   plan.joint_names = chain().jointNames();
   plan.dt = options.dt;
   const TcpPose start = forward(q_start);
+  std::map<std::string, TaskFrame> frames;  // by frame segment name
+  for (const SegmentTarget& t : targets)
+    if (!t.frame.empty() && !frames.count(t.frame))
+      frames[t.frame] = taskFrame(library, targets, start.position, t.frame, &plan.warnings);
   Eigen::Vector3d position = start.position;
   Eigen::Quaterniond orientation = start.orientation;
   Eigen::Vector3d velocity = Eigen::Vector3d::Zero();
@@ -198,7 +257,9 @@ ExecutionPlan TaskPlanner::plan(const SkillLibrary& library,
     std::vector<Eigen::VectorXd> params;
     PlannedSegment planned;
     planned.name = seg.name.empty() ? target.name : seg.name;
+    const TaskFrame* frame = target.frame.empty() ? nullptr : &frames.at(target.frame);
     for (const DemoSkill& d : seg.demos) {
+      if (frame && !frame->demo_yaw.count(d.demo_id)) continue;
       if (use_all) {
         const auto it = all_params.find(d.demo_id);
         if (it == all_params.end()) continue;
@@ -206,7 +267,7 @@ ExecutionPlan TaskPlanner::plan(const SkillLibrary& library,
       } else {
         params.push_back(d.parameters);
       }
-      dmps.push_back(d.dmp);
+      dmps.push_back(frame ? d.dmp.rotated(yawMatrix(-frame->demo_yaw.at(d.demo_id))) : d.dmp);
       planned.demos.push_back(d.demo_id);
     }
     if (dmps.empty())
@@ -214,8 +275,9 @@ ExecutionPlan TaskPlanner::plan(const SkillLibrary& library,
     if (!dmps.front().position || dmps.front().position->dims() != 3)
       throw std::invalid_argument("segment " + std::to_string(s) + " has no 3-D position DMP");
     const Eigen::VectorXd query = use_all ? all_query : Eigen::VectorXd(target.position);
-    const lfd::GeneralizationResult gen =
+    lfd::GeneralizationResult gen =
         lfd::generalizeSegment(dmps, params, query, options.generalization);
+    if (frame) gen.dmp = gen.dmp.rotated(yawMatrix(frame->yaw));
     if (gen.outside_demo_range) {
       planned.outside_demo_range = true;
       plan.warnings.push_back("segment " + planned.name + ": " + gen.warning);

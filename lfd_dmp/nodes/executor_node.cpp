@@ -131,7 +131,15 @@ class Executor {
           for (int k = 0; k < 3; ++k) r.offset[k] = number(s["offset"][k], where + ".offset");
         }
         if (s.hasMember("along_push")) r.along_push = number(s["along_push"], where);
+        if (s.hasMember("frame")) r.frame = text(s["frame"], where + ".frame");
         model.segments.push_back(r);
+      }
+      for (const auto& r : model.segments) {
+        bool known = r.frame.empty();
+        for (const auto& other : model.segments) known = known || other.name == r.frame;
+        if (!known)
+          throw std::runtime_error("executor: ~tasks: " + task + "." + r.name + ".frame '" +
+                                   r.frame + "' names no segment of the task");
       }
       models_[task] = model;
     }

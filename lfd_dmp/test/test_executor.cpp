@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <string>
+#include <vector>
 
 namespace {
 
@@ -54,30 +55,46 @@ lfd::SegmentDmp learnSegment(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
   return lfd::SegmentDmp::learn(d, params);
 }
 
-// Three demos of a two-segment "reach then carry" task around the home TCP pose; the gripper
-// closes during the first segment.
-lfd_dmp::SkillLibrary library(const lfd_dmp::TcpPose& home) {
+// A two-segment library: demo j moves home -> via[j] in t0 s (gripper g0 -> g1), then
+// via[j] -> end[j] in t1 s (gripper held at g1).
+struct TwoSegmentTask {
+  std::string task, first, second;
+  double g0 = 0.0, g1 = 0.0, t0 = 2.0, t1 = 2.5;
+};
+lfd_dmp::SkillLibrary twoSegmentLibrary(const TwoSegmentTask& spec, const lfd_dmp::TcpPose& home,
+                                        const std::vector<Eigen::Vector3d>& via,
+                                        const std::vector<Eigen::Vector3d>& end) {
   lfd_dmp::SkillLibrary lib;
-  lib.task = "grasp";
+  lib.task = spec.task;
   lib.segments.resize(2);
-  lib.segments[0].name = "approach";
-  lib.segments[1].name = "move";
-  const Eigen::Vector3d offsets[3] = {
-      {0.05, -0.05, -0.04}, {-0.05, -0.03, -0.05}, {0.0, 0.06, -0.045}};
-  for (int j = 0; j < 3; ++j) {
-    const Eigen::Vector3d grasp = home.position + offsets[j];
-    const Eigen::Vector3d goal = grasp + Eigen::Vector3d(-0.04 * j, 0.05, 0.12);
+  lib.segments[0].name = spec.first;
+  lib.segments[1].name = spec.second;
+  for (size_t j = 0; j < via.size(); ++j) {
     for (int s = 0; s < 2; ++s) {
       lfd_dmp::DemoSkill d;
-      d.demo_id = "demo_" + std::to_string(j);
-      d.dmp = s == 0 ? learnSegment(home.position, grasp, home.orientation, 0.04, 0.015, 2.0)
-                     : learnSegment(grasp, goal, home.orientation, 0.015, 0.015, 2.5);
+      d.demo_id = spec.task + "_" + std::to_string(j);
+      d.dmp = s == 0
+                  ? learnSegment(home.position, via[j], home.orientation, spec.g0, spec.g1, spec.t0)
+                  : learnSegment(via[j], end[j], home.orientation, spec.g1, spec.g1, spec.t1);
       d.parameters = lfd::goalParameters(d.dmp);
       lib.dmp_parameters = d.dmp.params;
       lib.segments[s].demos.push_back(d);
     }
   }
   return lib;
+}
+
+// Three demos of a two-segment "reach then carry" task around the home TCP pose; the gripper
+// closes during the first segment.
+lfd_dmp::SkillLibrary library(const lfd_dmp::TcpPose& home) {
+  const Eigen::Vector3d offsets[3] = {
+      {0.05, -0.05, -0.04}, {-0.05, -0.03, -0.05}, {0.0, 0.06, -0.045}};
+  std::vector<Eigen::Vector3d> grasp, goal;
+  for (int j = 0; j < 3; ++j) {
+    grasp.push_back(home.position + offsets[j]);
+    goal.push_back(grasp.back() + Eigen::Vector3d(-0.04 * j, 0.05, 0.12));
+  }
+  return twoSegmentLibrary({"grasp", "approach", "move", 0.04, 0.015, 2.0, 2.5}, home, grasp, goal);
 }
 
 TEST(GripperEvents, ClosesOnceAtTheMiddleOfTheRange) {
@@ -143,7 +160,8 @@ TEST(SegmentTargets, GraspAndPushRulesFollowTheSituation) {
        lfd_dmp::GoalReference::kGoal,
        {0, 0, 0},
        -0.052,
-       lfd_dmp::OrientationRule::kPushYaw},
+       lfd_dmp::OrientationRule::kPushYaw,
+       "push"},
       {"return", lfd_dmp::GoalReference::kStart, {0, 0, 0}, 0.0, lfd_dmp::OrientationRule::kStart}};
   s.object_position = {0.5, -0.16, -0.01};
   s.goal_position = {0.5, -0.30, -0.01};  // push along -y
@@ -153,6 +171,8 @@ TEST(SegmentTargets, GraspAndPushRulesFollowTheSituation) {
   EXPECT_NEAR((p[0].position - Eigen::Vector3d(0.5, -0.16 + 0.072, -0.01)).norm(), 0.0, 1e-12);
   EXPECT_NEAR((p[1].position - Eigen::Vector3d(0.5, -0.30 + 0.052, -0.01)).norm(), 0.0, 1e-12);
   EXPECT_NEAR((p[2].position - start.position).norm(), 0.0, 1e-12);
+  EXPECT_EQ(p[0].frame, "");
+  EXPECT_EQ(p[1].frame, "push");
   EXPECT_NEAR((*p[0].orientation * Eigen::Vector3d::UnitX() - Eigen::Vector3d(0, -1, 0)).norm(),
               0.0, 1e-9);
   s.goal_position = s.object_position;
@@ -231,6 +251,68 @@ TEST_F(PlannerTest, RefusesUnreachableGoalsAndMismatchedLibraries) {
                std::invalid_argument);
   lfd_dmp::SkillLibrary empty;
   EXPECT_THROW(planner_.plan(empty, {}, q0_, 0.04, opt), std::invalid_argument);
+}
+
+// Three push demos, each: approach (home -> behind the box), push (0.1 m straight along its
+// direction). Directions +x, -y and +x+y: the pushes differ only by their heading.
+lfd_dmp::SkillLibrary pushLibrary(const lfd_dmp::TcpPose& home) {
+  const Eigen::Vector3d contacts[3] = {
+      {0.02, 0.04, -0.05}, {0.08, 0.06, -0.05}, {0.0, -0.06, -0.05}};
+  const Eigen::Vector3d directions[3] = {Eigen::Vector3d::UnitX(), -Eigen::Vector3d::UnitY(),
+                                         Eigen::Vector3d(1, 1, 0).normalized()};
+  std::vector<Eigen::Vector3d> contact, end;
+  for (int j = 0; j < 3; ++j) {
+    contact.push_back(home.position + contacts[j]);
+    end.push_back(contact.back() + 0.1 * directions[j]);
+  }
+  return twoSegmentLibrary({"push", "approach", "push", 0.0, 0.0, 2.0, 3.0}, home, contact, end);
+}
+
+// Largest distance of the planned push segment from the straight stroke it should follow.
+double strokeDeviation(const lfd_dmp::ExecutionPlan& plan, const Eigen::Vector3d& a,
+                       const Eigen::Vector3d& b) {
+  const Eigen::Vector3d u = (b - a).normalized();
+  double worst = 0.0;
+  for (size_t k = plan.segments[1].begin; k < plan.segments[1].end; ++k) {
+    const Eigen::Vector3d r = plan.poses[k].position - a;
+    worst = std::max(worst, (r - r.dot(u) * u).norm());
+  }
+  return worst;
+}
+
+TEST_F(PlannerTest, TaskFrameKeepsAPushStraightInANewDirection) {
+  const lfd_dmp::SkillLibrary lib = pushLibrary(home_);
+  // A direction no demo pushed in: 29 degrees clockwise from +x.
+  const Eigen::Vector3d contact = home_.position + Eigen::Vector3d(0.03, 0.0, -0.05);
+  const Eigen::Vector3d end = contact + 0.1 * Eigen::Vector3d(std::cos(-0.5), std::sin(-0.5), 0);
+  std::vector<lfd_dmp::SegmentTarget> t = {{"approach", contact, home_.orientation, ""},
+                                           {"push", end, home_.orientation, "push"}};
+  lfd_dmp::ExecutorOptions opt;
+  opt.dt = 0.004;
+  for (bool local_linear : {true, false}) {
+    opt.generalization.local_linear = local_linear;
+    t[1].frame = "push";
+    const lfd_dmp::ExecutionPlan framed = planner_.plan(lib, t, q0_, std::nullopt, opt);
+    EXPECT_LT(strokeDeviation(framed, contact, end), 0.001) << "local_linear " << local_linear;
+    EXPECT_LT((framed.poses.back().position - end).norm(), 0.004);
+    t[1].frame.clear();
+    const lfd_dmp::ExecutionPlan world = planner_.plan(lib, t, q0_, std::nullopt, opt);
+    if (!local_linear) {  // the convex mix of the demos' headings bends the stroke
+      EXPECT_GT(strokeDeviation(world, contact, end), 0.005);
+    }
+  }
+  // A heading that is not defined, or a frame segment that does not exist: clear refusals.
+  const std::vector<lfd_dmp::SegmentTarget> no_stroke = {
+      {"approach", contact, home_.orientation, ""},
+      {"push", contact + Eigen::Vector3d(0.005, 0, 0.02), home_.orientation, "push"}};
+  try {
+    planner_.plan(lib, no_stroke, q0_, std::nullopt, opt);
+    FAIL() << "a push without a heading was planned";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("heading"), std::string::npos) << e.what();
+  }
+  t[1].frame = "lift";
+  EXPECT_THROW(planner_.plan(lib, t, q0_, std::nullopt, opt), std::invalid_argument);
 }
 
 }  // namespace

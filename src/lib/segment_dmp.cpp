@@ -149,6 +149,32 @@ SegmentTrajectory SegmentDmp::rollout(const SegmentRolloutOptions& o) const {
   return traj;
 }
 
+SegmentDmp SegmentDmp::rotated(const Eigen::Matrix3d& r) const {
+  if (!r.allFinite() || !(r.transpose() * r).isIdentity(1e-9) || !(r.determinant() > 0.0)) {
+    throw std::invalid_argument("SegmentDmp::rotated: the matrix is not a rotation");
+  }
+  if (position && position->dims() != 3) {
+    throw std::invalid_argument("SegmentDmp::rotated: the position part is " +
+                                std::to_string(position->dims()) + "-D, not 3-D");
+  }
+  SegmentDmp out = *this;
+  // Weights are rows of 3-vectors (one per basis function): w' = w r^T.
+  if (position) {
+    const PositionDmp& p = *position;
+    out.position.emplace(params, tau, p.weights() * r.transpose(), r * p.start(), r * p.goal(),
+                         r * p.startVelocity());
+  }
+  if (orientation) {
+    const OrientationDmp& o = *orientation;
+    const Eigen::Quaterniond q(r);
+    out.orientation.emplace(params, tau, o.weights() * r.transpose(), q * o.start(), q * o.goal(),
+                            r * o.startAngularVelocity());
+    out.orientation->normalized_input_ = o.normalizedInput();
+    out.orientation->sign_flips_ = o.signFlips();
+  }
+  return out;
+}
+
 // ---------------------------------------------------------------------------------------------
 
 SegmentDmpRunner::SegmentDmpRunner(const SegmentDmp& dmp, const SegmentRolloutOptions& o)

@@ -4,6 +4,8 @@
 #include "lfd_core/quaternion_log.hpp"
 #include "lfd_core/segment_dmp.hpp"
 
+#include "dmp_test_curves.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -113,6 +115,64 @@ TEST(OrientationDmp, SignFlipsAndNonUnitInputGiveTheSameDmp) {
   const lfd::SegmentDmp sd = lfd::SegmentDmp::learn(seg);
   ASSERT_EQ(sd.warnings.size(), 1u);
   EXPECT_NE(sd.warnings[0].find("normalized"), std::string::npos);
+}
+
+// A task frame is only usable if rotating a learned skill is the same as learning the rotated
+// demonstration, and rolling the rotated skill out gives the rotated motion.
+TEST(SegmentDmp, RotatedSkillIsTheSkillOfTheRotatedDemo) {
+  const Eigen::VectorXd t = Eigen::VectorXd::LinSpaced(400, 0.0, kDuration);
+  lfd::SegmentDemo demo;
+  demo.times = t;
+  demo.positions = lfd_test::curve3d(t, kDuration);
+  demo.quaternions = orientationDemo(t);
+  demo.gripper = Eigen::VectorXd::LinSpaced(t.size(), 0.08, 0.0);
+  const Eigen::Matrix3d r =
+      Eigen::AngleAxisd(0.9, Eigen::Vector3d(0.2, -0.4, 1.0).normalized()).toRotationMatrix();
+  const Eigen::Quaterniond qr(r);
+
+  lfd::SegmentDemo turned = demo;
+  turned.positions = demo.positions * r.transpose();
+  for (Eigen::Index i = 0; i < t.size(); ++i) {
+    const Eigen::Quaterniond q = qr * rowQuat(demo.quaternions, i);
+    turned.quaternions.row(i) << q.w(), q.x(), q.y(), q.z();
+  }
+  const lfd::SegmentDmp skill = lfd::SegmentDmp::learn(demo);
+  const lfd::SegmentDmp rotated = skill.rotated(r);
+  const lfd::SegmentDmp learned_turned = lfd::SegmentDmp::learn(turned);
+  const double wscale =
+      1.0 + skill.position->weights().norm() + skill.orientation->weights().norm();
+  EXPECT_LT((rotated.position->weights() - learned_turned.position->weights()).norm(),
+            1e-9 * wscale);
+  EXPECT_LT((rotated.orientation->weights() - learned_turned.orientation->weights()).norm(),
+            1e-9 * wscale);
+  EXPECT_EQ(rotated.gripper->weights(), skill.gripper->weights());
+
+  // New start and goal, given in the world: the rotated skill from rotated boundary conditions.
+  lfd::SegmentRolloutOptions o;
+  o.dt = 0.004;
+  o.start_position = Eigen::VectorXd(Eigen::Vector3d(0.1, 0.2, 0.3));
+  o.goal_position = Eigen::VectorXd(Eigen::Vector3d(0.5, -0.1, 0.4));
+  o.start_orientation = Eigen::Quaterniond(Eigen::AngleAxisd(0.2, Eigen::Vector3d::UnitX()));
+  o.goal_orientation = Eigen::Quaterniond(Eigen::AngleAxisd(-0.7, Eigen::Vector3d::UnitY()));
+  lfd::SegmentRolloutOptions ro = o;
+  ro.start_position = Eigen::VectorXd(r * Eigen::Vector3d(*o.start_position));
+  ro.goal_position = Eigen::VectorXd(r * Eigen::Vector3d(*o.goal_position));
+  ro.start_orientation = qr * *o.start_orientation;
+  ro.goal_orientation = qr * *o.goal_orientation;
+  const lfd::SegmentTrajectory a = skill.rollout(o);
+  const lfd::SegmentTrajectory b = rotated.rollout(ro);
+  ASSERT_EQ(a.times.size(), b.times.size());
+  EXPECT_LT((a.positions * r.transpose() - b.positions).cwiseAbs().maxCoeff(), 1e-9);
+  double worst_angle = 0.0;
+  for (Eigen::Index i = 0; i < a.times.size(); ++i) {
+    worst_angle = std::max(worst_angle,
+                           angleBetween(qr * rowQuat(a.quaternions, i), rowQuat(b.quaternions, i)));
+  }
+  EXPECT_LT(worst_angle, 1e-7);
+  EXPECT_LT((a.gripper - b.gripper).cwiseAbs().maxCoeff(), 1e-12);
+
+  EXPECT_THROW(skill.rotated(2.0 * r), std::invalid_argument);  // not orthonormal
+  EXPECT_THROW(skill.rotated(-Eigen::Matrix3d::Identity()), std::invalid_argument);  // reflection
 }
 
 TEST(OrientationDmp, StartEqualsGoalStaysBounded) {

@@ -44,6 +44,7 @@ struct SegmentGoalRule {
   Eigen::Vector3d offset = Eigen::Vector3d::Zero();
   double along_push = 0.0;
   OrientationRule orientation = OrientationRule::kLearned;
+  std::string frame;  ///< SegmentTarget::frame
 };
 
 /// One rule per segment of the task's skill library, in order.
@@ -64,6 +65,12 @@ struct SegmentTarget {
   std::string name;
   Eigen::Vector3d position = Eigen::Vector3d::Zero();
   std::optional<Eigen::Quaterniond> orientation;  ///< empty: the learned (generalized) goal
+  /// Generalize in the heading frame of the named segment ("" = base_link): each demo's DMP is
+  /// rotated about z so that that segment's start->goal direction (in xy) points along x,
+  /// interpolated there, and rotated into the new heading of that segment. Why: a push stroke has
+  /// the same shape in its own frame whatever its direction, while in base_link the forcing terms
+  /// of pushes in different directions point different ways and their mix pushes the box sideways.
+  std::string frame;
 };
 
 GoalReference parseGoalReference(const std::string& s);      ///< object | goal | start
@@ -73,6 +80,10 @@ OrientationRule parseOrientationRule(const std::string& s);  ///< object_yaw | g
 std::vector<SegmentTarget> segmentTargets(const TaskGoalModel& model,
                                           const TaskSituation& situation, const TcpPose& start,
                                           const Eigen::Quaterniond& gripper_orientation);
+
+/// Yaw of the horizontal direction from `from` to `to`; throws std::invalid_argument when their xy
+/// distance is below `min_length` (the heading is then undefined).
+double headingYaw(const Eigen::Vector3d& from, const Eigen::Vector3d& to, double min_length);
 
 /// A change of the thresholded gripper state at `sample` (close = true).
 struct GripperEvent {

@@ -64,6 +64,14 @@ struct SegmentDmp {
   void validate() const;
 
   SegmentTrajectory rollout(const SegmentRolloutOptions& options = {}) const;
+
+  /// The same skill seen in a frame rotated by `r` (a proper rotation of the world): the 3-D
+  /// position's forcing weights, start, goal and start velocity, and the orientation's weights,
+  /// start, goal and angular velocity are rotated; the gripper is unchanged. The transformation
+  /// system is rotation-covariant, so a rollout of the rotated DMP from rotated start and goal is
+  /// the rotated rollout. This lets demos of different headings be compared in a task frame.
+  /// Throws std::invalid_argument if r is not a rotation or the position part is not 3-D.
+  SegmentDmp rotated(const Eigen::Matrix3d& r) const;
 };
 
 /// Goal update for a running segment (moving goals); unset parts keep their current goal.
