@@ -1,6 +1,8 @@
 #include "lfd_dmp/skill_learner.hpp"
 
 #include <lfd_core/dmp_generalization.hpp>
+#include <lfd_core/quaternion_log.hpp>
+#include <lfd_core/smooth_derivatives.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -34,6 +36,27 @@ void checkRecording(const DemoRecording& rec) {
   if (rec.gripper.size() > 0 && rec.gripper.size() != m) fail("gripper must have M samples");
 }
 
+// The recording with its pose low-passed (quaternions on one hemisphere first, renormalized after).
+// Non-unit input quaternions are reported as without smoothing.
+DemoRecording smoothed(const DemoRecording& rec, double sigma, std::vector<std::string>* warnings) {
+  if (sigma <= 0.0) return rec;
+  DemoRecording out = rec;
+  out.positions = lfd::gaussianSmooth(rec.times, rec.positions, sigma);
+  if (rec.quaternions.cols() == 4) {
+    const lfd::QuaternionSequence seq = lfd::makeContinuousQuaternions(rec.quaternions);
+    if (seq.normalized_input)
+      warnings->push_back("demo " + rec.id + ": non-unit quaternions were normalized");
+    Eigen::MatrixXd q(rec.quaternions.rows(), 4);
+    for (size_t i = 0; i < seq.quaternions.size(); ++i) {
+      const Eigen::Quaterniond& r = seq.quaternions[i];
+      q.row(static_cast<Eigen::Index>(i)) << r.w(), r.x(), r.y(), r.z();
+    }
+    out.quaternions = lfd::gaussianSmooth(rec.times, q, sigma);
+    out.quaternions.rowwise().normalize();
+  }
+  return out;
+}
+
 }  // namespace
 
 LearnOutcome learnSkillLibrary(const std::vector<DemoRecording>& demos,
@@ -46,6 +69,8 @@ LearnOutcome learnSkillLibrary(const std::vector<DemoRecording>& demos,
                                 " changepoint lists");
   }
   options.params.validate();
+  if (!(options.smoothing_sigma >= 0.0) || !std::isfinite(options.smoothing_sigma))
+    throw std::invalid_argument("learnSkillLibrary: smoothing_sigma must be a finite value >= 0");
   // Majority vote on the number of segments (ties: fewer segments).
   std::map<size_t, size_t> votes;
   for (const auto& cps : changepoint_times) ++votes[cps.size()];
@@ -71,13 +96,12 @@ LearnOutcome learnSkillLibrary(const std::vector<DemoRecording>& demos,
   }
 
   for (size_t d = 0; d < demos.size(); ++d) {
-    const DemoRecording& rec = demos[d];
-    checkRecording(rec);
+    checkRecording(demos[d]);
+    const DemoRecording rec = smoothed(demos[d], options.smoothing_sigma, &outcome.warnings);
     const auto& cps = changepoint_times[d];
     if (cps.size() != cp_count) {
       outcome.warnings.push_back("demo " + rec.id + " skipped: " + std::to_string(cps.size()) +
-                                 " changepoints, the other demos have " +
-                                 std::to_string(cp_count));
+                                 " changepoints, the other demos have " + std::to_string(cp_count));
       continue;
     }
     // Boundaries: sample indices nearest to each changepoint; segments share boundary samples so

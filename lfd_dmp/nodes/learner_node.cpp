@@ -1,7 +1,8 @@
 // learner_node: service /learner/learn (lfd_msgs/LearnSkills). Reads the demonstration bags, cuts
 // them at the validated changepoints, learns one DMP set per segment per demo and writes the
 // skill library. Thin adapter over lfd_dmp::learnSkillLibrary / readDemoBag.
-// Private parameters: ~pose_topic, ~gripper_topic, ~gripper_joint, ~num_basis.
+// Private parameters (config/learner.yaml): ~pose_topic, ~gripper_topic, ~gripper_joint,
+// ~num_basis, ~smoothing_sigma.
 #include "lfd_dmp/demo_bag.hpp"
 #include "lfd_dmp/skill_learner.hpp"
 
@@ -19,6 +20,11 @@ class Learner {
     pnh.param<std::string>("gripper_topic", topics_.gripper, topics_.gripper);
     pnh.param<std::string>("gripper_joint", topics_.gripper_joint, topics_.gripper_joint);
     pnh.param<int>("num_basis", num_basis_, num_basis_);
+    pnh.param<double>("smoothing_sigma", smoothing_sigma_, smoothing_sigma_);
+    if (!(smoothing_sigma_ >= 0.0)) {
+      ROS_WARN("learner: ~smoothing_sigma %.3f < 0: smoothing off", smoothing_sigma_);
+      smoothing_sigma_ = 0.0;
+    }
   }
 
   bool learn(lfd_msgs::LearnSkills::Request& req, lfd_msgs::LearnSkills::Response& res) {
@@ -60,6 +66,7 @@ class Learner {
       opt.features = req.selected_features;
       opt.segment_names = req.segment_names;
       opt.params.num_basis = req.num_basis > 0 ? req.num_basis : num_basis_;
+      opt.smoothing_sigma = smoothing_sigma_;
       const lfd_dmp::LearnOutcome out = lfd_dmp::learnSkillLibrary(demos, cps, opt);
       lfd_dmp::saveSkillLibrary(out.library, req.output_path);
       res.success = true;
@@ -82,6 +89,7 @@ class Learner {
  private:
   lfd_dmp::DemoBagTopics topics_;
   int num_basis_ = lfd::DmpParameters().num_basis;
+  double smoothing_sigma_ = 0.0;
 };
 
 }  // namespace

@@ -91,4 +91,36 @@ SmoothDerivatives smoothDerivatives(const Eigen::VectorXd& times, const Eigen::M
   return out;
 }
 
+Eigen::MatrixXd gaussianSmooth(const Eigen::VectorXd& times, const Eigen::MatrixXd& values,
+                               double sigma) {
+  if (!(sigma >= 0.0) || !std::isfinite(sigma))
+    throw std::invalid_argument("gaussianSmooth: sigma must be a finite value >= 0");
+  if (times.size() != values.rows())
+    throw std::invalid_argument("gaussianSmooth: " + std::to_string(times.size()) + " times but " +
+                                std::to_string(values.rows()) + " samples");
+  if (!times.allFinite() || !values.allFinite())
+    throw std::invalid_argument("gaussianSmooth: NaN or infinite input");
+  const Eigen::Index m = times.size();
+  for (Eigen::Index i = 1; i < m; ++i)
+    if (!(times[i] > times[i - 1]))
+      throw std::invalid_argument("gaussianSmooth: times must be strictly increasing");
+  if (sigma == 0.0 || m < 2) return values;
+  const double reach = 4.0 * sigma, inv2s2 = 0.5 / (sigma * sigma);
+  Eigen::MatrixXd out(m, values.cols());
+  Eigen::Index lo = 0, hi = 0;  // window [lo, hi) slides with i
+  for (Eigen::Index i = 0; i < m; ++i) {
+    while (times[i] - times[lo] > reach) ++lo;
+    while (hi < m && times[hi] - times[i] <= reach) ++hi;
+    double s0 = 0.0;
+    Eigen::RowVectorXd acc = Eigen::RowVectorXd::Zero(values.cols());
+    for (Eigen::Index j = lo; j < hi; ++j) {
+      const double d = times[j] - times[i], w = std::exp(-d * d * inv2s2);
+      s0 += w;
+      acc += w * values.row(j);
+    }
+    out.row(i) = acc / s0;
+  }
+  return out;
+}
+
 }  // namespace lfd

@@ -62,6 +62,36 @@ TEST(SmoothDerivatives, ExactForPolynomialsOnNonUniformTimes) {
   }
 }
 
+// The demo smoother removes tremor-band noise, keeps the slow motion and lines (in the interior;
+// at the ends it averages one-sided, as for a recording that starts and ends at rest).
+TEST(GaussianSmooth, RemovesTremorKeepsMotionAndLines) {
+  const int m = 2000;
+  Eigen::VectorXd t(m);
+  for (int i = 0; i < m; ++i) t[i] = 0.005 * i + 0.001 * std::sin(0.7 * i);  // non-uniform
+  const double sigma = 0.05;
+  Eigen::MatrixXd y(m, 3);
+  for (int i = 0; i < m; ++i) {
+    y(i, 0) = 0.3 - 0.2 * t[i];                  // a line
+    y(i, 1) = std::sin(2 * M_PI * 0.5 * t[i]);   // 0.5 Hz motion
+    y(i, 2) = std::sin(2 * M_PI * 10.0 * t[i]);  // 10 Hz tremor
+  }
+  const Eigen::MatrixXd s = lfd::gaussianSmooth(t, y, sigma);
+  // Gains in the interior (2 s of margin) against exp(-2 (pi sigma f)^2).
+  const Eigen::Index a = 400, n = m - 800;
+  EXPECT_LT((s.col(0) - y.col(0)).segment(a, n).cwiseAbs().maxCoeff(), 2e-5);  // 0.2 s x 1e-4 s
+  EXPECT_LT(std::abs(s(0, 2)), 0.3);  // the one-sided ends still damp the tremor (to 29 %)
+  const double gain_slow = std::exp(-2 * std::pow(M_PI * sigma * 0.5, 2));
+  EXPECT_LT((s.col(1) - gain_slow * y.col(1)).segment(a, n).cwiseAbs().maxCoeff(), 0.01);
+  EXPECT_GT(gain_slow, 0.98);
+  EXPECT_LT(s.col(2).segment(a, n).cwiseAbs().maxCoeff(), 0.01);  // 1 % of the tremor is left
+  EXPECT_EQ(lfd::gaussianSmooth(t, y, 0.0), y);
+  EXPECT_THROW(lfd::gaussianSmooth(t, y, -0.1), std::invalid_argument);
+  EXPECT_THROW(lfd::gaussianSmooth(t.head(10), y, sigma), std::invalid_argument);
+  Eigen::MatrixXd bad = y;
+  bad(5, 1) = std::nan("");
+  EXPECT_THROW(lfd::gaussianSmooth(t, bad, sigma), std::invalid_argument);
+}
+
 TEST(PositionDmp, Reproduces2dCurveWithin0p1PercentOfExtent) {
   const double pct = reproductionRmsePercent(lfd_test::curve2d(demoTimes(), kDuration));
   RecordProperty("rmse_percent_2d", std::to_string(pct));

@@ -24,6 +24,9 @@ struct LearnOptions {
   std::vector<std::string> features;       ///< selected segmentation features (stored)
   std::vector<std::string> segment_names;  ///< optional; default "segment_<i>"
   lfd::DmpParameters params;
+  /// s; Gaussian low-pass of every recorded pose before it is cut and learned (lfd::gaussianSmooth;
+  /// 0 = off). Teleoperated demos carry tremor that the DMPs would otherwise replay.
+  double smoothing_sigma = 0.0;
 };
 
 struct LearnOutcome {
