@@ -42,6 +42,8 @@ lfd_msgs::DemoSegmentation demo_message(const DemoFeatures& demo,
   m.changepoint_times = r.changepoint_times;
   m.rejected.assign(r.rejected.begin(), r.rejected.end());
   m.rejected_times = r.rejected_times;
+  m.pruned.assign(r.pruned.begin(), r.pruned.end());
+  m.pruned_times = r.pruned_times;
   for (const lfd::SplitCandidate& c : r.clasp.candidates) {
     m.candidates.push_back(static_cast<uint32_t>(c.index));
     m.candidate_scores.push_back(c.score);

@@ -115,6 +115,8 @@ json to_json(const lfd::SegmentationPipelineResult& r, const std::vector<lfd::Fe
     demo["changepoint_times"] = s.changepoint_times;
     demo["rejected"] = s.rejected;
     demo["rejected_times"] = s.rejected_times;
+    demo["pruned"] = s.pruned;
+    demo["pruned_times"] = s.pruned_times;
     demo["events"] = s.events;
     demo["zones"] = zones;
     demo_list.push_back(demo);

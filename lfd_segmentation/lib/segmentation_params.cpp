@@ -104,6 +104,7 @@ SegmentationParams params_from_yaml(const YAML::Node& root) {
       get<bool>(root, "validate_with_sensors", p.pipeline.validate_with_sensors);
   p.pipeline.search_in_zones = get<bool>(root, "search_in_zones", p.pipeline.search_in_zones);
   p.pipeline.anchor_to_events = get<bool>(root, "anchor_to_events", p.pipeline.anchor_to_events);
+  p.pipeline.consensus_count = get<bool>(root, "consensus_count", p.pipeline.consensus_count);
   p.pipeline.threads = get<int>(root, "threads", p.pipeline.threads);
 
   const YAML::Node clasp = root["clasp"];

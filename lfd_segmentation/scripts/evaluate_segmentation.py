@@ -91,6 +91,7 @@ def evaluate_dataset(segment, folder, method, config):
         demos.append({"bag": os.path.basename(bag), "correct": ok, "reason": why,
                       "changepoints_s": list(demo.changepoint_times),
                       "rejected_s": list(demo.rejected_times),
+                      "pruned_s": list(demo.pruned_times),
                       "windows_s": windows,
                       "zones_s": [(z.begin_time, z.end_time) for z in demo.zones]})
     return {"task": task, "method": method, "demos": len(bags), "correct": correct,

@@ -9,7 +9,8 @@
       relevance.png           Fig. 4: mean correlation vs. DTW-weighted score, threshold T x best
       clasp_profile.png       Fig. 5: combined ClaSP profile, Kaiser-penalized profile, candidates
       segmentation.png        Fig. 8: selected features and sensors, confidence zones, validated
-                              changepoints (solid), rejected candidates (dashed), ground-truth
+                              changepoints (solid), rejected candidates (dashed), changepoints
+                              pruned to the task's count (dotted), ground-truth
                               phases from /lfd/phase as background (evaluation only)
 
   plot_segmentation.py --dataset BAG_DIR [--config ...] --out DIR [--demo ...] [--prefix NAME_]
@@ -441,6 +442,9 @@ def mark_changepoints(ax, demo, rate, label=True):
     for i, cp in enumerate(demo.get("rejected", [])):
         ax.axvline(cp / rate, color="dimgray", lw=1.4, ls="--",
                    label="rejected candidate" if label and i == 0 else None)
+    for i, cp in enumerate(demo.get("pruned", [])):
+        ax.axvline(cp / rate, color="purple", lw=1.4, ls=":",
+                   label="pruned to the task's count" if label and i == 0 else None)
 
 
 def plot_profile(seg, d, rate, out, prefix, written, tag=""):

@@ -261,36 +261,48 @@ MultivariateSegmentation segment_multivariate(const Eigen::MatrixXd& features,
       for (std::size_t i = 0; i < used_features.size(); ++i)
         out.first_feature_profiles[used_features[i]] = profiles[i];
     }
-    Eigen::Index best = -1;
-    for (Eigen::Index t = 0; t < penalized.size(); ++t) {
-      if (std::isnan(penalized[t]) || (best >= 0 && penalized[t] <= penalized[best])) continue;
-      if (!in_candidate_zone(begin + static_cast<std::size_t>(t))) continue;
-      best = t;
+    // Each zone is its own hypothesis: when the best in-zone split of this range is not
+    // significant, the range's other zones are still tested (next best first).
+    std::vector<bool> tested(zones.size(), false);
+    for (;;) {
+      Eigen::Index best = -1;
+      for (Eigen::Index t = 0; t < penalized.size(); ++t) {
+        if (std::isnan(penalized[t]) || (best >= 0 && penalized[t] <= penalized[best])) continue;
+        const std::size_t at = begin + static_cast<std::size_t>(t);
+        if (!in_candidate_zone(at)) continue;
+        if (restricted && tested[static_cast<std::size_t>(zone_of(at))]) continue;
+        best = t;
+      }
+      if (best < 0) return;
+      // ClaSP's own evidence (the significance at its argmax) decides whether the zone holds a
+      // changepoint; the zone's sensory event then says when (zone_anchors).
+      double weighted_log_p = 0.0, weight_sum = 0.0;
+      for (std::size_t i = 0; i < knns.size(); ++i) {
+        weighted_log_p +=
+            used_weights[i] * split_log10_p_value(knns[i], static_cast<std::size_t>(best));
+        weight_sum += used_weights[i];
+      }
+      SplitCandidate c;
+      const Eigen::Index anchor = anchor_for(penalized, begin, best);
+      c.index = begin + static_cast<std::size_t>(anchor >= 0 ? anchor : best);
+      c.profile_argmax = begin + static_cast<std::size_t>(best);
+      c.anchored = anchor >= 0;
+      c.range_begin = begin;
+      c.range_end = end;
+      c.score = penalized[best];
+      c.log10_p_value = weighted_log_p / weight_sum;
+      out.candidates.push_back(c);
+      const double needed = restricted && config.zone_p_value_threshold > 0.0
+                                ? std::log10(config.zone_p_value_threshold)
+                                : log10_threshold;
+      if (learn && c.log10_p_value > needed) {  // not significant
+        if (!restricted) return;                // plain ClaSP: the range stays whole
+        tested[static_cast<std::size_t>(zone_of(c.profile_argmax))] = true;
+        continue;
+      }
+      queue.push({c.score, out.candidates.size() - 1});
+      return;
     }
-    if (best < 0) return;
-    // ClaSP's own evidence (the significance at its argmax) decides whether the zone holds a
-    // changepoint; the zone's sensory event then says when (zone_anchors).
-    double weighted_log_p = 0.0, weight_sum = 0.0;
-    for (std::size_t i = 0; i < knns.size(); ++i) {
-      weighted_log_p +=
-          used_weights[i] * split_log10_p_value(knns[i], static_cast<std::size_t>(best));
-      weight_sum += used_weights[i];
-    }
-    SplitCandidate c;
-    const Eigen::Index anchor = anchor_for(penalized, begin, best);
-    c.index = begin + static_cast<std::size_t>(anchor >= 0 ? anchor : best);
-    c.profile_argmax = begin + static_cast<std::size_t>(best);
-    c.anchored = anchor >= 0;
-    c.range_begin = begin;
-    c.range_end = end;
-    c.score = penalized[best];
-    c.log10_p_value = weighted_log_p / weight_sum;
-    out.candidates.push_back(c);
-    const double needed = restricted && config.zone_p_value_threshold > 0.0
-                              ? std::log10(config.zone_p_value_threshold)
-                              : log10_threshold;
-    if (learn && c.log10_p_value > needed) return;  // not significant: range stays whole
-    queue.push({c.score, out.candidates.size() - 1});
   };
 
   evaluate(0, n, true);

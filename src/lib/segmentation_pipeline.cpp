@@ -5,7 +5,9 @@
 #include <chrono>
 #include <cmath>
 #include <exception>
+#include <map>
 #include <set>
+#include <sstream>
 #include <stdexcept>
 #include <thread>
 
@@ -85,6 +87,52 @@ void for_each_demo(std::size_t count, int threads, Job job) {
     } catch (const std::exception& e) {
       throw std::runtime_error(demo_context(d) + ": " + e.what());
     }
+  }
+}
+
+// SegmentationPipelineConfig::consensus_count. Significance of a changepoint: the log10 p-value
+// of the ClaSP candidate that placed it.
+void prune_to_consensus(const std::vector<FeatureMatrix>& demos,
+                        SegmentationPipelineResult* result) {
+  std::map<std::size_t, std::size_t> votes;  // changepoint count -> demos
+  for (const DemoSegmentationResult& d : result->demos) ++votes[d.changepoints.size()];
+  const auto top = std::max_element(
+      votes.begin(), votes.end(), [](const auto& a, const auto& b) { return a.second < b.second; });
+  const std::size_t n = result->demos.size();
+  if (n < 3 || 2 * top->second <= n) return;  // no clear majority: nothing to agree on
+  const std::size_t k = top->first;
+  for (std::size_t d = 0; d < n; ++d) {
+    DemoSegmentationResult& out = result->demos[d];
+    if (out.changepoints.size() <= k) continue;
+    std::vector<std::pair<double, std::size_t>> by_p;  // (log10 p, changepoint)
+    for (std::size_t cp : out.changepoints) {
+      double log_p = 0.0;
+      for (const SplitCandidate& c : out.clasp.candidates)
+        if (c.accepted && c.index == cp) log_p = c.log10_p_value;
+      by_p.emplace_back(log_p, cp);
+    }
+    std::stable_sort(by_p.begin(), by_p.end());
+    std::ostringstream msg;
+    msg << demo_context(d) << ": " << out.changepoints.size() << " changepoints where "
+        << top->second << " of " << n << " demonstrations have " << k
+        << "; dropped the least significant:";
+    out.changepoints.clear();
+    out.changepoint_times.clear();
+    for (std::size_t i = 0; i < by_p.size(); ++i) {
+      const std::size_t cp = by_p[i].second;
+      if (i < k) {
+        out.changepoints.push_back(cp);
+        continue;
+      }
+      out.pruned.push_back(cp);
+      msg << " t=" << demos[d].time_at(cp) << " (p=1e" << std::lround(by_p[i].first) << ")";
+    }
+    std::sort(out.changepoints.begin(), out.changepoints.end());
+    std::sort(out.pruned.begin(), out.pruned.end());
+    out.pruned_times.clear();
+    for (std::size_t cp : out.changepoints) out.changepoint_times.push_back(demos[d].time_at(cp));
+    for (std::size_t cp : out.pruned) out.pruned_times.push_back(demos[d].time_at(cp));
+    result->warnings.push_back(msg.str());
   }
 }
 
@@ -238,6 +286,7 @@ SegmentationPipelineResult run_segmentation_pipeline(
     for (std::size_t cp : out.changepoints) out.changepoint_times.push_back(demo.time_at(cp));
     for (std::size_t cp : out.rejected) out.rejected_times.push_back(demo.time_at(cp));
   });
+  if (config.consensus_count) prune_to_consensus(demos, &result);
   result.segmentation_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - segmentation_start).count();
   for (std::size_t d = 0; d < demos.size(); ++d) {

@@ -276,6 +276,32 @@ TEST(MultivariateSegmentation, ZoneThresholdAcceptsWeakerInZoneEvidence) {
   EXPECT_THROW(lfd::segment_multivariate(f, {1.0}, config), std::invalid_argument);
 }
 
+// The whole series' in-zone argmax is a weak change in the middle (where the Kaiser window does not
+// penalize): not significant enough. The other zone, with a strong change near the end, is still
+// tested and holds a changepoint; one insignificant zone does not close the others.
+TEST(MultivariateSegmentation, AnInsignificantZoneDoesNotCloseTheOthers) {
+  std::mt19937 rng(11);
+  std::normal_distribution<double> g(0.0, 1.0);
+  const int n = 1500, weak = 750, strong = 1300;
+  Eigen::MatrixXd f(n, 1);
+  for (int t = 0; t < n; ++t) {
+    const double s = std::sin(2.0 * M_PI * t / 40.0);
+    f(t, 0) = (t < weak ? s : (s >= 0 ? 1.0 : -1.0)) + g(rng) + (t < strong ? 0.0 : 4.0);
+  }
+  lfd::MultivariateSegmentationConfig config;
+  config.window_sizes = {20};
+  config.min_segment_length = 60;
+  config.candidate_zones = {{weak - 50, weak + 50}, {strong - 50, strong + 50}};
+  config.kaiser_beta = 6.0;  // a strong fade: the end's change ranks below the middle's
+  config.zone_p_value_threshold = 1e-40;  // the middle's split (1e-25) is not enough
+  const auto seg = lfd::segment_multivariate(f, {1.0}, config);
+  ASSERT_GE(seg.candidates.size(), 2u);
+  EXPECT_TRUE(config.candidate_zones[0].contains(seg.candidates[0].index));
+  EXPECT_FALSE(seg.candidates[0].accepted);
+  ASSERT_EQ(seg.changepoints.size(), 1u);
+  EXPECT_TRUE(config.candidate_zones[1].contains(seg.changepoints[0]));
+}
+
 // Over the whole series the Kaiser-penalized profile peaks between the two changes, outside
 // every zone: without anchors the in-zone argmax is the zone's edge (the flank of that peak).
 // With anchors ClaSP still decides which zones hold a changepoint, but each one sits on its

@@ -1,6 +1,8 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <map>
 #include <random>
 
 #include "lfd_core/segmentation_pipeline.hpp"
@@ -69,6 +71,52 @@ TEST(SegmentationPipeline, FindsTheGraspChangepointInEveryDemo) {
     ASSERT_FALSE(r.zones.empty());
     EXPECT_TRUE(r.zones[0].contains(demos[d].grasp));
   }
+}
+
+// One demo of four carries an extra change late in its second phase (the gripper slips a little,
+// the touch force drops and the hand shakes, like a hesitation mid-skill). Three demos agree on
+// one changepoint, so that demo keeps its most significant one and reports the other as pruned;
+// the other demos are untouched.
+TEST(SegmentationPipeline, ConsensusDropsTheExtraChangepointOfOneDemo) {
+  auto demos = make_demos(4);
+  lfd::FeatureMatrix& odd = demos[2].matrix;
+  const Eigen::Index slip = static_cast<Eigen::Index>(0.75 * static_cast<double>(odd.rows()));
+  odd.data.col(0).tail(odd.rows() - slip).array() += 0.06;
+  odd.data.col(4).tail(odd.rows() - slip).array() -= 4.0;
+  for (Eigen::Index i = slip; i < odd.rows(); ++i)
+    odd.data(i, 1) += 0.1 * std::sin(2 * M_PI * static_cast<double>(i) / 15.0);
+
+  lfd::SegmentationPipelineConfig config;
+  config.consensus_count = false;
+  const auto plain = lfd::run_segmentation_pipeline(matrices(demos), {"touch"}, config);
+  const auto& two = plain.demos[2];
+  ASSERT_EQ(two.changepoints.size(), 2u);  // the slip is a changepoint on its own
+  EXPECT_NEAR(double(two.changepoints[1]), double(slip), 0.1 * odd.rows());
+  std::map<std::size_t, double> log_p;
+  for (const lfd::SplitCandidate& c : two.clasp.candidates)
+    if (c.accepted) log_p[c.index] = c.log10_p_value;
+  const std::size_t stronger =
+      log_p.at(two.changepoints[0]) < log_p.at(two.changepoints[1]) ? 0 : 1;
+
+  config.consensus_count = true;
+  const auto result = lfd::run_segmentation_pipeline(matrices(demos), {"touch"}, config);
+  for (std::size_t d = 0; d < demos.size(); ++d) {
+    if (d == 2) continue;
+    EXPECT_EQ(result.demos[d].changepoints, plain.demos[d].changepoints) << "demo " << d;
+    EXPECT_TRUE(result.demos[d].pruned.empty());
+  }
+  const auto& one = result.demos[2];
+  ASSERT_EQ(one.changepoints.size(), 1u);
+  ASSERT_EQ(one.pruned.size(), 1u);
+  EXPECT_EQ(one.changepoints[0], two.changepoints[stronger]);
+  EXPECT_EQ(one.pruned[0], two.changepoints[1 - stronger]);
+  EXPECT_NEAR(one.pruned_times[0], odd.time_at(one.pruned[0]), 1e-12);
+  EXPECT_NE(std::find_if(result.warnings.begin(), result.warnings.end(),
+                         [](const std::string& w) {
+                           return w.find("demonstration 2: 2 changepoints where 3 of 4") !=
+                                  std::string::npos;
+                         }),
+            result.warnings.end());
 }
 
 TEST(SegmentationPipeline, SingleDemoFallsBackWithAWarning) {

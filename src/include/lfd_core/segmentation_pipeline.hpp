@@ -40,6 +40,11 @@ struct SegmentationPipelineConfig {
   /// With search_in_zones: each changepoint sits on the sensory event of its zone nearest to
   /// ClaSP's in-zone argmax (MultivariateSegmentationConfig::zone_anchors).
   bool anchor_to_events = true;
+  /// Demonstrations of one task hold the same skills: when more than half of the demos (at least
+  /// 3) agree on K validated changepoints, a demo with more keeps its K most significant ones and
+  /// reports the others as `pruned` (a hesitation mid-skill is then not a skill boundary). Demos
+  /// with fewer changepoints are left as they are.
+  bool consensus_count = true;
   /// Worker threads for DTW and the per-demonstration segmentations (<= 0 = all cores).
   int threads = 0;
 };
@@ -49,6 +54,8 @@ struct DemoSegmentationResult {
   std::vector<double> changepoint_times;  ///< their times (s, or index without a clock)
   std::vector<std::size_t> rejected;      ///< ClaSP changepoints outside every zone
   std::vector<double> rejected_times;
+  std::vector<std::size_t> pruned;  ///< validated, dropped to the consensus count (consensus_count)
+  std::vector<double> pruned_times;
   std::vector<Interval> zones;         ///< confidence zones (row indices, closed)
   std::vector<std::size_t> events;     ///< sensory events (row indices)
   std::size_t min_segment_length = 0;  ///< the min_s used for ClaSP and the zones
