@@ -567,6 +567,10 @@ def main():
                     help="learn and reproduce again even where results exist")
     # roslaunch (launch/pipeline.launch) appends __name:= / __log:= remappings: not ours.
     args = ap.parse_args([a for a in sys.argv[1:] if not a.startswith("__")])
+    # SIGTERM (kill, CI timeouts) and a SIGINT ignored by a non-interactive parent shell stop the
+    # run like Ctrl-C: masters and launches are torn down, the report is written.
+    signal.signal(signal.SIGINT, signal.default_int_handler)
+    signal.signal(signal.SIGTERM, lambda *_: signal.default_int_handler(signal.SIGINT, None))
     bad = [d for d in args.datasets if d not in DATASETS]
     if bad:
         say("error: unknown dataset(s) %s; known: %s" % (",".join(bad), ",".join(DATASETS)))
