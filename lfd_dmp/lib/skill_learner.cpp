@@ -85,6 +85,7 @@ LearnOutcome learnSkillLibrary(const std::vector<DemoRecording>& demos,
   lib.task = options.task;
   lib.features = options.features;
   lib.dmp_parameters = options.params;
+  lib.smoothing_sigma = options.smoothing_sigma;
   lib.position_names = {"x", "y", "z"};
   lib.generalization_parameters = "goal_position";
   for (size_t s = 0; s < num_segments; ++s) {

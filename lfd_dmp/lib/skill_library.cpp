@@ -139,6 +139,7 @@ json toJson(const SkillLibrary& lib) {
               {"generalization_parameters", lib.generalization_parameters},
               {"position_names", lib.position_names},
               {"dmp_parameters", toJson(lib.dmp_parameters)},
+              {"smoothing_sigma", lib.smoothing_sigma},
               {"segments", segments}};
 }
 
@@ -240,6 +241,10 @@ SkillLibrary skillLibraryFromJson(const json& j) {
     lib.position_names.push_back(text(names[i], "position_names[" + std::to_string(i) + "]"));
   }
   lib.dmp_parameters = dmpParametersFromJson(member(j, "dmp_parameters", root), "dmp_parameters");
+  if (j.contains("smoothing_sigma")) {
+    lib.smoothing_sigma = number(j["smoothing_sigma"], "smoothing_sigma");
+    if (!(lib.smoothing_sigma >= 0.0)) fail("smoothing_sigma", "must be >= 0 (s)");
+  }
   const json& segments = member(j, "segments", root);
   if (!segments.is_array()) fail("segments", "expected an array");
   for (size_t s = 0; s < segments.size(); ++s) {

@@ -97,6 +97,7 @@ TEST(SkillLearner, SmoothingKeepsTheMotionAndDropsTheTremor) {
   auto rollouts = [&](const lfd_dmp::DemoRecording& demo, double sigma) {
     opt.smoothing_sigma = sigma;
     const auto out = lfd_dmp::learnSkillLibrary({demo}, {{12.0, 14.0}}, opt);
+    EXPECT_EQ(out.library.smoothing_sigma, sigma);  // recorded with the skills
     std::vector<Eigen::MatrixXd> parts;
     for (size_t s = 0; s < out.library.segments.size(); ++s) {
       const lfd::PositionDmp& ref = *reference.segments[s].demos[0].dmp.position;

@@ -35,6 +35,7 @@ SkillLibrary makeLibrary() {
   SkillLibrary lib;
   lib.task = "grasp";
   lib.features = {"gripper_opening", "ee_speed", "ee_x"};
+  lib.smoothing_sigma = 0.05;
   for (int s = 0; s < 2; ++s) {
     lfd_dmp::SegmentSkills seg;
     seg.index = s;
@@ -78,6 +79,7 @@ TEST(SkillLibrary, RoundTripKeepsEverything) {
   EXPECT_EQ(lfd_dmp::toJson(back), lfd_dmp::toJson(lib));
   EXPECT_EQ(back.task, "grasp");
   EXPECT_EQ(back.features, lib.features);
+  EXPECT_EQ(back.smoothing_sigma, 0.05);
   ASSERT_EQ(back.segments.size(), 2u);
   EXPECT_EQ(back.segments[1].name, "move");
   const auto& a = lib.segments[1].demos[1].dmp;
@@ -133,6 +135,14 @@ TEST(SkillLibrary, ValidationNamesTheProblem) {
   j = good;
   j["segments"][0]["demos"][1]["dmp"].erase("orientation");
   EXPECT_NE(loadError(j).find("different parts"), std::string::npos);
+
+  j = good;
+  j["smoothing_sigma"] = -0.1;
+  EXPECT_NE(loadError(j).find("smoothing_sigma: must be >= 0"), std::string::npos) << loadError(j);
+
+  j = good;  // libraries written before the smoothing was recorded
+  j.erase("smoothing_sigma");
+  EXPECT_EQ(loadError(j), "");
 
   j = good;
   j["dmp_parameters"]["num_basis"] = 1;

@@ -57,6 +57,9 @@ struct SkillLibrary {
   std::string generalization_parameters = "goal_position";
   std::vector<std::string> position_names = {"x", "y", "z"};  ///< names of the position dims
   lfd::DmpParameters dmp_parameters;
+  /// s; the Gaussian low-pass applied to the demos before learning (LearnOptions; 0 = none).
+  /// Optional in the file (absent = 0, as written before it was recorded).
+  double smoothing_sigma = 0.0;
   std::vector<SegmentSkills> segments;
 };
 
