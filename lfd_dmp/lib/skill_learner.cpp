@@ -46,12 +46,7 @@ DemoRecording smoothed(const DemoRecording& rec, double sigma, std::vector<std::
     const lfd::QuaternionSequence seq = lfd::makeContinuousQuaternions(rec.quaternions);
     if (seq.normalized_input)
       warnings->push_back("demo " + rec.id + ": non-unit quaternions were normalized");
-    Eigen::MatrixXd q(rec.quaternions.rows(), 4);
-    for (size_t i = 0; i < seq.quaternions.size(); ++i) {
-      const Eigen::Quaterniond& r = seq.quaternions[i];
-      q.row(static_cast<Eigen::Index>(i)) << r.w(), r.x(), r.y(), r.z();
-    }
-    out.quaternions = lfd::gaussianSmooth(rec.times, q, sigma);
+    out.quaternions = lfd::gaussianSmooth(rec.times, lfd::quaternionRows(seq.quaternions), sigma);
     out.quaternions.rowwise().normalize();
   }
   return out;
@@ -98,13 +93,13 @@ LearnOutcome learnSkillLibrary(const std::vector<DemoRecording>& demos,
 
   for (size_t d = 0; d < demos.size(); ++d) {
     checkRecording(demos[d]);
-    const DemoRecording rec = smoothed(demos[d], options.smoothing_sigma, &outcome.warnings);
     const auto& cps = changepoint_times[d];
     if (cps.size() != cp_count) {
-      outcome.warnings.push_back("demo " + rec.id + " skipped: " + std::to_string(cps.size()) +
+      outcome.warnings.push_back("demo " + demos[d].id + " skipped: " + std::to_string(cps.size()) +
                                  " changepoints, the other demos have " + std::to_string(cp_count));
       continue;
     }
+    const DemoRecording rec = smoothed(demos[d], options.smoothing_sigma, &outcome.warnings);
     // Boundaries: sample indices nearest to each changepoint; segments share boundary samples so
     // consecutive DMPs join at the same pose.
     const Eigen::Index m = rec.times.size();

@@ -230,6 +230,9 @@ MultivariateSegmentation segment_multivariate(const Eigen::MatrixXd& features,
     }
     return nearest;
   };
+  const double needed_log10_p = restricted && config.zone_p_value_threshold > 0.0
+                                    ? std::log10(config.zone_p_value_threshold)
+                                    : log10_threshold;
   const auto evaluate = [&](std::size_t begin, std::size_t end, bool first) {
     const std::size_t len = end - begin;
     if (len < 2 * min_s + 1) return;
@@ -292,11 +295,8 @@ MultivariateSegmentation segment_multivariate(const Eigen::MatrixXd& features,
       c.score = penalized[best];
       c.log10_p_value = weighted_log_p / weight_sum;
       out.candidates.push_back(c);
-      const double needed = restricted && config.zone_p_value_threshold > 0.0
-                                ? std::log10(config.zone_p_value_threshold)
-                                : log10_threshold;
-      if (learn && c.log10_p_value > needed) {  // not significant
-        if (!restricted) return;                // plain ClaSP: the range stays whole
+      if (learn && c.log10_p_value > needed_log10_p) {  // not significant
+        if (!restricted) return;                        // plain ClaSP: the range stays whole
         tested[static_cast<std::size_t>(zone_of(c.profile_argmax))] = true;
         continue;
       }

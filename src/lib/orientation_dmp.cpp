@@ -20,12 +20,7 @@ AngularDerivatives angularDerivatives(const Eigen::VectorXd& times,
                                       const std::vector<Eigen::Quaterniond>& quaternions,
                                       const SmoothDerivativeOptions& options) {
   const Eigen::Index m = times.size();
-  Eigen::MatrixXd comps(m, 4);
-  for (Eigen::Index i = 0; i < m; ++i) {
-    const auto& q = quaternions[static_cast<size_t>(i)];
-    comps.row(i) << q.w(), q.x(), q.y(), q.z();
-  }
-  const SmoothDerivatives der = smoothDerivatives(times, comps, options);
+  const SmoothDerivatives der = smoothDerivatives(times, quaternionRows(quaternions), options);
   AngularDerivatives out;
   out.omega.resize(m, 3);
   out.omega_dot.resize(m, 3);

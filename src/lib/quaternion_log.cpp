@@ -59,4 +59,13 @@ QuaternionSequence makeContinuousQuaternions(const Eigen::MatrixXd& rows) {
   return out;
 }
 
+Eigen::MatrixXd quaternionRows(const std::vector<Eigen::Quaterniond>& quaternions) {
+  Eigen::MatrixXd rows(static_cast<Eigen::Index>(quaternions.size()), 4);
+  for (size_t i = 0; i < quaternions.size(); ++i) {
+    const Eigen::Quaterniond& q = quaternions[i];
+    rows.row(static_cast<Eigen::Index>(i)) << q.w(), q.x(), q.y(), q.z();
+  }
+  return rows;
+}
+
 }  // namespace lfd

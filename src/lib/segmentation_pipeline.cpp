@@ -129,7 +129,6 @@ void prune_to_consensus(const std::vector<FeatureMatrix>& demos,
     }
     std::sort(out.changepoints.begin(), out.changepoints.end());
     std::sort(out.pruned.begin(), out.pruned.end());
-    out.pruned_times.clear();
     for (std::size_t cp : out.changepoints) out.changepoint_times.push_back(demos[d].time_at(cp));
     for (std::size_t cp : out.pruned) out.pruned_times.push_back(demos[d].time_at(cp));
     result->warnings.push_back(msg.str());

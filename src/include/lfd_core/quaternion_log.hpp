@@ -30,4 +30,7 @@ struct QuaternionSequence {
 /// rows: M x 4 in (w, x, y, z) order. Throws std::invalid_argument on NaN/inf or (near) zero norm.
 QuaternionSequence makeContinuousQuaternions(const Eigen::MatrixXd& wxyz_rows);
 
+/// The inverse layout: M x 4 rows in (w, x, y, z) order.
+Eigen::MatrixXd quaternionRows(const std::vector<Eigen::Quaterniond>& quaternions);
+
 }  // namespace lfd
