@@ -36,6 +36,12 @@ Writes DIR/report.json and DIR/report.md, and prints the time of each stage. Sta
   timings.<stage>_s                      wall time of the stage's last run (datasets_s, segment_s,
                                          learn_s, reproduce_s; total_s their sum; a stage with
                                          nothing to redo keeps its previous time)
+  stage_errors.<stage>                   this run's error of a stage that failed (also in `problems`)
+  problems                               everything above that did not work, one line each
+A stage that fails (any exception, or a tool that exits non-zero) is recorded with its error under
+`stage_errors` and `problems` and ends the run with exit status 1. Every process a stage starts
+carries LFD_PIPELINE_TAG=<pid>:<stage> in its environment; whatever still runs when the stage ends
+(however it ends) is killed, roslaunch's nodes included.
 A task that cannot be learned or reproduced (e.g. push while its segmentation finds another number of
 changepoints than the task has transitions) is recorded with its error and listed under `problems`;
 the other tasks go on. <dataset> is <mode>_<task> (sim_grasp, sim_push, teleop_grasp, teleop_push).
@@ -48,6 +54,7 @@ Reduced runs (CI): `--demos N` records N configurations per dataset (spread over
 later stages use the bags present), `--goals N` reproduces N unseen goals per task (spread).
 """
 import argparse
+import collections
 import contextlib
 import glob
 import json
@@ -66,6 +73,8 @@ DATASETS = ("sim_grasp", "sim_push", "teleop_grasp", "teleop_push")
 TASKS_FILE = os.path.join(ROOT, "config", "tasks.yaml")
 EVALUATE_REPRODUCTION = os.path.join(ROOT, "lfd_dmp", "scripts", "evaluate_reproduction.py")
 PAPER_METHOD = "weighted_product"
+STDERR_TAIL_LINES = 3  # of a failed tool's stderr, quoted in the stage's error
+TAG_VAR = "LFD_PIPELINE_TAG"  # <pipeline pid>:<stage>, inherited by everything a stage starts
 
 
 def say(msg):
@@ -115,13 +124,69 @@ def private_master():
 
 
 def run(cmd, env=None):
+    """Runs a stage's tool; returns (exit status, its last stderr lines). Its stderr still shows."""
     say("$ " + " ".join(cmd))
-    proc = subprocess.Popen(cmd, env=env, start_new_session=True)
+    proc = subprocess.Popen(cmd, env=env, start_new_session=True, stderr=subprocess.PIPE,
+                            universal_newlines=True, errors="replace")
+    tail = collections.deque(maxlen=STDERR_TAIL_LINES)
     try:
-        return proc.wait()
+        for line in proc.stderr:
+            sys.stderr.write(line)
+            if line.strip():
+                tail.append(line.rstrip())
+        return proc.wait(), "\n".join(tail)
     except KeyboardInterrupt:
         stop_group(proc, 30)
         raise
+
+
+def failed(what, rc, tail):
+    """A stage error that carries the tool's own last words (e.g. its Python exception)."""
+    return RuntimeError("%s (exit %d)%s" % (what, rc, (": " + tail.replace("\n", " / ")) if tail else ""))
+
+
+def tagged_processes(prefix):
+    """PIDs (other than this one) whose environment carries LFD_PIPELINE_TAG=<prefix>...: every
+    process a stage started, including what roslaunch started in sessions of their own and what
+    outlived its parent."""
+    needle = ("\0%s=%s" % (TAG_VAR, prefix)).encode()
+    pids = []
+    for entry in os.listdir("/proc"):
+        if not entry.isdigit() or int(entry) == os.getpid():
+            continue
+        with contextlib.suppress(OSError):
+            with open("/proc/%s/environ" % entry, "rb") as f:
+                if needle in b"\0" + f.read():
+                    pids.append(int(entry))
+    return pids
+
+
+def kill_tagged(prefix, grace=5.0):
+    """Ends every process started under the tag: SIGTERM, then SIGKILL after `grace` seconds.
+    Returns the command names of those that were still running."""
+    pids = tagged_processes(prefix)
+    names = []
+    for pid in pids:
+        with contextlib.suppress(OSError):
+            with open("/proc/%d/comm" % pid) as f:
+                names.append(f.read().strip())
+        with contextlib.suppress(ProcessLookupError):
+            os.kill(pid, signal.SIGTERM)
+    deadline = time.time() + grace
+    while pids and time.time() < deadline:
+        time.sleep(0.1)
+        pids = [p for p in pids if os.path.exists("/proc/%d" % p) and not zombie(p)]
+    for pid in pids:
+        with contextlib.suppress(ProcessLookupError):
+            os.kill(pid, signal.SIGKILL)
+    return names
+
+
+def zombie(pid):
+    with contextlib.suppress(OSError):
+        with open("/proc/%d/stat" % pid) as f:
+            return f.read().rsplit(")", 1)[1].split()[0] == "Z"
+    return True
 
 
 @contextlib.contextmanager
@@ -173,11 +238,11 @@ def stage_datasets(out, args, report):
            "--out", data, "--datasets", ",".join(args.datasets),
            "--tasks-file", reduced_tasks_file(out, args.demos)]
     with private_master() as env:
-        rc = run(cmd, env)
+        rc, tail = run(cmd, env)
     report["datasets"] = {n: {"demos": count_bags(os.path.join(data, n)), "path": os.path.join(data, n)}
                           for n in args.datasets}
     if rc != 0:
-        raise RuntimeError("dataset generation failed (exit %d); see the table above" % rc)
+        raise failed("dataset generation failed; see the table above", rc, tail)
 
 
 def require_bags(data, names):
@@ -195,11 +260,11 @@ def stage_segment(out, args, report):
     result = os.path.join(out, "segmentation.json")
     with private_master() as env:
         with background_launch(["roslaunch", "lfd_launch", "segment.launch"], env):
-            rc = run(["/usr/bin/python3", os.path.join(ROOT, "lfd_segmentation", "scripts",
-                                                        "evaluate_segmentation.py"),
-                      "--datasets", data, "--names", ",".join(args.datasets), "--out", result], env)
+            rc, tail = run(["/usr/bin/python3", os.path.join(ROOT, "lfd_segmentation", "scripts",
+                                                              "evaluate_segmentation.py"),
+                            "--datasets", data, "--names", ",".join(args.datasets), "--out", result], env)
     if not os.path.exists(result):
-        raise RuntimeError("segmentation evaluation produced no result (exit %d)" % rc)
+        raise failed("segmentation evaluation produced no result", rc, tail)
     with open(result) as f:
         seg = json.load(f)
     report["segmentation"] = {}
@@ -211,7 +276,7 @@ def stage_segment(out, args, report):
         entry["selected_features"] = paper.get("selected_features", [])
         report["segmentation"][name] = entry
     if rc != 0:
-        raise RuntimeError("segmentation evaluation reported errors (exit %d)" % rc)
+        raise failed("segmentation evaluation reported errors", rc, tail)
 
 
 def by_mode(datasets):
@@ -274,13 +339,13 @@ def stage_learn(out, args, report):
                 result = os.path.join(skills, "learning_%s.json" % mode)
                 with contextlib.suppress(FileNotFoundError):
                     os.remove(result)
-                rc = run(["/usr/bin/python3", EVALUATE_REPRODUCTION, "--attach", "--learn-only",
+                rc, tail = run(["/usr/bin/python3", EVALUATE_REPRODUCTION, "--attach", "--learn-only",
                           "--dataset", data, "--mode", mode, "--tasks", ",".join(tasks),
                           "--library-dir", skills, "--library-name", "{task}_{mode}.json",
                           "--out", result], env)
                 res = load_json(result)
                 if res is None:
-                    raise RuntimeError("learning %s produced no result (exit %d)" % (mode, rc))
+                    raise failed("learning %s produced no result" % mode, rc, tail)
                 for task in tasks:
                     library = os.path.join(skills, "%s_%s.json" % (task, mode))
                     tr = res["tasks"].get(task, {"error": "not reached (interrupted?)"})
@@ -373,7 +438,7 @@ def stage_reproduce(out, args, report):
                         os.remove(path)
                     say("reproduce %s_%s: %d unseen goals %s" % (mode, task, len(ids), ids))
                     try:
-                        rc = run(["/usr/bin/python3", EVALUATE_REPRODUCTION, "--attach", "--no-learn",
+                        rc, tail = run(["/usr/bin/python3", EVALUATE_REPRODUCTION, "--attach", "--no-learn",
                                   "--dataset", os.path.join(out, "datasets"), "--mode", mode,
                                   "--tasks", task, "--goals", ",".join(map(str, ids)),
                                   "--library-dir", skills, "--library-name", "{task}_{mode}.json",
@@ -387,8 +452,7 @@ def stage_reproduce(out, args, report):
                         raise
                     res = load_json(path)
                     if res is None or task not in res["tasks"]:
-                        raise RuntimeError("reproduction %s_%s produced no result (exit %d)"
-                                           % (mode, task, rc))
+                        raise failed("reproduction %s_%s produced no result" % (mode, task), rc, tail)
                     entry = reproduction_entry(res["tasks"][task], path)
                     report[reproduction_key(mode)][task] = entry
                     say("reproduce %s_%s: %d/%d goals reached, time ratio %s" % (
@@ -460,8 +524,10 @@ STAGES = {"datasets": stage_datasets, "segment": stage_segment, "learn": stage_l
 
 
 def problems(report):
-    """Human-readable list of what did not work (learning errors, failed reproductions)."""
-    out = []
+    """Human-readable list of what did not work (failed stages, learning errors, failed
+    reproductions)."""
+    out = ["stage %s failed: %s" % (stage, error)
+           for stage, error in report.get("stage_errors", {}).items()]
     for name, e in sorted(report.get("learning", {}).items()):
         if e.get("error"):
             out.append("learn %s: %s" % (name, e["error"]))
@@ -599,17 +665,29 @@ def main():
         with contextlib.suppress(ValueError, OSError):
             report = json.load(open(report_path))
     report.setdefault("timings", {})
+    report["stage_errors"] = {}  # this run's
     status = 0
     try:
         for stage in stages:
             say("stage %s ..." % stage)
             start = time.time()
             outcome = None
+            os.environ[TAG_VAR] = "%d:%s" % (os.getpid(), stage)
             try:
                 outcome = STAGES[stage](out, args, report)
-            except RuntimeError as exc:
-                say("error in stage %s: %s" % (stage, exc))
+            except KeyboardInterrupt:
+                report["stage_errors"][stage] = "interrupted; rerun to resume"
+                raise
+            except Exception as exc:  # noqa: BLE001 (any failure is the stage's, and is reported)
+                error = str(exc) if isinstance(exc, RuntimeError) else "%s: %s" % (type(exc).__name__, exc)
+                say("error in stage %s: %s" % (stage, error))
+                report["stage_errors"][stage] = error
                 status = 1
+            finally:
+                left = kill_tagged(os.environ.pop(TAG_VAR))
+                if left:
+                    say("stage %s left %d process(es) running (%s): killed"
+                        % (stage, len(left), ", ".join(sorted(set(left)))))
             if outcome == "skipped":  # everything was already there: keep the measured time
                 say("stage %s: nothing to do (--force redoes it)" % stage)
                 continue
@@ -620,6 +698,8 @@ def main():
     except KeyboardInterrupt:
         say("interrupted: everything recorded so far is kept; rerun to resume")
         status = 130
+    finally:
+        kill_tagged("%d:" % os.getpid())
     report["timings"]["total_s"] = round(sum(v for k, v in report["timings"].items() if k != "total_s"), 2)
     print(write_report(out, report))
     for p in report["problems"]:
