@@ -132,7 +132,7 @@ def run(cmd, env=None):
     try:
         for line in proc.stderr:
             sys.stderr.write(line)
-            if line.strip():
+            if line.strip() and not line[0].isspace():  # a traceback's code lines are indented
                 tail.append(line.rstrip())
         return proc.wait(), "\n".join(tail)
     except KeyboardInterrupt:
