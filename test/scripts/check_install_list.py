@@ -321,21 +321,19 @@ def ros_package_file(key, mapping):
     return manifest if os.path.exists(manifest) else None
 
 
-def check(needs, provided, mapping, exempt, pkgs):
+def check(needs, provided, mapping, list_name):
     """{category: [problem lines]}."""
     problems = {k: [] for k in needs}
     files = {}
     for name in needs["python_modules"]:
         files[("python_modules", name)] = module_file(name)
     for name in needs["programs"]:
-        files[("programs", name)] = None if name in exempt else program_file(name)
+        files[("programs", name)] = program_file(name)
     for name in needs["ros_packages"]:
         files[("ros_packages", name)] = ros_package_file(name, mapping)
     paths = [f for f in files.values() if isinstance(f, str) and f not in ("builtin", "project")]
     owner = owners(paths)
     for (kind, name), f in sorted(files.items()):
-        if kind == "programs" and name in exempt:
-            continue
         users = ", ".join(sorted(needs[kind][name]))
         if f in ("builtin", "project"):
             continue
@@ -347,8 +345,8 @@ def check(needs, provided, mapping, exempt, pkgs):
             problems[kind].append("%s: %s belongs to no Debian package (needed by %s)" % (name, f, users))
         elif not debs & provided:
             hint = " (mapped in .ci/rosdep-keys.txt)" if isinstance(f, tuple) else " (%s)" % f
-            problems[kind].append("%s: provided by %s%s, which is not in .ci/apt-packages.txt or its "
-                                  "dependencies (needed by %s)" % (name, " or ".join(sorted(debs)), hint, users))
+            problems[kind].append("%s: provided by %s%s, which is not in %s or its dependencies "
+                                  "(needed by %s)" % (name, " or ".join(sorted(debs)), hint, list_name, users))
     return problems
 
 
@@ -372,12 +370,7 @@ def main():
     ap.add_argument("--verbose", action="store_true", help="print every need and who has it")
     args = ap.parse_args()
     listed = read_list(args.list)
-    mapping, exempt = {}, set()
-    for words in (line.split() for line in read_list(args.keys)):
-        if words[0] == "exempt-program":
-            exempt.add(words[1])
-        else:
-            mapping[words[0]] = words[1]
+    mapping = dict(line.split()[:2] for line in read_list(args.keys))
     pkgs, provides, essential = installed_packages()
     problems = {"installed": ["%s: listed in %s but not installed" % (p, rel(args.list))
                               for p in listed if p not in pkgs]}
@@ -386,7 +379,7 @@ def main():
     base = essential + ["apt"]
     provided = closure([p for p in listed + base if p in pkgs], pkgs, provides)
     needs = collect_needs()
-    problems.update(check(needs, provided, mapping, exempt, pkgs))
+    problems.update(check(needs, provided, mapping, rel(args.list)))
     counts = {k: len(v) for k, v in needs.items()}
     counts["installed"] = len(listed)
     if args.verbose:
