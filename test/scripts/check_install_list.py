@@ -118,7 +118,8 @@ def project_files():
 
 
 def rel(path):
-    return os.path.relpath(path, ROOT)
+    inside = os.path.abspath(path).startswith(ROOT + os.sep)
+    return os.path.relpath(path, ROOT) if inside else path
 
 
 def ros_package_names():
