@@ -113,7 +113,7 @@ TEST(SegmentationPipeline, ConsensusDropsTheExtraChangepointOfOneDemo) {
   EXPECT_NEAR(one.pruned_times[0], odd.time_at(one.pruned[0]), 1e-12);
   EXPECT_NE(std::find_if(result.warnings.begin(), result.warnings.end(),
                          [](const std::string& w) {
-                           return w.find("demonstration 2: 2 changepoints where 3 of 4") !=
+                           return w.find("demonstration 2: 2 changepoints where 3 of the 4") !=
                                   std::string::npos;
                          }),
             result.warnings.end());

@@ -124,8 +124,9 @@ TEST(SensoryEvents, LaggedLevelDifferenceSeesContactNotSpikesOrChatter) {
   level.merge_gap = 50;
   const Events events = lfd::detect_sensory_events(x, level);
   ASSERT_EQ(events.size(), 2u) << ::testing::PrintToString(events);
-  EXPECT_NEAR(static_cast<double>(events[0]), 150.0, 13.0);
-  EXPECT_NEAR(static_cast<double>(events[1]), 300.0, 13.0);
+  // Within a lag and a half: the median needs half its window of chatter before its level rises.
+  EXPECT_NEAR(static_cast<double>(events[0]), 150.0, 20.0);
+  EXPECT_NEAR(static_cast<double>(events[1]), 300.0, 20.0);
 }
 
 TEST(SensoryEvents, RejectsBadConfigAndInput) {
