@@ -97,22 +97,30 @@ std::vector<std::size_t> detect_sensory_events(const Eigen::Ref<const Eigen::Vec
   if (n < 2) return {};
   const std::vector<double> y = running_median(signal, config.median_window);
   const std::size_t lag = config.difference_lag, ahead = lag / 2, behind = lag - ahead;
+  // Only differences of fully smoothed samples: the median's window shrinks at the ends, where a
+  // single noisy sample would otherwise look like a level change.
+  const std::size_t edge = config.median_window > 1 ? config.median_window / 2 : 0;
   std::vector<double> mag(n, 0.0);
-  for (std::size_t t = behind; t + ahead < n; ++t) mag[t] = std::abs(y[t + ahead] - y[t - behind]);
+  for (std::size_t t = behind + edge; t + ahead + edge < n; ++t)
+    mag[t] = std::abs(y[t + ahead] - y[t - behind]);
   const double peak = *std::max_element(mag.begin(), mag.end());
   if (!(peak > 0.0)) return {};
-  // Signed differences whose spread is the noise: the lagged differences of the smoothed signal
-  // (noise-dominated wherever nothing happens), or with lag 1 the RAW first differences (a running
-  // median leaves plateaus whose differences are mostly 0).
+  // The noise is measured on the RAW first differences (nearly independent samples, so a block of
+  // a second gives a fair estimate; a running median leaves plateaus whose differences are mostly
+  // 0, and lagged differences of a smoothed signal are so correlated that a block holds only a few
+  // independent values). For white noise of sigma s the raw differences have sigma sqrt(2) s and
+  // the lagged differences of a median of w samples sqrt(2) * 1.2533 s / sqrt(w): the floor is
+  // scaled by 1.2533 / sqrt(w). Correlated noise is underestimated by the raw differences, which
+  // is why the floor is a generous number of sigmas.
   std::vector<double> diffs;
-  if (lag > 1) {
-    for (std::size_t t = behind; t + ahead < n; ++t) diffs.push_back(y[t + ahead] - y[t - behind]);
-  } else {
-    for (std::size_t t = 1; t < n; ++t)
-      diffs.push_back(signal[static_cast<Eigen::Index>(t)] - signal[static_cast<Eigen::Index>(t - 1)]);
-  }
-  const double sigma =
-      config.noise_floor_sigmas > 0.0 ? noise_sigma(diffs, config.noise_block) : 0.0;
+  for (std::size_t t = 1; t < n; ++t)
+    diffs.push_back(signal[static_cast<Eigen::Index>(t)] - signal[static_cast<Eigen::Index>(t - 1)]);
+  const double smoothing = lag > 1 && config.median_window > 1
+                               ? 1.2533 / std::sqrt(static_cast<double>(config.median_window))
+                               : 1.0;
+  const double sigma = config.noise_floor_sigmas > 0.0
+                           ? smoothing * noise_sigma(diffs, config.noise_block)
+                           : 0.0;
   const double noise_floor = config.noise_floor_sigmas * sigma;
   const double on = config.threshold == EventThreshold::kNoise
                         ? std::max(noise_floor, config.relative_floor * peak)
@@ -154,7 +162,9 @@ std::vector<std::size_t> detect_sensory_events(const Eigen::Ref<const Eigen::Vec
     if (b.end != n && b.end - b.begin < config.min_active_samples) continue;
     const std::size_t begin = std::min(b.begin + on_shift, n - 1);
     events.push_back(begin);
-    if (b.end != n) events.push_back(std::max(begin, b.end - off_shift));
+    // A burst that spans less than half a lag after the shifts is a single edge (a step): one event.
+    if (b.end != n && b.end - off_shift >= begin + (lag > 1 ? ahead : 1))
+      events.push_back(b.end - off_shift);
   }
   std::sort(events.begin(), events.end());
   events.erase(std::unique(events.begin(), events.end()), events.end());
