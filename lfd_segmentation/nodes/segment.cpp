@@ -28,7 +28,8 @@ const char* kUsage = R"(usage: segment [options] FILE...
   --state-columns a,b,c     CSV columns considered for segmentation (default: all other columns)
   --time-column NAME        CSV time column (default: time, t, timestamp or stamp if present)
   --rate HZ                 bag resampling rate / CSV sample rate (overrides a CSV time column)
-  --combination NAME        average | product | weighted_average | weighted_product
+  --combination NAME        average | product | weighted_average | weighted_product |
+                            distance_average | weighted_distance_average
   --threshold T             relevance threshold in (0,1]
   --min-segment-seconds S   min segment length min_s (s)
   --window-seconds S        fixed ClaSP window (s)
