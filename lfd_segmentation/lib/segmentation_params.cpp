@@ -128,6 +128,7 @@ SegmentationParams params_from_yaml(const YAML::Node& root) {
   ev.relative_floor = get<double>(events, "relative_floor", ev.relative_floor);
   ev.noise_floor_sigmas = get<double>(events, "noise_floor_sigmas", ev.noise_floor_sigmas);
   ev.hysteresis = get<double>(events, "hysteresis", ev.hysteresis);
+  ev.place_on_change = get<bool>(events, "place_on_change", ev.place_on_change);
   auto& t = p.time;
   t.event_median = non_negative(get<double>(events, "median_seconds", t.event_median),
                                 "events/median_seconds");

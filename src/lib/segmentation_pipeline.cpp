@@ -121,6 +121,9 @@ void prune_to_consensus(const std::vector<FeatureMatrix>& demos, bool validated,
       votes.begin(), votes.end(), [](const auto& a, const auto& b) { return a.second < b.second; });
   if (n < 3 || 2 * top->second <= n) return;  // no clear majority: nothing to agree on
   const std::size_t k = top->first;
+  // A majority that found nothing says nothing about where the boundaries are: the changepoints
+  // of the other demos each stand on a sensory event of their own.
+  if (k == 0) return;
   for (std::size_t d = 0; d < result->demos.size(); ++d) {
     DemoSegmentationResult& out = result->demos[d];
     if (out.changepoints.size() <= k) continue;

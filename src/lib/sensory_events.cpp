@@ -138,7 +138,7 @@ std::vector<std::size_t> detect_sensory_events(const Eigen::Ref<const Eigen::Vec
       // force that builds up slowly crosses `on` late (symmetric to the off-event below).
       std::size_t begin = t;
       const std::size_t floor_at = bursts.empty() ? 1 : bursts.back().end + 1;
-      while (begin > floor_at && mag[begin - 1] > off) --begin;
+      while (config.place_on_change && begin > floor_at && mag[begin - 1] > off) --begin;
       bursts.push_back({begin, n});
       active = true;
     } else if (active && mag[t] <= off) {
@@ -156,14 +156,15 @@ std::vector<std::size_t> detect_sensory_events(const Eigen::Ref<const Eigen::Vec
   }
   // With a lag the activity starts L/2 before the change and ends L/2 after it: move the events
   // back onto the change (see the header).
-  const std::size_t on_shift = lag > 1 ? ahead : 0, off_shift = lag > 1 ? behind : 0;
+  const bool shift = config.place_on_change && lag > 1;
+  const std::size_t on_shift = shift ? ahead : 0, off_shift = shift ? behind : 0;
   std::vector<std::size_t> events;
   for (const Burst& b : merged) {
     if (b.end != n && b.end - b.begin < config.min_active_samples) continue;
     const std::size_t begin = std::min(b.begin + on_shift, n - 1);
     events.push_back(begin);
     // A burst that spans less than half a lag after the shifts is a single edge (a step): one event.
-    if (b.end != n && b.end - off_shift >= begin + (lag > 1 ? ahead : 1))
+    if (b.end != n && b.end - off_shift >= begin + (shift ? ahead : 1))
       events.push_back(b.end - off_shift);
   }
   std::sort(events.begin(), events.end());

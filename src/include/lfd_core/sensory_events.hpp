@@ -65,6 +65,9 @@ struct SensoryEventConfig {
   /// is the 10th percentile of the others: the quiet stretches set it, however long the busy
   /// ones. 0 = one robust sigma over the whole demo.
   std::size_t noise_block = 0;
+  /// Events placed on the change (a burst's start taken where it left the off level, lag shifts
+  /// undone, a single-edge burst one event); false = where the thresholds are crossed.
+  bool place_on_change = true;
 };
 
 /// A closed interval of sample indices [begin, end] (eq. 1 uses closed intervals).
