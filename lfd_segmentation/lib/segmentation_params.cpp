@@ -111,8 +111,8 @@ SegmentationParams params_from_yaml(const YAML::Node& root) {
   auto& cc = seg.clasp;
   cc.window_selection = lfd::parse_window_selection(
       get<std::string>(clasp, "window_selection", lfd::to_string(cc.window_selection)));
-  p.time.min_window = non_negative(
-      get<double>(clasp, "min_window_seconds", p.time.min_window), "clasp/min_window_seconds");
+  p.time.min_window = non_negative(get<double>(clasp, "min_window_seconds", p.time.min_window),
+                                   "clasp/min_window_seconds");
   cc.k = get<std::size_t>(clasp, "k", cc.k);
   cc.distance =
       lfd::parse_clasp_distance(get<std::string>(clasp, "distance", lfd::to_string(cc.distance)));
@@ -130,17 +130,18 @@ SegmentationParams params_from_yaml(const YAML::Node& root) {
   ev.hysteresis = get<double>(events, "hysteresis", ev.hysteresis);
   ev.place_on_change = get<bool>(events, "place_on_change", ev.place_on_change);
   auto& t = p.time;
-  t.event_median = non_negative(get<double>(events, "median_seconds", t.event_median),
-                                "events/median_seconds");
+  t.event_median =
+      non_negative(get<double>(events, "median_seconds", t.event_median), "events/median_seconds");
   t.event_difference_lag =
       non_negative(get<double>(events, "difference_lag_seconds", t.event_difference_lag),
                    "events/difference_lag_seconds");
   t.event_merge_gap = non_negative(get<double>(events, "merge_gap_seconds", t.event_merge_gap),
                                    "events/merge_gap_seconds");
-  t.event_min_active = non_negative(
-      get<double>(events, "min_active_seconds", t.event_min_active), "events/min_active_seconds");
-  t.event_noise_block = non_negative(
-      get<double>(events, "noise_block_seconds", t.event_noise_block), "events/noise_block_seconds");
+  t.event_min_active = non_negative(get<double>(events, "min_active_seconds", t.event_min_active),
+                                    "events/min_active_seconds");
+  t.event_noise_block =
+      non_negative(get<double>(events, "noise_block_seconds", t.event_noise_block),
+                   "events/noise_block_seconds");
   // Sample counts would silently mean something else at another rate: refuse them.
   for (const char* key : {"median_window", "merge_gap", "difference_lag", "min_active_samples"})
     if (events && events[key])

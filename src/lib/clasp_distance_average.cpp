@@ -77,7 +77,8 @@ KnnResult distance_average_knn(const Eigen::MatrixXd& series, const std::vector<
       Channel& ch = channels[c];
       if (i > 0) {  // slide the dot products of query i - 1 to query i (backwards, in place)
         for (std::size_t j = m - 1; j >= 1; --j)
-          ch.qt[j] = ch.qt[j - 1] - ch.x[i - 1] * ch.x[j - 1] + ch.x[i + window - 1] * ch.x[j + window - 1];
+          ch.qt[j] = ch.qt[j - 1] - ch.x[i - 1] * ch.x[j - 1] +
+                     ch.x[i + window - 1] * ch.x[j + window - 1];
         ch.qt[0] = ch.first_row[i];
       }
       const double mi = ch.mean[i], si = ch.stdev[i];

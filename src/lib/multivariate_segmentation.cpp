@@ -285,7 +285,8 @@ MultivariateSegmentation segment_multivariate(const Eigen::MatrixXd& features,
         fitting_weights.push_back(used_weights[i]);
       }
       if (len < 3 * window || len < 2 * min_s + 1) return;
-      Eigen::MatrixXd block(static_cast<Eigen::Index>(len), static_cast<Eigen::Index>(fitting.size()));
+      Eigen::MatrixXd block(static_cast<Eigen::Index>(len),
+                            static_cast<Eigen::Index>(fitting.size()));
       for (std::size_t i = 0; i < fitting.size(); ++i)
         block.col(static_cast<Eigen::Index>(i)) =
             features.col(static_cast<Eigen::Index>(fitting[i]))

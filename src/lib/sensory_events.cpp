@@ -114,13 +114,13 @@ std::vector<std::size_t> detect_sensory_events(const Eigen::Ref<const Eigen::Vec
   // is why the floor is a generous number of sigmas.
   std::vector<double> diffs;
   for (std::size_t t = 1; t < n; ++t)
-    diffs.push_back(signal[static_cast<Eigen::Index>(t)] - signal[static_cast<Eigen::Index>(t - 1)]);
+    diffs.push_back(signal[static_cast<Eigen::Index>(t)] -
+                    signal[static_cast<Eigen::Index>(t - 1)]);
   const double smoothing = lag > 1 && config.median_window > 1
                                ? 1.2533 / std::sqrt(static_cast<double>(config.median_window))
                                : 1.0;
-  const double sigma = config.noise_floor_sigmas > 0.0
-                           ? smoothing * noise_sigma(diffs, config.noise_block)
-                           : 0.0;
+  const double sigma =
+      config.noise_floor_sigmas > 0.0 ? smoothing * noise_sigma(diffs, config.noise_block) : 0.0;
   const double noise_floor = config.noise_floor_sigmas * sigma;
   const double on = config.threshold == EventThreshold::kNoise
                         ? std::max(noise_floor, config.relative_floor * peak)
@@ -163,7 +163,8 @@ std::vector<std::size_t> detect_sensory_events(const Eigen::Ref<const Eigen::Vec
     if (b.end != n && b.end - b.begin < config.min_active_samples) continue;
     const std::size_t begin = std::min(b.begin + on_shift, n - 1);
     events.push_back(begin);
-    // A burst that spans less than half a lag after the shifts is a single edge (a step): one event.
+    // A burst that spans less than half a lag after the shifts is a single edge (a step): one
+    // event.
     if (b.end != n && b.end - off_shift >= begin + (shift ? ahead : 1))
       events.push_back(b.end - off_shift);
   }

@@ -380,9 +380,11 @@ TEST(DistanceAverage, OneChannelGivesTheUnivariateNeighbours) {
   std::normal_distribution<double> g(0.0, 1.0);
   Eigen::VectorXd x(300);
   for (Eigen::Index i = 0; i < x.size(); ++i) x[i] = std::sin(0.2 * i) + 0.3 * g(rng);
-  for (auto distance : {lfd::ClaspDistance::kEuclidean, lfd::ClaspDistance::kZNormalizedEuclidean}) {
+  for (auto distance :
+       {lfd::ClaspDistance::kEuclidean, lfd::ClaspDistance::kZNormalizedEuclidean}) {
     const lfd::KnnResult uni = lfd::brute_force_knn(x, 20, 3, 10, distance);
-    const lfd::KnnResult avg = lfd::distance_average_knn(Eigen::MatrixXd(x), {}, 20, 3, 10, distance);
+    const lfd::KnnResult avg =
+        lfd::distance_average_knn(Eigen::MatrixXd(x), {}, 20, 3, 10, distance);
     ASSERT_EQ(avg.num_subsequences, uni.num_subsequences);
     std::size_t same = 0;
     for (std::size_t i = 0; i < uni.indices.size(); ++i) same += uni.indices[i] == avg.indices[i];
@@ -406,9 +408,11 @@ TEST(DistanceAverage, ScaleFreeAndWeighted) {
   config.clasp.window_size = 20;
   config.clasp.distance = lfd::ClaspDistance::kEuclidean;  // raw distances: scales differ 1e6
   config.num_changepoints = 1;
-  for (auto c : {ProfileCombination::kDistanceAverage, ProfileCombination::kWeightedDistanceAverage}) {
+  for (auto c :
+       {ProfileCombination::kDistanceAverage, ProfileCombination::kWeightedDistanceAverage}) {
     config.combination = c;
-    const auto r = lfd::segment_multivariate(x, {1.0, c == ProfileCombination::kDistanceAverage ? 1.0 : 0.1}, config);
+    const auto r = lfd::segment_multivariate(
+        x, {1.0, c == ProfileCombination::kDistanceAverage ? 1.0 : 0.1}, config);
     ASSERT_EQ(r.changepoints.size(), 1u);
     EXPECT_NEAR(static_cast<double>(r.changepoints[0]), static_cast<double>(change), 25.0);
   }

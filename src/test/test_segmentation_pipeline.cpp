@@ -184,7 +184,6 @@ TEST(SegmentationPipeline, BadInputGivesClearErrors) {
   expect_error(empty, "demonstration 0");
 }
 
-
 // The same grasp, recorded at any rate: a continuous-time demo (gripper closing over 0.2 s at
 // `grasp_s`, one speed bump per phase, touch stepping up at the grasp) sampled at `rate` Hz.
 lfd::FeatureMatrix sampled_demo(double rate, double duration, double grasp_s, unsigned seed) {

@@ -131,7 +131,6 @@ TEST(SensoryEvents, LaggedLevelDifferenceSeesContactNotSpikesOrChatter) {
   EXPECT_NEAR(static_cast<double>(events[1]), 300.0, 20.0);
 }
 
-
 // Hand-made sensor signals at 50 Hz with the settings of config/segmentation.yaml (0.26 s median,
 // 0.5 s lag, 1 s merge gap, 5.5 sigma noise floor from 1 s blocks).
 SensoryEventConfig config_at_50hz(lfd::EventThreshold threshold) {
@@ -146,9 +145,10 @@ SensoryEventConfig config_at_50hz(lfd::EventThreshold threshold) {
 }
 
 // 18 s of oscillating, chattering contact (level 4, +-1.5 at 1.3 Hz, white chatter of 0.6: three
-// quarters of the demo), 2 s free, then a new light contact of level 1 at t = 21 s (sample 1050). One noise figure for the
-// whole demo is set by the chatter and hides the light onset; the quiet blocks' noise does not.
-// (The paper's 0.4 x max cannot see it either: the first onset is four times larger.)
+// quarters of the demo), 2 s free, then a new light contact of level 1 at t = 21 s (sample 1050).
+// One noise figure for the whole demo is set by the chatter and hides the light onset; the quiet
+// blocks' noise does not. (The paper's 0.4 x max cannot see it either: the first onset is four
+// times larger.)
 TEST(SensoryEvents, OnsetAfterALongOscillatingContact) {
   std::mt19937 rng(5);
   std::normal_distribution<double> g(0.0, 0.02), chatter(0.0, 0.6);

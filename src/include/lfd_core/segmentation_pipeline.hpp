@@ -21,20 +21,20 @@
 
 namespace lfd {
 
-/// Every time parameter of the segmentation, in seconds. When set in SegmentationPipelineConfig, the
-/// pipeline converts them to samples for each demonstration with that demonstration's own sample
-/// rate (median step of its clock), so one configuration holds at any recording rate. Rounded to
-/// the nearest sample; a window/lag/gap never drops below what the algorithm needs (>= 1 sample,
-/// windows >= 2, the median window odd).
+/// Every time parameter of the segmentation, in seconds. When set in SegmentationPipelineConfig,
+/// the pipeline converts them to samples for each demonstration with that demonstration's own
+/// sample rate (median step of its clock), so one configuration holds at any recording rate.
+/// Rounded to the nearest sample; a window/lag/gap never drops below what the algorithm needs (>= 1
+/// sample, windows >= 2, the median window odd).
 struct TimeParameters {
-  double min_segment = 1.0;        ///< min_s (s); 0 = automatic (max(2 * largest window, n / 20))
-  double window = 0.0;             ///< fixed ClaSP window for every feature (s); 0 = automatic
-  double min_window = 0.2;         ///< lower bound of the automatic ClaSP windows (s)
-  double event_median = 0.26;      ///< running-median window of the sensor signals (s)
+  double min_segment = 1.0;    ///< min_s (s); 0 = automatic (max(2 * largest window, n / 20))
+  double window = 0.0;         ///< fixed ClaSP window for every feature (s); 0 = automatic
+  double min_window = 0.2;     ///< lower bound of the automatic ClaSP windows (s)
+  double event_median = 0.26;  ///< running-median window of the sensor signals (s)
   double event_difference_lag = 0.5;  ///< lag of the level difference (s)
-  double event_merge_gap = 1.0;    ///< bursts closer than this merge (s)
-  double event_min_active = 0.0;   ///< bursts shorter than this are ignored (s)
-  double event_noise_block = 1.0;  ///< block length of the local noise estimate (s)
+  double event_merge_gap = 1.0;       ///< bursts closer than this merge (s)
+  double event_min_active = 0.0;      ///< bursts shorter than this are ignored (s)
+  double event_noise_block = 1.0;     ///< block length of the local noise estimate (s)
 };
 
 struct SegmentationPipelineConfig {
@@ -88,7 +88,7 @@ struct DemoSegmentationResult {
   std::vector<std::size_t> events;     ///< sensory events (row indices)
   std::size_t min_segment_length = 0;  ///< the min_s used for ClaSP and the zones
   std::size_t num_samples = 0;
-  double sample_rate = 0.0;  ///< Hz of the demonstration's clock (0 = index-only series)
+  double sample_rate = 0.0;        ///< Hz of the demonstration's clock (0 = index-only series)
   MultivariateSegmentation clasp;  ///< candidates, windows, profiles (paper Fig. 5, 8)
 };
 
