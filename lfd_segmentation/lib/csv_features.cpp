@@ -109,11 +109,11 @@ lfd::FeatureMatrix read_csv_features(const std::string& path, const std::string&
   if (rows == 0) throw std::invalid_argument("CSV file '" + path + "' has no data rows");
   m.data = Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(
       values.data(), rows, m.names.size());
-  if (time_index >= 0) {
-    m.time = std::move(time);
-  } else if (rate > 0) {
+  if (rate > 0) {  // an explicit rate overrides the time column (e.g. stamps of a bad clock)
     m.time.resize(rows);
     for (std::size_t r = 0; r < rows; ++r) m.time[r] = r / rate;
+  } else if (time_index >= 0) {
+    m.time = std::move(time);
   }
   return m;
 }

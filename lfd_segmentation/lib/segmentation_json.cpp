@@ -118,6 +118,8 @@ json to_json(const lfd::SegmentationPipelineResult& r, const std::vector<lfd::Fe
     demo["pruned"] = s.pruned;
     demo["pruned_times"] = s.pruned_times;
     demo["events"] = s.events;
+    demo["event_times"] = times_json(s.events, demos[d]);
+    demo["sample_rate"] = s.sample_rate;
     demo["zones"] = zones;
     demo_list.push_back(demo);
   }

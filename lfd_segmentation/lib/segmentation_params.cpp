@@ -65,12 +65,12 @@ TopicConfig parse_topic(const YAML::Node& node, std::size_t index) {
 
 lfd::SegmentationPipelineConfig SegmentationParams::pipeline_config() const {
   lfd::SegmentationPipelineConfig config = pipeline;
-  config.segmentation.min_segment_length =
-      min_segment_seconds > 0 ? static_cast<std::size_t>(std::lround(min_segment_seconds * rate))
-                              : 0;
-  config.window_size =
-      window_seconds > 0 ? std::max<std::size_t>(2, std::lround(window_seconds * rate)) : 0;
-  return config;
+  config.seconds = time;
+  config.seconds->min_segment = min_segment_seconds;
+  config.seconds->window = window_seconds;
+  lfd::SegmentationPipelineConfig nominal = lfd::in_samples(config, rate);
+  nominal.seconds = config.seconds;
+  return nominal;
 }
 
 SegmentationParams params_from_yaml(const YAML::Node& root) {
@@ -111,7 +111,8 @@ SegmentationParams params_from_yaml(const YAML::Node& root) {
   auto& cc = seg.clasp;
   cc.window_selection = lfd::parse_window_selection(
       get<std::string>(clasp, "window_selection", lfd::to_string(cc.window_selection)));
-  cc.min_window = get<std::size_t>(clasp, "min_window", cc.min_window);
+  p.time.min_window = non_negative(get<double>(clasp, "min_window_seconds", p.time.min_window),
+                                   "clasp/min_window_seconds");
   cc.k = get<std::size_t>(clasp, "k", cc.k);
   cc.distance =
       lfd::parse_clasp_distance(get<std::string>(clasp, "distance", lfd::to_string(cc.distance)));
@@ -121,13 +122,34 @@ SegmentationParams params_from_yaml(const YAML::Node& root) {
 
   const YAML::Node events = root["events"];
   auto& ev = p.pipeline.events;
+  ev.threshold = lfd::parse_event_threshold(
+      get<std::string>(events, "threshold", lfd::to_string(ev.threshold)));
   ev.threshold_ratio = get<double>(events, "threshold_ratio", ev.threshold_ratio);
-  ev.median_window = get<std::size_t>(events, "median_window", ev.median_window);
+  ev.relative_floor = get<double>(events, "relative_floor", ev.relative_floor);
   ev.noise_floor_sigmas = get<double>(events, "noise_floor_sigmas", ev.noise_floor_sigmas);
   ev.hysteresis = get<double>(events, "hysteresis", ev.hysteresis);
-  ev.min_active_samples = get<std::size_t>(events, "min_active_samples", ev.min_active_samples);
-  ev.merge_gap = get<std::size_t>(events, "merge_gap", ev.merge_gap);
-  ev.difference_lag = get<std::size_t>(events, "difference_lag", ev.difference_lag);
+  ev.place_on_change = get<bool>(events, "place_on_change", ev.place_on_change);
+  auto& t = p.time;
+  t.event_median =
+      non_negative(get<double>(events, "median_seconds", t.event_median), "events/median_seconds");
+  t.event_difference_lag =
+      non_negative(get<double>(events, "difference_lag_seconds", t.event_difference_lag),
+                   "events/difference_lag_seconds");
+  t.event_merge_gap = non_negative(get<double>(events, "merge_gap_seconds", t.event_merge_gap),
+                                   "events/merge_gap_seconds");
+  t.event_min_active = non_negative(get<double>(events, "min_active_seconds", t.event_min_active),
+                                    "events/min_active_seconds");
+  t.event_noise_block =
+      non_negative(get<double>(events, "noise_block_seconds", t.event_noise_block),
+                   "events/noise_block_seconds");
+  // Sample counts would silently mean something else at another rate: refuse them.
+  for (const char* key : {"median_window", "merge_gap", "difference_lag", "min_active_samples"})
+    if (events && events[key])
+      throw std::invalid_argument(std::string("segmentation parameter 'events/") + key +
+                                  "' counts samples; give it in seconds (events/*_seconds)");
+  if (clasp && clasp["min_window"])
+    throw std::invalid_argument(
+        "segmentation parameter 'clasp/min_window' counts samples; give clasp/min_window_seconds");
 
   const YAML::Node topics = root["topics"];
   if (topics) {

@@ -27,11 +27,12 @@ const char* kUsage = R"(usage: segment [options] FILE...
   --sensor-columns a,b,c    CSV columns used only for the confidence zones
   --state-columns a,b,c     CSV columns considered for segmentation (default: all other columns)
   --time-column NAME        CSV time column (default: time, t, timestamp or stamp if present)
-  --rate HZ                 bag resampling rate / CSV sample rate without a time column
-  --combination NAME        average | product | weighted_average | weighted_product
+  --rate HZ                 bag resampling rate / CSV sample rate (overrides a CSV time column)
+  --combination NAME        average | product | weighted_average | weighted_product |
+                            distance_average | weighted_distance_average
   --threshold T             relevance threshold in (0,1]
-  --min-s N                 min segment length in samples (--min-segment-seconds S in seconds)
-  --window N                fixed ClaSP window in samples (--window-seconds S in seconds)
+  --min-segment-seconds S   min segment length min_s (s)
+  --window-seconds S        fixed ClaSP window (s)
   --num-changepoints N      exact number of ClaSP changepoints (default: significance test)
   --threads N               worker threads (default: parameter 'threads')
   --feature-profiles        include every selected feature's ClaSP profile
@@ -64,7 +65,7 @@ struct Options {
   std::vector<std::string> files, sensors, states;
   std::string time_column, combination, output;
   double rate = 0, threshold = 0, min_seconds = 0, window_seconds = 0;
-  long min_s = 0, window = 0, num_changepoints = 0, threads = -1;
+  long num_changepoints = 0, threads = -1;
   bool timing = false, feature_profiles = false, profiles = true;
 };
 
@@ -104,12 +105,8 @@ Options parse_args(int argc, char** argv) {
       o.combination = value();
     } else if (arg == "--threshold") {
       o.threshold = number();
-    } else if (arg == "--min-s") {
-      o.min_s = static_cast<long>(number());
     } else if (arg == "--min-segment-seconds") {
       o.min_seconds = number();
-    } else if (arg == "--window") {
-      o.window = static_cast<long>(number());
     } else if (arg == "--window-seconds") {
       o.window_seconds = number();
     } else if (arg == "--num-changepoints") {
@@ -131,8 +128,8 @@ Options parse_args(int argc, char** argv) {
     }
   }
   if (o.files.empty()) throw std::invalid_argument(std::string("no input files\n") + kUsage);
-  if (o.min_s < 0 || o.window < 0 || o.min_seconds < 0 || o.window_seconds < 0) {
-    throw std::invalid_argument("min-s and window must be >= 0");
+  if (o.min_seconds < 0 || o.window_seconds < 0 || o.rate < 0) {
+    throw std::invalid_argument("--min-segment-seconds, --window-seconds and --rate must be >= 0");
   }
   return o;
 }
@@ -153,8 +150,6 @@ nlohmann::json run(const Options& o) {
   if (o.window_seconds > 0) params.window_seconds = o.window_seconds;
   if (o.threads >= 0) params.pipeline.threads = static_cast<int>(o.threads);
   lfd::SegmentationPipelineConfig config = params.pipeline_config();
-  if (o.min_s > 0) config.segmentation.min_segment_length = static_cast<std::size_t>(o.min_s);
-  if (o.window > 0) config.window_size = static_cast<std::size_t>(o.window);
   if (o.num_changepoints > 0)
     config.segmentation.num_changepoints = static_cast<int>(o.num_changepoints);
 
@@ -174,6 +169,11 @@ nlohmann::json run(const Options& o) {
       demos.push_back(std::move(demo.matrix));
     } else {
       demos.push_back(lfd_segmentation::read_csv_features(f, o.time_column, o.rate));
+      if (demos.back().time.empty())
+        throw std::invalid_argument(
+            "CSV file '" + f +
+            "' has no time column (time, t, timestamp, stamp or --time-column): give its sample "
+            "rate with --rate, the time parameters are in seconds");
     }
   }
   const double load_time = seconds_since(start);
@@ -187,8 +187,9 @@ nlohmann::json run(const Options& o) {
     // Plain parameter-free multivariate ClaSP over the chosen columns, equal weights.
     lfd::FeatureMatrix demo = states.empty() ? demos[0] : demos[0].select(states);
     lfd::check_finite(demo, o.files[0]);
-    lfd::MultivariateSegmentationConfig seg = config.segmentation;
-    if (config.window_size > 0) seg.window_sizes.assign(demo.cols(), config.window_size);
+    const lfd::SegmentationPipelineConfig own = lfd::in_samples(config, lfd::sample_rate_of(demo));
+    lfd::MultivariateSegmentationConfig seg = own.segmentation;
+    if (own.window_size > 0) seg.window_sizes.assign(demo.cols(), own.window_size);
     const lfd::MultivariateSegmentation s = lfd::segment_multivariate(demo.data, {}, seg);
     out = lfd_segmentation::to_json(s, demo, o.files[0], json_options);
     out["mode"] = "clasp";

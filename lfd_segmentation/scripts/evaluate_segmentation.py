@@ -7,13 +7,29 @@ validated changepoints with the ground-truth phase transitions recorded on /lfd/
 segmenter never reads). The protocol and its tolerance come from config/evaluation.yaml.
 
   evaluate_segmentation.py --datasets DIR [--names sim_grasp,sim_push] [--methods ...] --out result.json
+                           [--cli PATH/TO/segment [--config YAML] [--no-sensors]]
 
-Prints one table row per dataset and method, and writes every per-demo detail to --out.
+With --cli the master-free `segment` CLI is run instead of the service (same config and result);
+--no-sensors drops every sensor topic (pose-only input). Prints one table row per dataset and
+method, and writes every per-demo detail to --out.
+
+Metrics, per dataset and method:
+  rate       the paper's success rate: exactly one changepoint per expected transition window
+  covering   TSSB's Covering: for every true segment the best Jaccard overlap with a found segment,
+             weighted by its length (1 = same segmentation)
+  f1         TSSB's margin F1: a true changepoint (and the series' first and last sample, as TSSB
+             counts them) is found when a changepoint lies within the tolerance of it
+  err_med/p95  time error of each true transition (distance from the nearest changepoint to its
+             window, 0 inside), median and 95th percentile over the demos that found one
+A transition's point for Covering and F1 is the middle of its window (the grasp phase of a grasp,
+a single instant for the push contact and release).
 """
 import argparse
 import json
 import os
+import subprocess
 import sys
+import tempfile
 import time
 
 import rosbag
@@ -64,6 +80,118 @@ def judge(changepoint_times, windows):
     return True, "ok"
 
 
+def transition_points(phases, expected):
+    """(lo, hi) of each true transition without tolerance."""
+    return [(lo, hi) for lo, hi in expected_windows(phases, expected, 0.0)]
+
+
+def segments(points, start, end):
+    edges = [start] + sorted(p for p in points if start < p < end) + [end]
+    return list(zip(edges[:-1], edges[1:]))
+
+
+def covering(true_points, found_points, start, end):
+    """TSSB Covering (van den Burg & Williams): sum over true segments of |A| / N max_B J(A, B)."""
+    truth, found = segments(true_points, start, end), segments(found_points, start, end)
+    total = 0.0
+    for a0, a1 in truth:
+        best = 0.0
+        for b0, b1 in found:
+            inter = max(0.0, min(a1, b1) - max(a0, b0))
+            union = max(a1, b1) - min(a0, b0)
+            best = max(best, inter / union if union > 0 else 0.0)
+        total += (a1 - a0) * best
+    return total / (end - start) if end > start else 0.0
+
+
+def margin_f1(true_points, found_points, start, end, margin):
+    """TSSB's F1 with a margin: the first and last sample count as changepoints of both sides."""
+    truth = [start] + sorted(true_points) + [end]
+    found = [start] + sorted(p for p in found_points if start < p < end) + [end]
+    used, tp = set(), 0
+    for t in truth:
+        for i, f in enumerate(found):
+            if i not in used and abs(f - t) <= margin:
+                used.add(i)
+                tp += 1
+                break
+    precision, recall = tp / float(len(found)), tp / float(len(truth))
+    return 2 * precision * recall / (precision + recall) if precision + recall > 0 else 0.0
+
+
+def time_errors(windows, found):
+    """Distance from the nearest changepoint to each true transition window (0 inside)."""
+    errors = []
+    for lo, hi in windows:
+        if not found:
+            errors.append(None)
+            continue
+        errors.append(min(0.0 if lo <= c <= hi else min(abs(c - lo), abs(c - hi)) for c in found))
+    return errors
+
+
+def percentile(values, q):
+    if not values:
+        return float("nan")
+    v = sorted(values)
+    k = (len(v) - 1) * q
+    lo = int(k)
+    hi = min(lo + 1, len(v) - 1)
+    return v[lo] + (v[hi] - v[lo]) * (k - lo)
+
+
+def bag_span(bag_path):
+    with rosbag.Bag(bag_path) as bag:
+        return bag.get_start_time(), bag.get_end_time()
+
+
+class CliSegmenter(object):
+    """Runs the `segment` CLI on the bags of one dataset; returns a service-like result."""
+
+    def __init__(self, cli, config, no_sensors):
+        self.cli, self.config, self.no_sensors = cli, config, no_sensors
+
+    def _config(self):
+        if not self.no_sensors:
+            return self.config
+        with open(self.config) as f:
+            cfg = yaml.safe_load(f)
+        cfg["topics"] = [t for t in cfg["topics"] if t.get("role", "state") != "sensor"]
+        cfg["validate_with_sensors"] = False
+        tmp = tempfile.NamedTemporaryFile("w", suffix=".yaml", delete=False)
+        yaml.safe_dump(cfg, tmp)
+        tmp.close()
+        return tmp.name
+
+    def __call__(self, bags, method):
+        cmd = [self.cli, "--config", self._config(), "--no-profiles", "--combination", method] + bags
+        proc = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, universal_newlines=True)
+        if not proc.stdout.strip():
+            raise RuntimeError("segment CLI printed nothing: %s" % proc.stderr.strip()[-300:])
+        out = json.loads(proc.stdout)
+        if not out.get("success"):
+            raise RuntimeError("segmentation failed: %s" % out.get("error"))
+        demos = []
+        for d in out["demos"]:
+            t0 = d.get("start_time", 0.0)
+            demos.append({"changepoint_times": d["changepoint_times"], "rejected_times": d.get("rejected_times", []),
+                          "pruned_times": d.get("pruned_times", []),
+                          "zones": [(z["begin_time"], z["end_time"]) for z in d.get("zones", [])]})
+        return {"demos": demos, "selected_features": out["selected_features"],
+                "selected_weights": out["feature_weights"], "warnings": out["warnings"]}
+
+
+def call_service(segment, bags, method):
+    res = segment(SegmentRequest(bag_paths=bags, combination=method))
+    if not res.success:
+        raise RuntimeError("segmentation failed: %s" % res.error)
+    return {"demos": [{"changepoint_times": list(d.changepoint_times), "rejected_times": list(d.rejected_times),
+                       "pruned_times": list(d.pruned_times),
+                       "zones": [(z.begin_time, z.end_time) for z in d.zones]} for d in res.demos],
+            "selected_features": list(res.selected_features), "selected_weights": list(res.selected_weights),
+            "warnings": list(res.warnings)}
+
+
 def list_bags(folder):
     bags = sorted(os.path.join(folder, f) for f in os.listdir(folder) if f.endswith(".bag"))
     if not bags:
@@ -77,28 +205,37 @@ def evaluate_dataset(segment, folder, method, config):
     task = truth[0][0]
     expected = config["segmentation"]["expected"][task]
     tolerance = float(config["segmentation"]["tolerance_s"])
-    req = SegmentRequest(bag_paths=bags, combination=method)
     start = time.time()
-    res = segment(req)
+    res = segment(bags, method)
     elapsed = time.time() - start
-    if not res.success:
-        raise RuntimeError("segmentation failed: %s" % res.error)
-    demos, correct = [], 0
-    for bag, (_, phases), demo in zip(bags, truth, res.demos):
+    demos, correct, coverings, f1s, errors, missed = [], 0, [], [], [], 0
+    for bag, (_, phases), demo in zip(bags, truth, res["demos"]):
         windows = expected_windows(phases, expected, tolerance)
-        ok, why = judge(list(demo.changepoint_times), windows)
+        found = list(demo["changepoint_times"])
+        ok, why = judge(found, windows)
         correct += ok
+        t_start, t_end = bag_span(bag)
+        true_windows = transition_points(phases, expected)
+        points = [0.5 * (lo + hi) for lo, hi in true_windows]
+        cov = covering(points, found, t_start, t_end)
+        f1 = margin_f1(points, found, t_start, t_end, tolerance)
+        errs = time_errors(true_windows, found)
+        coverings.append(cov)
+        f1s.append(f1)
+        errors += [e for e in errs if e is not None]
+        missed += sum(e is None for e in errs)
         demos.append({"bag": os.path.basename(bag), "correct": ok, "reason": why,
-                      "changepoints_s": list(demo.changepoint_times),
-                      "rejected_s": list(demo.rejected_times),
-                      "pruned_s": list(demo.pruned_times),
-                      "windows_s": windows,
-                      "zones_s": [(z.begin_time, z.end_time) for z in demo.zones]})
+                      "changepoints_s": found, "rejected_s": demo["rejected_times"],
+                      "pruned_s": demo["pruned_times"], "windows_s": windows, "zones_s": demo["zones"],
+                      "covering": cov, "f1": f1, "time_errors_s": errs})
+    n = float(len(bags))
     return {"task": task, "method": method, "demos": len(bags), "correct": correct,
-            "success_rate": correct / float(len(bags)), "tolerance_s": tolerance,
-            "selected_features": list(res.selected_features),
-            "selected_weights": list(res.selected_weights),
-            "warnings": list(res.warnings), "service_time_s": elapsed, "details": demos}
+            "success_rate": correct / n, "tolerance_s": tolerance,
+            "covering": sum(coverings) / n, "f1": sum(f1s) / n,
+            "time_error_median_s": percentile(errors, 0.5), "time_error_p95_s": percentile(errors, 0.95),
+            "transitions_without_changepoint": missed,
+            "selected_features": res["selected_features"], "selected_weights": res["selected_weights"],
+            "warnings": res["warnings"], "service_time_s": elapsed, "details": demos}
 
 
 def main():
@@ -109,34 +246,44 @@ def main():
     ap.add_argument("--config", default=DEFAULT_CONFIG)
     ap.add_argument("--service", default="/segmentation/segment")
     ap.add_argument("--out", default="", help="write the full result as JSON here")
+    ap.add_argument("--cli", default="", help="run this `segment` CLI instead of the service")
+    ap.add_argument("--seg-config", default=os.path.join(HERE, "..", "..", "config", "segmentation.yaml"),
+                    help="segmentation parameters for --cli")
+    ap.add_argument("--no-sensors", action="store_true", help="with --cli: drop the sensor topics")
     args = ap.parse_args(rospy.myargv()[1:])
 
     with open(args.config) as f:
         config = yaml.safe_load(f)
     methods = [m for m in args.methods.split(",") if m] or config["segmentation"]["methods"]
-    try:
-        rospy.wait_for_service(args.service, timeout=30.0)
-    except rospy.ROSException:
-        print("error: segmentation service %s is not available" % args.service, file=sys.stderr)
-        return 2
-    segment = rospy.ServiceProxy(args.service, Segment)
+    if args.cli:
+        segment = CliSegmenter(args.cli, args.seg_config, args.no_sensors)
+    else:
+        try:
+            rospy.wait_for_service(args.service, timeout=30.0)
+        except rospy.ROSException:
+            print("error: segmentation service %s is not available" % args.service, file=sys.stderr)
+            return 2
+        proxy = rospy.ServiceProxy(args.service, Segment)
+        segment = lambda bags, method: call_service(proxy, bags, method)  # noqa: E731
 
     results, failures = {}, 0
-    print("%-14s %-18s %8s %6s %8s  %s" % ("dataset", "method", "correct", "rate", "time_s", "features"))
+    print("%-14s %-18s %8s %6s %6s %6s %7s %7s %8s  %s" % (
+        "dataset", "method", "correct", "rate", "cover", "f1", "err_med", "err_p95", "time_s", "features"))
     for name in [n for n in args.names.split(",") if n]:
         folder = os.path.join(args.datasets, name)
         results[name] = {}
         for method in methods:
             try:
                 r = evaluate_dataset(segment, folder, method, config)
-            except (RuntimeError, rospy.ServiceException, OSError) as exc:
+            except (RuntimeError, rospy.ServiceException, OSError, ValueError) as exc:
                 print("%-14s %-18s error: %s" % (name, method, exc))
                 results[name][method] = {"error": str(exc)}
                 failures += 1
                 continue
             results[name][method] = r
-            print("%-14s %-18s %4d/%-3d %5.0f%% %8.2f  %s" % (
-                name, method, r["correct"], r["demos"], 100 * r["success_rate"], r["service_time_s"],
+            print("%-14s %-18s %4d/%-3d %5.0f%% %6.3f %6.3f %7.3f %7.3f %8.2f  %s" % (
+                name, method, r["correct"], r["demos"], 100 * r["success_rate"], r["covering"], r["f1"],
+                r["time_error_median_s"], r["time_error_p95_s"], r["service_time_s"],
                 ",".join(r["selected_features"])))
     tol = config["segmentation"]["tolerance_s"]
     print("tolerance: a changepoint counts when within %.2f s of its ground-truth transition" % tol)
@@ -147,5 +294,6 @@ def main():
 
 
 if __name__ == "__main__":
-    rospy.init_node("evaluate_segmentation", anonymous=True, disable_signals=True)
+    if "--cli" not in sys.argv:
+        rospy.init_node("evaluate_segmentation", anonymous=True, disable_signals=True)
     sys.exit(main())

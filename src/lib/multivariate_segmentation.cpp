@@ -28,7 +28,13 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr double kMinScoreForLog = 1e-12;
 
 bool is_weighted(ProfileCombination c) {
-  return c == ProfileCombination::kWeightedAverage || c == ProfileCombination::kWeightedProduct;
+  return c == ProfileCombination::kWeightedAverage || c == ProfileCombination::kWeightedProduct ||
+         c == ProfileCombination::kWeightedDistanceAverage;
+}
+
+bool is_distance_average(ProfileCombination c) {
+  return c == ProfileCombination::kDistanceAverage ||
+         c == ProfileCombination::kWeightedDistanceAverage;
 }
 
 // Zeroth-order modified Bessel function of the first kind (power series; converges for all x).
@@ -50,8 +56,11 @@ ProfileCombination parse_profile_combination(const std::string& name) {
   if (name == "product") return ProfileCombination::kProduct;
   if (name == "weighted_average") return ProfileCombination::kWeightedAverage;
   if (name == "weighted_product") return ProfileCombination::kWeightedProduct;
+  if (name == "distance_average") return ProfileCombination::kDistanceAverage;
+  if (name == "weighted_distance_average") return ProfileCombination::kWeightedDistanceAverage;
   throw std::invalid_argument("unknown profile combination '" + name +
-                              "' (average, product, weighted_average, weighted_product)");
+                              "' (average, product, weighted_average, weighted_product, "
+                              "distance_average, weighted_distance_average)");
 }
 
 std::string to_string(ProfileCombination combination) {
@@ -64,6 +73,10 @@ std::string to_string(ProfileCombination combination) {
       return "weighted_average";
     case ProfileCombination::kWeightedProduct:
       return "weighted_product";
+    case ProfileCombination::kDistanceAverage:
+      return "distance_average";
+    case ProfileCombination::kWeightedDistanceAverage:
+      return "weighted_distance_average";
   }
   return "?";
 }
@@ -243,6 +256,11 @@ MultivariateSegmentation segment_multivariate(const Eigen::MatrixXd& features,
     for (std::size_t f : active) {
       const std::size_t wf = out.window_sizes[f];
       if (len < 3 * wf) continue;  // the sub-series is too short for this feature's window
+      if (is_distance_average(config.combination)) {  // one joint k-NN below instead
+        used_weights.push_back(w[f]);
+        used_features.push_back(f);
+        continue;
+      }
       ClaspConfig cfg = config.clasp;
       cfg.window_size = wf;
       cfg.min_segment_size = min_s;
@@ -255,8 +273,40 @@ MultivariateSegmentation segment_multivariate(const Eigen::MatrixXd& features,
       used_weights.push_back(w[f]);
       used_features.push_back(f);
     }
-    if (profiles.empty()) return;
-    const Eigen::VectorXd combined = combine_profiles(profiles, used_weights, config.combination);
+    if (used_features.empty()) return;
+    if (is_distance_average(config.combination)) {
+      // One k-NN over every usable feature at the largest of their windows (all must fit).
+      std::size_t window = 0;
+      for (std::size_t f : used_features) window = std::max(window, out.window_sizes[f]);
+      std::vector<std::size_t> fitting;
+      std::vector<double> fitting_weights;
+      for (std::size_t i = 0; i < used_features.size(); ++i) {
+        fitting.push_back(used_features[i]);
+        fitting_weights.push_back(used_weights[i]);
+      }
+      if (len < 3 * window || len < 2 * min_s + 1) return;
+      Eigen::MatrixXd block(static_cast<Eigen::Index>(len),
+                            static_cast<Eigen::Index>(fitting.size()));
+      for (std::size_t i = 0; i < fitting.size(); ++i)
+        block.col(static_cast<Eigen::Index>(i)) =
+            features.col(static_cast<Eigen::Index>(fitting[i]))
+                .segment(static_cast<Eigen::Index>(begin), static_cast<Eigen::Index>(len));
+      KnnResult knn = distance_average_knn(
+          block, fitting_weights, window, config.clasp.k,
+          static_cast<std::size_t>(config.clasp.exclusion_radius * static_cast<double>(window)),
+          config.clasp.distance);
+      profiles.assign(1, classification_score_profile(knn, min_s, config.clasp.score));
+      knns.assign(1, std::move(knn));
+      used_weights.assign(1, 1.0);
+      if (first) {  // per-feature profiles are not computed by this method
+        for (auto& p : out.first_feature_profiles) p.setZero();
+        used_features.clear();
+      }
+    }
+    const Eigen::VectorXd combined =
+        is_distance_average(config.combination)
+            ? profiles[0]
+            : combine_profiles(profiles, used_weights, config.combination);
     const Eigen::VectorXd penalized = combined.cwiseProduct(kaiser_window(len, config.kaiser_beta));
     if (first) {
       out.first_profile = combined;

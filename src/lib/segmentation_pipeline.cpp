@@ -90,18 +90,41 @@ void for_each_demo(std::size_t count, int threads, Job job) {
   }
 }
 
+// The sample-count settings of one demonstration: the config's own counts, or its seconds
+// converted at the demonstration's rate.
+struct DemoSettings {
+  SegmentationPipelineConfig config;
+  double rate = 0.0;
+};
+
+DemoSettings settings_for(const FeatureMatrix& demo, const SegmentationPipelineConfig& config) {
+  if (!config.seconds) return {config, 0.0};
+  const double rate = sample_rate_of(demo);
+  return {in_samples(config, rate), rate};
+}
+
 // SegmentationPipelineConfig::consensus_count. Significance of a changepoint: the log10 p-value
 // of the ClaSP candidate that placed it.
-void prune_to_consensus(const std::vector<FeatureMatrix>& demos,
+void prune_to_consensus(const std::vector<FeatureMatrix>& demos, bool validated,
                         SegmentationPipelineResult* result) {
+  // With sensor validation only demos with evidence vote: a demo without any sensory event had no
+  // zone, so its count of 0 says nothing about the task (a dead sensor, a missed contact).
   std::map<std::size_t, std::size_t> votes;  // changepoint count -> demos
-  for (const DemoSegmentationResult& d : result->demos) ++votes[d.changepoints.size()];
+  std::size_t n = 0;
+  for (const DemoSegmentationResult& d : result->demos) {
+    if (validated && d.events.empty()) continue;
+    ++votes[d.changepoints.size()];
+    ++n;
+  }
+  if (votes.empty()) return;
   const auto top = std::max_element(
       votes.begin(), votes.end(), [](const auto& a, const auto& b) { return a.second < b.second; });
-  const std::size_t n = result->demos.size();
   if (n < 3 || 2 * top->second <= n) return;  // no clear majority: nothing to agree on
   const std::size_t k = top->first;
-  for (std::size_t d = 0; d < n; ++d) {
+  // A majority that found nothing says nothing about where the boundaries are: the changepoints
+  // of the other demos each stand on a sensory event of their own.
+  if (k == 0) return;
+  for (std::size_t d = 0; d < result->demos.size(); ++d) {
     DemoSegmentationResult& out = result->demos[d];
     if (out.changepoints.size() <= k) continue;
     std::vector<std::pair<double, std::size_t>> by_p;  // (log10 p, changepoint)
@@ -114,7 +137,7 @@ void prune_to_consensus(const std::vector<FeatureMatrix>& demos,
     std::stable_sort(by_p.begin(), by_p.end());
     std::ostringstream msg;
     msg << demo_context(d) << ": " << out.changepoints.size() << " changepoints where "
-        << top->second << " of " << n << " demonstrations have " << k
+        << top->second << " of the " << n << " voting demonstrations have " << k
         << "; dropped the least significant:";
     out.changepoints.clear();
     out.changepoint_times.clear();
@@ -136,6 +159,45 @@ void prune_to_consensus(const std::vector<FeatureMatrix>& demos,
 }
 
 }  // namespace
+
+namespace {
+std::size_t samples(double seconds, double rate, std::size_t at_least) {
+  return std::max<std::size_t>(at_least, static_cast<std::size_t>(std::lround(seconds * rate)));
+}
+}  // namespace
+
+SegmentationPipelineConfig in_samples(const SegmentationPipelineConfig& config, double rate) {
+  SegmentationPipelineConfig s = config;
+  if (!config.seconds) return s;
+  if (!(rate > 0) || !std::isfinite(rate))
+    throw std::invalid_argument("sample rate must be > 0, got " + std::to_string(rate));
+  const TimeParameters& t = *config.seconds;
+  s.segmentation.min_segment_length = t.min_segment > 0 ? samples(t.min_segment, rate, 1) : 0;
+  s.window_size = t.window > 0 ? samples(t.window, rate, 2) : 0;
+  s.segmentation.clasp.min_window = samples(t.min_window, rate, 2);
+  s.events.median_window = samples(t.event_median, rate, 1) | 1;  // odd: a centred median
+  s.events.difference_lag = samples(t.event_difference_lag, rate, 1);
+  s.events.merge_gap = samples(t.event_merge_gap, rate, 0);
+  s.events.min_active_samples = samples(t.event_min_active, rate, 1);
+  s.events.noise_block = samples(t.event_noise_block, rate, 4);
+  s.seconds.reset();
+  return s;
+}
+
+double sample_rate_of(const FeatureMatrix& demo) {
+  if (demo.time.size() < 2 || demo.time.size() != static_cast<std::size_t>(demo.rows()))
+    throw std::invalid_argument(
+        "no clock: time parameters are in seconds, so the samples need timestamps (a time "
+        "column, bag stamps, or a rate)");
+  std::vector<double> steps(demo.time.size() - 1);
+  for (std::size_t i = 1; i < demo.time.size(); ++i) steps[i - 1] = demo.time[i] - demo.time[i - 1];
+  std::nth_element(steps.begin(), steps.begin() + steps.size() / 2, steps.end());
+  const double step = steps[steps.size() / 2];
+  if (!(step > 0) || !std::isfinite(step))
+    throw std::invalid_argument("the clock does not increase (median time step " +
+                                std::to_string(step) + " s)");
+  return 1.0 / step;
+}
 
 SegmentationPipelineResult run_segmentation_pipeline(
     const std::vector<FeatureMatrix>& demos, const std::vector<std::string>& sensor_features,
@@ -184,14 +246,17 @@ SegmentationPipelineResult run_segmentation_pipeline(
   for (std::size_t d = 0; d < demos.size(); ++d)
     check_finite(demos[d].select(used), demo_context(d));
 
-  const std::size_t min_s = config.segmentation.min_segment_length;
-  if (min_s > 0) {
-    for (std::size_t d = 0; d < demos.size(); ++d) {
-      if (static_cast<std::size_t>(demos[d].rows()) < 2 * min_s) {
-        throw std::invalid_argument(
-            demo_context(d) + " has " + std::to_string(demos[d].rows()) +
-            " samples, fewer than 2 * min_s = " + std::to_string(2 * min_s));
-      }
+  std::vector<DemoSettings> settings;
+  for (std::size_t d = 0; d < demos.size(); ++d) {
+    try {
+      settings.push_back(settings_for(demos[d], config));
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument(demo_context(d) + ": " + e.what());
+    }
+    const std::size_t min_s = settings.back().config.segmentation.min_segment_length;
+    if (min_s > 0 && static_cast<std::size_t>(demos[d].rows()) < 2 * min_s) {
+      throw std::invalid_argument(demo_context(d) + " has " + std::to_string(demos[d].rows()) +
+                                  " samples, fewer than 2 * min_s = " + std::to_string(2 * min_s));
     }
   }
 
@@ -242,10 +307,6 @@ SegmentationPipelineResult run_segmentation_pipeline(
       std::chrono::duration<double>(segmentation_start - relevance_start).count();
 
   // ---- II-C multivariate ClaSP + sensory validation, one demonstration per worker
-  MultivariateSegmentationConfig segmentation_config = config.segmentation;
-  if (config.window_size > 0) {
-    segmentation_config.window_sizes.assign(result.selected_features.size(), config.window_size);
-  }
   const bool validate = config.validate_with_sensors && !sensor_features.empty();
   if (!validate) {
     result.warnings.push_back(sensor_features.empty()
@@ -257,11 +318,15 @@ SegmentationPipelineResult run_segmentation_pipeline(
     const FeatureMatrix& demo = demos[d];
     DemoSegmentationResult& out = result.demos[d];
     out.num_samples = static_cast<std::size_t>(demo.rows());
+    out.sample_rate = settings[d].rate;
     const Eigen::MatrixXd state = demo.select(result.selected_features).data;
-    MultivariateSegmentationConfig demo_config = segmentation_config;
+    const SegmentationPipelineConfig& own = settings[d].config;
+    MultivariateSegmentationConfig demo_config = own.segmentation;
+    if (own.window_size > 0)
+      demo_config.window_sizes.assign(result.selected_features.size(), own.window_size);
     // Events do not depend on min_s: detected once, for the zone-guided search and validation.
     const SensorEvents events =
-        validate ? detect_sensor_events(demo.select(sensor_features).data, config.events)
+        validate ? detect_sensor_events(demo.select(sensor_features).data, own.events)
                  : SensorEvents{};
     const auto zones = [&](std::size_t min_s) {
       return confidence_zones(events.all, min_s, static_cast<std::size_t>(demo.rows()));
@@ -285,9 +350,16 @@ SegmentationPipelineResult run_segmentation_pipeline(
     for (std::size_t cp : out.changepoints) out.changepoint_times.push_back(demo.time_at(cp));
     for (std::size_t cp : out.rejected) out.rejected_times.push_back(demo.time_at(cp));
   });
-  if (config.consensus_count) prune_to_consensus(demos, &result);
+  if (config.consensus_count) prune_to_consensus(demos, validate, &result);
   result.segmentation_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - segmentation_start).count();
+  for (std::size_t d = 0; d < demos.size() && validate; ++d) {
+    for (const std::string& sensor : sensor_features) {
+      if (is_constant(demos[d], demos[d].require(sensor)))
+        result.warnings.push_back(demo_context(d) + ": sensor '" + sensor +
+                                  "' is constant (dead or disconnected?): no zone from it");
+    }
+  }
   for (std::size_t d = 0; d < demos.size(); ++d) {
     if (validate && result.demos[d].events.empty()) {
       result.warnings.push_back(demo_context(d) +

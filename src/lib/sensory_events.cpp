@@ -11,6 +11,8 @@ namespace lfd {
 namespace {
 
 void check_config(const SensoryEventConfig& c) {
+  if (!(c.relative_floor >= 0.0 && c.relative_floor <= 1.0))
+    throw std::invalid_argument("sensory events: relative_floor must be in [0, 1]");
   if (!(c.threshold_ratio > 0.0 && c.threshold_ratio <= 1.0))
     throw std::invalid_argument("sensory events: threshold_ratio must be in (0, 1], got " +
                                 std::to_string(c.threshold_ratio));
@@ -21,6 +23,30 @@ void check_config(const SensoryEventConfig& c) {
     throw std::invalid_argument("sensory events: noise_floor_sigmas must be >= 0");
   if (c.difference_lag < 1)
     throw std::invalid_argument("sensory events: difference_lag must be >= 1");
+}
+
+double median_of(std::vector<double> v);
+
+// Robust sigma (1.4826 x MAD about the median) of v.
+double robust_sigma(std::vector<double> v) {
+  const double med = median_of(v);
+  for (double& x : v) x = std::abs(x - med);
+  return 1.4826 * median_of(v);
+}
+
+// SensoryEventConfig::noise_block: the quiet blocks' sigma (10th percentile of the blocks that
+// move at all); block 0 = one sigma over everything.
+double noise_sigma(const std::vector<double>& d, std::size_t block) {
+  if (block == 0 || d.size() < 2 * block) return robust_sigma(d);
+  std::vector<double> sigmas;
+  for (std::size_t b = 0; b + block <= d.size(); b += block) {
+    const double s = robust_sigma(std::vector<double>(d.begin() + b, d.begin() + b + block));
+    if (s > 0.0) sigmas.push_back(s);
+  }
+  if (sigmas.empty()) return 0.0;
+  const std::size_t k = sigmas.size() / 10;
+  std::nth_element(sigmas.begin(), sigmas.begin() + static_cast<std::ptrdiff_t>(k), sigmas.end());
+  return sigmas[k];
 }
 
 double median_of(std::vector<double> v) {
@@ -53,6 +79,16 @@ std::vector<double> running_median(const Eigen::Ref<const Eigen::VectorXd>& x, s
 
 }  // namespace
 
+EventThreshold parse_event_threshold(const std::string& name) {
+  if (name == "ratio_of_max") return EventThreshold::kRatioOfMax;
+  if (name == "noise") return EventThreshold::kNoise;
+  throw std::invalid_argument("unknown event threshold '" + name + "' (ratio_of_max, noise)");
+}
+
+std::string to_string(EventThreshold threshold) {
+  return threshold == EventThreshold::kNoise ? "noise" : "ratio_of_max";
+}
+
 std::vector<std::size_t> detect_sensory_events(const Eigen::Ref<const Eigen::VectorXd>& signal,
                                                const SensoryEventConfig& config) {
   check_config(config);
@@ -61,27 +97,34 @@ std::vector<std::size_t> detect_sensory_events(const Eigen::Ref<const Eigen::Vec
   if (n < 2) return {};
   const std::vector<double> y = running_median(signal, config.median_window);
   const std::size_t lag = config.difference_lag, ahead = lag / 2, behind = lag - ahead;
+  // Only differences of fully smoothed samples: the median's window shrinks at the ends, where a
+  // single noisy sample would otherwise look like a level change.
+  const std::size_t edge = config.median_window > 1 ? config.median_window / 2 : 0;
   std::vector<double> mag(n, 0.0);
-  for (std::size_t t = behind; t + ahead < n; ++t) mag[t] = std::abs(y[t + ahead] - y[t - behind]);
+  for (std::size_t t = behind + edge; t + ahead + edge < n; ++t)
+    mag[t] = std::abs(y[t + ahead] - y[t - behind]);
   const double peak = *std::max_element(mag.begin(), mag.end());
   if (!(peak > 0.0)) return {};
-  double on = config.threshold_ratio * peak;
-  if (config.noise_floor_sigmas > 0.0 && lag > 1) {
-    // Lagged differences of a smoothed signal are noise-dominated wherever nothing happens, so
-    // their own robust spread is the noise level.
-    std::vector<double> lagged(mag.begin() + static_cast<std::ptrdiff_t>(behind),
-                               mag.end() - static_cast<std::ptrdiff_t>(ahead));
-    on = std::max(on, config.noise_floor_sigmas * 1.4826 * median_of(lagged));
-  } else if (config.noise_floor_sigmas > 0.0) {
-    // Noise level of the RAW differences: a running median leaves plateaus whose differences are
-    // mostly 0, which would make the robust sigma of the smoothed differences meaningless.
-    std::vector<double> raw(n - 1);
-    for (std::size_t t = 1; t < n; ++t)
-      raw[t - 1] = signal[static_cast<Eigen::Index>(t)] - signal[static_cast<Eigen::Index>(t - 1)];
-    const double med = median_of(raw);
-    for (double& v : raw) v = std::abs(v - med);
-    on = std::max(on, config.noise_floor_sigmas * 1.4826 * median_of(raw));
-  }
+  // The noise is measured on the RAW first differences (nearly independent samples, so a block of
+  // a second gives a fair estimate; a running median leaves plateaus whose differences are mostly
+  // 0, and lagged differences of a smoothed signal are so correlated that a block holds only a few
+  // independent values). For white noise of sigma s the raw differences have sigma sqrt(2) s and
+  // the lagged differences of a median of w samples sqrt(2) * 1.2533 s / sqrt(w): the floor is
+  // scaled by 1.2533 / sqrt(w). Correlated noise is underestimated by the raw differences, which
+  // is why the floor is a generous number of sigmas.
+  std::vector<double> diffs;
+  for (std::size_t t = 1; t < n; ++t)
+    diffs.push_back(signal[static_cast<Eigen::Index>(t)] -
+                    signal[static_cast<Eigen::Index>(t - 1)]);
+  const double smoothing = lag > 1 && config.median_window > 1
+                               ? 1.2533 / std::sqrt(static_cast<double>(config.median_window))
+                               : 1.0;
+  const double sigma =
+      config.noise_floor_sigmas > 0.0 ? smoothing * noise_sigma(diffs, config.noise_block) : 0.0;
+  const double noise_floor = config.noise_floor_sigmas * sigma;
+  const double on = config.threshold == EventThreshold::kNoise
+                        ? std::max(noise_floor, config.relative_floor * peak)
+                        : std::max(noise_floor, config.threshold_ratio * peak);
   const double off = config.hysteresis * on;
 
   struct Burst {
@@ -91,7 +134,12 @@ std::vector<std::size_t> detect_sensory_events(const Eigen::Ref<const Eigen::Vec
   bool active = false;
   for (std::size_t t = 1; t < n; ++t) {
     if (!active && mag[t] > on) {
-      bursts.push_back({t, n});
+      // The activity began where it left the off level, not where it crossed the on level: a
+      // force that builds up slowly crosses `on` late (symmetric to the off-event below).
+      std::size_t begin = t;
+      const std::size_t floor_at = bursts.empty() ? 1 : bursts.back().end + 1;
+      while (config.place_on_change && begin > floor_at && mag[begin - 1] > off) --begin;
+      bursts.push_back({begin, n});
       active = true;
     } else if (active && mag[t] <= off) {
       bursts.back().end = t;
@@ -106,12 +154,22 @@ std::vector<std::size_t> detect_sensory_events(const Eigen::Ref<const Eigen::Vec
     else
       merged.push_back(b);
   }
+  // With a lag the activity starts L/2 before the change and ends L/2 after it: move the events
+  // back onto the change (see the header).
+  const bool shift = config.place_on_change && lag > 1;
+  const std::size_t on_shift = shift ? ahead : 0, off_shift = shift ? behind : 0;
   std::vector<std::size_t> events;
   for (const Burst& b : merged) {
     if (b.end != n && b.end - b.begin < config.min_active_samples) continue;
-    events.push_back(b.begin);
-    if (b.end != n) events.push_back(b.end);
+    const std::size_t begin = std::min(b.begin + on_shift, n - 1);
+    events.push_back(begin);
+    // A burst that spans less than half a lag after the shifts is a single edge (a step): one
+    // event.
+    if (b.end != n && b.end - off_shift >= begin + (shift ? ahead : 1))
+      events.push_back(b.end - off_shift);
   }
+  std::sort(events.begin(), events.end());
+  events.erase(std::unique(events.begin(), events.end()), events.end());
   return events;
 }
 

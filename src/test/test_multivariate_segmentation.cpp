@@ -370,3 +370,55 @@ TEST(MultivariateSegmentation, ConstantColumnIsIgnoredAndBadInputRejected) {
 }
 
 }  // namespace
+
+namespace {
+
+// Distance averaging: with one channel, z-normalizing its distance profile keeps the order, so
+// the neighbours are exactly the univariate self-join's.
+TEST(DistanceAverage, OneChannelGivesTheUnivariateNeighbours) {
+  std::mt19937 rng(4);
+  std::normal_distribution<double> g(0.0, 1.0);
+  Eigen::VectorXd x(300);
+  for (Eigen::Index i = 0; i < x.size(); ++i) x[i] = std::sin(0.2 * i) + 0.3 * g(rng);
+  for (auto distance :
+       {lfd::ClaspDistance::kEuclidean, lfd::ClaspDistance::kZNormalizedEuclidean}) {
+    const lfd::KnnResult uni = lfd::brute_force_knn(x, 20, 3, 10, distance);
+    const lfd::KnnResult avg =
+        lfd::distance_average_knn(Eigen::MatrixXd(x), {}, 20, 3, 10, distance);
+    ASSERT_EQ(avg.num_subsequences, uni.num_subsequences);
+    std::size_t same = 0;
+    for (std::size_t i = 0; i < uni.indices.size(); ++i) same += uni.indices[i] == avg.indices[i];
+    EXPECT_GE(same, uni.indices.size() * 99 / 100);  // ties aside
+  }
+}
+
+// Two channels of very different scales: the small one carries the change, the large one is
+// noise. The z-normalized average gives both the same say, so the change is found; weighting the
+// noise channel to 0 leaves the change channel alone.
+TEST(DistanceAverage, ScaleFreeAndWeighted) {
+  std::mt19937 rng(9);
+  std::normal_distribution<double> g(0.0, 1.0);
+  const Eigen::Index n = 600, change = 180;  // off-centre: the Kaiser window favours 300
+  Eigen::MatrixXd x(n, 2);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    x(i, 0) = 0.001 * (i < change ? std::sin(0.3 * i) : std::sin(0.9 * i)) + 0.00005 * g(rng);
+    x(i, 1) = 1000.0 * g(rng);
+  }
+  lfd::MultivariateSegmentationConfig config;
+  config.clasp.window_size = 20;
+  config.clasp.distance = lfd::ClaspDistance::kEuclidean;  // raw distances: scales differ 1e6
+  config.num_changepoints = 1;
+  for (auto c :
+       {ProfileCombination::kDistanceAverage, ProfileCombination::kWeightedDistanceAverage}) {
+    config.combination = c;
+    const auto r = lfd::segment_multivariate(
+        x, {1.0, c == ProfileCombination::kDistanceAverage ? 1.0 : 0.1}, config);
+    ASSERT_EQ(r.changepoints.size(), 1u);
+    EXPECT_NEAR(static_cast<double>(r.changepoints[0]), static_cast<double>(change), 25.0);
+  }
+  EXPECT_EQ(lfd::parse_profile_combination("weighted_distance_average"),
+            ProfileCombination::kWeightedDistanceAverage);
+  EXPECT_EQ(lfd::to_string(ProfileCombination::kDistanceAverage), "distance_average");
+}
+
+}  // namespace

@@ -113,7 +113,7 @@ TEST(SegmentationPipeline, ConsensusDropsTheExtraChangepointOfOneDemo) {
   EXPECT_NEAR(one.pruned_times[0], odd.time_at(one.pruned[0]), 1e-12);
   EXPECT_NE(std::find_if(result.warnings.begin(), result.warnings.end(),
                          [](const std::string& w) {
-                           return w.find("demonstration 2: 2 changepoints where 3 of 4") !=
+                           return w.find("demonstration 2: 2 changepoints where 3 of the 4") !=
                                   std::string::npos;
                          }),
             result.warnings.end());
@@ -182,6 +182,98 @@ TEST(SegmentationPipeline, BadInputGivesClearErrors) {
   empty[0].data.resize(0, 5);
   empty[0].time.clear();
   expect_error(empty, "demonstration 0");
+}
+
+// The same grasp, recorded at any rate: a continuous-time demo (gripper closing over 0.2 s at
+// `grasp_s`, one speed bump per phase, touch stepping up at the grasp) sampled at `rate` Hz.
+lfd::FeatureMatrix sampled_demo(double rate, double duration, double grasp_s, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> noise(0.0, 1.0);
+  lfd::FeatureMatrix m;
+  m.names = {"gripper", "speed", "touch"};
+  const int n = static_cast<int>(std::lround(duration * rate));
+  m.data.resize(n, 3);
+  for (int i = 0; i < n; ++i) {
+    const double t = i / rate;
+    m.time.push_back(t);
+    const double closing = std::clamp((t - grasp_s) / 0.2, 0.0, 1.0);
+    m.data(i, 0) = 0.08 * (1.0 - closing) + 0.0005 * noise(rng);
+    const bool carried = t >= grasp_s;
+    const double phase = carried ? (t - grasp_s) / (duration - grasp_s) : t / grasp_s;
+    m.data(i, 1) = std::sin(M_PI * phase) * (carried ? 0.2 : 0.3) +
+                   0.05 * std::sin(2 * M_PI * t / (carried ? 0.3 : 0.8)) + 0.003 * noise(rng);
+    m.data(i, 2) = (carried ? 5.0 : 0.0) + 0.05 * noise(rng);
+  }
+  return m;
+}
+
+// Seconds, not samples: the same demos resampled to 25, 50, 100 and 200 Hz give the same
+// changepoint times within 0.05 s (with sample counts fixed for 50 Hz, 200 Hz would see windows,
+// lags and min_s four times shorter in time).
+TEST(SegmentationPipeline, SameChangepointsAtAnyRate) {
+  lfd::SegmentationPipelineConfig config;
+  config.seconds = lfd::TimeParameters{};
+  const std::vector<double> grasps = {3.0, 3.4, 2.8, 3.2};
+  std::map<double, std::vector<std::vector<double>>> times;  // rate -> demo -> changepoints
+  for (double rate : {25.0, 50.0, 100.0, 200.0}) {
+    std::vector<lfd::FeatureMatrix> demos;
+    for (std::size_t d = 0; d < grasps.size(); ++d)
+      demos.push_back(sampled_demo(rate, 8.0, grasps[d], static_cast<unsigned>(7 + d)));
+    const auto result = lfd::run_segmentation_pipeline(demos, {"touch"}, config);
+    for (std::size_t d = 0; d < grasps.size(); ++d) {
+      EXPECT_NEAR(result.demos[d].sample_rate, rate, 1e-6);
+      EXPECT_EQ(result.demos[d].min_segment_length, static_cast<std::size_t>(std::lround(rate)));
+      times[rate].push_back(result.demos[d].changepoint_times);
+    }
+  }
+  for (std::size_t d = 0; d < grasps.size(); ++d) {
+    const auto& reference = times[50.0][d];
+    ASSERT_EQ(reference.size(), 1u) << "demo " << d;
+    EXPECT_NEAR(reference[0], grasps[d], 0.05) << "demo " << d;
+    for (double rate : {25.0, 100.0, 200.0}) {
+      ASSERT_EQ(times[rate][d].size(), reference.size()) << rate << " Hz, demo " << d;
+      EXPECT_NEAR(times[rate][d][0], reference[0], 0.05) << rate << " Hz, demo " << d;
+    }
+  }
+}
+
+TEST(SegmentationPipeline, SecondsNeedAClock) {
+  auto demos = matrices(make_demos(3));
+  demos[1].time.clear();
+  lfd::SegmentationPipelineConfig config;
+  config.seconds = lfd::TimeParameters{};
+  expect_error(demos, "demonstration 1: no clock", config);
+}
+
+// A dead (constant) sensor: a warning naming it, no zone, no changepoint, no crash.
+TEST(SegmentationPipeline, DeadSensorWarnsAndGivesNoZone) {
+  auto demos = matrices(make_demos(3));
+  demos[1].data.col(4).setConstant(0.0);
+  const auto result = lfd::run_segmentation_pipeline(demos, {"touch"});
+  EXPECT_TRUE(result.demos[1].zones.empty());
+  EXPECT_TRUE(result.demos[1].changepoints.empty());
+  EXPECT_NE(std::find_if(result.warnings.begin(), result.warnings.end(),
+                         [](const std::string& w) {
+                           return w.find("demonstration 1: sensor 'touch' is constant") !=
+                                  std::string::npos;
+                         }),
+            result.warnings.end());
+  EXPECT_EQ(result.demos[0].changepoints.size(), 1u);
+}
+
+// Consensus counts only the demos with evidence: three demos whose sensor is dead (no event, so
+// no changepoint) must not out-vote the one demo whose changepoint has its own sensory event.
+TEST(SegmentationPipeline, DemosWithoutEventsDoNotVote) {
+  auto synthetic = make_demos(5);
+  auto demos = matrices(synthetic);
+  for (std::size_t d : {1u, 2u, 3u}) demos[d].data.col(4).setConstant(0.0);
+  const auto result = lfd::run_segmentation_pipeline(demos, {"touch"});
+  for (std::size_t d : {0u, 4u}) {
+    ASSERT_EQ(result.demos[d].changepoints.size(), 1u) << "demo " << d;
+    EXPECT_TRUE(result.demos[d].pruned.empty()) << "demo " << d;
+    EXPECT_NEAR(double(result.demos[d].changepoints[0]), double(synthetic[d].grasp),
+                0.1 * result.demos[d].num_samples);
+  }
 }
 
 }  // namespace

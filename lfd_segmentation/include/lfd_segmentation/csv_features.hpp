@@ -1,6 +1,6 @@
 // CSV -> feature matrix for the `segment` CLI: a header row names the columns, one row per
-// sample, comma separated. An optional time column (seconds) becomes the clock; without one the
-// samples are taken as uniformly spaced at `rate` Hz (or indices when rate <= 0).
+// sample, comma separated. An optional time column (seconds) becomes the clock; `rate` > 0 Hz
+// overrides it with uniformly spaced samples; with neither the matrix has no clock.
 #pragma once
 
 #include <string>

@@ -29,10 +29,13 @@ struct SegmentationParams {
   std::vector<TopicConfig> topics;
   double min_segment_seconds = 0.0;  ///< 0 = automatic
   double window_seconds = 0.0;       ///< 0 = automatic
-  /// Everything else; its sample-based min_s/window fields are derived from the seconds above.
+  /// The other time parameters (events, ClaSP's minimum window), in seconds; its min_segment and
+  /// window are taken from the two fields above.
+  lfd::TimeParameters time;
+  /// Everything else. The pipeline converts the seconds with each demonstration's own rate.
   lfd::SegmentationPipelineConfig pipeline;
-
-  /// The pipeline configuration with min_s and the window converted to samples at `rate`.
+  /// The pipeline configuration with the seconds attached (and, for callers that work in samples
+  /// of the nominal clock, the sample counts filled at `rate`).
   lfd::SegmentationPipelineConfig pipeline_config() const;
 };
 

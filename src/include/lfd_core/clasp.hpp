@@ -101,6 +101,14 @@ std::size_t select_window_size(const Eigen::Ref<const Eigen::VectorXd>& series,
 KnnResult self_join_knn(const Eigen::Ref<const Eigen::VectorXd>& series, std::size_t window,
                         std::size_t k, std::size_t exclusion_zone,
                         ClaspDistance distance = ClaspDistance::kZNormalizedEuclidean);
+/// Multivariate k-NN by distance averaging (ClaSP authors' multivariate method, as claspy does):
+/// rows = samples, columns = channels; each channel's distance profile of a query is z-normalized
+/// (trivial matches set to its maximum first), the profiles are averaged with `weights` (empty =
+/// equal), and the k smallest averages are the neighbours. `distances` then hold the averaged
+/// z-scores, not Euclidean distances. O(d n^2) time, O(d n) memory.
+KnnResult distance_average_knn(const Eigen::MatrixXd& series, const std::vector<double>& weights,
+                               std::size_t window, std::size_t k, std::size_t exclusion_zone,
+                               ClaspDistance distance = ClaspDistance::kZNormalizedEuclidean);
 /// O(n^2 w) reference implementation (tests).
 KnnResult brute_force_knn(const Eigen::Ref<const Eigen::VectorXd>& series, std::size_t window,
                           std::size_t k, std::size_t exclusion_zone,

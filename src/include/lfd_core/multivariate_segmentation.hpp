@@ -23,9 +23,15 @@ enum class ProfileCombination {
   kProduct,          ///< geometric mean (the product, normalised to stay in [0, 1])
   kWeightedAverage,  ///< sum_f w_f p_f / sum_f w_f
   kWeightedProduct,  ///< prod_f p_f^(w_f / sum w) = exp(sum_f w_f log p_f / sum_f w_f)
+  /// Not a profile combination: one k-NN on the per-channel distance profiles, each z-normalized
+  /// and averaged before the neighbours are taken (the ClaSP authors' multivariate method,
+  /// distance_average_knn), one window for all features (the largest of theirs), one profile.
+  kDistanceAverage,
+  kWeightedDistanceAverage,  ///< the same with the profiles weighted by feature relevance
 };
 
-/// "average", "product", "weighted_average", "weighted_product" (throws std::invalid_argument).
+/// "average", "product", "weighted_average", "weighted_product", "distance_average",
+/// "weighted_distance_average" (throws std::invalid_argument).
 ProfileCombination parse_profile_combination(const std::string& name);
 std::string to_string(ProfileCombination combination);
 

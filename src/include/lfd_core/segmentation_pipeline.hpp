@@ -9,6 +9,7 @@
 #pragma once
 
 #include <cstddef>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -20,7 +21,26 @@
 
 namespace lfd {
 
+/// Every time parameter of the segmentation, in seconds. When set in SegmentationPipelineConfig,
+/// the pipeline converts them to samples for each demonstration with that demonstration's own
+/// sample rate (median step of its clock), so one configuration holds at any recording rate.
+/// Rounded to the nearest sample; a window/lag/gap never drops below what the algorithm needs (>= 1
+/// sample, windows >= 2, the median window odd).
+struct TimeParameters {
+  double min_segment = 1.0;    ///< min_s (s); 0 = automatic (max(2 * largest window, n / 20))
+  double window = 0.0;         ///< fixed ClaSP window for every feature (s); 0 = automatic
+  double min_window = 0.2;     ///< lower bound of the automatic ClaSP windows (s)
+  double event_median = 0.26;  ///< running-median window of the sensor signals (s)
+  double event_difference_lag = 0.5;  ///< lag of the level difference (s)
+  double event_merge_gap = 1.0;       ///< bursts closer than this merge (s)
+  double event_min_active = 0.0;      ///< bursts shorter than this are ignored (s)
+  double event_noise_block = 1.0;     ///< block length of the local noise estimate (s)
+};
+
 struct SegmentationPipelineConfig {
+  /// Time parameters in seconds (see TimeParameters); when unset, the sample counts of
+  /// `segmentation`, `window_size` and `events` are used as they are (index-only series).
+  std::optional<TimeParameters> seconds;
   /// II-B threshold T and DTW settings.
   FeatureRelevanceConfig relevance;
   /// II-C combination, ClaSP settings, Kaiser beta. Its min_segment_length (min_s, samples; 0 =
@@ -49,6 +69,14 @@ struct SegmentationPipelineConfig {
   int threads = 0;
 };
 
+/// The configuration with its seconds (if any) converted to sample counts at `rate` (Hz) and
+/// `seconds` cleared; unchanged without seconds. Throws std::invalid_argument for rate <= 0.
+SegmentationPipelineConfig in_samples(const SegmentationPipelineConfig& config, double rate);
+
+/// Sample rate (Hz) of a demonstration's clock: 1 / median step. Throws std::invalid_argument when
+/// the demonstration has no clock (no timestamps) or a non-increasing one.
+double sample_rate_of(const FeatureMatrix& demo);
+
 struct DemoSegmentationResult {
   std::vector<std::size_t> changepoints;  ///< validated changepoints (row indices, sorted)
   std::vector<double> changepoint_times;  ///< their times (s, or index without a clock)
@@ -60,6 +88,7 @@ struct DemoSegmentationResult {
   std::vector<std::size_t> events;     ///< sensory events (row indices)
   std::size_t min_segment_length = 0;  ///< the min_s used for ClaSP and the zones
   std::size_t num_samples = 0;
+  double sample_rate = 0.0;        ///< Hz of the demonstration's clock (0 = index-only series)
   MultivariateSegmentation clasp;  ///< candidates, windows, profiles (paper Fig. 5, 8)
 };
 

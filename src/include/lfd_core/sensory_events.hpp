@@ -14,17 +14,40 @@
 //     of the raw first difference, so a sensor carrying only noise produces no event at all;
 //   - hysteresis: activity switches off below hysteresis * thr (1 = the paper's single threshold);
 //   - min_active_samples / merge_gap: drop one-sample blips, merge bursts closer than merge_gap;
-//   - difference_lag: level change over a lag instead of the sample-to-sample difference.
+//   - difference_lag: level change over a lag instead of the sample-to-sample difference. With a
+//     lag L > 1 a step at t0 keeps the lagged difference high from t0 - L/2 to t0 + L/2, so the
+//     events are moved back onto the change: the on-event by +L/2, the off-event by -L/2 (a step
+//     gives one event at t0, a ramp one at its start and one at its end).
+//   - threshold kNoise + noise_block: the threshold is a statistic of the noise measured where the
+//     sensor is quiet (see EventThreshold).
 #pragma once
 
 #include <Eigen/Core>
 #include <cstddef>
+#include <string>
 #include <vector>
 
 namespace lfd {
 
+/// How the activity threshold is set.
+enum class EventThreshold {
+  /// The paper: threshold_ratio x the largest difference (raised to the noise floor if any).
+  kRatioOfMax,
+  /// A statistic of the noise: noise_floor_sigmas x the noise sigma estimated where the sensor is
+  /// quiet (noise_block), and at least relative_floor x the largest difference so that a
+  /// noise-free sensor's small wobbles are not events. Does not depend on how much of the demo
+  /// is busy: a long oscillating contact cannot raise it above the contact onset.
+  kNoise,
+};
+
+/// "ratio_of_max" (the paper's 0.4 x max) or "noise" (throws std::invalid_argument otherwise).
+EventThreshold parse_event_threshold(const std::string& name);
+std::string to_string(EventThreshold threshold);
+
 struct SensoryEventConfig {
+  EventThreshold threshold = EventThreshold::kRatioOfMax;
   double threshold_ratio = 0.4;        ///< paper's 0.4 x max |first difference|
+  double relative_floor = 0.1;         ///< kNoise: threshold >= this x the largest difference
   std::size_t median_window = 5;       ///< odd; 0 or 1 = no smoothing (paper-literal)
   double noise_floor_sigmas = 6.0;     ///< 0 = paper-literal (no noise floor)
   double hysteresis = 0.5;             ///< in (0, 1]; 1 = paper-literal single threshold
@@ -36,6 +59,15 @@ struct SensoryEventConfig {
   /// zero-mean vibration (a swinging load, chattering contact) is not an event, while contact
   /// made or lost is. The noise floor then comes from these lagged differences themselves.
   std::size_t difference_lag = 1;
+  /// Local noise estimate: the differences are cut into blocks of this many samples, each block's
+  /// robust sigma (1.4826 x MAD about its median) is taken, blocks that do not move at all (a
+  /// sensor holding a stale value, a quantized sensor at rest) are left out, and the noise sigma
+  /// is the 10th percentile of the others: the quiet stretches set it, however long the busy
+  /// ones. 0 = one robust sigma over the whole demo.
+  std::size_t noise_block = 0;
+  /// Events placed on the change (a burst's start taken where it left the off level, lag shifts
+  /// undone, a single-edge burst one event); false = where the thresholds are crossed.
+  bool place_on_change = true;
 };
 
 /// A closed interval of sample indices [begin, end] (eq. 1 uses closed intervals).
