@@ -9,6 +9,7 @@
 #include <map>
 #include <memory>
 #include <numeric>
+#include <unordered_map>
 #include <sstream>
 #include <stdexcept>
 
@@ -24,10 +25,21 @@ std::string feature_name(const std::string& topic, const std::string& field) {
   return topic + (topic.empty() || topic.back() == '/' ? "" : "/") + field;
 }
 
+// The stream MessageInstance::write copies a message's bytes into: it sizes the buffer itself,
+// so the record header is parsed once per message (MessageInstance::size() would parse it again).
+struct BufferStream {
+  std::vector<std::uint8_t>* buffer;
+  std::uint8_t* advance(std::uint32_t bytes) {
+    const std::size_t used = buffer->size();
+    buffer->resize(used + bytes);
+    return buffer->data() + used;
+  }
+};
+
 // The serialized bytes of one message, as they were recorded.
 void message_bytes(const rosbag::MessageInstance& m, std::vector<std::uint8_t>& buffer) {
-  buffer.resize(m.size());
-  ros::serialization::OStream stream(buffer.data(), static_cast<std::uint32_t>(buffer.size()));
+  buffer.clear();
+  BufferStream stream{&buffer};
   m.write(stream);
 }
 
@@ -45,19 +57,17 @@ class TopicReader {
  public:
   explicit TopicReader(const TopicConfig& cfg) : cfg_(cfg) {}
 
-  void read(rosbag::View& view) {
-    for (const rosbag::MessageInstance& m : view) {
-      message_bytes(m, buffer_);
-      rosmsg::FieldReader& reader = reader_for(m);
-      reader.read(buffer_.data(), buffer_.size());
-      const double stamp = reader.header_stamp();
-      // A zero stamp means "not stamped" (e.g. the PR2 world model): the receive time is the clock.
-      const double t = stamp != 0.0 ? stamp : m.getTime().toSec();
-      for (std::size_t k = 0; k < streams_.size(); ++k) {
-        if (!reader.present(k)) continue;  // this message does not carry the index or name
-        streams_[k].time.push_back(t);
-        streams_[k].values.push_back(reader.value(k));
-      }
+  // One message of the topic, `bytes` its serialized form.
+  void read(const rosbag::MessageInstance& m, const std::vector<std::uint8_t>& bytes) {
+    rosmsg::FieldReader& reader = reader_for(m, bytes);
+    reader.read(bytes.data(), bytes.size());
+    const double stamp = reader.header_stamp();
+    // A zero stamp means "not stamped" (e.g. the PR2 world model): the receive time is the clock.
+    const double t = stamp != 0.0 ? stamp : m.getTime().toSec();
+    for (std::size_t k = 0; k < streams_.size(); ++k) {
+      if (!reader.present(k)) continue;  // this message does not carry the index or name
+      streams_[k].time.push_back(t);
+      streams_[k].values.push_back(reader.value(k));
     }
   }
 
@@ -74,7 +84,8 @@ class TopicReader {
   }
 
  private:
-  rosmsg::FieldReader& reader_for(const rosbag::MessageInstance& m) {
+  rosmsg::FieldReader& reader_for(const rosbag::MessageInstance& m,
+                                  const std::vector<std::uint8_t>& bytes) {
     // getMD5Sum() refers to the connection's record: its address identifies the connection.
     if (&m.getMD5Sum() == last_connection_) return *last_reader_;
     const std::string key = m.getDataType() + " " + m.getMD5Sum();
@@ -87,7 +98,7 @@ class TopicReader {
         throw std::invalid_argument("topic " + cfg_.topic + ": the bag's definition of " +
                                     m.getDataType() + " cannot be parsed: " + e.what());
       }
-      if (!schema_) first_message(schema);
+      if (!schema_) first_message(schema, bytes);
       try {
         it = readers_.emplace(key, rosmsg::FieldReader(schema, fields_)).first;
       } catch (const rosmsg::UnknownField& e) {
@@ -100,9 +111,9 @@ class TopicReader {
     return it->second;
   }
 
-  void first_message(const rosmsg::MessageSchema& schema) {
+  void first_message(const rosmsg::MessageSchema& schema, const std::vector<std::uint8_t>& bytes) {
     schema_ = std::make_unique<rosmsg::MessageSchema>(schema);
-    sample_ = buffer_;
+    sample_ = bytes;
     try {
       fields_ = rosmsg::expand_fields(schema, sample_.data(), sample_.size(), cfg_.fields);
     } catch (const rosmsg::UnknownField& e) {
@@ -125,7 +136,6 @@ class TopicReader {
   std::map<std::string, rosmsg::FieldReader> readers_;
   const std::string* last_connection_ = nullptr;
   rosmsg::FieldReader* last_reader_ = nullptr;
-  std::vector<std::uint8_t> buffer_;
 };
 
 void open_bag(rosbag::Bag& bag, const std::string& path) {
@@ -145,19 +155,34 @@ std::string topics_in(rosbag::Bag& bag) {
   return available;
 }
 
-// Reads every configured topic of one bag file into the readers.
+// Reads every configured topic of one bag file into the readers, in one pass over the file (a
+// view per topic would read every chunk once per topic).
 void read_part(const std::string& path, const std::vector<TopicConfig>& topics,
                std::vector<TopicReader>& readers) {
   rosbag::Bag bag;
   open_bag(bag, path);
   try {
-    for (std::size_t k = 0; k < topics.size(); ++k) {
-      rosbag::View view(bag, rosbag::TopicQuery(topics[k].topic));
-      if (view.size() == 0) {
-        throw std::invalid_argument("no messages on topic " + topics[k].topic +
+    std::vector<std::string> names;
+    for (const TopicConfig& cfg : topics) {
+      if (rosbag::View(bag, rosbag::TopicQuery(cfg.topic)).size() == 0) {
+        throw std::invalid_argument("no messages on topic " + cfg.topic +
                                     " (topics in the bag:" + topics_in(bag) + ")");
       }
-      readers[k].read(view);
+      names.push_back(cfg.topic);
+    }
+    // getTopic() refers to the connection's record: its address identifies the connection.
+    std::unordered_map<const std::string*, std::vector<TopicReader*>> readers_of;
+    std::vector<std::uint8_t> bytes;
+    for (const rosbag::MessageInstance& m : rosbag::View(bag, rosbag::TopicQuery(names))) {
+      auto it = readers_of.find(&m.getTopic());
+      if (it == readers_of.end()) {
+        std::vector<TopicReader*> mine;
+        for (std::size_t k = 0; k < topics.size(); ++k)
+          if (topics[k].topic == m.getTopic()) mine.push_back(&readers[k]);
+        it = readers_of.emplace(&m.getTopic(), std::move(mine)).first;
+      }
+      message_bytes(m, bytes);
+      for (TopicReader* reader : it->second) reader->read(m, bytes);
     }
   } catch (const std::invalid_argument& e) {
     throw std::invalid_argument("bag '" + path + "': " + e.what());
