@@ -5,7 +5,10 @@
 #include <ros/serialization.h>
 #include <topic_tools/shape_shifter.h>
 
+#include <cstdio>
 #include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
 
 #include "lfd_segmentation/bag_features.hpp"
 
@@ -216,6 +219,39 @@ TEST_F(BagAnyType, MessagesThatDoNotMatchTheirDefinitionAreErrors) {
   } catch (const std::invalid_argument& e) {
     EXPECT_NE(std::string(e.what()).find("robot_pkg/Point"), std::string::npos) << e.what();
   }
+}
+
+std::string run(const std::string& command, int* status) {
+  std::string out;
+  FILE* pipe = popen((command + " 2>/dev/null").c_str(), "r");
+  char chunk[4096];
+  while (std::size_t n = std::fread(chunk, 1, sizeof(chunk), pipe)) out.append(chunk, n);
+  *status = WEXITSTATUS(pclose(pipe));
+  return out;
+}
+
+// The CLI takes another robot's topics from a file (--topics) and lists a bag's fields.
+TEST_F(BagAnyType, CliListsFieldsAndTakesTopicsFromAFile) {
+  int status = -1;
+  const std::string listing = run(std::string(SEGMENT_CLI) + " --list-fields " + part(1), &status);
+  EXPECT_EQ(status, 0);
+  EXPECT_NE(listing.find("/arm/state (robot_pkg/ArmState, 200 messages)"), std::string::npos)
+      << listing;
+  EXPECT_NE(listing.find("  actual/positions/<0..1> or <name: j0, j1>\n"), std::string::npos)
+      << listing;
+  const std::string topics = (dir_ / "topics.yaml").string();
+  std::ofstream(topics) << "topics:\n  - topic: /arm/state\n    fields: [actual/velocities/0]\n";
+  const std::string out = (dir_ / "out.json").string();
+  run(std::string(SEGMENT_CLI) + " --topics " + topics + " --output " + out + " " + part(1) + "," +
+          part(2) + " " + part(1),
+      &status);
+  EXPECT_EQ(status, 1);
+  std::ifstream in(out);
+  const nlohmann::json json = nlohmann::json::parse(in);
+  EXPECT_FALSE(json["success"].get<bool>());
+  const std::string error = json["error"];
+  EXPECT_NE(error.find("no field 'actual/velocities/0'"), std::string::npos) << error;
+  EXPECT_NE(error.find("\n  gripper"), std::string::npos) << error;
 }
 
 }  // namespace
