@@ -9,9 +9,9 @@
 #include <map>
 #include <memory>
 #include <numeric>
-#include <unordered_map>
 #include <sstream>
 #include <stdexcept>
+#include <unordered_map>
 
 #include "lfd_core/ros_message_reader.hpp"
 
@@ -43,7 +43,8 @@ void message_bytes(const rosbag::MessageInstance& m, std::vector<std::uint8_t>& 
   m.write(stream);
 }
 
-std::string field_list(const rosmsg::MessageSchema& schema, const std::vector<std::uint8_t>& sample) {
+std::string field_list(const rosmsg::MessageSchema& schema,
+                       const std::vector<std::uint8_t>& sample) {
   std::string out;
   for (const std::string& f : rosmsg::list_numeric_fields(schema, sample.data(), sample.size()))
     out += "\n  " + f;
@@ -75,9 +76,9 @@ class TopicReader {
   std::vector<lfd::Stream> take_streams() {
     for (std::size_t k = 0; k < streams_.size(); ++k) {
       if (streams_[k].values.empty()) {
-        throw std::invalid_argument("topic " + cfg_.topic + " has no data for field '" +
-                                    fields_[k] + "'; numeric fields of its first message:" +
-                                    field_list(*schema_, sample_));
+        throw std::invalid_argument(
+            "topic " + cfg_.topic + " has no data for field '" + fields_[k] +
+            "'; numeric fields of its first message:" + field_list(*schema_, sample_));
       }
     }
     return std::move(streams_);
@@ -102,8 +103,8 @@ class TopicReader {
       try {
         it = readers_.emplace(key, rosmsg::FieldReader(schema, fields_)).first;
       } catch (const rosmsg::UnknownField& e) {
-        throw std::invalid_argument("topic " + cfg_.topic + " (" + m.getDataType() + "): " +
-                                    e.what());
+        throw std::invalid_argument("topic " + cfg_.topic + " (" + m.getDataType() +
+                                    "): " + e.what());
       }
     }
     last_connection_ = &m.getMD5Sum();
@@ -117,8 +118,8 @@ class TopicReader {
     try {
       fields_ = rosmsg::expand_fields(schema, sample_.data(), sample_.size(), cfg_.fields);
     } catch (const rosmsg::UnknownField& e) {
-      throw std::invalid_argument("topic " + cfg_.topic + " (" + schema.root().name + "): " +
-                                  e.what());
+      throw std::invalid_argument("topic " + cfg_.topic + " (" + schema.root().name +
+                                  "): " + e.what());
     }
     for (const std::string& field : fields_) {
       lfd::Stream s;

@@ -1,8 +1,8 @@
 // Bags of message types this build has never seen: written raw with topic_tools::ShapeShifter
 // (definition + bytes only), read back by path through the definitions stored in the bag.
 #include <gtest/gtest.h>
-#include <rosbag/bag.h>
 #include <ros/serialization.h>
+#include <rosbag/bag.h>
 #include <topic_tools/shape_shifter.h>
 
 #include <cstdio>
@@ -103,7 +103,8 @@ void write_part(const std::string& path, double start, double duration) {
     const double t = start + i * 0.01;
     write_raw(bag, "/arm/state", "robot_pkg/ArmState", kArmDefinition, t + 0.02,
               arm_message(t, 1.0 + t - 100, 2.0));
-    if (i % 5 == 0) write_raw(bag, "/world", "robot_pkg/World", kWorldDefinition, t, world_message(t - 100));
+    if (i % 5 == 0)
+      write_raw(bag, "/world", "robot_pkg/World", kWorldDefinition, t, world_message(t - 100));
   }
   bag.close();
 }
@@ -154,7 +155,8 @@ TEST_F(BagAnyType, ReadsFieldsOfUnknownTypesByPath) {
 
 TEST_F(BagAnyType, UnknownFieldListsTheTopicsFields) {
   try {
-    lfd_segmentation::read_bag_streams(part(1), {{"/arm/state", FeatureRole::kState, {"actual/velocities/0"}}});
+    lfd_segmentation::read_bag_streams(
+        part(1), {{"/arm/state", FeatureRole::kState, {"actual/velocities/0"}}});
     FAIL() << "unknown field accepted";
   } catch (const std::invalid_argument& e) {
     const std::string what = e.what();
@@ -164,10 +166,12 @@ TEST_F(BagAnyType, UnknownFieldListsTheTopicsFields) {
     EXPECT_NE(what.find("\n  header/stamp"), std::string::npos) << what;
   }
   try {
-    lfd_segmentation::read_bag_streams(part(1), {{"/world", FeatureRole::kState, {"objects/3/position/0"}}});
+    lfd_segmentation::read_bag_streams(part(1),
+                                       {{"/world", FeatureRole::kState, {"objects/3/position/0"}}});
     FAIL() << "a field no message carries was accepted";
   } catch (const std::invalid_argument& e) {
-    EXPECT_NE(std::string(e.what()).find("no data for field 'objects/3/position/0'"), std::string::npos)
+    EXPECT_NE(std::string(e.what()).find("no data for field 'objects/3/position/0'"),
+              std::string::npos)
         << e.what();
     EXPECT_NE(std::string(e.what()).find("objects/<0..0>/position/<0..2>"), std::string::npos)
         << e.what();
@@ -178,7 +182,8 @@ TEST_F(BagAnyType, UnknownFieldListsTheTopicsFields) {
 }
 
 TEST_F(BagAnyType, PartsInOrderMakeOneDemonstrationWithTheirGaps) {
-  const std::vector<TopicConfig> topics{{"/arm/state", FeatureRole::kState, {"actual/positions/0"}}};
+  const std::vector<TopicConfig> topics{
+      {"/arm/state", FeatureRole::kState, {"actual/positions/0"}}};
   const auto demo = lfd_segmentation::read_bag_features(part(1) + "," + part(2), topics, 50.0);
   const lfd::FeatureMatrix& m = demo.matrix;
   EXPECT_NEAR(m.time.front(), 100.0, 1e-9);
@@ -204,7 +209,8 @@ TEST_F(BagAnyType, MessagesThatDoNotMatchTheirDefinitionAreErrors) {
     lfd_segmentation::read_bag_streams(bad, topics);
     FAIL() << "truncated message accepted";
   } catch (const std::runtime_error& e) {
-    EXPECT_NE(std::string(e.what()).find("field 'gripper' of robot_pkg/ArmState"), std::string::npos)
+    EXPECT_NE(std::string(e.what()).find("field 'gripper' of robot_pkg/ArmState"),
+              std::string::npos)
         << e.what();
   }
   const std::string broken = (dir_ / "broken_definition.bag").string();

@@ -9,7 +9,8 @@
 namespace lfd::rosmsg {
 
 // ROS 1 serializes little-endian; the reads below copy bytes straight into host integers.
-static_assert(__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__, "ros_message_reader assumes a little-endian host");
+static_assert(__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__,
+              "ros_message_reader assumes a little-endian host");
 
 namespace {
 
@@ -134,7 +135,8 @@ Resolved resolve(const MessageSchema& schema, const std::vector<std::string>& pa
         type = fd.message;
         continue;
       }
-      if (i + 1 != path.size()) unknown(path, name + " is a " + fd.type_name + ", it has no fields");
+      if (i + 1 != path.size())
+        unknown(path, name + " is a " + fd.type_name + ", it has no fields");
       r.end = fd.kind == Kind::kString ? End::kString : End::kNumber;
       return r;
     }
@@ -157,7 +159,8 @@ Resolved resolve(const MessageSchema& schema, const std::vector<std::string>& pa
         type = fd.message;
         continue;
       }
-      if (i + 1 != path.size()) unknown(path, name + " holds " + fd.type_name + ", it has no fields");
+      if (i + 1 != path.size())
+        unknown(path, name + " holds " + fd.type_name + ", it has no fields");
       r.end = End::kElement;
       r.index = static_cast<std::uint32_t>(value);
       return r;
@@ -312,9 +315,9 @@ double to_double(Kind kind, const std::uint8_t* p) {
 // What to do with the fields of one message instance; a null action skips the field.
 struct PlanNode;
 struct FieldAction {
-  int scalar_slot = -1;   // numeric scalar -> scalars
-  int array_slot = -1;    // array -> arrays (data pointer and count)
-  int strings_slot = -1;  // string or string[] -> strings
+  int scalar_slot = -1;             // numeric scalar -> scalars
+  int array_slot = -1;              // array -> arrays (data pointer and count)
+  int strings_slot = -1;            // string or string[] -> strings
   std::unique_ptr<PlanNode> child;  // nested message
   std::vector<std::pair<std::uint32_t, std::unique_ptr<PlanNode>>> elements;  // sorted
 };
@@ -361,8 +364,8 @@ class Plan {
         out.key = r.key;
         if (r.end == End::kKey) {
           const std::size_t type = level_types(schema_, r.hops)[r.key_level];
-          out.key_slot = slot(ensure(node_at(r, r.key_level), type, r.key_field)->strings_slot,
-                              strings_);
+          out.key_slot =
+              slot(ensure(node_at(r, r.key_level), type, r.key_field)->strings_slot, strings_);
         }
         break;
       case End::kString:
@@ -461,7 +464,8 @@ class Plan {
       const auto index = static_cast<std::uint32_t>(h.element);
       auto it = std::lower_bound(a->elements.begin(), a->elements.end(), index,
                                  [](const auto& e, std::uint32_t i) { return e.first < i; });
-      if (it == a->elements.end() || it->first != index) it = a->elements.emplace(it, index, node(type));
+      if (it == a->elements.end() || it->first != index)
+        it = a->elements.emplace(it, index, node(type));
       n = it->second.get();
     }
     return n;
@@ -650,7 +654,8 @@ FieldReader::FieldReader(const MessageSchema& schema, const std::vector<std::str
     const MessageType& h = schema.type(schema.root().fields[header].message);
     const int stamp = h.field_index("stamp");
     if (stamp >= 0 && h.fields[stamp].kind == Kind::kTime && !h.fields[stamp].is_array())
-      impl_->stamp_output = static_cast<long>(impl_->plan.add(resolve(schema, {"header", "stamp"})));
+      impl_->stamp_output =
+          static_cast<long>(impl_->plan.add(resolve(schema, {"header", "stamp"})));
   }
   impl_->values.resize(paths.size());
   impl_->present.resize(paths.size());
@@ -670,10 +675,18 @@ void FieldReader::read(const std::uint8_t* data, std::size_t size) {
     m.stamp = 0;
 }
 
-std::size_t FieldReader::size() const { return impl_->outputs.size(); }
-bool FieldReader::present(std::size_t k) const { return impl_->present.at(k); }
-double FieldReader::value(std::size_t k) const { return impl_->values.at(k); }
-double FieldReader::header_stamp() const { return impl_->stamp; }
+std::size_t FieldReader::size() const {
+  return impl_->outputs.size();
+}
+bool FieldReader::present(std::size_t k) const {
+  return impl_->present.at(k);
+}
+double FieldReader::value(std::size_t k) const {
+  return impl_->values.at(k);
+}
+double FieldReader::header_stamp() const {
+  return impl_->stamp;
+}
 
 // ---------------------------------------------------------------------------------------------
 // Sample queries, expansion and listing
@@ -777,7 +790,8 @@ void list_fields(const MessageSchema& schema, const std::uint8_t* sample, std::s
         out.push_back(name + "/<empty> (array of " + f.type_name + ")");
       } else {
         p.push_back("0");
-        list_fields(schema, sample, size, f.message, p, name + "/" + range(n) + "/", max_names, out);
+        list_fields(schema, sample, size, f.message, p, name + "/" + range(n) + "/", max_names,
+                    out);
       }
       continue;
     }
@@ -806,8 +820,7 @@ std::vector<std::string> expand_fields(const MessageSchema& schema, const std::u
       expand(schema, sample, size, split_path(pattern), out);
     } catch (const UnknownField& e) {
       std::string fields;
-      for (const std::string& f : list_numeric_fields(schema, sample, size))
-        fields += "\n  " + f;
+      for (const std::string& f : list_numeric_fields(schema, sample, size)) fields += "\n  " + f;
       throw UnknownField(std::string(e.what()) + "\nnumeric fields of " + schema.root().name +
                          " (first message):" + fields);
     }
@@ -823,8 +836,8 @@ std::vector<std::string> list_numeric_fields(const MessageSchema& schema,
   return out;
 }
 
-std::size_t array_length(const MessageSchema& schema, const std::uint8_t* sample,
-                         std::size_t size, const std::string& path) {
+std::size_t array_length(const MessageSchema& schema, const std::uint8_t* sample, std::size_t size,
+                         const std::string& path) {
   const std::vector<std::string> parts = split_path(path);
   const Resolved r = resolve(schema, parts);
   if (r.end != End::kArray) unknown(parts, "'" + path + "' is not an array");
@@ -835,7 +848,8 @@ std::vector<std::string> string_values(const MessageSchema& schema, const std::u
                                        std::size_t size, const std::string& path) {
   const std::vector<std::string> parts = split_path(path);
   const Resolved r = resolve(schema, parts);
-  if (r.end != End::kString && !(r.end == End::kArray && last_field(schema, r).kind == Kind::kString))
+  if (r.end != End::kString &&
+      !(r.end == End::kArray && last_field(schema, r).kind == Kind::kString))
     unknown(parts, "'" + path + "' is not a string or string[]");
   return strings_of(schema, sample, size, r);
 }

@@ -34,7 +34,9 @@ std::size_t builtin_size(Kind kind) {
   return 0;
 }
 
-bool is_numeric(Kind kind) { return kind != Kind::kString && kind != Kind::kMessage; }
+bool is_numeric(Kind kind) {
+  return kind != Kind::kString && kind != Kind::kMessage;
+}
 
 int MessageType::field_index(const std::string& field) const {
   for (std::size_t k = 0; k < fields.size(); ++k) {
@@ -47,11 +49,11 @@ namespace {
 
 std::optional<Kind> builtin_kind(const std::string& name) {
   static const std::map<std::string, Kind> kinds{
-      {"bool", Kind::kBool},       {"int8", Kind::kInt8},       {"byte", Kind::kInt8},
-      {"uint8", Kind::kUint8},     {"char", Kind::kUint8},      {"int16", Kind::kInt16},
-      {"uint16", Kind::kUint16},   {"int32", Kind::kInt32},     {"uint32", Kind::kUint32},
-      {"int64", Kind::kInt64},     {"uint64", Kind::kUint64},   {"float32", Kind::kFloat32},
-      {"float64", Kind::kFloat64}, {"string", Kind::kString},   {"time", Kind::kTime},
+      {"bool", Kind::kBool},        {"int8", Kind::kInt8},     {"byte", Kind::kInt8},
+      {"uint8", Kind::kUint8},      {"char", Kind::kUint8},    {"int16", Kind::kInt16},
+      {"uint16", Kind::kUint16},    {"int32", Kind::kInt32},   {"uint32", Kind::kUint32},
+      {"int64", Kind::kInt64},      {"uint64", Kind::kUint64}, {"float32", Kind::kFloat32},
+      {"float64", Kind::kFloat64},  {"string", Kind::kString}, {"time", Kind::kTime},
       {"duration", Kind::kDuration}};
   const auto it = kinds.find(name);
   if (it == kinds.end()) return std::nullopt;
@@ -66,8 +68,9 @@ std::string trim(const std::string& s) {
 
 bool is_identifier(const std::string& s) {
   if (s.empty() || !std::isalpha(static_cast<unsigned char>(s[0]))) return false;
-  return std::all_of(s.begin(), s.end(),
-                     [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; });
+  return std::all_of(s.begin(), s.end(), [](char c) {
+    return std::isalnum(static_cast<unsigned char>(c)) || c == '_';
+  });
 }
 
 bool is_separator(const std::string& line) {
@@ -133,7 +136,8 @@ bool parse_line(const std::string& raw, const std::string& package, const std::s
   std::string line = trim(raw);
   if (line.empty() || line[0] == '#') return false;
   const auto space = line.find_first_of(" \t");
-  if (space == std::string::npos) throw MessageError(where + ": expected 'type name', got '" + line + "'");
+  if (space == std::string::npos)
+    throw MessageError(where + ": expected 'type name', got '" + line + "'");
   const std::string type_token = line.substr(0, space);
   std::string rest = line.substr(space + 1);
   const auto equals = rest.find('=');

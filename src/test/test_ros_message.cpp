@@ -70,7 +70,9 @@ Point position
 int16[] counts
 )";
 
-MessageSchema sample_schema() { return MessageSchema::parse("test_pkg/Sample", kSampleDefinition); }
+MessageSchema sample_schema() {
+  return MessageSchema::parse("test_pkg/Sample", kSampleDefinition);
+}
 
 struct Item {
   std::string id;
@@ -96,7 +98,11 @@ Bytes sample_bytes(std::uint32_t stamp_sec = 100, std::vector<Item> items = {}) 
   }
   b.put<std::uint32_t>(7).put<std::uint32_t>(250000000);  // t = 7.25 s
   b.put<std::int32_t>(-2).put<std::int32_t>(500000000);   // d = -1.5 s
-  b.put<std::uint32_t>(4).put<std::uint8_t>(9).put<std::uint8_t>(8).put<std::uint8_t>(255).put<std::uint8_t>(6);
+  b.put<std::uint32_t>(4)
+      .put<std::uint8_t>(9)
+      .put<std::uint8_t>(8)
+      .put<std::uint8_t>(255)
+      .put<std::uint8_t>(6);
   b.put<std::int8_t>(-5).put<std::uint8_t>(200).put<std::int64_t>(-1234567890123LL);
   return b;
 }
@@ -150,15 +156,28 @@ TEST(RosMessageSchema, BadDefinitionsAreErrors) {
 TEST(RosMessageReader, ReadsNestedArraysStringsTimeByPath) {
   const MessageSchema s = sample_schema();
   const Bytes b = sample_bytes();
-  const std::vector<std::string> paths{
-      "mode",       "flag",           "ratio",     "fixed/2",   "values/1",
-      "values/bb",  "p/norm",         "items/1/position/x",       "items/0/counts/1",
-      "t",          "d",              "blob/2",    "small",     "letter",
-      "big",        "header/seq",     "header/stamp",             "p/y"};
+  const std::vector<std::string> paths{"mode",
+                                       "flag",
+                                       "ratio",
+                                       "fixed/2",
+                                       "values/1",
+                                       "values/bb",
+                                       "p/norm",
+                                       "items/1/position/x",
+                                       "items/0/counts/1",
+                                       "t",
+                                       "d",
+                                       "blob/2",
+                                       "small",
+                                       "letter",
+                                       "big",
+                                       "header/seq",
+                                       "header/stamp",
+                                       "p/y"};
   FieldReader reader(s, paths);
   reader.read(b.data.data(), b.data.size());
-  const std::vector<double> expected{3, 1,  0.25, 3.5, 20, 20, 13,  4,  -8,
-                                     7.25, -1.5, 255, -5, 200, -1234567890123.0, 42, 100.5, 4};
+  const std::vector<double> expected{
+      3, 1, 0.25, 3.5, 20, 20, 13, 4, -8, 7.25, -1.5, 255, -5, 200, -1234567890123.0, 42, 100.5, 4};
   ASSERT_EQ(reader.size(), paths.size());
   for (std::size_t k = 0; k < paths.size(); ++k) {
     EXPECT_TRUE(reader.present(k)) << paths[k];
@@ -169,13 +188,15 @@ TEST(RosMessageReader, ReadsNestedArraysStringsTimeByPath) {
 
 TEST(RosMessageReader, ElementsAMessageDoesNotCarryAreAbsent) {
   const MessageSchema s = sample_schema();
-  FieldReader reader(s, {"values/5", "values/zz", "items/2/position/x", "items/1/counts/0", "mode"});
+  FieldReader reader(s,
+                     {"values/5", "values/zz", "items/2/position/x", "items/1/counts/0", "mode"});
   const Bytes b = sample_bytes();
   reader.read(b.data.data(), b.data.size());
   for (std::size_t k = 0; k < 4; ++k) EXPECT_FALSE(reader.present(k)) << k;
   EXPECT_TRUE(reader.present(4));
   // The same reader on a message with three items sees the third.
-  const Bytes more = sample_bytes(0, {{"a", 0, 0, 0, {1}}, {"b", 0, 0, 0, {2}}, {"c", 9, 0, 0, {}}});
+  const Bytes more =
+      sample_bytes(0, {{"a", 0, 0, 0, {1}}, {"b", 0, 0, 0, {2}}, {"c", 9, 0, 0, {}}});
   reader.read(more.data.data(), more.data.size());
   EXPECT_TRUE(reader.present(2));
   EXPECT_DOUBLE_EQ(reader.value(2), 9.0);
@@ -243,7 +264,8 @@ TEST(RosMessageReader, UnknownPathsListTheFields) {
   Bytes two;
   two.put<std::uint32_t>(2).put(1.0).put(2.0);
   EXPECT_NE(unknown_message(plain, two, "a/x").find("without a string[]"), std::string::npos);
-  EXPECT_NE(unknown_message(s, b, "items/leg/id").find("index it with a number"), std::string::npos);
+  EXPECT_NE(unknown_message(s, b, "items/leg/id").find("index it with a number"),
+            std::string::npos);
   EXPECT_NE(unknown_message(s, b, "mode/x").find("has no fields"), std::string::npos);
   EXPECT_THROW(FieldReader(s, {"p/w"}), UnknownField);
   EXPECT_THROW(FieldReader(s, {"values/*"}), UnknownField);
@@ -289,10 +311,10 @@ TEST(RosMessageReader, NamesIndexArraysFromTheNearestKeyArray) {
   EXPECT_FALSE(r.present(2));
   EXPECT_DOUBLE_EQ(r.header_stamp(), 0.0);  // zero stamp: the caller uses the receive time
 
-  const MessageSchema state = MessageSchema::parse(
-      "ctrl/State",
-      "string[] joint_names\nPoint actual\nPoint error\n"
-      "===\nMSG: ctrl/Point\nfloat64[] positions\n");
+  const MessageSchema state =
+      MessageSchema::parse("ctrl/State",
+                           "string[] joint_names\nPoint actual\nPoint error\n"
+                           "===\nMSG: ctrl/Point\nfloat64[] positions\n");
   Bytes c;
   c.put<std::uint32_t>(2).str("j0").str("j1");
   c.put<std::uint32_t>(2).put(1.0).put(2.0);

@@ -6,8 +6,8 @@
 //   error/positions/3                element 3 of an array of numbers
 //   objects/0/pose/pose/position/x   element 0 of an array of messages, then its fields
 //   position/R_GRIPPER               an array of numbers indexed by name: the name is looked up in
-//                                    the nearest string[] called name, names or *_names (the array's
-//                                    own message first, then the enclosing ones), e.g.
+//                                    the nearest string[] called name, names or *_names (the
+//                                    array's own message first, then the enclosing ones), e.g.
 //                                    sensor_msgs/JointState position/<joint> or
 //                                    JointTrajectoryControllerState actual/positions/<joint>
 //   twist/linear/norm                sqrt(x^2 + y^2 + z^2) of a message with numeric x, y, z and no
@@ -82,8 +82,8 @@ std::vector<std::string> list_numeric_fields(const MessageSchema& schema,
                                              std::size_t max_names = 8);
 
 /// The length of the array at `path` in `sample` (fixed arrays: their length).
-std::size_t array_length(const MessageSchema& schema, const std::uint8_t* sample,
-                         std::size_t size, const std::string& path);
+std::size_t array_length(const MessageSchema& schema, const std::uint8_t* sample, std::size_t size,
+                         const std::string& path);
 
 /// The string (one element) or string[] at `path` in `sample`.
 std::vector<std::string> string_values(const MessageSchema& schema, const std::uint8_t* sample,

@@ -47,7 +47,7 @@ constexpr int kVariableLength = -2;  ///< T[]: uint32 count, then the elements
 struct FieldDefinition {
   std::string name;
   Kind kind = Kind::kFloat64;
-  std::string type_name;      ///< builtin name, or the resolved "pkg/Type" of a message
+  std::string type_name;       ///< builtin name, or the resolved "pkg/Type" of a message
   int array_length = kScalar;  ///< kScalar, kVariableLength or the fixed length N of T[N]
   std::size_t message = 0;     ///< index in MessageSchema::types() when kind == kMessage
 
