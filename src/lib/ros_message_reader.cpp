@@ -22,6 +22,9 @@ struct Hop {
   std::size_t type = 0;   // message type holding the field
   std::size_t field = 0;  // index in that type
   long element = -1;      // element of an array of messages, -1 otherwise
+  // Or the first element whose scalar field `match_field` equals `match_value` ("id=13").
+  int match_field = -1;
+  std::string match_value;
 };
 
 enum class End {
@@ -110,6 +113,37 @@ bool find_xyz(const MessageType& t, std::array<std::size_t, 3>* fields) {
   throw UnknownField("no field '" + join(path, path.size()) + "': " + reason);
 }
 
+// "field=value" after an array of messages: the first element whose scalar field equals value.
+void select_by_value(const MessageSchema& schema, const FieldDefinition& array,
+                     const std::vector<std::string>& path, std::size_t i, Hop& hop) {
+  const std::string& selector = path[i];
+  const MessageType& element = schema.type(array.message);
+  const auto equals = selector.find('=');
+  const std::string name = "'" + join(path, i) + "'";
+  if (equals == std::string::npos) {
+    unknown(path, name + " is an array of " + array.type_name +
+                      ": index it with a number, *, or <field>=<value> (e.g. id=3)");
+  }
+  const int f = element.field_index(selector.substr(0, equals));
+  if (f < 0 || element.fields[f].is_array() || element.fields[f].kind == Kind::kMessage) {
+    unknown(path, "'" + selector.substr(0, equals) + "' is no number or string field of " +
+                      element.name + " (it has " + field_names(element) + ")");
+  }
+  const std::string value = selector.substr(equals + 1);
+  if (element.fields[f].kind != Kind::kString) {
+    try {
+      std::size_t used = 0;
+      std::stod(value, &used);
+      if (used != value.size()) throw std::invalid_argument(value);
+    } catch (const std::exception&) {
+      unknown(path, "'" + value + "' is not a number, as " + element.name + "'s " +
+                        element.fields[f].name + " is");
+    }
+  }
+  hop.match_field = f;
+  hop.match_value = value;
+}
+
 Resolved resolve(const MessageSchema& schema, const std::vector<std::string>& path) {
   Resolved r;
   std::size_t type = 0;
@@ -165,10 +199,14 @@ Resolved resolve(const MessageSchema& schema, const std::vector<std::string>& pa
       r.index = static_cast<std::uint32_t>(value);
       return r;
     }
-    if (fd.kind == Kind::kMessage || fd.array_length != kVariableLength) {
-      unknown(path, name + " is an array of " + fd.type_name +
-                        (fd.array_length >= 0 ? "[" + std::to_string(fd.array_length) + "]" : "") +
-                        ": index it with a number or *");
+    if (fd.kind == Kind::kMessage) {
+      select_by_value(schema, fd, path, i, r.hops.back());
+      type = fd.message;
+      continue;
+    }
+    if (fd.array_length != kVariableLength) {
+      unknown(path, name + " is an array of " + fd.type_name + "[" +
+                        std::to_string(fd.array_length) + "]: index it with a number or *");
     }
     if (!find_key_array(schema, r.hops, &r.key_level, &r.key_field)) {
       unknown(path, name + " is an array of " + fd.type_name +
@@ -222,6 +260,10 @@ std::vector<std::string> path_to_level(const MessageSchema& schema, const Resolv
     const Hop& h = r.hops[k];
     out.push_back(schema.type(h.type).fields[h.field].name);
     if (h.element >= 0) out.push_back(std::to_string(h.element));
+    if (h.match_field >= 0) {
+      const MessageType& element = schema.type(schema.type(h.type).fields[h.field].message);
+      out.push_back(element.fields[h.match_field].name + "=" + h.match_value);
+    }
   }
   return out;
 }
@@ -247,6 +289,9 @@ class Cursor {
     return n;
   }
   std::size_t remaining() const { return size_ - pos_; }
+  std::size_t position() const { return pos_; }
+  // Back to a position this cursor has already passed (to walk an element again).
+  void rewind(std::size_t pos) { pos_ = std::min(pos, pos_); }
   std::size_t size() const { return size_; }
 
  private:
@@ -314,12 +359,22 @@ double to_double(Kind kind, const std::uint8_t* p) {
 
 // What to do with the fields of one message instance; a null action skips the field.
 struct PlanNode;
+// An element of an array of messages chosen by the value of one of its fields.
+struct Selector {
+  int field = -1;  // in the element type
+  std::string text;
+  double number = 0;
+  int key_slot = -1;  // scalars (numbers) or strings slot of the probed field
+  std::unique_ptr<PlanNode> plan;
+};
 struct FieldAction {
   int scalar_slot = -1;             // numeric scalar -> scalars
   int array_slot = -1;              // array -> arrays (data pointer and count)
   int strings_slot = -1;            // string or string[] -> strings
   std::unique_ptr<PlanNode> child;  // nested message
   std::vector<std::pair<std::uint32_t, std::unique_ptr<PlanNode>>> elements;  // sorted
+  std::vector<Selector> selectors;
+  std::unique_ptr<PlanNode> probe;  // reads the selectors' fields of every element
 };
 struct PlanNode {
   std::vector<std::unique_ptr<FieldAction>> actions;  // one per field of the type
@@ -456,6 +511,10 @@ class Plan {
       const Hop& h = r.hops[k];
       FieldAction* a = ensure(n, h.type, h.field);
       const std::size_t type = schema_.type(h.type).fields[h.field].message;
+      if (h.match_field >= 0) {
+        n = selector(a, type, h);
+        continue;
+      }
       if (h.element < 0) {
         if (!a->child) a->child = node(type);
         n = a->child.get();
@@ -469,6 +528,24 @@ class Plan {
       n = it->second.get();
     }
     return n;
+  }
+  PlanNode* selector(FieldAction* a, std::size_t type, const Hop& h) {
+    for (Selector& s : a->selectors)
+      if (s.field == h.match_field && s.text == h.match_value) return s.plan.get();
+    if (!a->probe) a->probe = node(type);
+    Selector s;
+    s.field = h.match_field;
+    s.text = h.match_value;
+    FieldAction* key = ensure(a->probe.get(), type, static_cast<std::size_t>(h.match_field));
+    if (schema_.type(type).fields[h.match_field].kind == Kind::kString) {
+      s.key_slot = slot(key->strings_slot, strings_);
+    } else {
+      s.number = std::stod(h.match_value);
+      s.key_slot = slot(key->scalar_slot, scalars_);
+    }
+    s.plan = node(type);
+    a->selectors.push_back(std::move(s));
+    return a->selectors.back().plan.get();
   }
   FieldAction* action(const Resolved& r) {
     return ensure(node_at(r, r.hops.size() - 1), r.hops.back().type, r.hops.back().field);
@@ -547,6 +624,7 @@ class Plan {
   void visit_elements(const FieldDefinition& f, const FieldAction& a, const MessageType& owner,
                       std::uint32_t count, Cursor& c) {
     const MessageType& type = schema_.type(f.message);
+    if (!a.selectors.empty()) return visit_selected(type, a, count, c);
     std::uint32_t next = 0;  // first element not yet consumed
     for (const auto& [index, plan] : a.elements) {
       if (index >= count) break;
@@ -555,6 +633,45 @@ class Plan {
       next = index + 1;
     }
     skip_elements(f, type, owner, count - std::min(next, count), c);
+  }
+
+  // Every element is probed for the selectors' fields, then walked again by the plan of its
+  // index and of each selector it is the first match of.
+  void visit_selected(const MessageType& type, const FieldAction& a, std::uint32_t count,
+                      Cursor& c) {
+    std::vector<char> matched(a.selectors.size(), 0);
+    auto element_plan = a.elements.begin();
+    for (std::uint32_t k = 0; k < count; ++k) {
+      for (const Selector& s : a.selectors) {  // the probe reads this element's keys only
+        if (type.fields[s.field].kind == Kind::kString) {
+          strings_[s.key_slot].clear();
+          strings_set_[s.key_slot] = 0;
+        } else {
+          scalar_set_[s.key_slot] = 0;
+        }
+      }
+      const std::size_t start = c.position();
+      walk(a.probe.get(), type, c);  // every walk of one element ends at the same byte
+      while (element_plan != a.elements.end() && element_plan->first < k) ++element_plan;
+      if (element_plan != a.elements.end() && element_plan->first == k) {
+        c.rewind(start);
+        walk(element_plan->second.get(), type, c);
+      }
+      for (std::size_t j = 0; j < a.selectors.size(); ++j) {
+        if (matched[j] || !selected(type, a.selectors[j])) continue;
+        matched[j] = 1;
+        c.rewind(start);
+        walk(a.selectors[j].plan.get(), type, c);
+      }
+    }
+  }
+
+  bool selected(const MessageType& type, const Selector& s) const {
+    if (type.fields[s.field].kind == Kind::kString) {
+      const auto& v = strings_[s.key_slot];
+      return strings_set_[s.key_slot] && v.size() == 1 && v[0] == s.text;
+    }
+    return scalar_set_[s.key_slot] && scalars_[s.key_slot] == s.number;
   }
 
   void skip_elements(const FieldDefinition& f, const MessageType& type, const MessageType& owner,

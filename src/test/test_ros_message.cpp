@@ -328,3 +328,47 @@ TEST(RosMessageReader, NamesIndexArraysFromTheNearestKeyArray) {
 }
 
 }  // namespace
+
+namespace {
+
+// Arrays of messages whose order is not fixed (a world model's objects, /tf's transforms): an
+// element chosen by the value of one of its fields.
+TEST(RosMessageReader, ElementsSelectedByAFieldValue) {
+  const MessageSchema s = sample_schema();
+  const Bytes b =
+      sample_bytes(1, {{"leg", 1, 2, 3, {7}}, {"top", 4, 5, 6, {8, 9}}, {"top", 7, 0, 0, {}}});
+  FieldReader r(s, {"items/id=top/position/x", "items/id=top/counts/1", "items/id=leg/position/z",
+                    "items/id=nope/position/x", "items/1/position/y", "header/seq"});
+  r.read(b.data.data(), b.data.size());
+  EXPECT_DOUBLE_EQ(r.value(0), 4.0);  // the first match
+  EXPECT_DOUBLE_EQ(r.value(1), 9.0);
+  EXPECT_DOUBLE_EQ(r.value(2), 3.0);
+  EXPECT_FALSE(r.present(3));
+  EXPECT_DOUBLE_EQ(r.value(4), 5.0);  // indices and selectors together
+  EXPECT_DOUBLE_EQ(r.value(5), 42.0);
+  // Reordered elements: the selector follows the element, the index does not.
+  const Bytes swapped = sample_bytes(1, {{"top", 4, 5, 6, {8, 9}}, {"leg", 1, 2, 3, {7}}});
+  r.read(swapped.data.data(), swapped.data.size());
+  EXPECT_DOUBLE_EQ(r.value(0), 4.0);
+  EXPECT_DOUBLE_EQ(r.value(2), 3.0);
+  EXPECT_DOUBLE_EQ(r.value(4), 2.0);
+  // Every truncation is still an error, never a read past the buffer.
+  for (std::size_t n = 0; n < b.data.size(); ++n) {
+    std::vector<std::uint8_t> cut(b.data.begin(), b.data.begin() + n);
+    EXPECT_THROW(r.read(cut.data(), cut.size()), MessageError) << n;
+  }
+  // Numeric fields select by number; bad selectors name what is wrong.
+  const MessageSchema objects = MessageSchema::parse(
+      "p/World", "Object[] objects\n===\nMSG: p/Object\nint32 id\nfloat64 x\n");
+  Bytes w;
+  w.put<std::uint32_t>(2).put<std::int32_t>(13).put(0.5).put<std::int32_t>(0).put(0.25);
+  FieldReader o(objects, {"objects/id=0/x", "objects/id=13/x"});
+  o.read(w.data.data(), w.data.size());
+  EXPECT_DOUBLE_EQ(o.value(0), 0.25);
+  EXPECT_DOUBLE_EQ(o.value(1), 0.5);
+  EXPECT_THROW(FieldReader(objects, {"objects/id=leg/x"}), UnknownField);
+  EXPECT_THROW(FieldReader(objects, {"objects/colour=red/x"}), UnknownField);
+  EXPECT_THROW(FieldReader(objects, {"objects/leg/x"}), UnknownField);
+}
+
+}  // namespace
