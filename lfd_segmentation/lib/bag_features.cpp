@@ -11,7 +11,6 @@
 #include <numeric>
 #include <sstream>
 #include <stdexcept>
-#include <unordered_map>
 
 #include "lfd_core/ros_message_reader.hpp"
 
@@ -156,34 +155,27 @@ std::string topics_in(rosbag::Bag& bag) {
   return available;
 }
 
-// Reads every configured topic of one bag file into the readers, in one pass over the file (a
-// view per topic would read every chunk once per topic).
+// Reads every configured topic of one bag file into the readers, a view per topic as the typed
+// reader did (measured: one view over all topics saved no CPU, its connection merge costs as much
+// as rereading the cached chunks).
 void read_part(const std::string& path, const std::vector<TopicConfig>& topics,
                std::vector<TopicReader>& readers) {
   rosbag::Bag bag;
   open_bag(bag, path);
   try {
-    std::vector<std::string> names;
     for (const TopicConfig& cfg : topics) {
       if (rosbag::View(bag, rosbag::TopicQuery(cfg.topic)).size() == 0) {
         throw std::invalid_argument("no messages on topic " + cfg.topic +
                                     " (topics in the bag:" + topics_in(bag) + ")");
       }
-      names.push_back(cfg.topic);
     }
-    // getTopic() refers to the connection's record: its address identifies the connection.
-    std::unordered_map<const std::string*, std::vector<TopicReader*>> readers_of;
     std::vector<std::uint8_t> bytes;
-    for (const rosbag::MessageInstance& m : rosbag::View(bag, rosbag::TopicQuery(names))) {
-      auto it = readers_of.find(&m.getTopic());
-      if (it == readers_of.end()) {
-        std::vector<TopicReader*> mine;
-        for (std::size_t k = 0; k < topics.size(); ++k)
-          if (topics[k].topic == m.getTopic()) mine.push_back(&readers[k]);
-        it = readers_of.emplace(&m.getTopic(), std::move(mine)).first;
+    for (std::size_t k = 0; k < topics.size(); ++k) {
+      for (const rosbag::MessageInstance& m :
+           rosbag::View(bag, rosbag::TopicQuery(topics[k].topic))) {
+        message_bytes(m, bytes);
+        readers[k].read(m, bytes);
       }
-      message_bytes(m, bytes);
-      for (TopicReader* reader : it->second) reader->read(m, bytes);
     }
   } catch (const std::invalid_argument& e) {
     throw std::invalid_argument("bag '" + path + "': " + e.what());
