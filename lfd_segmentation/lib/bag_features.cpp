@@ -1,198 +1,187 @@
 #include "lfd_segmentation/bag_features.hpp"
 
-#include <geometry_msgs/PoseStamped.h>
-#include <geometry_msgs/TwistStamped.h>
-#include <geometry_msgs/WrenchStamped.h>
-#include <lfd_msgs/Touch.h>
+#include <ros/serialization.h>
 #include <rosbag/bag.h>
 #include <rosbag/view.h>
-#include <sensor_msgs/Imu.h>
-#include <sensor_msgs/JointState.h>
-#include <cmath>
 
 #include <algorithm>
-#include <functional>
+#include <filesystem>
 #include <map>
+#include <memory>
 #include <numeric>
+#include <sstream>
 #include <stdexcept>
+
+#include "lfd_core/ros_message_reader.hpp"
 
 namespace lfd_segmentation {
 
 namespace {
 
-template <typename Msg>
-using FieldMap = std::map<std::string, std::function<double(const Msg&)>>;
-
-#define LFD_FIELD(path, expr)                          \
-  {                                                    \
-    path, [](const auto& m) { return double(m.expr); } \
-  }
-// "<vector>/norm" is the magnitude, e.g. the hand's speed, which keeps its shape whatever the
-// direction of the motion (pushes toward +x and toward +y look alike).
-#define LFD_NORM(path, expr)                                                             \
-  {                                                                                      \
-    path, [](const auto& m) {                                                            \
-      return std::sqrt(m.expr.x * m.expr.x + m.expr.y * m.expr.y + m.expr.z * m.expr.z); \
-    }                                                                                    \
-  }
-#define LFD_XYZ(prefix, expr)                                                                     \
-  LFD_FIELD(prefix "/x", expr.x), LFD_FIELD(prefix "/y", expr.y), LFD_FIELD(prefix "/z", expr.z), \
-      LFD_NORM(prefix "/norm", expr)
-
-const FieldMap<geometry_msgs::PoseStamped>& pose_fields() {
-  static const FieldMap<geometry_msgs::PoseStamped> f{
-      LFD_XYZ("pose/position", pose.position), LFD_XYZ("pose/orientation", pose.orientation),
-      LFD_FIELD("pose/orientation/w", pose.orientation.w)};
-  return f;
-}
-const FieldMap<geometry_msgs::TwistStamped>& twist_fields() {
-  static const FieldMap<geometry_msgs::TwistStamped> f{LFD_XYZ("twist/linear", twist.linear),
-                                                       LFD_XYZ("twist/angular", twist.angular)};
-  return f;
-}
-const FieldMap<geometry_msgs::WrenchStamped>& wrench_fields() {
-  static const FieldMap<geometry_msgs::WrenchStamped> f{LFD_XYZ("wrench/force", wrench.force),
-                                                        LFD_XYZ("wrench/torque", wrench.torque)};
-  return f;
-}
-const FieldMap<sensor_msgs::Imu>& imu_fields() {
-  static const FieldMap<sensor_msgs::Imu> f{LFD_XYZ("orientation", orientation),
-                                            LFD_FIELD("orientation/w", orientation.w),
-                                            LFD_XYZ("angular_velocity", angular_velocity),
-                                            LFD_XYZ("linear_acceleration", linear_acceleration)};
-  return f;
-}
-#undef LFD_XYZ
-#undef LFD_NORM
-#undef LFD_FIELD
-
-template <typename Msg>
-double stamp_of(const Msg& msg, const rosbag::MessageInstance& m) {
-  return msg.header.stamp.isZero() ? m.getTime().toSec() : msg.header.stamp.toSec();
-}
+namespace rosmsg = lfd::rosmsg;
 
 std::string feature_name(const std::string& topic, const std::string& field) {
   return topic + (topic.empty() || topic.back() == '/' ? "" : "/") + field;
 }
 
-// Fixed-layout messages: each field is a member path.
-template <typename Msg>
-void read_fixed(rosbag::View& view, const TopicConfig& cfg, const FieldMap<Msg>& fields,
-                std::vector<lfd::Stream>& out) {
-  std::vector<const std::function<double(const Msg&)>*> getters;
-  for (const std::string& field : cfg.fields) {
-    auto it = fields.find(field);
-    if (it == fields.end()) {
-      std::string known;
-      for (const auto& [name, _] : fields) known += " " + name;
-      throw std::invalid_argument("topic " + cfg.topic + " has no field '" + field +
-                                  "' (fields:" + known + ")");
-    }
-    getters.push_back(&it->second);
-    lfd::Stream s;
-    s.name = feature_name(cfg.topic, field);
-    s.interpolation = cfg.interpolation;
-    out.push_back(std::move(s));
+// The stream MessageInstance::write copies a message's bytes into: it sizes the buffer itself,
+// so the record header is parsed once per message (MessageInstance::size() would parse it again).
+struct BufferStream {
+  std::vector<std::uint8_t>* buffer;
+  std::uint8_t* advance(std::uint32_t bytes) {
+    const std::size_t used = buffer->size();
+    buffer->resize(used + bytes);
+    return buffer->data() + used;
   }
-  const std::size_t first = out.size() - getters.size();
-  for (const rosbag::MessageInstance& m : view) {
-    const auto msg = m.instantiate<Msg>();
-    if (!msg) continue;
-    const double t = stamp_of(*msg, m);
-    for (std::size_t k = 0; k < getters.size(); ++k) {
-      out[first + k].time.push_back(t);
-      out[first + k].values.push_back((*getters[k])(*msg));
-    }
-  }
-}
-
-// Name-indexed messages (JointState arrays, Touch values): fields "<array>/<name>" or "<array>/*".
-struct NamedField {
-  std::string array;  // position | velocity | effort | values
-  std::string name;
 };
 
-std::vector<NamedField> expand_named_fields(const TopicConfig& cfg,
-                                            const std::vector<std::string>& arrays,
-                                            const std::vector<std::string>& first_names) {
-  std::vector<NamedField> fields;
-  for (const std::string& field : cfg.fields) {
-    const auto slash = field.find('/');
-    const std::string array = field.substr(0, slash);
-    if (slash == std::string::npos ||
-        std::find(arrays.begin(), arrays.end(), array) == arrays.end()) {
-      std::string known;
-      for (const std::string& a : arrays) known += " " + a + "/<name>";
-      throw std::invalid_argument("topic " + cfg.topic + ": bad field '" + field + "' (expected" +
-                                  known + ")");
-    }
-    const std::string name = field.substr(slash + 1);
-    if (name == "*") {
-      for (const std::string& n : first_names) fields.push_back({array, n});
-    } else {
-      fields.push_back({array, name});
-    }
-  }
-  return fields;
+// The serialized bytes of one message, as they were recorded.
+void message_bytes(const rosbag::MessageInstance& m, std::vector<std::uint8_t>& buffer) {
+  buffer.clear();
+  BufferStream stream{&buffer};
+  m.write(stream);
 }
 
-std::vector<lfd::Stream> read_named_topic(rosbag::View& view, const TopicConfig& cfg,
-                                          const std::string& datatype) {
-  const bool joints = datatype == "sensor_msgs/JointState";
-  const std::vector<std::string> arrays =
-      joints ? std::vector<std::string>{"position", "velocity", "effort"}
-             : std::vector<std::string>{"values"};
-  // Names of the first message resolve the "*" fields.
-  std::vector<std::string> first_names;
-  for (const rosbag::MessageInstance& m : view) {
-    if (joints) {
-      if (auto msg = m.instantiate<sensor_msgs::JointState>()) {
-        first_names = msg->name;
-        break;
+std::string field_list(const rosmsg::MessageSchema& schema,
+                       const std::vector<std::uint8_t>& sample) {
+  std::string out;
+  for (const std::string& f : rosmsg::list_numeric_fields(schema, sample.data(), sample.size()))
+    out += "\n  " + f;
+  return out;
+}
+
+// One configured topic across the parts of a demonstration. Its features (the configured fields,
+// "*" expanded) are fixed by the first message of the first part; every connection (message
+// definition) on the topic gets a reader of those features.
+class TopicReader {
+ public:
+  explicit TopicReader(const TopicConfig& cfg) : cfg_(cfg) {}
+
+  // One message of the topic, `bytes` its serialized form.
+  void read(const rosbag::MessageInstance& m, const std::vector<std::uint8_t>& bytes) {
+    rosmsg::FieldReader& reader = reader_for(m, bytes);
+    reader.read(bytes.data(), bytes.size());
+    const double stamp = reader.header_stamp();
+    // A zero stamp means "not stamped" (e.g. the PR2 world model): the receive time is the clock.
+    const double t = stamp != 0.0 ? stamp : m.getTime().toSec();
+    for (std::size_t k = 0; k < streams_.size(); ++k) {
+      if (!reader.present(k)) continue;  // this message does not carry the index or name
+      streams_[k].time.push_back(t);
+      streams_[k].values.push_back(reader.value(k));
+    }
+  }
+
+  // The streams, once every part is read; a feature no message carried is an error.
+  std::vector<lfd::Stream> take_streams() {
+    for (std::size_t k = 0; k < streams_.size(); ++k) {
+      if (streams_[k].values.empty()) {
+        throw std::invalid_argument(
+            "topic " + cfg_.topic + " has no data for field '" + fields_[k] +
+            "'; numeric fields of its first message:" + field_list(*schema_, sample_));
       }
-    } else if (auto msg = m.instantiate<lfd_msgs::Touch>()) {
-      first_names = msg->names;
-      break;
+    }
+    return std::move(streams_);
+  }
+
+ private:
+  rosmsg::FieldReader& reader_for(const rosbag::MessageInstance& m,
+                                  const std::vector<std::uint8_t>& bytes) {
+    // getMD5Sum() refers to the connection's record: its address identifies the connection.
+    if (&m.getMD5Sum() == last_connection_) return *last_reader_;
+    const std::string key = m.getDataType() + " " + m.getMD5Sum();
+    auto it = readers_.find(key);
+    if (it == readers_.end()) {
+      rosmsg::MessageSchema schema;
+      try {
+        schema = rosmsg::MessageSchema::parse(m.getDataType(), m.getMessageDefinition());
+      } catch (const rosmsg::MessageError& e) {
+        throw std::invalid_argument("topic " + cfg_.topic + ": the bag's definition of " +
+                                    m.getDataType() + " cannot be parsed: " + e.what());
+      }
+      if (!schema_) first_message(schema, bytes);
+      try {
+        it = readers_.emplace(key, rosmsg::FieldReader(schema, fields_)).first;
+      } catch (const rosmsg::UnknownField& e) {
+        throw std::invalid_argument("topic " + cfg_.topic + " (" + m.getDataType() +
+                                    "): " + e.what());
+      }
+    }
+    last_connection_ = &m.getMD5Sum();
+    last_reader_ = &it->second;
+    return it->second;
+  }
+
+  void first_message(const rosmsg::MessageSchema& schema, const std::vector<std::uint8_t>& bytes) {
+    schema_ = std::make_unique<rosmsg::MessageSchema>(schema);
+    sample_ = bytes;
+    try {
+      fields_ = rosmsg::expand_fields(schema, sample_.data(), sample_.size(), cfg_.fields);
+    } catch (const rosmsg::UnknownField& e) {
+      throw std::invalid_argument("topic " + cfg_.topic + " (" + schema.root().name +
+                                  "): " + e.what());
+    }
+    for (const std::string& field : fields_) {
+      lfd::Stream s;
+      s.name = feature_name(cfg_.topic, field);
+      s.interpolation = cfg_.interpolation;
+      streams_.push_back(std::move(s));
     }
   }
-  const std::vector<NamedField> fields = expand_named_fields(cfg, arrays, first_names);
-  std::vector<lfd::Stream> streams(fields.size());
-  for (std::size_t k = 0; k < fields.size(); ++k) {
-    streams[k].name = feature_name(cfg.topic, fields[k].array + "/" + fields[k].name);
-    streams[k].interpolation = cfg.interpolation;
+
+  const TopicConfig& cfg_;
+  std::vector<std::string> fields_;
+  std::vector<lfd::Stream> streams_;
+  std::unique_ptr<rosmsg::MessageSchema> schema_;  // of the first message
+  std::vector<std::uint8_t> sample_;               // the first message, for the error lists
+  std::map<std::string, rosmsg::FieldReader> readers_;
+  const std::string* last_connection_ = nullptr;
+  rosmsg::FieldReader* last_reader_ = nullptr;
+};
+
+void open_bag(rosbag::Bag& bag, const std::string& path) {
+  try {
+    bag.open(path, rosbag::bagmode::Read);
+  } catch (const std::exception& e) {
+    throw std::runtime_error("cannot open bag '" + path + "': " + e.what());
   }
-  auto add = [&](double t, const std::vector<std::string>& names,
-                 const std::function<const std::vector<double>*(const std::string&)>& array) {
-    for (std::size_t k = 0; k < fields.size(); ++k) {
-      const auto it = std::find(names.begin(), names.end(), fields[k].name);
-      if (it == names.end()) continue;  // this message does not carry the name
-      const std::vector<double>* values = array(fields[k].array);
-      const std::size_t index = static_cast<std::size_t>(it - names.begin());
-      if (values->size() <= index) continue;  // e.g. an empty effort array
-      streams[k].time.push_back(t);
-      streams[k].values.push_back((*values)[index]);
-    }
-  };
-  for (const rosbag::MessageInstance& m : view) {
-    if (joints) {
-      const auto msg = m.instantiate<sensor_msgs::JointState>();
-      if (!msg) continue;
-      add(stamp_of(*msg, m), msg->name, [&](const std::string& a) {
-        return a == "position" ? &msg->position : a == "velocity" ? &msg->velocity : &msg->effort;
-      });
-    } else {
-      const auto msg = m.instantiate<lfd_msgs::Touch>();
-      if (!msg) continue;
-      add(stamp_of(*msg, m), msg->names, [&](const std::string&) { return &msg->values; });
-    }
+}
+
+std::string topics_in(rosbag::Bag& bag) {
+  std::string available;
+  rosbag::View all(bag);
+  for (const rosbag::ConnectionInfo* c : all.getConnections()) {
+    if (c->topic != kGroundTruthTopic) available += " " + c->topic;
   }
-  for (const lfd::Stream& s : streams) {
-    if (s.values.empty()) {
-      throw std::invalid_argument("topic " + cfg.topic + " has no data for field '" +
-                                  s.name.substr(cfg.topic.size() + 1) + "'");
+  return available;
+}
+
+// Reads every configured topic of one bag file into the readers, a view per topic as the typed
+// reader did (measured: one view over all topics saved no CPU, its connection merge costs as much
+// as rereading the cached chunks).
+void read_part(const std::string& path, const std::vector<TopicConfig>& topics,
+               std::vector<TopicReader>& readers) {
+  rosbag::Bag bag;
+  open_bag(bag, path);
+  try {
+    for (const TopicConfig& cfg : topics) {
+      if (rosbag::View(bag, rosbag::TopicQuery(cfg.topic)).size() == 0) {
+        throw std::invalid_argument("no messages on topic " + cfg.topic +
+                                    " (topics in the bag:" + topics_in(bag) + ")");
+      }
     }
+    std::vector<std::uint8_t> bytes;
+    for (std::size_t k = 0; k < topics.size(); ++k) {
+      for (const rosbag::MessageInstance& m :
+           rosbag::View(bag, rosbag::TopicQuery(topics[k].topic))) {
+        message_bytes(m, bytes);
+        readers[k].read(m, bytes);
+      }
+    }
+  } catch (const std::invalid_argument& e) {
+    throw std::invalid_argument("bag '" + path + "': " + e.what());
+  } catch (const std::exception& e) {
+    throw std::runtime_error("cannot read bag '" + path + "' (truncated or corrupt?): " + e.what());
   }
-  return streams;
 }
 
 // Messages are stored in receive order; sort each stream by stamp so resampling sees a clock.
@@ -210,56 +199,43 @@ void sort_by_time(lfd::Stream& s) {
 
 }  // namespace
 
+std::vector<std::string> demo_parts(const std::string& path) {
+  if (path.find(',') == std::string::npos || std::filesystem::exists(path)) return {path};
+  std::vector<std::string> parts;
+  std::stringstream in(path);
+  std::string part;
+  while (std::getline(in, part, ',')) {
+    if (part.empty()) throw std::invalid_argument("empty bag name in '" + path + "'");
+    parts.push_back(part);
+  }
+  return parts;
+}
+
 std::vector<lfd::Stream> read_bag_streams(const std::string& path,
                                           const std::vector<TopicConfig>& topics,
                                           std::vector<FeatureRole>* roles) {
   if (topics.empty()) throw std::invalid_argument("no topics configured for the features");
+  for (const TopicConfig& cfg : topics) {
+    if (cfg.topic == kGroundTruthTopic) {
+      throw std::invalid_argument("bag '" + path + "': " + kGroundTruthTopic +
+                                  " is ground truth and is never read by the segmenter");
+    }
+  }
+  std::vector<TopicReader> readers;
+  readers.reserve(topics.size());
+  for (const TopicConfig& cfg : topics) readers.emplace_back(cfg);
+  for (const std::string& part : demo_parts(path)) read_part(part, topics, readers);
   std::vector<lfd::Stream> streams;
   if (roles) roles->clear();
-  rosbag::Bag bag;
-  try {
-    bag.open(path, rosbag::bagmode::Read);
-  } catch (const std::exception& e) {
-    throw std::runtime_error("cannot open bag '" + path + "': " + e.what());
-  }
-  try {
-    for (const TopicConfig& cfg : topics) {
-      if (cfg.topic == kGroundTruthTopic) {
-        throw std::invalid_argument(std::string(kGroundTruthTopic) +
-                                    " is ground truth and is never read by the segmenter");
-      }
-      rosbag::View view(bag, rosbag::TopicQuery(cfg.topic));
-      if (view.size() == 0) {
-        std::string available;
-        rosbag::View all(bag);
-        for (const rosbag::ConnectionInfo* c : all.getConnections()) {
-          if (c->topic != kGroundTruthTopic) available += " " + c->topic;
-        }
-        throw std::invalid_argument("no messages on topic " + cfg.topic +
-                                    " (topics in the bag:" + available + ")");
-      }
-      const std::string datatype = view.getConnections().front()->datatype;
-      const std::size_t before = streams.size();
-      if (datatype == "geometry_msgs/PoseStamped") {
-        read_fixed(view, cfg, pose_fields(), streams);
-      } else if (datatype == "geometry_msgs/TwistStamped") {
-        read_fixed(view, cfg, twist_fields(), streams);
-      } else if (datatype == "geometry_msgs/WrenchStamped") {
-        read_fixed(view, cfg, wrench_fields(), streams);
-      } else if (datatype == "sensor_msgs/Imu") {
-        read_fixed(view, cfg, imu_fields(), streams);
-      } else if (datatype == "sensor_msgs/JointState" || datatype == "lfd_msgs/Touch") {
-        for (lfd::Stream& s : read_named_topic(view, cfg, datatype))
-          streams.push_back(std::move(s));
-      } else {
-        throw std::invalid_argument("topic " + cfg.topic + " has unsupported type " + datatype);
-      }
-      if (roles) roles->insert(roles->end(), streams.size() - before, cfg.role);
+  for (std::size_t k = 0; k < topics.size(); ++k) {
+    std::vector<lfd::Stream> topic_streams;
+    try {
+      topic_streams = readers[k].take_streams();
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument("bag '" + path + "': " + e.what());
     }
-  } catch (const std::invalid_argument& e) {
-    throw std::invalid_argument("bag '" + path + "': " + e.what());
-  } catch (const std::exception& e) {
-    throw std::runtime_error("cannot read bag '" + path + "' (truncated or corrupt?): " + e.what());
+    if (roles) roles->insert(roles->end(), topic_streams.size(), topics[k].role);
+    for (lfd::Stream& s : topic_streams) streams.push_back(std::move(s));
   }
   for (lfd::Stream& s : streams) sort_by_time(s);
   return streams;
@@ -282,6 +258,36 @@ DemoFeatures read_bag_features(const std::string& path, const std::vector<TopicC
     if (roles[k] == FeatureRole::kContext) demo.context_features.push_back(streams[k].name);
   }
   return demo;
+}
+
+std::string describe_bag(const std::string& path) {
+  std::ostringstream out;
+  for (const std::string& part : demo_parts(path)) {
+    rosbag::Bag bag;
+    open_bag(bag, part);
+    out << part << "\n";
+    try {
+      rosbag::View all(bag);
+      std::map<std::string, const rosbag::ConnectionInfo*> topics;
+      for (const rosbag::ConnectionInfo* c : all.getConnections()) topics.emplace(c->topic, c);
+      for (const auto& [topic, connection] : topics) {
+        rosbag::View view(bag, rosbag::TopicQuery(topic));
+        out << topic << " (" << connection->datatype << ", " << view.size() << " messages)";
+        if (topic == kGroundTruthTopic || view.size() == 0) {
+          out << (view.size() ? ": ground truth, never read by the segmenter\n" : "\n");
+          continue;
+        }
+        std::vector<std::uint8_t> sample;
+        message_bytes(*view.begin(), sample);
+        const rosmsg::MessageSchema schema =
+            rosmsg::MessageSchema::parse(connection->datatype, connection->msg_def);
+        out << field_list(schema, sample) << "\n";
+      }
+    } catch (const std::exception& e) {
+      throw std::runtime_error("cannot read bag '" + part + "': " + e.what());
+    }
+  }
+  return out.str();
 }
 
 }  // namespace lfd_segmentation

@@ -22,8 +22,12 @@
 namespace {
 
 const char* kUsage = R"(usage: segment [options] FILE...
-  FILE                      demonstration bags (*.bag) or CSV files (header row, one row per sample)
+  FILE                      demonstration bags (*.bag) or CSV files (header row, one row per sample);
+                            a.bag,b.bag,... = one demonstration recorded in several bags, in order
   --config PATH             parameters (default: )" LFD_CONFIG_DIR R"(/segmentation.yaml)
+  --topics PATH             YAML whose 'topics:' list (topic, role, fields) replaces the config's:
+                            another robot's bags without editing the parameters
+  --list-fields             print every topic of the bag(s) and its numeric field paths, then exit
   --sensor-columns a,b,c    CSV columns used only for the confidence zones
   --state-columns a,b,c     CSV columns considered for segmentation (default: all other columns)
   --time-column NAME        CSV time column (default: time, t, timestamp or stamp if present)
@@ -62,6 +66,8 @@ double seconds_since(std::chrono::steady_clock::time_point t) {
 
 struct Options {
   std::string config = std::string(LFD_CONFIG_DIR) + "/segmentation.yaml";
+  std::string topics;  ///< --topics: a YAML file with the topics list
+  bool list_fields = false;
   std::vector<std::string> files, sensors, states;
   std::string time_column, combination, output;
   double rate = 0, threshold = 0, min_seconds = 0, window_seconds = 0;
@@ -93,6 +99,10 @@ Options parse_args(int argc, char** argv) {
       std::exit(0);
     } else if (arg == "--config") {
       o.config = value();
+    } else if (arg == "--topics") {
+      o.topics = value();
+    } else if (arg == "--list-fields") {
+      o.list_fields = true;
     } else if (arg == "--sensor-columns") {
       o.sensors = split_list(value());
     } else if (arg == "--state-columns") {
@@ -137,6 +147,10 @@ Options parse_args(int argc, char** argv) {
 nlohmann::json run(const Options& o) {
   const auto start = std::chrono::steady_clock::now();
   lfd_segmentation::SegmentationParams params = lfd_segmentation::load_params_file(o.config);
+  if (!o.topics.empty()) {
+    params.topics = lfd_segmentation::load_params_file(o.topics).topics;
+    if (params.topics.empty()) throw std::invalid_argument(o.topics + " has no 'topics:' list");
+  }
   if (o.rate > 0) params.rate = o.rate;
   if (!o.combination.empty()) {
     params.pipeline.segmentation.combination = lfd::parse_profile_combination(o.combination);
@@ -225,6 +239,10 @@ int main(int argc, char** argv) {
   int status = 0;
   try {
     options = parse_args(argc, argv);
+    if (options.list_fields) {
+      for (const std::string& f : options.files) std::cout << lfd_segmentation::describe_bag(f);
+      return 0;
+    }
     out = run(options);
   } catch (const std::exception& e) {
     std::cerr << "segment: error: " << e.what() << "\n";

@@ -1,8 +1,11 @@
 // Demonstration bag -> feature matrix: every configured topic field becomes one named feature
-// ("<topic>/<field>", e.g. /ee_twist/twist/linear/x), resampled onto one clock. Supported types:
-// sensor_msgs/JointState (position|velocity|effort/<joint>), geometry_msgs/PoseStamped,
-// TwistStamped, WrenchStamped, sensor_msgs/Imu and lfd_msgs/Touch (values/<name>). Sample times
-// are the header stamps (the bag receive time when a stamp is zero).
+// ("<topic>/<field>", e.g. /ee_twist/twist/linear/x), resampled onto one clock. Any message type:
+// fields are read by path with the message definitions stored in the bag (lfd_core's
+// ros_message_reader.hpp gives the path syntax: nested fields, array indices, names looked up in a
+// name/names/*_names array, "<vector>/norm", and "*" expanded over the first message). Sample times
+// are the header stamps, the bag receive time when a message has no header or a zero stamp.
+// A demonstration may be recorded in several bag files: "a.bag,b.bag,c.bag" reads them in order as
+// one demonstration, on their own (absolute) stamps, so gaps between the files stay gaps.
 #pragma once
 
 #include <string>
@@ -21,9 +24,14 @@ struct DemoFeatures {
   std::vector<std::string> context_features;  ///< role context: in the matrix, used by neither
 };
 
+/// The bag files of one demonstration: `path` itself, or its comma-separated parts (unless a file
+/// of that very name exists).
+std::vector<std::string> demo_parts(const std::string& path);
+
 /// Raw (not resampled) streams of the configured fields of one bag. Throws std::runtime_error for
-/// unreadable/truncated bags and std::invalid_argument for a missing topic or field, an unsupported
-/// message type or the ground-truth topic.
+/// unreadable/truncated bags or messages that do not match their definition, and
+/// std::invalid_argument for a missing topic, a field that does not exist (listing the topic's
+/// numeric fields), a field no message carries, or the ground-truth topic.
 std::vector<lfd::Stream> read_bag_streams(const std::string& path,
                                           const std::vector<TopicConfig>& topics,
                                           std::vector<FeatureRole>* roles = nullptr);
@@ -31,5 +39,9 @@ std::vector<lfd::Stream> read_bag_streams(const std::string& path,
 /// read_bag_streams + resampling at `rate` Hz (errors name the bag).
 DemoFeatures read_bag_features(const std::string& path, const std::vector<TopicConfig>& topics,
                                double rate);
+
+/// Every topic of the bag(s) with its type, message count and numeric fields (paths as they are
+/// written in the configuration's `fields`). Throws std::runtime_error for unreadable bags.
+std::string describe_bag(const std::string& path);
 
 }  // namespace lfd_segmentation
