@@ -252,7 +252,8 @@ def run_and_score(segment, method, inputs, truths, spans, tolerance):
     for path, true_windows, (t_start, t_end), demo in zip(inputs, truths, spans, res["demos"]):
         found = list(demo["changepoint_times"])
         s = score_demo(found, true_windows, t_start, t_end, tolerance)
-        s.update({"bag": path, "changepoints_s": found, "changepoints_rel_s": [c - t_start for c in found],
+        s.update({"bag": ",".join(os.path.basename(p) for p in path.split(",")), "changepoints_s": found,
+                  "changepoints_rel_s": [c - t_start for c in found],
                   "rejected_s": demo["rejected_times"], "pruned_s": demo["pruned_times"],
                   "zones_s": demo["zones"]})
         scores.append(s)
