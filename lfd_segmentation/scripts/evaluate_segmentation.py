@@ -193,7 +193,6 @@ class CliSegmenter(object):
             raise RuntimeError("segmentation failed: %s" % out.get("error"))
         demos = []
         for d in out["demos"]:
-            t0 = d.get("start_time", 0.0)
             demos.append({"changepoint_times": d["changepoint_times"], "rejected_times": d.get("rejected_times", []),
                           "pruned_times": d.get("pruned_times", []),
                           "zones": [(z["begin_time"], z["end_time"]) for z in d.get("zones", [])]})
@@ -248,6 +247,8 @@ def run_and_score(segment, method, inputs, truths, spans, tolerance):
     start = time.time()
     res = segment(inputs, method)
     elapsed = time.time() - start
+    if len(res["demos"]) != len(inputs):
+        raise RuntimeError("segmenter returned %d demos for %d inputs" % (len(res["demos"]), len(inputs)))
     scores = []
     for path, true_windows, (t_start, t_end), demo in zip(inputs, truths, spans, res["demos"]):
         found = list(demo["changepoint_times"])
@@ -280,10 +281,13 @@ def load_truth_file(path):
     """Read a ground-truth file (YAML or JSON, format in the module docstring) into
     [(name, [bag paths], [changepoint seconds from the first bag's start])]."""
     with open(path) as f:
-        data = yaml.safe_load(f)
+        return parse_truth(yaml.safe_load(f), os.path.dirname(os.path.abspath(path)), path)
+
+
+def parse_truth(data, base, path):
+    """A ground-truth file's content; relative bag paths are taken from `base`."""
     if not isinstance(data, dict) or not isinstance(data.get("demos"), list) or not data["demos"]:
         raise RuntimeError("%s: expected a 'demos:' list (see evaluate_segmentation.py --help)" % path)
-    base = os.path.dirname(os.path.abspath(path))
     demos = []
     for i, d in enumerate(data["demos"]):
         if not isinstance(d, dict) or not d.get("bags") or "changepoints_s" not in d:
@@ -344,14 +348,9 @@ def datasets_to_run(args, config):
             if args.write_truth:
                 with open(args.write_truth, "w") as f:
                     yaml.safe_dump(content, f, sort_keys=False)
-            tmp = args.write_truth or tempfile.NamedTemporaryFile("w", suffix=".yaml", delete=False).name
-            if not args.write_truth:
-                with open(tmp, "w") as f:
-                    yaml.safe_dump(content, f, sort_keys=False)
-            truth_path = tmp
+            demos = parse_truth(content, os.path.dirname(os.path.abspath(args.labels)), args.labels)
         else:
-            truth_path = args.truth
-        demos = load_truth_file(truth_path)
+            demos = load_truth_file(args.truth)
         # a labels.json is named by its folder (pr2_ikea), a truth file by itself
         name = (os.path.basename(os.path.dirname(os.path.abspath(args.labels))) if args.labels
                 else os.path.splitext(os.path.basename(args.truth))[0])
@@ -401,7 +400,7 @@ def main():
         for method in methods:
             try:
                 r = evaluate(segment, method, tol)
-            except (RuntimeError, rospy.ServiceException, OSError, ValueError) as exc:
+            except (RuntimeError, rospy.ServiceException, rosbag.ROSBagException, OSError, ValueError) as exc:
                 print("%-14s %-18s error: %s" % (name, method, exc))
                 results[name][method] = {"error": str(exc)}
                 failures += 1
