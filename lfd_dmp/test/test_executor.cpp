@@ -258,7 +258,7 @@ TEST_F(PlannerTest, RefusesUnreachableGoalsAndMismatchedLibraries) {
 TEST_F(PlannerTest, OverflowingSkillWeightsAreAClearError) {
   lfd_dmp::SkillLibrary lib = lib_;
   for (lfd_dmp::DemoSkill& demo : lib.segments[0].demos) {
-    const lfd::PositionDmp& p = *demo.dmp.position;
+    const lfd::PositionDmp p = *demo.dmp.position;  // a copy: emplace destroys the original
     demo.dmp.position.emplace(p.parameters(), p.tau(),
                               Eigen::MatrixXd::Constant(p.weights().rows(), p.weights().cols(), 1e300),
                               p.start(), p.goal(), p.startVelocity());
