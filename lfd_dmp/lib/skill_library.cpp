@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <sstream>
 #include <stdexcept>
 
 namespace lfd_dmp {
@@ -60,6 +61,25 @@ Eigen::VectorXd vector(const json& j, const std::string& where, long expected = 
   return v;
 }
 
+// Finite is not enough: a rollout of a huge number overflows to inf/NaN downstream (IK, the
+// bridge). Learned forcing weights of real demos stay below 1e4 (scaled accelerations); 1e9 leaves
+// room for any fit and still keeps every rollout finite. Positions beyond 1 km are no workcell's.
+constexpr double kMaxWeightMagnitude = 1e9;
+constexpr double kMaxPositionMagnitude = 1e3;  // m
+
+template <class Matrix>
+Matrix bounded(Matrix values, double limit, const std::string& where, const char* what) {
+  for (Eigen::Index k = 0; k < values.size(); ++k) {
+    if (std::abs(values.data()[k]) > limit) {
+      std::ostringstream msg;
+      msg << what << " " << values.data()[k] << " (element " << k << ") exceeds the limit of "
+          << limit << " (the file is corrupt or not a learned skill)";
+      fail(where, msg.str());
+    }
+  }
+  return values;
+}
+
 Eigen::MatrixXd weights(const json& j, const std::string& where, long dims, int num_basis) {
   if (!j.is_array()) fail(where, "expected an array of per-dimension weight arrays");
   if (static_cast<long>(j.size()) != dims) {
@@ -70,7 +90,7 @@ Eigen::MatrixXd weights(const json& j, const std::string& where, long dims, int 
   for (long d = 0; d < dims; ++d) {
     w.col(d) = vector(j[static_cast<size_t>(d)], where + "[" + std::to_string(d) + "]", num_basis);
   }
-  return w;
+  return bounded(w, kMaxWeightMagnitude, where, "weight");
 }
 
 Eigen::Quaterniond quaternion(const json& j, const std::string& where) {
@@ -176,11 +196,14 @@ lfd::SegmentDmp segmentDmpFromJson(const json& j, const lfd::DmpParameters& para
     if (j.contains("position")) {
       const std::string w = where + ".position";
       const json& p = j["position"];
-      const Eigen::VectorXd goal = vector(member(p, "goal", w), w + ".goal");
+      const Eigen::VectorXd goal = bounded(vector(member(p, "goal", w), w + ".goal"),
+                                           kMaxPositionMagnitude, w + ".goal", "position");
       const long d = goal.size();
       if (d < 1) fail(w + ".goal", "needs at least one dimension");
       dmp.position.emplace(params, dmp.tau, weights(member(p, "weights", w), w + ".weights", d, n),
-                           vector(member(p, "start", w), w + ".start", d), goal,
+                           bounded(vector(member(p, "start", w), w + ".start", d),
+                                   kMaxPositionMagnitude, w + ".start", "position"),
+                           goal,
                            vector(member(p, "start_velocity", w), w + ".start_velocity", d));
     }
     if (j.contains("orientation")) {
@@ -196,7 +219,8 @@ lfd::SegmentDmp segmentDmpFromJson(const json& j, const lfd::DmpParameters& para
       const std::string w = where + ".gripper";
       const json& g = j["gripper"];
       Eigen::MatrixXd gw(n, 1);
-      gw.col(0) = vector(member(g, "weights", w), w + ".weights", n);
+      gw.col(0) = bounded(vector(member(g, "weights", w), w + ".weights", n), kMaxWeightMagnitude,
+                          w + ".weights", "weight");
       dmp.gripper.emplace(params, dmp.tau, gw,
                           Eigen::VectorXd::Constant(1, number(member(g, "start", w), w + ".start")),
                           Eigen::VectorXd::Constant(1, number(member(g, "goal", w), w + ".goal")),

@@ -82,6 +82,36 @@ TEST(DmpTool, LearnThenRolloutToANewGoal) {
   for (const auto& p : {csv, json, traj_csv}) std::remove(p.c_str());
 }
 
+// Issue 12: `dmp_tool learn --basis 300` crashed (Eigen LDLT under -march=native with pinned
+// alignment). 300 and 1000 basis functions (1000 > the demo's 1200 samples / 2) must learn, save,
+// load and reproduce the demo.
+TEST(DmpTool, LearnsWithHundredsOfBasisFunctions) {
+  const std::string csv = writeDemoCsv("many_basis.csv", 0.6, 1200);
+  const std::string traj_csv = tempPath("many_basis_traj.csv");
+  for (const std::string basis : {"300", "1000"}) {
+    const std::string json = tempPath("many_basis_" + basis + ".json");
+    std::string out, err;
+    ASSERT_EQ(run({"learn", "--csv", csv, "--out", json, "--basis", basis}, &out, &err), 0)
+        << basis << ": " << err;
+    const lfd_dmp::SkillLibrary lib = lfd_dmp::loadSkillLibrary(json);
+    ASSERT_EQ(lib.segments.size(), 1u);
+    const lfd::PositionDmp& p = *lib.segments[0].demos[0].dmp.position;
+    EXPECT_EQ(p.weights().rows(), std::stoi(basis));
+    EXPECT_TRUE(p.weights().allFinite());
+    std::ostringstream dt;
+    dt.precision(17);
+    dt << 2.0 / 1199;
+    ASSERT_EQ(run({"rollout", "--library", json, "--out", traj_csv, "--dt", dt.str()}, &out, &err), 0)
+        << err;
+    const lfd_dmp::CsvTrajectory again = lfd_dmp::readTrajectoryCsv(traj_csv);
+    const lfd_dmp::CsvTrajectory demo = lfd_dmp::readTrajectoryCsv(csv);
+    ASSERT_EQ(again.demo.positions.rows(), demo.demo.positions.rows());
+    EXPECT_LT((again.demo.positions - demo.demo.positions).cwiseAbs().maxCoeff(), 1e-3) << basis;
+    std::remove(json.c_str());
+  }
+  for (const auto& p : {csv, traj_csv}) std::remove(p.c_str());
+}
+
 TEST(DmpTool, GeneralizesAcrossDemosOfALibrary) {
   lfd_dmp::SkillLibrary lib;
   for (double gx : {0.5, 0.8}) {

@@ -10,9 +10,8 @@
 
 namespace {
 
-const std::string kUrdf =
-    std::string(__FILE__).substr(0, std::string(__FILE__).rfind("/lfd_dmp/")) +
-    "/lfd_sim_bridge/models/jvrc1_like.urdf";
+// From CMake, not __FILE__: ccache (CCACHE_BASEDIR) makes __FILE__ relative to the build tree.
+const std::string kUrdf = std::string(LFD_REPO_DIR) + "/lfd_sim_bridge/models/jvrc1_like.urdf";
 
 lfd::KinematicChain chain() {
   return lfd::KinematicChain::fromUrdfFile(kUrdf, "base_link", "r_gripper_tcp");
@@ -251,6 +250,29 @@ TEST_F(PlannerTest, RefusesUnreachableGoalsAndMismatchedLibraries) {
                std::invalid_argument);
   lfd_dmp::SkillLibrary empty;
   EXPECT_THROW(planner_.plan(empty, {}, q0_, 0.04, opt), std::invalid_argument);
+}
+
+// Issue 12: a library (built in memory, past the loader's bounds) whose finite weights are so
+// huge that the rollout overflows crashed the executor node (IK returned an empty joint vector).
+// Planning must fail with a clear error instead.
+TEST_F(PlannerTest, OverflowingSkillWeightsAreAClearError) {
+  lfd_dmp::SkillLibrary lib = lib_;
+  for (lfd_dmp::DemoSkill& demo : lib.segments[0].demos) {
+    const lfd::PositionDmp p = *demo.dmp.position;  // a copy: emplace destroys the original
+    demo.dmp.position.emplace(p.parameters(), p.tau(),
+                              Eigen::MatrixXd::Constant(p.weights().rows(), p.weights().cols(), 1e300),
+                              p.start(), p.goal(), p.startVelocity());
+  }
+  lfd_dmp::ExecutorOptions opt;
+  opt.dt = 0.01;
+  const Eigen::Vector3d grasp = home_.position + Eigen::Vector3d(0.02, 0.0, -0.045);
+  try {
+    planner_.plan(lib, targets(grasp, grasp), q0_, 0.04, opt);
+    FAIL() << "a plan from overflowing weights was accepted";
+  } catch (const std::exception& e) {
+    const std::string msg = e.what();
+    EXPECT_NE(msg.find("finite"), std::string::npos) << msg;
+  }
 }
 
 // Three push demos, each: approach (home -> behind the box), push (0.1 m straight along its

@@ -124,6 +124,20 @@ TEST(SkillLibrary, ValidationNamesTheProblem) {
             std::string::npos)
       << loadError(j);
 
+  // Issue 12: finite but huge numbers overflowed the rollout and crashed the executor's IK.
+  j = good;
+  j["segments"][0]["demos"][1]["dmp"]["position"]["weights"][2][5] = 1e300;
+  EXPECT_NE(loadError(j).find("segments[0].demos[1].dmp.position.weights: weight 1e+300"),
+            std::string::npos)
+      << loadError(j);
+  j = good;
+  j["segments"][1]["demos"][0]["dmp"]["gripper"]["weights"][3] = -1e12;
+  EXPECT_NE(loadError(j).find("gripper.weights: weight -1e+12"), std::string::npos) << loadError(j);
+  j = good;
+  j["segments"][0]["demos"][0]["dmp"]["position"]["goal"][0] = 1e300;
+  EXPECT_NE(loadError(j).find("position.goal: position 1e+300"), std::string::npos)
+      << loadError(j);
+
   j = good;
   j["segments"][0]["demos"][0]["dmp"].erase("tau");
   EXPECT_NE(loadError(j).find("missing field \"tau\""), std::string::npos);

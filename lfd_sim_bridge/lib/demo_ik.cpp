@@ -45,7 +45,15 @@ JointPath CartesianToJoints::convert(const std::vector<TimedPose>& samples,
   Eigen::VectorXd previous = seed;
   const Eigen::VectorXd& vmax = chain.velocityLimits();
   for (const TimedPose& sample : samples) {
+    if (!std::isfinite(sample.t) || !sample.pose.position.allFinite() ||
+        !sample.pose.orientation.coeffs().allFinite()) {
+      throw std::invalid_argument("TCP pose at t=" + std::to_string(sample.t) +
+                                  " s is not finite; no joint solution can be computed");
+    }
     const Eigen::Isometry3d target = base_inv * toIsometry(sample.pose);
+    if (!target.matrix().allFinite())
+      throw std::invalid_argument("TCP pose at t=" + std::to_string(sample.t) +
+                                  " s overflows in the chain base frame");
     ik_.solve(target, previous, result_);
     auto within = [this](const lfd::IkResult& r) {
       return r.converged || (r.position_error <= tolerance_.position &&
@@ -54,6 +62,10 @@ JointPath CartesianToJoints::convert(const std::vector<TimedPose>& samples,
     if (!within(result_)) {
       // Warm start failed (e.g. a joint limit blocks the branch): try the solver's restarts.
       const lfd::IkResult retry = ik_.reach(target, previous);
+      if (!retry.failure.empty()) {
+        throw std::runtime_error("IK failed for the TCP pose at t=" + std::to_string(sample.t) +
+                                 " s: " + retry.failure);
+      }
       if (!within(retry)) {
         std::ostringstream msg;
         msg << "IK cannot reach the TCP pose at t=" << sample.t << " s, position ("

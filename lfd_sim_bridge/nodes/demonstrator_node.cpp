@@ -671,10 +671,14 @@ class Demonstrator {
 int main(int argc, char** argv) {
   ros::init(argc, argv, "demonstrator");
   ros::NodeHandle nh, pnh("~");
-  ros::AsyncSpinner spinner(2);
-  spinner.start();
   try {
     Demonstrator demonstrator(nh, pnh);
+    // Declared after the demonstrator so it is destroyed (its threads joined) first: callbacks
+    // write the demonstrator's members, which must not be freed under a running callback. Once
+    // run() unpauses the sim, /joint_states arrives at full simulation rate, and a spinner that
+    // outlived the demonstrator crashed the node at exit (free(): invalid pointer, SIGSEGV).
+    ros::AsyncSpinner spinner(2);
+    spinner.start();
     demonstrator.run();
   } catch (const std::exception& e) {
     ROS_FATAL("demonstrator: %s", e.what());

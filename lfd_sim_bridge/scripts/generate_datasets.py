@@ -10,11 +10,13 @@ A dataset that already holds every bag is skipped, and the demonstrator skips ba
 so a rerun resumes where an interrupted one stopped (*.bag.active leftovers are removed first).
 Uses the ROS master of ROS_MASTER_URI when one is running, else starts a private one.
 Prints a table: dataset, demos, mean duration, physical successes, recorded topics.
-Exit status 0 only if every dataset is complete and every demo succeeded physically.
+Exit status 0 only if every dataset is complete, every demo succeeded physically and no node of
+the launch crashed (a crash is reported even when the retry recorded the missing demos).
 """
 import argparse
 import glob
 import os
+import re
 import shutil
 import socket
 import subprocess
@@ -89,19 +91,29 @@ def demo_errors(out):
     return errors
 
 
-def generate(name, out_root, args, log_dir):
+# roslaunch's line for a node that ended by a signal: "[demonstrator-5] process has died [pid 42,
+# exit code -6, cmd ...". A negative code is the signal number (6 SIGABRT, 11 SIGSEGV).
+CRASH_LINE = re.compile(r"\[([\w-]+)\] process has died \[pid (\d+), exit code (-\d+)")
+
+
+def crashes_in(log_text):
+    """[(process, pid, signal)] of every node of the launch that died by a signal."""
+    return [(m.group(1), int(m.group(2)), -int(m.group(3))) for m in CRASH_LINE.finditer(log_text)]
+
+
+def generate(name, out_root, args, log_dir, crashes):
     """Records the missing demos of one dataset; a demo that fails is tried once more (a fresh
     scene), as a demonstrator redoes a botched demonstration."""
     elapsed = 0.0
     for attempt in (1, 2):
-        done, took = record_missing(name, out_root, args, log_dir, attempt)
+        done, took = record_missing(name, out_root, args, log_dir, attempt, crashes)
         elapsed += took
         if done:
             break
     return elapsed
 
 
-def record_missing(name, out_root, args, log_dir, attempt):
+def record_missing(name, out_root, args, log_dir, attempt, crashes):
     mode, task = name.split("_")
     out = os.path.join(out_root, name)
     ids = configurations(args.tasks_file, task, mode)
@@ -123,7 +135,9 @@ def record_missing(name, out_root, args, log_dir, attempt):
            "output_dir:=" + out, "seed:=%d" % args.seed, "tasks_file:=" + args.tasks_file,
            "configurations:=[%s]" % ",".join(str(i) for i in missing)]
     start = time.time()
-    with open(os.path.join(log_dir, name + ".log"), "w" if attempt == 1 else "a") as log:
+    log_path = os.path.join(log_dir, name + ".log")
+    log_start = os.path.getsize(log_path) if attempt > 1 and os.path.exists(log_path) else 0
+    with open(log_path, "w" if attempt == 1 else "a") as log:
         try:
             subprocess.run(cmd, stdout=log, stderr=subprocess.STDOUT, timeout=args.timeout,
                            check=False)
@@ -132,6 +146,13 @@ def record_missing(name, out_root, args, log_dir, attempt):
                   file=sys.stderr)
     elapsed = time.time() - start
     print("[datasets] %s: %.1f s wall" % (name, elapsed), flush=True)
+    with open(log_path, errors="replace") as log:
+        log.seek(log_start)
+        for process, pid, signal in crashes_in(log.read()):
+            # A crash is a bug even when the retry records the missing demos: never hide it.
+            print("[datasets] %s: CRASH: %s (pid %d) was killed by signal %d (see %s)"
+                  % (name, process, pid, signal, log_path), file=sys.stderr, flush=True)
+            crashes.append((name, process, signal))
     return False, elapsed
 
 
@@ -187,13 +208,17 @@ def main():
         for n in names:
             shutil.rmtree(os.path.join(out_root, n), ignore_errors=True)
     start = time.time()
+    crashes = []
     with Master():
         for n in names:
-            generate(n, out_root, args, log_dir)
+            generate(n, out_root, args, log_dir, crashes)
     total = time.time() - start
     print("[datasets] generation took %.1f s wall in total (logs in %s)" % (total, log_dir))
     ok = summarize(out_root, names, args)
-    return 0 if ok else 1
+    if crashes:
+        print("[datasets] %d node crash(es) during generation: %s" % (len(crashes), ", ".join(
+            "%s/%s signal %d" % c for c in crashes)))
+    return 0 if ok and not crashes else 1
 
 
 if __name__ == "__main__":

@@ -1,6 +1,7 @@
 // Unit test of the demonstrator's Cartesian -> joint conversion on the real robot model: a whole
 // grasp demonstration is planned, sampled and solved, and forward kinematics of the joint path
 // must reproduce the Cartesian path.
+#include <limits>
 #include <random>
 
 #include <gtest/gtest.h>
@@ -100,4 +101,29 @@ TEST(CartesianToJoints, UnreachablePoseIsAClearError) {
 int main(int argc, char** argv) {
   testing::InitGoogleTest(&argc, argv);
   return RUN_ALL_TESTS();
+}
+
+// Issue 12: a pose so far away that IK's error overflows (a skill library with weights of 1e300)
+// made convert() read an empty joint vector (segfault in the executor). Non-finite or overflowing
+// poses must be a clear error.
+TEST(CartesianToJoints, OverflowingOrNonFinitePoseIsAClearError) {
+  const lfd::KinematicChain chain = rightArm();
+  lfd::IkOptions options;
+  demo::CartesianToJoints converter(chain, Eigen::Isometry3d::Identity(), options);
+  const Eigen::VectorXd q0 = readyPosture(chain);
+  const demo::Pose start = converter.forward(q0);
+  for (double x : {1e300, std::numeric_limits<double>::infinity(),
+                   std::numeric_limits<double>::quiet_NaN()}) {
+    demo::Pose far = start;
+    far.position.x() = x;
+    const std::vector<demo::TimedPose> samples = {{0.0, start}, {0.1, far}};
+    try {
+      converter.convert(samples, q0);
+      ADD_FAILURE() << "no error for x = " << x;
+    } catch (const std::exception& e) {
+      const std::string what = e.what();
+      EXPECT_NE(what.find("t=0.1"), std::string::npos) << what;
+      EXPECT_NE(what.find("finite"), std::string::npos) << what;
+    }
+  }
 }

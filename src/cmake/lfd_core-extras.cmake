@@ -1,4 +1,4 @@
-# Every package that uses lfd_core must share its Eigen ABI: lfd_core is built with -march=native
-# (AVX) but pins Eigen's alignment to the SSE2 defaults, so fixed-size members and heap arrays
-# agree across the library boundary whatever flags the consumer compiles with.
-add_definitions(-DEIGEN_MAX_ALIGN_BYTES=16 -DEIGEN_MALLOC_ALREADY_ALIGNED=1)
+# Every package that uses lfd_core shares its Eigen ABI: no ISA flags, Eigen's alignment defaults.
+# Checked at the end of the package's CMakeLists (after its targets exist).
+include(${CMAKE_CURRENT_LIST_DIR}/lfd_eigen_abi.cmake)
+cmake_language(DEFER DIRECTORY ${CMAKE_CURRENT_SOURCE_DIR} CALL lfd_check_eigen_abi)

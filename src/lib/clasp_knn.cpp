@@ -155,56 +155,98 @@ inline double similarity(double qt, std::size_t i, std::size_t j, const PairTerm
   return 2.0 * qt - t.c[i] - t.c[j];
 }
 
-// Rows i = 0 .. m-1 of the upper triangle. `qt` holds row 0 on entry (diagonals >= d0).
+// One row's sweep, as raw pointers: this is the code compiled for AVX2 as well as the baseline,
+// so it holds no STL or Eigen (see DESIGN.md, Build-wide rules). Candidates that beat a row's
+// k-th best go back through `offer` (rare: most blocks have none).
+struct RowSweep {
+  const double* x = nullptr;  // centred series
+  std::size_t w = 0, m = 0, d0 = 0;
+  const double *A = nullptr, *B = nullptr, *C = nullptr, *F = nullptr;
+  double* q = nullptr;            // dot product per diagonal d, advanced row by row
+  const double* worst = nullptr;  // k-th best similarity of every row (updated by offer)
+  void (*offer)(void* top, std::size_t row, std::size_t candidate, double s) = nullptr;
+  void* top = nullptr;
+};
+
 template <bool kZNorm>
-void join_rows(const std::vector<double>& x, std::size_t w, std::size_t d0, const PairTerms& t,
-               std::vector<double>& qt, TopK& top) {
-  const std::size_t m = x.size() - w + 1;
-  const double* xa = x.data();
-  const double* A = t.a.data();
-  const double* B = t.b.data();
-  const double* C = t.c.data();
-  const double* F = t.f.data();
-  double* q = qt.data();
+inline __attribute__((always_inline)) void sweep_row(const RowSweep& r, std::size_t i) {
   constexpr std::size_t kBlock = 32;
   double block_sim[kBlock];
-  for (std::size_t i = 0; i + d0 < m; ++i) {
-    const std::size_t d_end = m - i;  // j = i + d < m
-    // Row i's dot products from row i-1's: drop x[i-1] x[i-1+d], add x[i+w-1] x[i+w-1+d]. Row 0
-    // is already exact; zero factors (and in-range pointers) keep the loop branch-free.
-    const double x_out = i > 0 ? xa[i - 1] : 0.0;
-    const double x_in = i > 0 ? xa[i + w - 1] : 0.0;
-    const double* out_row = i > 0 ? xa + i - 1 : xa;
-    const double* in_row = i > 0 ? xa + i + w - 1 : xa;
-    const double ai = A[i], bi = B[i], ci = C[i], fi = F[i];
-    const double* Aj = A + i;
-    const double* Bj = B + i;
-    const double* Cj = C + i;
-    const double* Fj = F + i;
-    const double* worst_j = top.worst() + i;
-    // One fused, vectorizable sweep per block: advance the dot products, form the similarities
-    // and test them against the k-th best of row i and of each row j. Candidates rarely beat
-    // those, so most blocks end there. worst_i only grows: testing a block against its value at
-    // the block start is conservative.
-    for (std::size_t d_block = d0; d_block < d_end; d_block += kBlock) {
-      const std::size_t len = std::min(kBlock, d_end - d_block);
-      const double worst_i = top.worst(i);
-      int hits = 0;
-      for (std::size_t l = 0; l < len; ++l) {
-        const std::size_t d = d_block + l;
-        const double qd = q[d] + x_in * in_row[d] - x_out * out_row[d];
-        q[d] = qd;
-        const double v = kZNorm ? qd * ai * Aj[d] - bi * Bj[d] + fi * Fj[d] : 2.0 * qd - ci - Cj[d];
-        block_sim[l] = v;
-        hits |= static_cast<int>(v >= worst_i) | static_cast<int>(v >= worst_j[d]);
-      }
-      if (!hits) continue;
-      for (std::size_t l = 0; l < len; ++l) {
-        const std::size_t d = d_block + l;
-        const double v = block_sim[l];
-        if (v >= top.worst(i)) top.offer(i, static_cast<std::int32_t>(i + d), v);
-        if (v >= worst_j[d]) top.offer(i + d, static_cast<std::int32_t>(i), v);
-      }
+  const std::size_t d_end = r.m - i;  // j = i + d < m
+  const double* xa = r.x;
+  // Row i's dot products from row i-1's: drop x[i-1] x[i-1+d], add x[i+w-1] x[i+w-1+d]. Row 0
+  // is already exact; zero factors (and in-range pointers) keep the loop branch-free.
+  const double x_out = i > 0 ? xa[i - 1] : 0.0;
+  const double x_in = i > 0 ? xa[i + r.w - 1] : 0.0;
+  const double* out_row = i > 0 ? xa + i - 1 : xa;
+  const double* in_row = i > 0 ? xa + i + r.w - 1 : xa;
+  const double ai = r.A[i], bi = r.B[i], ci = r.C[i], fi = r.F[i];
+  const double* Aj = r.A + i;
+  const double* Bj = r.B + i;
+  const double* Cj = r.C + i;
+  const double* Fj = r.F + i;
+  const double* worst_j = r.worst + i;
+  double* q = r.q;
+  // One fused, vectorizable sweep per block: advance the dot products, form the similarities
+  // and test them against the k-th best of row i and of each row j. Candidates rarely beat
+  // those, so most blocks end there. worst_i only grows: testing a block against its value at
+  // the block start is conservative.
+  for (std::size_t d_block = r.d0; d_block < d_end; d_block += kBlock) {
+    const std::size_t len = d_end - d_block < kBlock ? d_end - d_block : kBlock;
+    const double worst_i = r.worst[i];
+    int hits = 0;
+    for (std::size_t l = 0; l < len; ++l) {
+      const std::size_t d = d_block + l;
+      const double qd = q[d] + x_in * in_row[d] - x_out * out_row[d];
+      q[d] = qd;
+      const double v = kZNorm ? qd * ai * Aj[d] - bi * Bj[d] + fi * Fj[d] : 2.0 * qd - ci - Cj[d];
+      block_sim[l] = v;
+      hits |= static_cast<int>(v >= worst_i) | static_cast<int>(v >= worst_j[d]);
+    }
+    if (!hits) continue;
+    for (std::size_t l = 0; l < len; ++l) {
+      const std::size_t d = d_block + l;
+      const double v = block_sim[l];
+      if (v >= r.worst[i]) r.offer(r.top, i, i + d, v);
+      if (v >= worst_j[d]) r.offer(r.top, i + d, i, v);
+    }
+  }
+}
+
+// Chosen per CPU at load time. AVX2 without FMA: both versions give bit-identical similarities.
+__attribute__((target_clones("avx2", "default"))) void sweep_row_znorm(const RowSweep& r,
+                                                                        std::size_t i) {
+  sweep_row<true>(r, i);
+}
+__attribute__((target_clones("avx2", "default"))) void sweep_row_euclidean(const RowSweep& r,
+                                                                            std::size_t i) {
+  sweep_row<false>(r, i);
+}
+
+// Rows i = 0 .. m-1 of the upper triangle. `qt` holds row 0 on entry (diagonals >= d0).
+void join_rows(const std::vector<double>& x, std::size_t w, std::size_t d0, const PairTerms& t,
+               ClaspDistance distance, std::vector<double>& qt, TopK& top) {
+  RowSweep r;
+  r.x = x.data();
+  r.w = w;
+  r.m = x.size() - w + 1;
+  r.d0 = d0;
+  r.A = t.a.data();
+  r.B = t.b.data();
+  r.C = t.c.data();
+  r.F = t.f.data();
+  r.q = qt.data();
+  r.worst = top.worst();
+  r.top = &top;
+  r.offer = [](void* top_list, std::size_t row, std::size_t candidate, double s) {
+    static_cast<TopK*>(top_list)->offer(row, static_cast<std::int32_t>(candidate), s);
+  };
+  const bool znorm = distance != ClaspDistance::kEuclidean;
+  for (std::size_t i = 0; i + d0 < r.m; ++i) {
+    if (znorm) {
+      sweep_row_znorm(r, i);
+    } else {
+      sweep_row_euclidean(r, i);
     }
   }
 }
@@ -229,10 +271,7 @@ KnnResult self_join_knn(const Eigen::Ref<const Eigen::VectorXd>& series, std::si
     for (std::size_t l = 0; l < w; ++l) acc += x[l] * x[d + l];
     qt[d] = acc;
   }
-  if (distance == ClaspDistance::kEuclidean)
-    join_rows<false>(x, w, d0, t, qt, top);
-  else
-    join_rows<true>(x, w, d0, t, qt, top);
+  join_rows(x, w, d0, t, distance, qt, top);
   return top.finish(w, m, distance);
 }
 

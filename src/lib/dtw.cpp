@@ -10,9 +10,11 @@
 #include <string>
 #include <thread>
 
-#ifdef __AVX__
-#include <immintrin.h>
-#endif
+#include <immintrin.h>  // usable without -mavx: the AVX2 sweep enables the ISA per function
+
+// v8f values only pass between this file's internal inline functions: the GCC 4.6 note on the
+// ABI of 32-byte vector arguments without AVX concerns no interface.
+#pragma GCC diagnostic ignored "-Wpsabi"
 
 namespace lfd {
 
@@ -192,40 +194,64 @@ typedef int v8i __attribute__((vector_size(32)));
 static_assert(kDtwLanes == 8, "kernel is written for 8 float lanes");
 constexpr int kStripe = 4;
 
-inline v8f vmin(v8f a, v8f b) {
-#ifdef __AVX__
-  return (v8f)_mm256_min_ps((__m256)a, (__m256)b);
-#else
-  return a < b ? a : b;
-#endif
-}
-
-// Bit k set when a[k] < b[k].
-inline unsigned lane_mask_lt(v8f a, v8f b) {
-#ifdef __AVX__
-  return static_cast<unsigned>(_mm256_movemask_ps(_mm256_cmp_ps((__m256)a, (__m256)b, _CMP_LT_OQ)));
-#else
-  const v8i lt = a < b;
-  unsigned bits = 0;
-  for (int k = 0; k < 8; ++k) bits |= (lt[k] ? 1u : 0u) << k;
-  return bits;
-#endif
-}
-
 inline v8f splat(float x) {
   return v8f{x, x, x, x, x, x, x, x};
 }
 
-struct LanePair {
-  const DtwPairView* view = nullptr;  // null = unused lane
+// GCC caps a vector type's alignment at what the ISA loads aligned: alignof(v8f) is 16 in this
+// (baseline) file but 32 inside the AVX2 sweep, which then uses aligned 32-byte loads. Storage
+// shared with the sweep is therefore this explicitly 32-byte aligned wrapper.
+struct alignas(32) Lanes {
+  v8f v;
 };
+static_assert(sizeof(Lanes) == sizeof(v8f), "Lanes arrays are v8f arrays");
 
 // Reusable buffers of one worker thread.
 struct Workspace {
-  std::vector<v8f> a, b, prev;
+  std::vector<Lanes> a, b, prev;
   std::vector<std::uint8_t> steps;  // [row][col][0:up bits, 1:left bits]
   std::vector<std::uint8_t> end_column;
 };
+
+// What the row sweep reads and writes, as raw pointers: the ISA-specific code below touches no
+// STL or Eigen, so no inline function of theirs is ever emitted with AVX for the whole program.
+struct SweepArgs {
+  std::size_t padded_rows = 0, cols = 0;
+  const v8f* a = nullptr;
+  const v8f* b = nullptr;
+  v8f* prev = nullptr;
+  std::uint8_t* steps = nullptr;
+  const std::uint8_t* end_column = nullptr;
+  Lanes radius{};
+  long max_radius = 0;
+  const DtwPairView* const* lanes = nullptr;
+  int used = 0;
+  double* costs = nullptr;
+};
+
+// The sweep, compiled twice: for the baseline ISA (SSE2) and for AVX2, chosen at run time by
+// the CPU (no -march flag in the build). AVX2 only, no FMA: both give bit-identical costs.
+namespace baseline_isa {
+#include "dtw_sweep.inc"
+}  // namespace baseline_isa
+#pragma GCC push_options
+#pragma GCC target("avx2")
+#define LFD_DTW_AVX2 1  // the pragma does not define __AVX__: select the intrinsics explicitly
+namespace avx2_isa {
+#include "dtw_sweep.inc"
+}  // namespace avx2_isa
+#undef LFD_DTW_AVX2
+#pragma GCC pop_options
+
+template <bool kPaths, bool kBand>
+void sweep_rows(const SweepArgs& args) {
+  static const bool has_avx2 = __builtin_cpu_supports("avx2");
+  if (has_avx2) {
+    avx2_isa::sweep_rows<kPaths, kBand>(args);
+  } else {
+    baseline_isa::sweep_rows<kPaths, kBand>(args);
+  }
+}
 
 template <bool kPaths, bool kBand>
 void run_group(const DtwPairView* const* lanes, int used, int band, Workspace& ws, double* costs,
@@ -237,14 +263,14 @@ void run_group(const DtwPairView* const* lanes, int used, int band, Workspace& w
   }
   const std::size_t padded_rows = (rows + kStripe - 1) / kStripe * kStripe;
   // Interleave: a[i][k] = lane k's a[i]; padding stays 0 (never reaches a lane's end cell).
-  ws.a.assign(padded_rows, splat(0.f));
-  ws.b.assign(cols, splat(0.f));
-  ws.prev.assign(cols, splat(INFINITY));
+  ws.a.assign(padded_rows, Lanes{splat(0.f)});
+  ws.b.assign(cols, Lanes{splat(0.f)});
+  ws.prev.assign(cols, Lanes{splat(INFINITY)});
   ws.end_column.assign(cols, 0);
   for (int k = 0; k < used; ++k) {
     const DtwPairView& p = *lanes[k];
-    for (std::size_t i = 0; i < p.n; ++i) ws.a[i][k] = static_cast<float>(p.a[i]);
-    for (std::size_t j = 0; j < p.m; ++j) ws.b[j][k] = static_cast<float>(p.b[j]);
+    for (std::size_t i = 0; i < p.n; ++i) ws.a[i].v[k] = static_cast<float>(p.a[i]);
+    for (std::size_t j = 0; j < p.m; ++j) ws.b[j].v[k] = static_cast<float>(p.b[j]);
     ws.end_column[p.m - 1] = 1;
   }
   if (kPaths) {
@@ -255,81 +281,28 @@ void run_group(const DtwPairView* const* lanes, int used, int band, Workspace& w
     }
     ws.steps.resize(bytes);
   }
-  v8f radius = splat(0.f);
-  long max_radius = long(rows + cols);  // no band: every column
+  SweepArgs args;
+  args.max_radius = long(rows + cols);  // no band: every column
   if (kBand) {
-    max_radius = 0;
+    args.max_radius = 0;
     for (int k = 0; k < used; ++k) {
       const long n = long(lanes[k]->n), m = long(lanes[k]->m);
       const long r = std::max<long>(band, std::labs(n - m));
-      radius[k] = static_cast<float>(r);
-      max_radius = std::max(max_radius, r);
+      args.radius.v[k] = static_cast<float>(r);
+      args.max_radius = std::max(args.max_radius, r);
     }
   }
-  const v8f inf = splat(INFINITY);
-  v8f* const prev = ws.prev.data();
-  const v8f* const bvec = ws.b.data();
-
-  for (std::size_t i0 = 0; i0 < padded_rows; i0 += kStripe) {
-    const v8f a0 = ws.a[i0], a1 = ws.a[i0 + 1], a2 = ws.a[i0 + 2], a3 = ws.a[i0 + 3];
-    // Columns that lie in some lane's band for one of the stripe's rows. Outside them every
-    // lane's cell is infinite; `prev` already holds row i0-1 there (or infinity, never written).
-    const std::size_t j_begin = std::size_t(std::max<long>(0, long(i0) - max_radius));
-    const std::size_t j_end =
-        std::size_t(std::min<long>(long(cols), long(i0) + kStripe + max_radius));
-    v8f left0 = inf, left1 = inf, left2 = inf, left3 = inf;                      // D[i][j-1]
-    v8f diag0 = j_begin > 0 ? prev[j_begin - 1] : (i0 == 0 ? splat(0.f) : inf);  // D[i0-1][j-1]
-    v8f lo0{}, lo1{}, lo2{}, lo3{}, hi0{}, hi1{}, hi2{}, hi3{};
-    if (kBand) {
-      lo0 = splat(float(i0)) - radius, hi0 = splat(float(i0)) + radius;
-      lo1 = lo0 + 1.f, hi1 = hi0 + 1.f, lo2 = lo0 + 2.f, hi2 = hi0 + 2.f;
-      lo3 = lo0 + 3.f, hi3 = hi0 + 3.f;
-    }
-    std::uint8_t* s0 = kPaths ? ws.steps.data() + (i0 * cols) * 2 : nullptr;
-    std::uint8_t* s1 = s0 + (kPaths ? cols * 2 : 0);
-    std::uint8_t* s2 = s1 + (kPaths ? cols * 2 : 0);
-    std::uint8_t* s3 = s2 + (kPaths ? cols * 2 : 0);
-
-    for (std::size_t j = j_begin; j < j_end; ++j) {
-      const v8f b = bvec[j];
-      const v8f up0 = prev[j];
-      v8f jf{};
-      if (kBand) jf = splat(float(j));
-        // One cell of row r: out = c + min(diag, up, left), with the step bits for backtracking.
-#define LFD_DTW_CELL(r, a_r, up, diag, left, out)                                \
-  do {                                                                           \
-    const v8f d = a_r - b;                                                       \
-    const v8f vertical = vmin(diag, up);                                         \
-    out = d * d + vmin(vertical, left);                                          \
-    if (kBand) {                                                                 \
-      const v8i ok = (jf >= lo##r) & (jf <= hi##r);                              \
-      out = ok ? out : inf;                                                      \
-    }                                                                            \
-    if (kPaths) {                                                                \
-      s##r[2 * j] = static_cast<std::uint8_t>(lane_mask_lt(up, diag));           \
-      s##r[2 * j + 1] = static_cast<std::uint8_t>(lane_mask_lt(left, vertical)); \
-    }                                                                            \
-  } while (0)
-      v8f out0, out1, out2, out3;
-      LFD_DTW_CELL(0, a0, up0, diag0, left0, out0);
-      LFD_DTW_CELL(1, a1, out0, left0, left1, out1);
-      LFD_DTW_CELL(2, a2, out1, left1, left2, out2);
-      LFD_DTW_CELL(3, a3, out2, left2, left3, out3);
-#undef LFD_DTW_CELL
-      diag0 = up0;
-      left0 = out0, left1 = out1, left2 = out2, left3 = out3;
-      prev[j] = out3;
-      if (ws.end_column[j]) {
-        const v8f stripe[kStripe] = {out0, out1, out2, out3};
-        for (int k = 0; k < used; ++k) {
-          const std::size_t end_row = lanes[k]->n - 1;
-          if (lanes[k]->m - 1 == j && end_row >= i0 && end_row < i0 + kStripe) {
-            costs[k] = stripe[end_row - i0][k];
-          }
-        }
-      }
-    }
-  }
+  args.padded_rows = padded_rows;
+  args.cols = cols;
+  args.a = &ws.a.data()->v;
+  args.b = &ws.b.data()->v;
+  args.prev = &ws.prev.data()->v;
+  args.steps = kPaths ? ws.steps.data() : nullptr;
+  args.end_column = ws.end_column.data();
+  args.lanes = lanes;
+  args.used = used;
+  args.costs = costs;
+  sweep_rows<kPaths, kBand>(args);
 
   if (kPaths) {
     for (int k = 0; k < used; ++k) {

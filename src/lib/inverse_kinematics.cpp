@@ -96,6 +96,9 @@ bool InverseKinematics::solve(const Eigen::Isometry3d& target,
     throw std::invalid_argument("InverseKinematics: seed has " + std::to_string(seed.size()) +
                                 " values, chain has " + std::to_string(n) + " joints");
   if (!seed.allFinite()) throw std::invalid_argument("InverseKinematics: seed is not finite");
+  if (!target.matrix().allFinite())
+    throw std::invalid_argument("InverseKinematics: target pose is not finite");
+  result.failure.clear();
   const Vector6d& w = options_.weights;
   const Vector6d sqrt_w = w.cwiseSqrt();
   const Vector6d mask = (w.array() > 0).cast<double>();
@@ -215,10 +218,20 @@ IkResult InverseKinematics::reach(const Eigen::Isometry3d& target,
     solve(target, start, trial);
     const double cost = trial.position_error + 0.1 * trial.orientation_error;
     if (trial.converged) return trial;
-    if (cost < best_cost) {
+    if (cost < best_cost) {  // false for a NaN or infinite cost
       best_cost = cost;
       best = trial;
     }
+  }
+  if (!std::isfinite(best_cost)) {
+    // Every attempt's pose error overflowed (e.g. a target 1e300 m away): there is no best
+    // effort to return, and a zero error would read as success.
+    best.q = seed;
+    chain_.clampToLimits(best.q);
+    best.converged = false;
+    best.position_error = best.orientation_error = std::numeric_limits<double>::infinity();
+    best.failure = "the pose error is not finite for any seed (target position " +
+                   std::to_string(target.translation().norm()) + " m from the chain base)";
   }
   return best;
 }

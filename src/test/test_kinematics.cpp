@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <random>
 #include <stdexcept>
 #include <string>
@@ -255,3 +256,35 @@ TEST(InverseKinematics, PreferredPostureShapesTheRedundancy) {
 }
 
 }  // namespace
+
+// Issue 12: a finite target so far away that every attempt's pose error overflows returned an
+// empty q with error 0 (read as success; the executor then indexed the empty vector).
+TEST(InverseKinematics, OverflowingTargetIsAClearFailureNeverAnEmptyResult) {
+  const auto chain = taskChain();
+  lfd::InverseKinematics ik(chain);
+  Eigen::Isometry3d huge = Eigen::Isometry3d::Identity();
+  huge.translation() << 1e300, -1e300, 1e300;
+  const lfd::IkResult r = ik.reach(huge, chain.midRange());
+  EXPECT_FALSE(r.converged);
+  ASSERT_EQ(r.q.size(), chain.dof());
+  EXPECT_TRUE(chain.withinLimits(r.q));
+  EXPECT_FALSE(std::isfinite(r.position_error));
+  EXPECT_NE(r.failure.find("not finite"), std::string::npos) << r.failure;
+  // A reachable target afterwards: no failure left over from the previous query.
+  Eigen::Isometry3d near = chain.forward(chain.midRange());
+  const lfd::IkResult ok = ik.reach(near, chain.midRange());
+  EXPECT_TRUE(ok.converged);
+  EXPECT_TRUE(ok.failure.empty());
+}
+
+TEST(InverseKinematics, NonFiniteTargetIsRefused) {
+  const auto chain = taskChain();
+  lfd::InverseKinematics ik(chain);
+  for (double bad : {std::numeric_limits<double>::quiet_NaN(),
+                     std::numeric_limits<double>::infinity()}) {
+    Eigen::Isometry3d target = chain.forward(chain.midRange());
+    target.translation().x() = bad;
+    EXPECT_THROW(ik.reach(target, chain.midRange()), std::invalid_argument);
+    EXPECT_THROW(ik.solve(target, chain.midRange()), std::invalid_argument);
+  }
+}

@@ -14,6 +14,7 @@
 #include <Eigen/Core>
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
+#include <string>
 
 #include "lfd_core/kinematic_chain.hpp"
 
@@ -45,6 +46,9 @@ struct IkResult {
   int iterations = 0;
   double position_error = 0.0;     // m, weighted axes only
   double orientation_error = 0.0;  // rad, weighted axes only
+  // Why no usable answer exists (empty when q is the best effort): e.g. a target so far away
+  // that its pose error overflows. Errors are then infinite and q is the clamped seed.
+  std::string failure;
 };
 
 class InverseKinematics {
@@ -66,6 +70,8 @@ class InverseKinematics {
 
   // Reachability query: tries the seed, the preferred posture and options().restarts further
   // deterministic seeds; returns the first converged result (or the best one, converged = false).
+  // Never returns an empty q: when no attempt has a finite error, `failure` says why. Throws
+  // std::invalid_argument for a non-finite target or seed.
   IkResult reach(const Eigen::Isometry3d& target, const Eigen::Ref<const Eigen::VectorXd>& seed);
 
   // Weighted pose error (target relative to current) as a 6-vector (position, rotation vector).
