@@ -401,7 +401,8 @@ def main():
             try:
                 r = evaluate(segment, method, tol)
             except (RuntimeError, rospy.ServiceException, rosbag.ROSBagException, OSError, ValueError) as exc:
-                print("%-14s %-18s error: %s" % (name, method, exc))
+                # stderr: the pipeline quotes a failed tool's last stderr lines in its report
+                print("%-14s %-18s error: %s" % (name, method, exc), file=sys.stderr)
                 results[name][method] = {"error": str(exc)}
                 failures += 1
                 continue

@@ -192,6 +192,8 @@ def python_needs(path, needs, own_modules):
 def shell_commands(text):
     """Command lines (lists of words) of a shell script, roughly as bash sees them."""
     text = text.replace("\\\n", " ")
+    text = re.sub(r"\b\w+=\([^)]*\)", "", text)  # array assignments: words, not commands
+    text = re.sub(r"\bcommand -[vV] \S+", "true", text)  # a probe for an optional program
     functions = set(re.findall(r"^\s*([\w-]+)\s*\(\)", text, re.M))
     for line in text.splitlines():
         lex = shlex.shlex(line, posix=True, punctuation_chars=True)
