@@ -10,6 +10,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
+#include "../../src/test/ros_serialized_bytes.hpp"
 #include "lfd_segmentation/bag_features.hpp"
 
 namespace {
@@ -50,24 +51,6 @@ uint32 seq
 time stamp
 string frame_id
 )";
-
-struct Bytes {
-  std::vector<std::uint8_t> data;
-  template <typename T>
-  Bytes& put(T v) {
-    const auto* p = reinterpret_cast<const std::uint8_t*>(&v);
-    data.insert(data.end(), p, p + sizeof(T));
-    return *this;
-  }
-  Bytes& str(const std::string& s) {
-    put<std::uint32_t>(static_cast<std::uint32_t>(s.size()));
-    data.insert(data.end(), s.begin(), s.end());
-    return *this;
-  }
-  Bytes& header(std::uint32_t sec, std::uint32_t nsec) {
-    return put<std::uint32_t>(0).put(sec).put(nsec).str("base");
-  }
-};
 
 void write_raw(rosbag::Bag& bag, const std::string& topic, const std::string& type,
                const std::string& definition, double t, Bytes bytes) {

@@ -6,6 +6,7 @@
 
 #include "lfd_core/ros_message_reader.hpp"
 #include "lfd_core/ros_message_schema.hpp"
+#include "ros_serialized_bytes.hpp"
 
 namespace {
 
@@ -14,22 +15,6 @@ using lfd::rosmsg::Kind;
 using lfd::rosmsg::MessageError;
 using lfd::rosmsg::MessageSchema;
 using lfd::rosmsg::UnknownField;
-
-// Serializes like ROS 1: little-endian, uint32 lengths before strings and variable arrays.
-struct Bytes {
-  std::vector<std::uint8_t> data;
-  template <typename T>
-  Bytes& put(T v) {
-    const auto* p = reinterpret_cast<const std::uint8_t*>(&v);
-    data.insert(data.end(), p, p + sizeof(T));
-    return *this;
-  }
-  Bytes& str(const std::string& s) {
-    put<std::uint32_t>(static_cast<std::uint32_t>(s.size()));
-    data.insert(data.end(), s.begin(), s.end());
-    return *this;
-  }
-};
 
 // A made-up type that uses every construct: comments, constants (a string constant keeps its
 // '#'), Header, builtins and aliases, fixed and variable arrays, strings, time and duration,
