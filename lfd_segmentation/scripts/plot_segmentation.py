@@ -547,7 +547,8 @@ def plot_segmentation(bag, seg, d, out, prefix, written, ground_truth, tag=""):
 
 
 def report_rates(report):
-    """{dataset: {method: rate or None}} from a pipeline report.json or evaluate_segmentation.py output."""
+    """{dataset: {method: rate or None}} from a pipeline report.json or evaluate_segmentation.py output
+    (the same segmentation records, lfd_tools.report)."""
     if isinstance(report, dict) and isinstance(report.get("segmentation"), dict):
         rates, tol = {}, None
         for name, entry in report["segmentation"].items():
@@ -555,10 +556,6 @@ def report_rates(report):
             rates[name] = dict(methods)
             tol = entry.get("tolerance_s", tol)
         return rates, tol
-    if isinstance(report, dict) and isinstance(report.get("results"), dict):
-        rates = {name: {m: r.get("success_rate") for m, r in methods.items()}
-                 for name, methods in report["results"].items()}
-        return rates, report.get("tolerance_s")
     raise UserError("the report has no 'segmentation' section (run the pipeline's segment stage)")
 
 

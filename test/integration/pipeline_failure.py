@@ -5,7 +5,6 @@ import os
 import shutil
 import signal
 import subprocess
-import sys
 import tempfile
 import time
 import unittest
@@ -13,6 +12,7 @@ import uuid
 
 import rospkg
 import rostest
+from lfd_tools import processes
 
 PIPELINE = os.path.join(rospkg.RosPack().get_path("lfd_launch"), "scripts", "pipeline.py")
 TIMEOUT = 120  # s for the pipeline to fail and clean up
@@ -109,21 +109,19 @@ class ClientFailsOnData(FailingStage, unittest.TestCase):
 
 
 class StageCleanup(unittest.TestCase):
-    """pipeline.kill_tagged ends what a stage started even when it left its parent's session and
+    """kill_tagged (lfd_tools.processes, the pipeline's stage cleanup) ends what a stage started even when it left its parent's session and
     outlived it (as roslaunch's nodes do when roslaunch is killed): a process group is not enough."""
 
     def test_orphan_in_its_own_session_is_killed(self):
-        sys.path.insert(0, os.path.dirname(PIPELINE))
-        import pipeline  # noqa: E402
         tag = "%d:cleanup_test" % os.getpid()
-        env = dict(os.environ, **{pipeline.TAG_VAR: tag})
+        env = dict(os.environ, **{processes.TAG_VAR: tag})
         # a child that starts a grandchild in a new session, then exits: the grandchild is orphaned
         subprocess.run(["/usr/bin/python3", "-c", "import subprocess; subprocess.Popen(['sleep', '300'],"
                         " start_new_session=True)"], env=env, check=True)
         time.sleep(0.5)
-        self.assertEqual(len(pipeline.tagged_processes(tag)), 1)
-        self.assertEqual(pipeline.kill_tagged(tag), ["sleep"])
-        self.assertEqual(pipeline.tagged_processes(tag), [])
+        self.assertEqual(len(processes.tagged_processes(tag)), 1)
+        self.assertEqual(processes.kill_tagged(tag), ["sleep"])
+        self.assertEqual(processes.tagged_processes(tag), [])
 
 
 def all_tests():

@@ -266,6 +266,9 @@ def collect_needs():
     needs = {"python_modules": {}, "programs": {}, "ros_packages": {}}
     own = ros_package_names()
     own_modules = own | {os.path.basename(f)[:-3] for f in project_files() if f.endswith(".py")}
+    # the project's Python packages (lfd_tools): folders with an __init__.py
+    own_modules |= {os.path.basename(os.path.dirname(f)) for f in project_files()
+                    if os.path.basename(f) == "__init__.py"}
     for f in sorted(project_files()):
         name = os.path.basename(f)
         if f.endswith(".py"):
