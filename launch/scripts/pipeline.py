@@ -6,13 +6,14 @@ its own (so one stage's /use_sim_time never leaks into the next):
   datasets   generate the demonstration datasets (resumes: existing bags are kept)
   segment    segment every dataset through the segmentation service, for all four combination
              methods, and score it against the demonstrator's ground truth
-  learn      launch/learn.launch: per dataset, segment its bags (/segmentation/segment, the paper's
-             method of config/segmentation.yaml; never the ground truth) and learn the skill
-             library from the validated changepoints (/learner/learn) -> DIR/skills/<task>_<mode>.json
-  reproduce  launch/reproduce.launch: per learned library, reproduce every unseen goal of
-             config/tasks.yaml (`unseen.<mode>`) in MuJoCo through /executor/execute and judge the
-             object's final pose with config/evaluation.yaml `reproduction`
-             (lfd_dmp/scripts/evaluate_reproduction.py) -> DIR/reproduction/<task>_<mode>.json
+  learn      launch/learn.launch + lfd_dmp/scripts/learn_skills.py: per dataset, segment its bags
+             (/segmentation/segment, the paper's method of config/segmentation.yaml; never the
+             ground truth) and learn the skill library from the validated changepoints
+             (/learner/learn) -> DIR/skills/<task>_<mode>.json
+  reproduce  launch/reproduce.launch + lfd_dmp/scripts/reproduce_goals.py: per learned library,
+             reproduce every unseen goal of config/tasks.yaml (`unseen.<mode>`) in MuJoCo through
+             /executor/execute and judge the object's final pose with config/evaluation.yaml
+             `reproduction` (lfd_tools.judge) -> DIR/reproduction/<task>_<mode>.json
   figures    no master: the paper's figures per dataset (skill map, correlation matrix, relevance
              histograms, ClaSP profile with the Kaiser filter, segmentation with its zones; from
              the first demonstration), the success-rate bars per method and dataset, and MuJoCo
@@ -20,17 +21,18 @@ its own (so one stage's /use_sim_time never leaks into the next):
              first reproduction of each task (recorded by the reproduce stage) at the end of each
              segment -> DIR/figures
 
-Writes DIR/report.json and DIR/report.md, and prints the time of each stage. Stable report.json keys:
+Writes DIR/report.json and DIR/report.md, and prints the time of each stage. report.json holds the
+records of lfd_tools.report as the tools wrote them (their fields are documented there):
   datasets.<dataset>.demos
-  segmentation.<dataset>.success_rate, segmentation.<dataset>.methods.<method>
-  learning.<dataset>.segments            segments in the learned library (expected_segments beside)
-  learning.<dataset>.changepoint_counts  validated changepoints per demo, warnings, error (if any)
-  reproduction.<task>.success_rate       sim library on the sim unseen goals (successes / goals)
-  reproduction.<task>.execution_time_ratio  mean executed time / mean demonstration duration
-  reproduction.<task>.goals              per goal: id, success, object_position_error_m,
-                                         object_yaw_error_rad, tcp_position_error_m,
-                                         tcp_orientation_error_rad, time_ratio, error
-  reproduction_teleop.<task>.*           the same for the teleop library on the teleop goals
+  segmentation.<dataset>                 success_rate (paper's method), methods.<method> (rate),
+                                         results.<method> (every figure, per-demo details)
+  learning.<dataset>                     segments (expected_segments beside), changepoint_counts,
+                                         warnings, error (if any)
+  reproduction.<task>                    sim library on the sim unseen goals: success_rate,
+                                         execution_time_ratio, goals[] (id, success,
+                                         object_position_error_m, object_yaw_error_rad,
+                                         tcp_position_error_m, time_ratio, error, ...)
+  reproduction_teleop.<task>             the same for the teleop library on the teleop goals
                                          (with --reproduce-modes sim,teleop; default sim only)
   figures.<dataset|success_rates>        PNG paths relative to DIR
   timings.<stage>_s                      wall time of the stage's last run (datasets_s, segment_s,

@@ -20,7 +20,6 @@ after an error or Ctrl-C with what was done. A task whose learning fails is repo
 the other tasks still run. Exit status 0 only if every task was learned.
 """
 import argparse
-import json
 import os
 import sys
 
@@ -81,8 +80,8 @@ def main():
     services = {"/learner/learn": LearnSkills}
     if args.changepoints == "segmentation":
         services["/segmentation/segment"] = Segment
-    results, status = {"learning": {}, "changepoint_source": args.changepoints, "complete": False}, 0
-    try:
+    results, status = {"learning": {}, "changepoint_source": args.changepoints}, 0
+    with report.written_on_exit(out, results):
         with master.graph_for_this_process(["lfd_launch", "learn.launch", "output:=log"]):
             proxies = master.service_proxies("learn_skills", services)
             for task in [t for t in args.tasks.split(",") if t]:
@@ -103,17 +102,8 @@ def main():
                 print("%-5s learn: %d segment(s) x %d demo(s), changepoints per demo %s -> %s"
                       % (task, record["segments"], record["demos_used"], record["changepoint_counts"],
                          library), flush=True)
-        results["complete"] = True
-    finally:
-        with open(out, "w") as f:
-            json.dump(results, f, indent=1)
-        print("JSON: %s" % out)
     return status
 
 
 if __name__ == "__main__":
-    try:
-        sys.exit(main())
-    except KeyboardInterrupt:
-        print("interrupted: the libraries learned so far are written", file=sys.stderr)
-        sys.exit(130)
+    sys.exit(report.run_client(main))

@@ -20,7 +20,6 @@ import argparse
 import json
 import math
 import os
-import signal
 import subprocess
 import sys
 import time
@@ -174,8 +173,8 @@ def main():
     tasks_cfg, evaluation = lfd_config.load_tasks(), lfd_config.load_evaluation()
     wanted = {int(g) for g in args.goals.split(",") if g}
     key = report.reproduction_key(args.mode)
-    results, status = {key: {}, "complete": False}, 0
-    try:
+    results, status = {key: {}}, 0
+    with report.written_on_exit(out, results):
         with master.graph_for_this_process(["lfd_launch", "reproduce.launch", "library_dir:=" + lib_dir]):
             cell = Cell(tasks_cfg, evaluation)
             for task in [t for t in args.tasks.split(",") if t]:
@@ -190,18 +189,8 @@ def main():
                 reproduce_task(cell, task, args.mode, library, goals, args, record)
                 if not goals or record["successes"] < len(goals):
                     status = 1
-        results["complete"] = True
-    finally:
-        with open(out, "w") as f:
-            json.dump(results, f, indent=1)
-        print("JSON: %s" % out)
     return status
 
 
 if __name__ == "__main__":
-    signal.signal(signal.SIGTERM, lambda *_: signal.default_int_handler(signal.SIGINT, None))
-    try:
-        sys.exit(main())
-    except KeyboardInterrupt:
-        print("interrupted: the results so far are written (\"complete\": false)", file=sys.stderr)
-        sys.exit(130)
+    sys.exit(report.run_client(main))

@@ -34,23 +34,13 @@ import subprocess
 import sys
 
 import numpy as np
+from lfd_tools import figures
 
 plt = None  # matplotlib.pyplot, imported with the first figure: bad input fails fast without it
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 DEFAULT_CONFIG = os.path.join(HERE, "..", "..", "config", "segmentation.yaml")
 GROUND_TRUTH_TOPIC = "/lfd/phase"
-DPI = 100
-# Figure sizes in inches (x DPI = the PNG's pixels); the rostest checks them.
-SIZES = {
-    "skill_map": (12, 7),
-    "correlation_best": (7, 6),
-    "correlation_all": (12, 10),
-    "relevance": (13, 6),
-    "clasp_profile": (12, 7),
-    "segmentation": (12, 8),
-    "success_rates": (10, 5.5),
-}
 PAPER_RATE = {"sim": 0.8, "teleop": 0.5}  # Fig. 9: ~80 % in simulation, ~50 % on the real robot
 METHOD_ORDER = ["average", "product", "weighted_average", "weighted_product"]
 PHASE_COLOURS = ["#f2e2c4", "#c9dcf0", "#d5ecd0", "#ead3ea", "#f6d6d0", "#e0e0e0"]
@@ -247,12 +237,12 @@ def new_figure(kind, **kw):
         matplotlib.use("Agg")
         import matplotlib.pyplot
         plt = matplotlib.pyplot
-    return plt.figure(figsize=SIZES[kind], dpi=DPI, **kw)
+    return plt.figure(figsize=figures.SIZES[kind], dpi=figures.DPI, **kw)
 
 
 def save(fig, out, prefix, kind, written, tag=""):
     path = os.path.join(out, "%s%s%s.png" % (prefix, kind, tag))
-    fig.savefig(path, dpi=DPI)
+    fig.savefig(path, dpi=figures.DPI)
     plt.close(fig)
     written.append(path)
     print(path)

@@ -1,5 +1,6 @@
 #!/usr/bin/python3
 """rostest (pipeline_failure.test): a failing stage is reported and leaves nothing running."""
+import contextlib
 import json
 import os
 import shutil
@@ -21,17 +22,10 @@ TIMEOUT = 120  # s for the pipeline to fail and clean up
 def processes_with(marker):
     """(pid, command) of every process whose environment holds `marker`."""
     found = []
-    for entry in os.listdir("/proc"):
-        if not entry.isdigit():
-            continue
-        try:
-            with open("/proc/%s/environ" % entry, "rb") as f:
-                if marker.encode() not in f.read():
-                    continue
-            with open("/proc/%s/cmdline" % entry, "rb") as f:
-                found.append((int(entry), f.read().replace(b"\0", b" ").decode(errors="replace")))
-        except OSError:
-            continue
+    for pid in processes.processes_with(marker.encode()):
+        with contextlib.suppress(OSError):
+            with open("/proc/%d/cmdline" % pid, "rb") as f:
+                found.append((pid, f.read().replace(b"\0", b" ").decode(errors="replace")))
     return found
 
 

@@ -20,21 +20,16 @@ import yaml
 from catkin.find_in_workspaces import find_in_workspaces
 from geometry_msgs.msg import PoseStamped, TwistStamped
 from lfd_msgs.msg import Phase, Touch
+from lfd_tools import figures
 from lfd_tools import report as report_records
 from matplotlib import image as mpimg
 from sensor_msgs.msg import JointState
 
 RATE_HZ = 100.0  # recording rate of the synthetic topics
 # (width, height) in pixels of each figure; a layout that crops or resizes the canvas fails here.
-SEGMENT_FIGURES = {
-    "skill_map": (1200, 700),
-    "correlation_best": (700, 600),
-    "correlation_all": (1200, 1000),
-    "relevance": (1300, 600),
-    "clasp_profile": (1200, 700),
-    "segmentation": (1200, 800),
-}
-REPORT_FIGURES = {"success_rates": (1000, 550)}
+SEGMENT_FIGURES = {kind: figures.size_px(kind) for kind in (
+    "skill_map", "correlation_best", "correlation_all", "relevance", "clasp_profile", "segmentation")}
+REPORT_FIGURES = {"success_rates": figures.size_px("success_rates")}
 
 
 def smoothstep(t, t0, duration):

@@ -11,7 +11,11 @@ holds them unchanged:
     reproduction_teleop.<task>    goals[] goal_records; teleop libraries on the teleop goals
 Lengths in metres, angles in radians, times in seconds (the key says which).
 """
+import contextlib
+import json
 import math
+import signal
+import sys
 
 PAPER_METHOD = "weighted_product"
 
@@ -84,3 +88,28 @@ def reproduction_record(library, library_summary, goals, error=None):
 def reproduction_key(mode):
     """report.json's section of a mode's reproductions."""
     return "reproduction" if mode == "sim" else "reproduction_%s" % mode
+
+
+@contextlib.contextmanager
+def written_on_exit(path, results):
+    """Yields `results` (a dict the block fills in) and writes it as JSON to `path` however the
+    block ends (an error, Ctrl-C): "complete" is true only when it ended normally."""
+    results["complete"] = False
+    try:
+        yield results
+        results["complete"] = True
+    finally:
+        with open(path, "w") as f:
+            json.dump(results, f, indent=1)
+        print("JSON: %s" % path, flush=True)
+
+
+def run_client(main):
+    """Runs a client's main(): its exit status; 130 after Ctrl-C or SIGTERM (what was done is
+    written by written_on_exit)."""
+    signal.signal(signal.SIGTERM, lambda *_: signal.default_int_handler(signal.SIGINT, None))
+    try:
+        return main()
+    except KeyboardInterrupt:
+        print("interrupted: the results so far are written (\"complete\": false)", file=sys.stderr)
+        return 130
