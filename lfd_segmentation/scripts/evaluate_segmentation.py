@@ -179,6 +179,8 @@ def main():
                 r = evaluate(segment, method, tol)
             except (RuntimeError, rospy.ServiceException, rosbag.ROSBagException, OSError, ValueError) as exc:
                 print("%-14s %-18s error: %s" % (name, method, exc))
+                # also where a caller (the pipeline) looks for a tool's last words
+                print("error: %s %s: %s" % (name, method, exc), file=sys.stderr)
                 results[name][method] = {"error": str(exc)}
                 failures += 1
                 continue

@@ -27,6 +27,7 @@ earliest end, `rate` Hz, linear or zero-order hold). Time axes are seconds from 
 sample. Prints the path of each PNG written; exits 2 with a message on bad input.
 """
 import argparse
+import contextlib
 import json
 import math
 import os
@@ -34,13 +35,14 @@ import subprocess
 import sys
 
 import numpy as np
+from lfd_tools import bags as lfd_bags
 from lfd_tools import figures
 
 plt = None  # matplotlib.pyplot, imported with the first figure: bad input fails fast without it
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 DEFAULT_CONFIG = os.path.join(HERE, "..", "..", "config", "segmentation.yaml")
-GROUND_TRUTH_TOPIC = "/lfd/phase"
+GROUND_TRUTH_TOPIC = lfd_bags.PHASE_TOPIC
 PAPER_RATE = {"sim": 0.8, "teleop": 0.5}  # Fig. 9: ~80 % in simulation, ~50 % on the real robot
 METHOD_ORDER = ["average", "product", "weighted_average", "weighted_product"]
 PHASE_COLOURS = ["#f2e2c4", "#c9dcf0", "#d5ecd0", "#ead3ea", "#f6d6d0", "#e0e0e0"]
@@ -199,10 +201,9 @@ def read_bag(path, config, with_ground_truth):
                     v = np.array([x for _, x in samples])
                     order = np.argsort(t, kind="stable")
                     streams.append((name, role, zoh, t[order], v[order]))
-            if with_ground_truth:
-                for _, m, t in bag.read_messages(topics=[GROUND_TRUTH_TOPIC]):
-                    if not phases or phases[-1][0] != m.name:
-                        phases.append((m.name, stamp_of(m, t)))
+        if with_ground_truth:
+            with contextlib.suppress(RuntimeError):  # no /lfd/phase: no background
+                phases = lfd_bags.phase_transitions(path)[1]
     except UserError:
         raise
     except Exception as e:  # rosbag raises several exception types for corrupt bags
