@@ -201,8 +201,13 @@ def shell_commands(text):
             tokens = list(lex)
         except ValueError:  # an unbalanced quote on a line of a multi-line string
             continue
-        words, at_start, skip = [], True, False
+        words, at_start, skip, in_array = [], True, False, False
         for i, tok in enumerate(tokens):
+            if in_array or (tok in ("(", "()") and i > 0 and tokens[i - 1].endswith("=")):
+                in_array = (in_array or tok == "(") and tok != ")"  # `a=(x y)`: words, no command
+                continue
+            if at_start and tok == "command" and i + 1 < len(tokens) and tokens[i + 1] in ("-v", "-V"):
+                at_start, words = False, None  # `command -v X` looks X up, it does not run it
             if all(c in "();<>|&" for c in tok):
                 if set(tok) <= set("<>&") and ("<" in tok or ">" in tok):
                     skip = True  # a redirection: its target is no command
