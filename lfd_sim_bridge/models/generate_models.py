@@ -16,7 +16,6 @@ gripper centre plane: 0 = closed, 0.045 = fully open (gap = 2 * R_GRIPPER).
 Run: /usr/bin/python3 lfd_sim_bridge/models/generate_models.py
 """
 
-import math
 import os
 
 HERE = os.path.dirname(os.path.abspath(__file__))
