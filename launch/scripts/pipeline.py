@@ -220,7 +220,7 @@ def stage_learn(out, args, report):
                 result = os.path.join(skills, "learning_%s.json" % mode)
                 with contextlib.suppress(FileNotFoundError):
                     os.remove(result)
-                rc, tail = run(["/usr/bin/python3", LEARN_SKILLS, "--dataset", data, "--mode", mode,
+                rc, tail = run(["/usr/bin/python3", LEARN_SKILLS, "--attach", "--dataset", data, "--mode", mode,
                                 "--tasks", ",".join(tasks), "--library-dir", skills, "--out", result], env)
                 res = load_json(result)
                 if res is None:
@@ -290,7 +290,7 @@ def reproduce_one(results, skills, mode, task, ids, report, env):
     say("reproduce %s_%s: %d unseen goals %s" % (mode, task, len(ids), ids))
     section = report[records.reproduction_key(mode)]
     try:
-        rc, tail = run(["/usr/bin/python3", REPRODUCE_GOALS, "--library-dir", skills, "--mode", mode,
+        rc, tail = run(["/usr/bin/python3", REPRODUCE_GOALS, "--attach", "--library-dir", skills, "--mode", mode,
                         "--tasks", task, "--goals", ",".join(map(str, ids)), "--record-dir", results,
                         "--out", path], env)
     except KeyboardInterrupt:  # report the goals done; a rerun redoes the task

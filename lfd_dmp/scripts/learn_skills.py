@@ -3,7 +3,7 @@
 
   learn_skills.py --dataset DIR [--mode sim] [--tasks grasp,push]
                   [--changepoints segmentation|ground_truth] [--library-dir DIR]
-                  [--library-name '{task}_{mode}.json'] [--out FILE.json]
+                  [--library-name '{task}_{mode}.json'] [--attach] [--out FILE.json]
 
 Bags: DIR/<mode>_<task>/*.bag (lfd_sim_bridge/scripts/generate_datasets.py). Changepoints:
 `segmentation` (default) calls /segmentation/segment (the paper's method of config/segmentation.yaml);
@@ -13,8 +13,8 @@ transition's `to` phase in config/evaluation.yaml) and is labelled as such in th
 learner's majority vote on the changepoint counts decides the number of segments and whether the
 names fit (otherwise they are left unnamed, with its warning). Boundaries are never made up.
 
-Uses the services running at ROS_MASTER_URI (launch/learn.launch, as the pipeline's learn stage
-does); without a master it starts a private one with learn.launch for the run.
+Starts a private master with launch/learn.launch for the run, or with --attach uses the services
+running at ROS_MASTER_URI (the pipeline's learn stage, which runs learn.launch once).
 Writes {"learning": {"<mode>_<task>": record}} (lfd_tools.report.learning_record) to --out, also
 after an error or Ctrl-C with what was done. A task whose learning fails is reported with its error;
 the other tasks still run. Exit status 0 only if every task was learned.
@@ -70,6 +70,8 @@ def main():
     ap.add_argument("--library-dir", default=None, help="default: <dataset>/skills_<changepoints>")
     ap.add_argument("--library-name", default="{task}_{mode}.json", help="{task} and {mode} are replaced")
     ap.add_argument("--out", default=None, help="default: <library-dir>/learning_<mode>.json")
+    ap.add_argument("--attach", action="store_true",
+                    help="use the nodes running at ROS_MASTER_URI (default: start a private master and the launch)")
     args = ap.parse_args()
     dataset = os.path.abspath(args.dataset)
     lib_dir = os.path.abspath(args.library_dir or os.path.join(dataset, "skills_" + args.changepoints))
@@ -82,7 +84,7 @@ def main():
         services["/segmentation/segment"] = Segment
     results, status = {"learning": {}, "changepoint_source": args.changepoints}, 0
     with report.written_on_exit(out, results):
-        with master.graph_for_this_process(["lfd_launch", "learn.launch", "output:=log"]):
+        with master.graph_for_this_process(["lfd_launch", "learn.launch", "output:=log"], args.attach):
             proxies = master.service_proxies("learn_skills", services)
             for task in [t for t in args.tasks.split(",") if t]:
                 key = "%s_%s" % (args.mode, task)

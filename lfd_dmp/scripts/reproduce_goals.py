@@ -4,14 +4,14 @@ physically (DESIGN.md "How we judge it").
 
   reproduce_goals.py --library-dir DIR [--mode sim] [--tasks grasp,push]
                      [--library-name '{task}_{mode}.json'] [--goals 100,101] [--duration-scale 1]
-                     [--record-dir DIR] [--out FILE.json]
+                     [--record-dir DIR] [--attach] [--out FILE.json]
 
 Per goal: /bridge/reset (robot posture + objects), /bridge/set_scene (the task's object at its
 start, the other objects parked), /executor/execute toward the goal; then the object's final pose
 is judged with the task's criteria of config/evaluation.yaml `reproduction` (lfd_tools.judge).
 Time ratio = executed time / mean demonstrated duration of the learned segments (same span).
-Uses the nodes running at ROS_MASTER_URI (launch/reproduce.launch, as the pipeline's reproduce stage
-does); without a master it starts a private one with reproduce.launch for the run.
+Starts a private master with launch/reproduce.launch for the run, or with --attach uses the nodes
+running at ROS_MASTER_URI (the pipeline's reproduce stage, which runs reproduce.launch once).
 Writes {"<reproduction key>": {task: record}} (lfd_tools.report.reproduction_record; the key is
 `reproduction` for sim, `reproduction_<mode>` otherwise) to --out, also after an error or Ctrl-C
 with the goals done ("complete": false). Exit status 0 only if every goal was reached.
@@ -167,6 +167,8 @@ def main():
     ap.add_argument("--record-dir", default=None,
                     help="record the first goal of each task into a bag there (snapshots, rviz)")
     ap.add_argument("--out", default=None, help="default: <library-dir>/reproduction_<mode>.json")
+    ap.add_argument("--attach", action="store_true",
+                    help="use the nodes running at ROS_MASTER_URI (default: start a private master and the launch)")
     args = ap.parse_args()
     lib_dir = os.path.abspath(args.library_dir)
     out = args.out or os.path.join(lib_dir, "reproduction_%s.json" % args.mode)
@@ -175,7 +177,7 @@ def main():
     key = report.reproduction_key(args.mode)
     results, status = {key: {}}, 0
     with report.written_on_exit(out, results):
-        with master.graph_for_this_process(["lfd_launch", "reproduce.launch", "library_dir:=" + lib_dir]):
+        with master.graph_for_this_process(["lfd_launch", "reproduce.launch", "library_dir:=" + lib_dir], args.attach):
             cell = Cell(tasks_cfg, evaluation)
             for task in [t for t in args.tasks.split(",") if t]:
                 record = results[key][task] = {}

@@ -97,15 +97,25 @@ def background_launch(cmd, env, stdout=subprocess.DEVNULL):
 
 
 @contextlib.contextmanager
-def graph_for_this_process(launch_args):
-    """The nodes running at ROS_MASTER_URI when a master answers; else a private master with
-    `roslaunch <launch_args>` on it, used by this process until the block ends."""
-    if master_online():
+def graph_for_this_process(launch_args, attach):
+    """With `attach`, the nodes running at ROS_MASTER_URI (an error when no master answers); else a
+    private master with `roslaunch <launch_args>` on it, used by this process until the block ends
+    (never another run's master that happens to answer on the default port)."""
+    if attach:
+        if not master_online():
+            raise RuntimeError("no ROS master answers at %s (--attach)" % os.environ.get("ROS_MASTER_URI"))
         yield
         return
-    with master_for_this_process() as env:
-        with background_launch(["roslaunch"] + list(launch_args), env):
-            yield
+    previous = os.environ.get("ROS_MASTER_URI")
+    with private_master() as env:
+        os.environ["ROS_MASTER_URI"] = env["ROS_MASTER_URI"]
+        try:
+            with background_launch(["roslaunch"] + list(launch_args), env):
+                yield
+        finally:
+            os.environ.pop("ROS_MASTER_URI", None)
+            if previous is not None:
+                os.environ["ROS_MASTER_URI"] = previous
 
 
 def wait_for_param(name, timeout):

@@ -105,11 +105,14 @@ def written_on_exit(path, results):
 
 
 def run_client(main):
-    """Runs a client's main(): its exit status; 130 after Ctrl-C or SIGTERM (what was done is
-    written by written_on_exit)."""
+    """Runs a client's main(): its exit status; 1 with a one-line error for a RuntimeError; 130
+    after Ctrl-C or SIGTERM (what was done is written by written_on_exit)."""
     signal.signal(signal.SIGTERM, lambda *_: signal.default_int_handler(signal.SIGINT, None))
     try:
         return main()
+    except RuntimeError as exc:  # no master, a service that never came up, a bad config: said plainly
+        print("error: %s" % exc, file=sys.stderr)
+        return 1
     except KeyboardInterrupt:
         print("interrupted: the results so far are written (\"complete\": false)", file=sys.stderr)
         return 130
