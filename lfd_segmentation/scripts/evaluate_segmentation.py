@@ -158,11 +158,11 @@ def main():
     ap.add_argument("--no-sensors", action="store_true", help="with --cli: drop the sensor topics")
     args = ap.parse_args(rospy.myargv()[1:])
 
-    args.seg_config = args.seg_config or lfd_config.config_path("segmentation.yaml")
-    config = lfd_config.load_evaluation(args.config or None)
-    methods = [m for m in args.methods.split(",") if m] or config["segmentation"]["methods"]
-    tol = args.tolerance if args.tolerance is not None else float(config["segmentation"]["tolerance_s"])
     try:
+        args.seg_config = args.seg_config or lfd_config.config_path("segmentation.yaml")
+        config = lfd_config.load_evaluation(args.config or None)
+        methods = [m for m in args.methods.split(",") if m] or config["segmentation"]["methods"]
+        tol = args.tolerance if args.tolerance is not None else float(config["segmentation"]["tolerance_s"])
         segment = make_segmenter(args)
         rows = datasets_to_run(args, config)
     except (RuntimeError, OSError, KeyError, ValueError, yaml.YAMLError) as exc:
