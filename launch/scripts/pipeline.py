@@ -6,13 +6,14 @@ its own (so one stage's /use_sim_time never leaks into the next):
   datasets   generate the demonstration datasets (resumes: existing bags are kept)
   segment    segment every dataset through the segmentation service, for all four combination
              methods, and score it against the demonstrator's ground truth
-  learn      launch/learn.launch: per dataset, segment its bags (/segmentation/segment, the paper's
-             method of config/segmentation.yaml; never the ground truth) and learn the skill
-             library from the validated changepoints (/learner/learn) -> DIR/skills/<task>_<mode>.json
-  reproduce  launch/reproduce.launch: per learned library, reproduce every unseen goal of
-             config/tasks.yaml (`unseen.<mode>`) in MuJoCo through /executor/execute and judge the
-             object's final pose with config/evaluation.yaml `reproduction`
-             (lfd_dmp/scripts/evaluate_reproduction.py) -> DIR/reproduction/<task>_<mode>.json
+  learn      launch/learn.launch + lfd_dmp/scripts/learn_skills.py: per dataset, segment its bags
+             (/segmentation/segment, the paper's method of config/segmentation.yaml; never the
+             ground truth) and learn the skill library from the validated changepoints
+             (/learner/learn) -> DIR/skills/<task>_<mode>.json
+  reproduce  launch/reproduce.launch + lfd_dmp/scripts/reproduce_goals.py: per learned library,
+             reproduce every unseen goal of config/tasks.yaml (`unseen.<mode>`) in MuJoCo through
+             /executor/execute and judge the object's final pose with config/evaluation.yaml
+             `reproduction` (lfd_tools.judge) -> DIR/reproduction/<task>_<mode>.json
   figures    no master: the paper's figures per dataset (skill map, correlation matrix, relevance
              histograms, ClaSP profile with the Kaiser filter, segmentation with its zones; from
              the first demonstration), the success-rate bars per method and dataset, and MuJoCo
@@ -20,17 +21,18 @@ its own (so one stage's /use_sim_time never leaks into the next):
              first reproduction of each task (recorded by the reproduce stage) at the end of each
              segment -> DIR/figures
 
-Writes DIR/report.json and DIR/report.md, and prints the time of each stage. Stable report.json keys:
+Writes DIR/report.json and DIR/report.md, and prints the time of each stage. report.json holds the
+records of lfd_tools.report as the tools wrote them (their fields are documented there):
   datasets.<dataset>.demos
-  segmentation.<dataset>.success_rate, segmentation.<dataset>.methods.<method>
-  learning.<dataset>.segments            segments in the learned library (expected_segments beside)
-  learning.<dataset>.changepoint_counts  validated changepoints per demo, warnings, error (if any)
-  reproduction.<task>.success_rate       sim library on the sim unseen goals (successes / goals)
-  reproduction.<task>.execution_time_ratio  mean executed time / mean demonstration duration
-  reproduction.<task>.goals              per goal: id, success, object_position_error_m,
-                                         object_yaw_error_rad, tcp_position_error_m,
-                                         tcp_orientation_error_rad, time_ratio, error
-  reproduction_teleop.<task>.*           the same for the teleop library on the teleop goals
+  segmentation.<dataset>                 success_rate (paper's method), methods.<method> (rate),
+                                         results.<method> (every figure, per-demo details)
+  learning.<dataset>                     segments (expected_segments beside), changepoint_counts,
+                                         warnings, error (if any)
+  reproduction.<task>                    sim library on the sim unseen goals: success_rate,
+                                         execution_time_ratio, goals[] (id, success,
+                                         object_position_error_m, object_yaw_error_rad,
+                                         tcp_position_error_m, time_ratio, error, ...)
+  reproduction_teleop.<task>             the same for the teleop library on the teleop goals
                                          (with --reproduce-modes sim,teleop; default sim only)
   figures.<dataset|success_rates>        PNG paths relative to DIR
   timings.<stage>_s                      wall time of the stage's last run (datasets_s, segment_s,
@@ -56,71 +58,30 @@ later stages use the bags present), `--goals N` reproduces N unseen goals per ta
 import argparse
 import collections
 import contextlib
-import glob
 import json
 import os
 import signal
-import socket
 import subprocess
 import sys
 import time
 
 import yaml
+from lfd_tools import config as lfd_config
+from lfd_tools import judge, report as records
+from lfd_tools.master import background_launch, private_master, stop_group
+from lfd_tools.processes import TAG_VAR, kill_tagged
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.abspath(os.path.join(HERE, "..", ".."))
 DATASETS = ("sim_grasp", "sim_push", "teleop_grasp", "teleop_push")
 TASKS_FILE = os.path.join(ROOT, "config", "tasks.yaml")
-EVALUATE_REPRODUCTION = os.path.join(ROOT, "lfd_dmp", "scripts", "evaluate_reproduction.py")
-PAPER_METHOD = "weighted_product"
+LEARN_SKILLS = os.path.join(ROOT, "lfd_dmp", "scripts", "learn_skills.py")
+REPRODUCE_GOALS = os.path.join(ROOT, "lfd_dmp", "scripts", "reproduce_goals.py")
 STDERR_TAIL_LINES = 3  # of a failed tool's stderr, quoted in the stage's error
-TAG_VAR = "LFD_PIPELINE_TAG"  # <pipeline pid>:<stage>, inherited by everything a stage starts
 
 
 def say(msg):
     print("[pipeline] %s" % msg, flush=True)
-
-
-def stop_group(proc, timeout):
-    """SIGINT a process group (roslaunch/roscore shut down cleanly on it), SIGKILL if it hangs."""
-    with contextlib.suppress(ProcessLookupError):
-        os.killpg(proc.pid, signal.SIGINT)
-    try:
-        proc.wait(timeout=timeout)
-    except subprocess.TimeoutExpired:
-        os.killpg(proc.pid, signal.SIGKILL)
-        proc.wait()
-
-
-def free_port():
-    with socket.socket() as s:
-        s.bind(("localhost", 0))
-        return s.getsockname()[1]
-
-
-@contextlib.contextmanager
-def private_master():
-    """A roscore on a free port for one stage; stopped (with all it started) on exit."""
-    port = free_port()
-    env = dict(os.environ, ROS_MASTER_URI="http://localhost:%d" % port)
-    core = subprocess.Popen(["roscore", "-p", str(port)], env=env, stdout=subprocess.DEVNULL,
-                            stderr=subprocess.DEVNULL, start_new_session=True)
-    deadline = time.time() + 30
-    while time.time() < deadline:
-        with socket.socket() as s:
-            if s.connect_ex(("localhost", port)) == 0:
-                break
-        if core.poll() is not None:
-            raise RuntimeError("roscore exited at start (port %d)" % port)
-        time.sleep(0.2)
-    else:
-        stop_group(core, 15)
-        raise RuntimeError("roscore did not come up on port %d" % port)
-    time.sleep(1.0)  # the parameter server answers a little after the port opens
-    try:
-        yield env
-    finally:
-        stop_group(core, 15)
 
 
 def run(cmd, env=None):
@@ -143,61 +104,6 @@ def run(cmd, env=None):
 def failed(what, rc, tail):
     """A stage error that carries the tool's own last words (e.g. its Python exception)."""
     return RuntimeError("%s (exit %d)%s" % (what, rc, (": " + tail.replace("\n", " / ")) if tail else ""))
-
-
-def tagged_processes(prefix):
-    """PIDs (other than this one) whose environment carries LFD_PIPELINE_TAG=<prefix>...: every
-    process a stage started, including what roslaunch started in sessions of their own and what
-    outlived its parent."""
-    needle = ("\0%s=%s" % (TAG_VAR, prefix)).encode()
-    pids = []
-    for entry in os.listdir("/proc"):
-        if not entry.isdigit() or int(entry) == os.getpid():
-            continue
-        with contextlib.suppress(OSError):
-            with open("/proc/%s/environ" % entry, "rb") as f:
-                if needle in b"\0" + f.read():
-                    pids.append(int(entry))
-    return pids
-
-
-def kill_tagged(prefix, grace=5.0):
-    """Ends every process started under the tag: SIGTERM, then SIGKILL after `grace` seconds.
-    Returns the command names of those that were still running."""
-    pids = tagged_processes(prefix)
-    names = []
-    for pid in pids:
-        with contextlib.suppress(OSError):
-            with open("/proc/%d/comm" % pid) as f:
-                names.append(f.read().strip())
-        with contextlib.suppress(ProcessLookupError):
-            os.kill(pid, signal.SIGTERM)
-    deadline = time.time() + grace
-    while pids and time.time() < deadline:
-        time.sleep(0.1)
-        pids = [p for p in pids if os.path.exists("/proc/%d" % p) and not zombie(p)]
-    for pid in pids:
-        with contextlib.suppress(ProcessLookupError):
-            os.kill(pid, signal.SIGKILL)
-    return names
-
-
-def zombie(pid):
-    with contextlib.suppress(OSError):
-        with open("/proc/%d/stat" % pid) as f:
-            return f.read().rsplit(")", 1)[1].split()[0] == "Z"
-    return True
-
-
-@contextlib.contextmanager
-def background_launch(cmd, env):
-    """roslaunch in the background for the duration of a stage."""
-    say("$ " + " ".join(cmd) + " &")
-    proc = subprocess.Popen(cmd, env=env, start_new_session=True, stdout=subprocess.DEVNULL)
-    try:
-        yield proc
-    finally:
-        stop_group(proc, 20)
 
 
 def count_bags(folder):
@@ -265,16 +171,7 @@ def stage_segment(out, args, report):
                             "--datasets", data, "--names", ",".join(args.datasets), "--out", result], env)
     if not os.path.exists(result):
         raise failed("segmentation evaluation produced no result", rc, tail)
-    with open(result) as f:
-        seg = json.load(f)
-    report["segmentation"] = {}
-    for name, methods in seg["results"].items():
-        entry = {"methods": {m: r.get("success_rate") for m, r in methods.items()},
-                 "tolerance_s": seg["tolerance_s"]}
-        paper = methods.get(PAPER_METHOD, {})
-        entry["success_rate"] = paper.get("success_rate")
-        entry["selected_features"] = paper.get("selected_features", [])
-        report["segmentation"][name] = entry
+    report["segmentation"] = load_json(result)["segmentation"]  # the records, as written
     if rc != 0:
         raise failed("segmentation evaluation reported errors", rc, tail)
 
@@ -293,22 +190,6 @@ def load_json(path):
         with open(path) as f:
             return json.load(f)
     return None
-
-
-def learning_entry(task_result, library):
-    """report.json learning.<dataset> from one task of evaluate_reproduction.py --learn-only."""
-    lr = task_result.get("learning") or {}
-    entry = {"library": library if os.path.exists(library) else None,
-             "segments": task_result.get("segments") if os.path.exists(library) else 0,
-             "expected_segments": lr.get("expected_segments"),
-             "demos_used": lr.get("num_demos"), "bags": lr.get("bags"),
-             "changepoint_counts": lr.get("changepoint_counts", []),
-             "selected_features": lr.get("selected_features", []),
-             "changepoint_source": lr.get("changepoint_source"),
-             "warnings": lr.get("warnings", [])}
-    if task_result.get("error"):
-        entry["error"] = task_result["error"]
-    return entry
 
 
 def stage_learn(out, args, report):
@@ -339,19 +220,16 @@ def stage_learn(out, args, report):
                 result = os.path.join(skills, "learning_%s.json" % mode)
                 with contextlib.suppress(FileNotFoundError):
                     os.remove(result)
-                rc, tail = run(["/usr/bin/python3", EVALUATE_REPRODUCTION, "--attach", "--learn-only",
-                          "--dataset", data, "--mode", mode, "--tasks", ",".join(tasks),
-                          "--library-dir", skills, "--library-name", "{task}_{mode}.json",
-                          "--out", result], env)
+                rc, tail = run(["/usr/bin/python3", LEARN_SKILLS, "--attach", "--dataset", data, "--mode", mode,
+                                "--tasks", ",".join(tasks), "--library-dir", skills, "--out", result], env)
                 res = load_json(result)
                 if res is None:
                     raise failed("learning %s produced no result" % mode, rc, tail)
                 for task in tasks:
-                    library = os.path.join(skills, "%s_%s.json" % (task, mode))
-                    tr = res["tasks"].get(task, {"error": "not reached (interrupted?)"})
-                    entry = learning_entry(tr, library)
-                    learning["%s_%s" % (mode, task)] = entry
-                    if tr.get("error") is None and os.path.exists(library):
+                    key = "%s_%s" % (mode, task)
+                    entry = res["learning"].get(key, {"error": "not reached (interrupted?)"})
+                    learning[key] = entry
+                    if entry.get("error") is None and os.path.exists(entry.get("library") or ""):
                         with open(os.path.join(skills, "%s_%s.learning.json" % (task, mode)), "w") as f:
                             json.dump(entry, f, indent=1, sort_keys=True)
     return None
@@ -363,38 +241,9 @@ def goal_ids(task, mode, n):
     return [e["id"] for e in spread(unseen, n)]
 
 
-def nan_to_none(v):
-    return None if v is None or v != v else v
-
-
-def reproduction_entry(task_result, result_path):
-    runs = task_result.get("runs", [])
-    entry = {"success_rate": task_result.get("success_rate"),
-             "successes": task_result.get("successes", 0), "goals_total": len(runs),
-             "execution_time_ratio": task_result.get("mean_time_ratio"),
-             "mean_object_position_error_m": nan_to_none(task_result.get("mean_object_position_error")),
-             "mean_tcp_position_error_m": task_result.get("mean_tcp_final_error"),
-             "segments": task_result.get("segments"), "library": task_result.get("library"),
-             "result": result_path,
-             "goals": [{"id": r["id"], "success": r["success"],
-                        "object_position_error_m": nan_to_none(r.get("object_position_error")),
-                        "object_yaw_error_rad": nan_to_none(r.get("object_yaw_error")),
-                        "tcp_position_error_m":
-                            r.get("tcp_final_position_error") if r["executed"] else None,
-                        "tcp_orientation_error_rad":
-                            r.get("tcp_final_orientation_error") if r["executed"] else None,
-                        "time_ratio": r.get("time_ratio"), "execution_time_s": r.get("execution_time"),
-                        "error": r.get("error", "")} for r in runs]}
-    if task_result.get("error"):
-        entry["error"] = task_result["error"]
-    errors = sorted({g["error"] for g in entry["goals"] if g["error"]})
-    if errors and not entry.get("error") and not entry["successes"]:
-        entry["error"] = "; ".join(errors)
-    return entry
-
-
-def reproduction_key(mode):
-    return "reproduction" if mode == "sim" else "reproduction_%s" % mode
+def task_record(result_path, mode, task):
+    """A task's reproduction record from a reproduce_goals.py result file (None if absent)."""
+    return ((load_json(result_path) or {}).get(records.reproduction_key(mode)) or {}).get(task)
 
 
 def stage_reproduce(out, args, report):
@@ -405,7 +254,7 @@ def stage_reproduce(out, args, report):
     for mode, tasks in by_mode(args.datasets).items():
         if mode not in args.reproduce_modes:
             continue
-        section = report.setdefault(reproduction_key(mode), {})
+        section = report.setdefault(records.reproduction_key(mode), {})
         for task in tasks:
             library = os.path.join(skills, "%s_%s.json" % (task, mode))
             path = os.path.join(results, "%s_%s.json" % (task, mode))
@@ -413,53 +262,49 @@ def stage_reproduce(out, args, report):
             if not os.path.exists(library):
                 err = (report.get("learning", {}).get("%s_%s" % (mode, task), {}).get("error")
                        or "no skill library %s: run the learn stage" % library)
-                section[task] = {"success_rate": None, "execution_time_ratio": None, "goals": [],
-                                 "error": "not reproduced: " + err}
+                section[task] = records.reproduction_record(library, (None, 0, 0), [], "not reproduced: " + err)
                 say("reproduce %s_%s: %s" % (mode, task, section[task]["error"]))
                 continue
-            done = load_json(path)
-            runs = ((done or {}).get("tasks", {}).get(task) or {}).get("runs", [])
-            if (not args.force and done and done.get("complete") and [r["id"] for r in runs] == ids
+            done = task_record(path, mode, task)
+            if (not args.force and done and load_json(path).get("complete")
+                    and [g["id"] for g in done["goals"]] == ids
                     and os.path.getmtime(path) > os.path.getmtime(library)):
-                say("reproduce %s_%s: results newer than the library kept (--force reruns)"
-                    % (mode, task))
-                section[task] = reproduction_entry(done["tasks"][task], path)
+                say("reproduce %s_%s: results newer than the library kept (--force reruns)" % (mode, task))
+                section[task] = done
                 continue
             todo.setdefault(mode, []).append((task, ids))
     if not todo:
         return "skipped"
     with private_master() as env:
-        with background_launch(["roslaunch", "lfd_launch", "reproduce.launch",
-                                "library_dir:=" + skills], env):
+        with background_launch(["roslaunch", "lfd_launch", "reproduce.launch", "library_dir:=" + skills], env):
             for mode, items in todo.items():
                 for task, ids in items:
-                    path = os.path.join(results, "%s_%s.json" % (task, mode))
-                    with contextlib.suppress(FileNotFoundError):
-                        os.remove(path)
-                    say("reproduce %s_%s: %d unseen goals %s" % (mode, task, len(ids), ids))
-                    try:
-                        rc, tail = run(["/usr/bin/python3", EVALUATE_REPRODUCTION, "--attach", "--no-learn",
-                                  "--dataset", os.path.join(out, "datasets"), "--mode", mode,
-                                  "--tasks", task, "--goals", ",".join(map(str, ids)),
-                                  "--library-dir", skills, "--library-name", "{task}_{mode}.json",
-                                  "--record-dir", results, "--out", path], env)
-                    except KeyboardInterrupt:  # report the goals done; a rerun redoes the task
-                        res = load_json(path)
-                        if res and task in res["tasks"]:
-                            entry = reproduction_entry(res["tasks"][task], path)
-                            entry["interrupted"] = True
-                            report[reproduction_key(mode)][task] = entry
-                        raise
-                    res = load_json(path)
-                    if res is None or task not in res["tasks"]:
-                        raise failed("reproduction %s_%s produced no result" % (mode, task), rc, tail)
-                    entry = reproduction_entry(res["tasks"][task], path)
-                    report[reproduction_key(mode)][task] = entry
-                    say("reproduce %s_%s: %d/%d goals reached, time ratio %s" % (
-                        mode, task, entry["successes"], len(ids),
-                        "-" if entry["execution_time_ratio"] is None
-                        else "%.2f" % entry["execution_time_ratio"]))
+                    reproduce_one(results, skills, mode, task, ids, report, env)
     return None
+
+
+def reproduce_one(results, skills, mode, task, ids, report, env):
+    path = os.path.join(results, "%s_%s.json" % (task, mode))
+    with contextlib.suppress(FileNotFoundError):
+        os.remove(path)
+    say("reproduce %s_%s: %d unseen goals %s" % (mode, task, len(ids), ids))
+    section = report[records.reproduction_key(mode)]
+    try:
+        rc, tail = run(["/usr/bin/python3", REPRODUCE_GOALS, "--attach", "--library-dir", skills, "--mode", mode,
+                        "--tasks", task, "--goals", ",".join(map(str, ids)), "--record-dir", results,
+                        "--out", path], env)
+    except KeyboardInterrupt:  # report the goals done; a rerun redoes the task
+        entry = task_record(path, mode, task)
+        if entry:
+            section[task] = dict(entry, interrupted=True)
+        raise
+    entry = task_record(path, mode, task)
+    if entry is None:
+        raise failed("reproduction %s_%s produced no result" % (mode, task), rc, tail)
+    section[task] = entry
+    say("reproduce %s_%s: %d/%d goals reached, time ratio %s" % (
+        mode, task, entry["successes"], len(ids),
+        "-" if entry["execution_time_ratio"] is None else "%.2f" % entry["execution_time_ratio"]))
 
 
 def run_quiet(cmd, env=None):
@@ -503,13 +348,12 @@ def stage_figures(out, args, report):
         bags = sorted(b for b in os.listdir(os.path.join(data, name)) if b.endswith(".bag"))
         made[name] += snapshots(report, name, os.path.join(data, name, bags[0]), figs)
     # The first reproduction of each task was recorded: snapshots at the end of each segment.
-    for result in sorted(glob.glob(os.path.join(out, "reproduction", "*_*.json"))):
-        for task, entry in (load_json(result) or {}).get("tasks", {}).items():
-            for run in entry.get("runs", []):
-                if not (run.get("bag") and run.get("segment_end_times")):
-                    continue
-                key = "reproduction_" + os.path.basename(result)[:-len(".json")]
-                made[key] = snapshots(report, key, run["bag"], figs, run["segment_end_times"])
+    for mode in ("sim", "teleop"):
+        for task, entry in sorted(report.get(records.reproduction_key(mode), {}).items()):
+            for goal in entry.get("goals", []):
+                if goal.get("bag") and goal.get("segment_end_times_s"):
+                    name = "reproduction_%s_%s" % (task, mode)
+                    made[name] = snapshots(report, name, goal["bag"], figs, goal["segment_end_times_s"])
     write_report(out, report)  # the bars read this run's rates from report.json
     if report.get("segmentation"):
         made["success_rates"] = run_quiet(["/usr/bin/python3", plot, "--report",
@@ -553,7 +397,7 @@ def write_report(out, report):
     if "segmentation" in report:
         methods = sorted({m for e in report["segmentation"].values() for m in e["methods"]})
         lines += ["## Segmentation success rate", "",
-                  "| dataset | " + " | ".join(methods) + " | selected features (%s) |" % PAPER_METHOD,
+                  "| dataset | " + " | ".join(methods) + " | selected features (%s) |" % records.PAPER_METHOD,
                   "| --- " * (len(methods) + 2) + "|"]
         for name, e in sorted(report["segmentation"].items()):
             cells = ["%.0f%%" % (100 * e["methods"][m]) if e["methods"].get(m) is not None else "error"
@@ -585,9 +429,10 @@ def write_report(out, report):
                 "-" if e.get("execution_time_ratio") is None else "%.2f" % e["execution_time_ratio"],
                 mm(e.get("mean_object_position_error_m")), mm(e.get("mean_tcp_position_error_m")),
                 (e.get("error") or "").replace("|", "/")))
-        lines += ["", "Success: the stick ends lifted >= 10 cm within 3 cm of its goal; the box within "
-                  "3 cm of its target (config/evaluation.yaml). Time ratio: executed / mean "
-                  "demonstrated duration.", ""]
+        criteria = lfd_config.load_evaluation()["reproduction"]
+        lines += ["", "Success (config/evaluation.yaml): " + "; ".join(
+            judge.describe_criteria(t, criteria[t]) for t in sorted(report[key]) if t in criteria)
+            + ". Time ratio: executed / mean demonstrated duration.", ""]
         for task, e in sorted(report[key].items()):
             if not e.get("goals"):
                 continue

@@ -76,6 +76,15 @@ LearnOutcome learnSkillLibrary(const std::vector<DemoRecording>& demos,
   const size_t num_segments = cp_count + 1;
 
   LearnOutcome outcome;
+  // The task's names fit only the number of segments it has: a 1-segment library of a 3-segment
+  // task is not called "approach" (the executor refuses unnamed segments with a clear error).
+  const bool named = options.segment_names.size() == num_segments;
+  if (!options.segment_names.empty() && !named) {
+    outcome.warnings.push_back("the demos give " + std::to_string(num_segments) +
+                               " segment(s) (majority of changepoint counts), the task has " +
+                               std::to_string(options.segment_names.size()) +
+                               ": segments left unnamed; the executor will refuse this library");
+  }
   SkillLibrary& lib = outcome.library;
   lib.task = options.task;
   lib.features = options.features;
@@ -86,8 +95,7 @@ LearnOutcome learnSkillLibrary(const std::vector<DemoRecording>& demos,
   for (size_t s = 0; s < num_segments; ++s) {
     SegmentSkills seg;
     seg.index = static_cast<int>(s);
-    seg.name = s < options.segment_names.size() ? options.segment_names[s]
-                                                : "segment_" + std::to_string(s);
+    seg.name = named ? options.segment_names[s] : "segment_" + std::to_string(s);
     lib.segments.push_back(seg);
   }
 

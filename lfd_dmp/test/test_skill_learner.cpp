@@ -49,7 +49,7 @@ TEST(SkillLearner, CutsDemosAtChangepointsIntoSegmentDmps) {
   std::vector<std::vector<double>> cps = {{12.0, 14.0}, {12.0, 14.0}, {13.0}};  // c: inconsistent
   lfd_dmp::LearnOptions opt;
   opt.task = "grasp";
-  opt.segment_names = {"approach", "move"};
+  opt.segment_names = {"approach", "grasp", "move"};
   opt.features = {"gripper", "speed"};
   const auto out = lfd_dmp::learnSkillLibrary(demos, cps, opt);
   EXPECT_EQ(out.demos_used, 2u);
@@ -58,7 +58,7 @@ TEST(SkillLearner, CutsDemosAtChangepointsIntoSegmentDmps) {
   const auto& lib = out.library;
   ASSERT_EQ(lib.segments.size(), 3u);
   EXPECT_EQ(lib.segments[0].name, "approach");
-  EXPECT_EQ(lib.segments[2].name, "segment_2");
+  EXPECT_EQ(lib.segments[2].name, "move");
   EXPECT_EQ(lib.features, opt.features);
   for (const auto& seg : lib.segments) ASSERT_EQ(seg.demos.size(), 2u);
   // Segment 0 of demo b ends at its object; its goal parameters are that position.
@@ -80,6 +80,22 @@ TEST(SkillLearner, CutsDemosAtChangepointsIntoSegmentDmps) {
 
 // A teleoperated demo: the same motion plus 10 Hz, 3 mm tremor. Without smoothing the DMPs replay
 // the tremor (centimetres once the start velocity is the robot's); with it, the intended motion.
+TEST(SkillLearner, NamesSegmentsOnlyWhenTheVoteGivesTheTasksCount) {
+  // The vote (2 of 3 demos: two changepoints -> three segments) does not give the two segments the
+  // task names: no segment is called "approach", and the warning says why.
+  std::vector<lfd_dmp::DemoRecording> demos = {recording("a.bag", 0.6), recording("b.bag", 0.7),
+                                               recording("c.bag", 0.65)};
+  std::vector<std::vector<double>> cps = {{12.0, 14.0}, {12.0, 14.0}, {13.0}};
+  lfd_dmp::LearnOptions opt;
+  opt.task = "grasp";
+  opt.segment_names = {"approach", "move"};
+  const auto out = lfd_dmp::learnSkillLibrary(demos, cps, opt);
+  ASSERT_EQ(out.library.segments.size(), 3u);
+  for (size_t s = 0; s < 3; ++s) EXPECT_EQ(out.library.segments[s].name, "segment_" + std::to_string(s));
+  ASSERT_EQ(out.warnings.size(), 2u);
+  EXPECT_NE(out.warnings[0].find("left unnamed"), std::string::npos) << out.warnings[0];
+}
+
 TEST(SkillLearner, SmoothingKeepsTheMotionAndDropsTheTremor) {
   const lfd_dmp::DemoRecording clean = recording("clean.bag", 0.6);
   lfd_dmp::DemoRecording shaky = clean;

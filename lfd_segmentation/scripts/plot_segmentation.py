@@ -27,6 +27,7 @@ earliest end, `rate` Hz, linear or zero-order hold). Time axes are seconds from 
 sample. Prints the path of each PNG written; exits 2 with a message on bad input.
 """
 import argparse
+import contextlib
 import json
 import math
 import os
@@ -34,23 +35,14 @@ import subprocess
 import sys
 
 import numpy as np
+from lfd_tools import bags as lfd_bags
+from lfd_tools import figures
 
 plt = None  # matplotlib.pyplot, imported with the first figure: bad input fails fast without it
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 DEFAULT_CONFIG = os.path.join(HERE, "..", "..", "config", "segmentation.yaml")
-GROUND_TRUTH_TOPIC = "/lfd/phase"
-DPI = 100
-# Figure sizes in inches (x DPI = the PNG's pixels); the rostest checks them.
-SIZES = {
-    "skill_map": (12, 7),
-    "correlation_best": (7, 6),
-    "correlation_all": (12, 10),
-    "relevance": (13, 6),
-    "clasp_profile": (12, 7),
-    "segmentation": (12, 8),
-    "success_rates": (10, 5.5),
-}
+GROUND_TRUTH_TOPIC = lfd_bags.PHASE_TOPIC
 PAPER_RATE = {"sim": 0.8, "teleop": 0.5}  # Fig. 9: ~80 % in simulation, ~50 % on the real robot
 METHOD_ORDER = ["average", "product", "weighted_average", "weighted_product"]
 PHASE_COLOURS = ["#f2e2c4", "#c9dcf0", "#d5ecd0", "#ead3ea", "#f6d6d0", "#e0e0e0"]
@@ -209,10 +201,9 @@ def read_bag(path, config, with_ground_truth):
                     v = np.array([x for _, x in samples])
                     order = np.argsort(t, kind="stable")
                     streams.append((name, role, zoh, t[order], v[order]))
-            if with_ground_truth:
-                for _, m, t in bag.read_messages(topics=[GROUND_TRUTH_TOPIC]):
-                    if not phases or phases[-1][0] != m.name:
-                        phases.append((m.name, stamp_of(m, t)))
+        if with_ground_truth:
+            with contextlib.suppress(RuntimeError):  # no /lfd/phase: no background
+                phases = lfd_bags.phase_transitions(path)[1]
     except UserError:
         raise
     except Exception as e:  # rosbag raises several exception types for corrupt bags
@@ -247,12 +238,12 @@ def new_figure(kind, **kw):
         matplotlib.use("Agg")
         import matplotlib.pyplot
         plt = matplotlib.pyplot
-    return plt.figure(figsize=SIZES[kind], dpi=DPI, **kw)
+    return plt.figure(figsize=figures.SIZES[kind], dpi=figures.DPI, **kw)
 
 
 def save(fig, out, prefix, kind, written, tag=""):
     path = os.path.join(out, "%s%s%s.png" % (prefix, kind, tag))
-    fig.savefig(path, dpi=DPI)
+    fig.savefig(path, dpi=figures.DPI)
     plt.close(fig)
     written.append(path)
     print(path)
@@ -547,7 +538,8 @@ def plot_segmentation(bag, seg, d, out, prefix, written, ground_truth, tag=""):
 
 
 def report_rates(report):
-    """{dataset: {method: rate or None}} from a pipeline report.json or evaluate_segmentation.py output."""
+    """{dataset: {method: rate or None}} from a pipeline report.json or evaluate_segmentation.py output
+    (the same segmentation records, lfd_tools.report)."""
     if isinstance(report, dict) and isinstance(report.get("segmentation"), dict):
         rates, tol = {}, None
         for name, entry in report["segmentation"].items():
@@ -555,10 +547,6 @@ def report_rates(report):
             rates[name] = dict(methods)
             tol = entry.get("tolerance_s", tol)
         return rates, tol
-    if isinstance(report, dict) and isinstance(report.get("results"), dict):
-        rates = {name: {m: r.get("success_rate") for m, r in methods.items()}
-                 for name, methods in report["results"].items()}
-        return rates, report.get("tolerance_s")
     raise UserError("the report has no 'segmentation' section (run the pipeline's segment stage)")
 
 

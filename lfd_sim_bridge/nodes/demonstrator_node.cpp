@@ -55,6 +55,29 @@ T param(const ros::NodeHandle& pnh, const std::string& name, const T& fallback) 
   return pnh.getParam(name, value) ? value : fallback;
 }
 
+// Physical success criteria of config/evaluation.yaml `reproduction.<task>`, the one place they
+// are written (the Python judges read the same file): the launch loads that file into
+// ~evaluation. No fallback numbers, so the demonstrator cannot judge by other ones.
+demo::SuccessCriteria successCriteria(const ros::NodeHandle& pnh, const std::string& task) {
+  const std::string ns = "evaluation/reproduction/" + task + "/";
+  // demo::judge measures the grasp in 3-D and the push horizontally: refuse a file that says
+  // otherwise rather than judge by another rule than the Python judges.
+  const std::string distance = param<std::string>(pnh, ns + "distance", "");
+  const std::string judged = task == "push" ? "xy" : "xyz";
+  if (distance != judged) {
+    throw std::invalid_argument("~" + ns + "distance is '" + distance + "'; the demonstrator judges " +
+                                task + " by distance '" + judged + "'");
+  }
+  demo::SuccessCriteria c;
+  if (!pnh.getParam(ns + "tolerance_m", c.tolerance)) {
+    throw std::invalid_argument("~" + ns + "tolerance_m is not set: load config/evaluation.yaml "
+                                "into the demonstrator's ~evaluation namespace");
+  }
+  c.min_lift = 0.0;  // a task without min_lift_m (push) has no lift requirement
+  pnh.getParam(ns + "min_lift_m", c.min_lift);
+  return c;
+}
+
 void loadDouble(const ros::NodeHandle& pnh, const std::string& name, double* value) {
   pnh.getParam(name, *value);
 }
@@ -135,8 +158,7 @@ class Demonstrator {
     gripper_joint_ = nh.param<std::string>("/bridge/gripper_joint", "R_GRIPPER");
     grasp_offset_ = param(pnh, "grasp_offset_range", 0.015);
     grasp_yaw_ = param(pnh, "grasp_yaw_range", 0.08);
-    criteria_.tolerance = param(pnh, "success_tolerance", 0.03);
-    criteria_.min_lift = param(pnh, "success_min_lift", 0.10);
+    criteria_ = successCriteria(pnh, task_);
 
     geometry_.grasp_orientation = setup_.grasp_orientation;
     geometry_.push_orientation = setup_.push_orientation;

@@ -43,10 +43,8 @@ namespace {
 struct Options {
   std::string bag;
   std::string out;
-  // The package's own scene: this source file sits in <package>/nodes/.
-  std::string model =
-      (std::filesystem::path(__FILE__).parent_path().parent_path() / "models" / "workcell.xml")
-          .string();
+  // The package's own scene (LFD_SIM_MODEL_DIR: <package>/models, set by CMake).
+  std::string model = (std::filesystem::path(LFD_SIM_MODEL_DIR) / "workcell.xml").string();
   std::string times;  // empty: segment ends
   bool relative = false;
   int width = 960;

@@ -18,17 +18,15 @@ import glob
 import os
 import re
 import shutil
-import socket
 import subprocess
 import sys
 import time
 
-import rosgraph
-import rospkg
 import yaml
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from check_demo_bag import check_bag  # noqa: E402
+from lfd_tools import bags as lfd_bags
+from lfd_tools import config as lfd_config
+from lfd_tools.master import master_for_this_process
 
 DATASETS = ("sim_grasp", "sim_push", "teleop_grasp", "teleop_push")
 
@@ -42,42 +40,6 @@ def configurations(tasks_file, task, mode):
 
 def bag_name(out, task, mode, config):
     return os.path.join(out, "%s_%s_%02d.bag" % (task, mode, config))
-
-
-def free_port():
-    with socket.socket() as s:
-        s.bind(("localhost", 0))
-        return s.getsockname()[1]
-
-
-class Master:
-    """A private roscore when none is reachable, stopped on exit."""
-
-    def __init__(self):
-        self.proc = None
-
-    def __enter__(self):
-        if rosgraph.is_master_online():
-            return self
-        port = free_port()
-        os.environ["ROS_MASTER_URI"] = "http://localhost:%d" % port
-        self.proc = subprocess.Popen(["roscore", "-p", str(port)], stdout=subprocess.DEVNULL,
-                                     stderr=subprocess.DEVNULL)
-        deadline = time.time() + 30
-        while not rosgraph.is_master_online():
-            if time.time() > deadline or self.proc.poll() is not None:
-                raise RuntimeError("could not start roscore on port %d" % port)
-            time.sleep(0.1)
-        return self
-
-    def __exit__(self, *exc):
-        if self.proc and self.proc.poll() is None:
-            self.proc.send_signal(2)
-            try:
-                self.proc.wait(15)
-            except subprocess.TimeoutExpired:
-                self.proc.kill()
-                self.proc.wait()
 
 
 def demo_errors(out):
@@ -158,11 +120,12 @@ def record_missing(name, out_root, args, log_dir, attempt, crashes):
 
 def summarize(out_root, names, args):
     rows, all_ok, all_topics = [], True, set()
+    evaluation = lfd_config.load_evaluation()
     for name in names:
         mode, task = name.split("_")
         ids = configurations(args.tasks_file, task, mode)
         bags = [bag_name(os.path.join(out_root, name), task, mode, i) for i in ids]
-        results = [check_bag(b) for b in bags if os.path.exists(b)]
+        results = [lfd_bags.demo_outcome(b, evaluation) for b in bags if os.path.exists(b)]
         ok = sum(bool(r["success"]) for r in results)
         durations = [r["duration"] for r in results if "duration" in r]
         topics = sorted({t for r in results for t in r.get("topics", {})})
@@ -200,7 +163,7 @@ def main():
         if n not in DATASETS:
             parser.error("unknown dataset '%s' (choose from %s)" % (n, ", ".join(DATASETS)))
     if args.tasks_file is None:
-        args.tasks_file = os.path.join(rospkg.RosPack().get_path("lfd_config"), "tasks.yaml")
+        args.tasks_file = lfd_config.config_path("tasks.yaml")
     out_root = os.path.abspath(args.out)
     log_dir = os.path.join(out_root, "logs")
     os.makedirs(log_dir, exist_ok=True)
@@ -209,7 +172,7 @@ def main():
             shutil.rmtree(os.path.join(out_root, n), ignore_errors=True)
     start = time.time()
     crashes = []
-    with Master():
+    with master_for_this_process():
         for n in names:
             generate(n, out_root, args, log_dir, crashes)
     total = time.time() - start

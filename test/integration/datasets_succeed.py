@@ -5,26 +5,23 @@ import glob
 import os
 import shutil
 import subprocess
-import sys
 import unittest
 
 import rospkg
 import rospy
 import rostest
-import yaml
+
+from lfd_tools import bags as lfd_bags
+from lfd_tools import config as lfd_config
 
 SCRIPTS = os.path.join(rospkg.RosPack().get_path("lfd_sim_bridge"), "scripts")
-sys.path.insert(0, SCRIPTS)
-from check_demo_bag import check_bag  # noqa: E402
 
 
 class DatasetsSucceed(unittest.TestCase):
     def test_every_demo_succeeds(self):
         rospy.init_node("datasets_test", anonymous=True)
         out = rospy.get_param("datasets_test/output_dir")
-        tasks_file = os.path.join(rospkg.RosPack().get_path("lfd_config"), "tasks.yaml")
-        with open(tasks_file) as f:
-            tasks = yaml.safe_load(f)
+        tasks, evaluation = lfd_config.load_tasks(), lfd_config.load_evaluation()
         try:
             gen = subprocess.run([os.path.join(SCRIPTS, "generate_datasets.py"), "--out", out],
                                  stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
@@ -37,7 +34,7 @@ class DatasetsSucceed(unittest.TestCase):
                 bags = sorted(glob.glob(os.path.join(out, name, "*.bag")))
                 self.assertEqual(len(bags), expected, "%s: %d bags\n%s" % (name, len(bags), gen.stdout))
                 for bag in bags:
-                    r = check_bag(bag)
+                    r = lfd_bags.demo_outcome(bag, evaluation)
                     self.assertEqual(r.get("task"), task, bag)
                     self.assertEqual(r.get("mode"), mode, bag)
                     self.assertTrue(r["success"], "%s: %s" % (bag, r["reason"]))

@@ -4,7 +4,6 @@ an unseen goal in sim; error paths keep the executor alive."""
 import glob
 import math
 import os
-import sys
 import threading
 import time
 import unittest
@@ -16,9 +15,10 @@ import yaml
 from geometry_msgs.msg import Point, Pose, PoseStamped, Quaternion
 from lfd_msgs.msg import DemoSegmentation
 from lfd_msgs.srv import ExecuteTask, LearnSkills, ResetSim, SetScene
+from lfd_tools import bags as lfd_bags
+from lfd_tools import config as lfd_config
+from lfd_tools import judge
 
-sys.path.insert(0, os.path.join(rospkg.RosPack().get_path("lfd_dmp"), "scripts"))
-from evaluate_reproduction import ground_truth_changepoints  # noqa: E402
 
 
 def pose(e):
@@ -48,10 +48,12 @@ class ExecutorReproduce(unittest.TestCase):
         bags = sorted(glob.glob(os.path.join(cls.out, "*.bag")))
         assert len(bags) == 4, bags
         cls.library = os.path.join(cls.out, "grasp.json")
-        segs = [DemoSegmentation(source=b, changepoint_times=ground_truth_changepoints(b, "grasp"))
+        evaluation = lfd_config.load_evaluation()
+        expected = lfd_config.expected_transitions(evaluation, "grasp")
+        segs = [DemoSegmentation(source=b, changepoint_times=lfd_bags.ground_truth_changepoints(b, expected))
                 for b in bags]
         res = cls.learn(task="grasp", output_path=cls.library, segmentations=segs,
-                        segment_names=["approach", "move"])
+                        segment_names=lfd_config.segment_names(evaluation, "grasp"))
         assert res.success, res.error
 
     def setup_scene(self, entry):
@@ -112,11 +114,10 @@ class ExecutorReproduce(unittest.TestCase):
         while rospy.Time.now() < end:
             time.sleep(0.01)
         stick = rospy.wait_for_message("/objects/stick/pose", PoseStamped, timeout=10).pose
-        g = entry["goal"]
-        dist = math.sqrt((stick.position.x - g[0]) ** 2 + (stick.position.y - g[1]) ** 2 +
-                         (stick.position.z - g[2]) ** 2)
-        self.assertGreater(stick.position.z - self.tasks["table_top"], 0.10)
-        self.assertLess(dist, 0.03)
+        p = stick.position
+        outcome = judge.physical_outcome(lfd_config.criteria_of(lfd_config.load_evaluation(), "grasp"),
+                                         (p.x, p.y, p.z), entry["goal"], self.tasks["table_top"])
+        self.assertTrue(outcome["success"], outcome["reason"])
 
 
 if __name__ == "__main__":

@@ -11,12 +11,13 @@ import unittest
 
 import rospkg
 import rostest
+from lfd_tools import config as lfd_config
 
 PIPELINE = os.path.join(rospkg.RosPack().get_path("lfd_launch"), "scripts", "pipeline.py")
 DEMOS = 3                 # sim grasp demonstrations recorded (spread over tasks.yaml's 9)
 GOALS = 3                 # unseen grasp goals reproduced (spread over tasks.yaml's 10)
 MIN_SEGMENTATION = 2 / 3  # sim grasp demos with exactly one changepoint at approach->move
-MIN_REPRODUCTION = 2 / 3  # unseen goals where the stick ends lifted within 3 cm of its goal
+MIN_REPRODUCTION = 2 / 3  # unseen goals reached (config/evaluation.yaml's grasp criteria)
 PIPELINE_TIMEOUT = 270    # s of wall time for the full run (the rostest limit is 360)
 
 
@@ -98,11 +99,12 @@ class PipelineE2E(unittest.TestCase):
 
     def test_4_reproduction(self):
         grasp = self.report["reproduction"]["grasp"]
+        tolerance = lfd_config.criteria_of(lfd_config.load_evaluation(), "grasp")["tolerance_m"]
         self.assertEqual(len(grasp["goals"]), GOALS)
         self.assertGreaterEqual(grasp["success_rate"], MIN_REPRODUCTION - 1e-9, grasp["goals"])
         for g in grasp["goals"]:
             if g["success"]:
-                self.assertLessEqual(g["object_position_error_m"], 0.03)
+                self.assertLessEqual(g["object_position_error_m"], tolerance)
                 self.assertGreater(g["time_ratio"], 0.5)
                 self.assertLess(g["time_ratio"], 2.0)
         self.assertGreater(grasp["execution_time_ratio"], 0.5)

@@ -1,11 +1,11 @@
 #!/usr/bin/python3
 """rostest (pipeline_failure.test): a failing stage is reported and leaves nothing running."""
+import contextlib
 import json
 import os
 import shutil
 import signal
 import subprocess
-import sys
 import tempfile
 import time
 import unittest
@@ -13,6 +13,7 @@ import uuid
 
 import rospkg
 import rostest
+from lfd_tools import processes
 
 PIPELINE = os.path.join(rospkg.RosPack().get_path("lfd_launch"), "scripts", "pipeline.py")
 TIMEOUT = 120  # s for the pipeline to fail and clean up
@@ -21,17 +22,10 @@ TIMEOUT = 120  # s for the pipeline to fail and clean up
 def processes_with(marker):
     """(pid, command) of every process whose environment holds `marker`."""
     found = []
-    for entry in os.listdir("/proc"):
-        if not entry.isdigit():
-            continue
-        try:
-            with open("/proc/%s/environ" % entry, "rb") as f:
-                if marker.encode() not in f.read():
-                    continue
-            with open("/proc/%s/cmdline" % entry, "rb") as f:
-                found.append((int(entry), f.read().replace(b"\0", b" ").decode(errors="replace")))
-        except OSError:
-            continue
+    for pid in processes.processes_with(marker.encode()):
+        with contextlib.suppress(OSError):
+            with open("/proc/%d/cmdline" % pid, "rb") as f:
+                found.append((pid, f.read().replace(b"\0", b" ").decode(errors="replace")))
     return found
 
 
@@ -98,8 +92,9 @@ class FailingStage:
 
 class ClientDiesAtOnce(FailingStage, unittest.TestCase):
     """The fresh-machine failure: the evaluation client cannot import its messages and dies while
-    roslaunch is still starting the segmentation node."""
-    ENV = {"PYTHONPATH": ""}
+    roslaunch is still starting the segmentation node. Only lfd_tools (the pipeline's own package,
+    from its source folder) is importable: no message package."""
+    ENV = {"PYTHONPATH": os.path.join(rospkg.RosPack().get_path("lfd_launch"), "src")}
     SAYS = "ModuleNotFoundError: No module named 'lfd_msgs'"
 
 
@@ -109,21 +104,19 @@ class ClientFailsOnData(FailingStage, unittest.TestCase):
 
 
 class StageCleanup(unittest.TestCase):
-    """pipeline.kill_tagged ends what a stage started even when it left its parent's session and
+    """kill_tagged (lfd_tools.processes, the pipeline's stage cleanup) ends what a stage started even when it left its parent's session and
     outlived it (as roslaunch's nodes do when roslaunch is killed): a process group is not enough."""
 
     def test_orphan_in_its_own_session_is_killed(self):
-        sys.path.insert(0, os.path.dirname(PIPELINE))
-        import pipeline  # noqa: E402
         tag = "%d:cleanup_test" % os.getpid()
-        env = dict(os.environ, **{pipeline.TAG_VAR: tag})
+        env = dict(os.environ, **{processes.TAG_VAR: tag})
         # a child that starts a grandchild in a new session, then exits: the grandchild is orphaned
         subprocess.run(["/usr/bin/python3", "-c", "import subprocess; subprocess.Popen(['sleep', '300'],"
                         " start_new_session=True)"], env=env, check=True)
         time.sleep(0.5)
-        self.assertEqual(len(pipeline.tagged_processes(tag)), 1)
-        self.assertEqual(pipeline.kill_tagged(tag), ["sleep"])
-        self.assertEqual(pipeline.tagged_processes(tag), [])
+        self.assertEqual(len(processes.tagged_processes(tag)), 1)
+        self.assertEqual(processes.kill_tagged(tag), ["sleep"])
+        self.assertEqual(processes.tagged_processes(tag), [])
 
 
 def all_tests():

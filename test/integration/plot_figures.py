@@ -20,20 +20,16 @@ import yaml
 from catkin.find_in_workspaces import find_in_workspaces
 from geometry_msgs.msg import PoseStamped, TwistStamped
 from lfd_msgs.msg import Phase, Touch
+from lfd_tools import figures
+from lfd_tools import report as report_records
 from matplotlib import image as mpimg
 from sensor_msgs.msg import JointState
 
 RATE_HZ = 100.0  # recording rate of the synthetic topics
 # (width, height) in pixels of each figure; a layout that crops or resizes the canvas fails here.
-SEGMENT_FIGURES = {
-    "skill_map": (1200, 700),
-    "correlation_best": (700, 600),
-    "correlation_all": (1200, 1000),
-    "relevance": (1300, 600),
-    "clasp_profile": (1200, 700),
-    "segmentation": (1200, 800),
-}
-REPORT_FIGURES = {"success_rates": (1000, 550)}
+SEGMENT_FIGURES = {kind: figures.size_px(kind) for kind in (
+    "skill_map", "correlation_best", "correlation_all", "relevance", "clasp_profile", "segmentation")}
+REPORT_FIGURES = {"success_rates": figures.size_px("success_rates")}
 
 
 def smoothstep(t, t0, duration):
@@ -198,10 +194,10 @@ class PlotFigures(unittest.TestCase):
         self.assertEqual(r.returncode, 0, r.stderr)
         png_checks(self, os.path.join(out, "success_rates.png"), "success_rates",
                    REPORT_FIGURES["success_rates"])
-        # evaluate_segmentation.py's own output (results.<dataset>.<method>) is accepted too.
-        evaluation = {"tolerance_s": 0.5, "results": {
-            "sim_push": {"weighted_product": {"success_rate": 0.75}, "average": {"success_rate": 0.5},
-                         "product": {"error": "the service failed"}}}}
+        # evaluate_segmentation.py's own output: the same records (lfd_tools.report), a failed method too.
+        evaluation = {"tolerance_s": 0.5, "segmentation": {"sim_push": report_records.segmentation_record(
+            {"weighted_product": {"success_rate": 0.75}, "average": {"success_rate": 0.5},
+             "product": {"error": "the service failed"}}, 0.5)}}
         with open(path, "w") as f:
             json.dump(evaluation, f)
         r = self.plot("--report", path, "--out", out, "--prefix", "eval_")

@@ -31,9 +31,7 @@ from lfd_msgs.msg import Phase
 from PIL import Image
 from sensor_msgs.msg import JointState
 
-# The Xvfb / roslaunch / screen-grab helpers of launch/scripts/rviz_screenshot.py.
-sys.path.insert(0, os.path.join(rospkg.RosPack().get_path("lfd_launch"), "scripts"))
-import rviz_screenshot  # noqa: E402
+from lfd_tools import rviz as rviz_screenshot  # the Xvfb / roslaunch / screen-grab helpers
 
 DRAW_TIMEOUT = 100.0  # s for rviz to start and draw under software GL on a loaded 2-core machine
 # Smallest pixel counts accepted (1280x1024 screen, lfd.rviz view). Measured on a correct

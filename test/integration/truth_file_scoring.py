@@ -5,22 +5,17 @@ Hand-made case: tiny bags (a two-part demo and a one-part demo) whose first stam
 ground-truth file in the documented format, and a stand-in segmenter returning chosen changepoint
 times. Checks the paper's success rule, Covering, margin F1 and time errors against values worked
 out by hand, and the labels.json converter. No master, no segmentation: a second or two."""
-import importlib.util
 import json
 import os
 import tempfile
 import unittest
 
 import rosbag
-import rospkg
 import rospy
 import rostest
+from lfd_tools import bags as lfd_bags
+from lfd_tools import segmentation_scoring
 from std_msgs.msg import Float64
-
-SCRIPT = os.path.join(rospkg.RosPack().get_path("lfd_segmentation"), "scripts", "evaluate_segmentation.py")
-spec = importlib.util.spec_from_file_location("evaluate_segmentation", SCRIPT)
-ev = importlib.util.module_from_spec(spec)
-spec.loader.exec_module(ev)
 
 
 def write_bag(path, t0, t1):
@@ -58,7 +53,7 @@ class TruthFileScoring(unittest.TestCase):
 
     def evaluate(self, changepoints, tolerance=0.5):
         seg = FakeSegmenter(changepoints)
-        out = ev.evaluate_truth_file(seg, ev.load_truth_file(self.truth), "product", tolerance)
+        out = segmentation_scoring.evaluate_truth_file(seg, lfd_bags.load_truth_file(self.truth), "product", tolerance)
         return seg, out
 
     def test_parts_are_joined_in_order_and_times_relative_to_the_first_bag(self):
@@ -105,18 +100,18 @@ class TruthFileScoring(unittest.TestCase):
         path = os.path.join(self.dir, "labels.json")
         with open(path, "w") as f:
             json.dump(labels, f)
-        demos = ev.truth_from_labels(path)["demos"]  # the single-part run has no boundary: left out
+        demos = lfd_bags.truth_from_labels(path)["demos"]  # the single-part run has no boundary: left out
         self.assertEqual([d["name"] for d in demos], ["r2"])
         self.assertEqual(demos[0]["bags"], [os.path.join(self.dir, "r2/p1.bag"), os.path.join(self.dir, "r2/p2.bag")])
         self.assertEqual(demos[0]["changepoints_s"], [4.5])
-        self.assertEqual([d["name"] for d in ev.truth_from_labels(path, ["r1", "r2"])["demos"]], ["r1", "r2"])
+        self.assertEqual([d["name"] for d in lfd_bags.truth_from_labels(path, ["r1", "r2"])["demos"]], ["r1", "r2"])
 
     def test_malformed_truth_file_gives_a_clear_error(self):
         bad = os.path.join(self.dir, "bad.yaml")
         with open(bad, "w") as f:
             f.write("demos:\n  - {name: a}\n")
         with self.assertRaisesRegex(RuntimeError, "needs 'bags' and 'changepoints_s'"):
-            ev.load_truth_file(bad)
+            lfd_bags.load_truth_file(bad)
 
 
 if __name__ == "__main__":

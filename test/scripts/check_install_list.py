@@ -192,8 +192,6 @@ def python_needs(path, needs, own_modules):
 def shell_commands(text):
     """Command lines (lists of words) of a shell script, roughly as bash sees them."""
     text = text.replace("\\\n", " ")
-    text = re.sub(r"\b\w+=\([^)]*\)", "", text)  # array assignments: words, not commands
-    text = re.sub(r"\bcommand -[vV] \S+", "true", text)  # a probe for an optional program
     functions = set(re.findall(r"^\s*([\w-]+)\s*\(\)", text, re.M))
     for line in text.splitlines():
         lex = shlex.shlex(line, posix=True, punctuation_chars=True)
@@ -203,8 +201,13 @@ def shell_commands(text):
             tokens = list(lex)
         except ValueError:  # an unbalanced quote on a line of a multi-line string
             continue
-        words, at_start, skip = [], True, False
+        words, at_start, skip, in_array = [], True, False, False
         for i, tok in enumerate(tokens):
+            if in_array or (tok in ("(", "()") and i > 0 and tokens[i - 1].endswith("=")):
+                in_array = (in_array or tok == "(") and tok != ")"  # `a=(x y)`: words, no command
+                continue
+            if at_start and tok == "command" and i + 1 < len(tokens) and tokens[i + 1] in ("-v", "-V"):
+                at_start, words = False, None  # `command -v X` looks X up, it does not run it
             if all(c in "();<>|&" for c in tok):
                 if set(tok) <= set("<>&") and ("<" in tok or ">" in tok):
                     skip = True  # a redirection: its target is no command
@@ -268,6 +271,9 @@ def collect_needs():
     needs = {"python_modules": {}, "programs": {}, "ros_packages": {}}
     own = ros_package_names()
     own_modules = own | {os.path.basename(f)[:-3] for f in project_files() if f.endswith(".py")}
+    # the project's Python packages (lfd_tools): folders with an __init__.py
+    own_modules |= {os.path.basename(os.path.dirname(f)) for f in project_files()
+                    if os.path.basename(f) == "__init__.py"}
     for f in sorted(project_files()):
         name = os.path.basename(f)
         if f.endswith(".py"):

@@ -22,7 +22,9 @@ struct DemoRecording {
 struct LearnOptions {
   std::string task;
   std::vector<std::string> features;       ///< selected segmentation features (stored)
-  std::vector<std::string> segment_names;  ///< optional; default "segment_<i>"
+  /// optional: the task's segment names, used only when the majority vote gives that many segments
+  /// (otherwise "segment_<i>" and a warning); default "segment_<i>"
+  std::vector<std::string> segment_names;
   lfd::DmpParameters params;
   /// s; Gaussian low-pass of every recorded pose before it is cut and learned (lfd::gaussianSmooth;
   /// 0 = off). Teleoperated demos carry tremor that the DMPs would otherwise replay.

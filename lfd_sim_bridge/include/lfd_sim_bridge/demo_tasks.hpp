@@ -39,10 +39,11 @@ TaskSetup loadTaskSetup(const std::string& path, const std::string& task, const 
 
 // Physical success of a demonstration (the evaluation protocol): grasp = the stick ends at least
 // `min_lift` above the table and within `tolerance` of its goal; push = the box ends within
-// `tolerance` of its target (horizontal distance).
+// `tolerance` of its target (horizontal distance). The numbers are config/evaluation.yaml's
+// `reproduction` block (the demonstrator node reads them); no defaults here, so none can differ.
 struct SuccessCriteria {
-  double tolerance = 0.03;
-  double min_lift = 0.10;
+  double tolerance = 0.0;  // m
+  double min_lift = 0.0;   // m above the table (grasp)
 };
 
 struct Outcome {
@@ -53,7 +54,7 @@ struct Outcome {
 };
 
 Outcome judge(const std::string& task, const Pose& object_end, const Pose& goal, double table_top,
-              const SuccessCriteria& criteria = SuccessCriteria());
+              const SuccessCriteria& criteria);
 
 }  // namespace demo
 }  // namespace lfd_sim_bridge

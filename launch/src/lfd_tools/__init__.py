@@ -1,0 +1,8 @@
+"""lfd_tools: what the lfd scripts share, each written once.
+
+  master   a private ROS master (roscore on a free port) and process-group shutdown
+  config   config/evaluation.yaml and config/tasks.yaml, read and checked
+  judge    the one judge of segmentation success and of physical success (pure Python)
+  bags     the bag and ground-truth readers (/lfd/phase, ground-truth files, demo outcomes)
+  report   the result records the producers write and report.json holds
+"""

@@ -1,0 +1,140 @@
+"""The readers of recorded data: ground truth on /lfd/phase, ground-truth files (for recordings
+without it), bag spans, and a demonstration's outcome (its metadata goal and the object's final
+pose, judged by lfd_tools.judge)."""
+import glob
+import json
+import os
+
+import rosbag
+
+from lfd_tools import config, judge
+
+PHASE_TOPIC = "/lfd/phase"
+METADATA_TOPIC = "/lfd/metadata"
+
+
+def list_bags(folder):
+    bags = sorted(glob.glob(os.path.join(folder, "*.bag")))
+    if not bags:
+        raise RuntimeError("no .bag files in %s" % folder)
+    return bags
+
+
+def bags_of(paths):
+    """Bags named, or found in the folders named."""
+    for p in paths:
+        if os.path.isdir(p):
+            yield from sorted(glob.glob(os.path.join(p, "*.bag")))
+        else:
+            yield p
+
+
+def bag_span(bag_path):
+    with rosbag.Bag(bag_path) as bag:
+        return bag.get_start_time(), bag.get_end_time()
+
+
+def phase_transitions(bag_path):
+    """(task, [(phase name, start time)]) from the ground-truth phase topic, in order."""
+    task, phases = None, []
+    with rosbag.Bag(bag_path) as bag:
+        for _, msg, t in bag.read_messages(topics=[PHASE_TOPIC]):
+            stamp = msg.header.stamp.to_sec() if msg.header.stamp.to_sec() > 0 else t.to_sec()
+            task = task or msg.task
+            if not phases or phases[-1][0] != msg.name:
+                phases.append((msg.name, stamp))
+    if not phases:
+        raise RuntimeError("%s has no %s ground truth" % (bag_path, PHASE_TOPIC))
+    return task, phases
+
+
+def ground_truth_changepoints(bag_path, expected):
+    """Bag times at which each expected transition's `to` phase starts (the demonstrator's segment
+    boundaries: grasp, the start of move; push, of push and return)."""
+    _, phases = phase_transitions(bag_path)
+    firsts = {}
+    for name, start in phases:
+        firsts.setdefault(name, start)
+    missing = [t["to"] for t in expected if t["to"] not in firsts]
+    if missing:
+        raise RuntimeError("%s: no %s message for phase(s) %s" % (bag_path, PHASE_TOPIC, missing))
+    return [firsts[t["to"]] for t in expected]
+
+
+# ---- ground-truth files ------------------------------------------------------------------------
+
+
+def load_truth_file(path):
+    """A ground-truth file (YAML or JSON: demos: [{name, bags, changepoints_s}]) as
+    [(name, [bag paths], [changepoint seconds from the first bag's start])]."""
+    return parse_truth(config.load_yaml(path), os.path.dirname(os.path.abspath(path)), path)
+
+
+def parse_truth(data, base, path):
+    """A ground-truth file's content; relative bag paths are taken from `base`."""
+    if not isinstance(data, dict) or not isinstance(data.get("demos"), list) or not data["demos"]:
+        raise RuntimeError("%s: expected a 'demos:' list (see evaluate_segmentation.py --help)" % path)
+    demos = []
+    for i, d in enumerate(data["demos"]):
+        if not isinstance(d, dict) or not d.get("bags") or "changepoints_s" not in d:
+            raise RuntimeError("%s: demo %d needs 'bags' and 'changepoints_s'" % (path, i))
+        bags = d["bags"] if isinstance(d["bags"], list) else [d["bags"]]
+        bags = [b if os.path.isabs(b) else os.path.join(base, b) for b in bags]
+        demos.append((str(d.get("name", i)), bags, sorted(float(t) for t in d["changepoints_s"])))
+    return demos
+
+
+def truth_from_labels(path, runs=None):
+    """A labels.json of phase-split runs (the pr2_ikea format: runs.<name>.parts[].file in order,
+    boundaries_rel = each next part's start from the run's first stamp) as a ground-truth file's
+    content. Without `runs`, every run split into two parts or more, in the file's order (a
+    single-part run has no labelled boundary)."""
+    with open(path) as f:
+        labels = json.load(f)
+    base = os.path.dirname(os.path.abspath(path))
+    names = runs or [n for n, r in labels["runs"].items() if len(r["parts"]) > 1]
+    demos = []
+    for name in names:
+        run = labels["runs"][name]
+        demos.append({"name": name, "bags": [os.path.join(base, p["file"]) for p in run["parts"]],
+                      "changepoints_s": list(run["boundaries_rel"])})
+    return {"demos": demos}
+
+
+# ---- a demonstration's physical outcome ----------------------------------------------------------
+
+
+def demo_outcome(path, evaluation):
+    """Physical success of a recorded demonstration, from its bag alone: the goal from its metadata
+    (the first message, /lfd/metadata extra_json) and the object's last pose, judged with the
+    task's criteria of evaluation.yaml. A dict: bag, task, mode, configuration, speed, success,
+    distance_m, height_m, duration, topics (name -> count), reason."""
+    result = {"bag": path, "success": False, "reason": ""}
+    try:
+        with rosbag.Bag(path) as bag:
+            info = bag.get_type_and_topic_info().topics
+            result["topics"] = {name: t.message_count for name, t in info.items()}
+            result["duration"] = bag.get_end_time() - bag.get_start_time()
+            first = next(bag.read_messages(), None)
+            if first is None or first.topic != METADATA_TOPIC:
+                result["reason"] = "the first message is not %s" % METADATA_TOPIC
+                return result
+            meta = first.message
+            extra = json.loads(meta.extra_json)
+            result.update(task=meta.task, mode=meta.mode, configuration=meta.configuration, speed=meta.speed)
+            criteria = config.criteria_of(evaluation, meta.task)
+            table_top = float(extra["table_top"])
+            last = None
+            for _, msg, _ in bag.read_messages(topics=["/objects/%s/pose" % criteria["object"]]):
+                last = msg
+    except (rosbag.ROSBagException, OSError, ValueError, KeyError, RuntimeError) as exc:
+        result["reason"] = "unreadable: %s" % exc
+        return result
+    if last is None:
+        result["reason"] = "no /objects/%s/pose message" % criteria["object"]
+        return result
+    p = last.pose.position
+    outcome = judge.physical_outcome(criteria, (p.x, p.y, p.z), extra["goal"]["position"], table_top)
+    result.update(success=outcome["success"], distance_m=outcome["distance_m"],
+                  height_m=outcome["height_m"], reason=outcome["reason"])
+    return result

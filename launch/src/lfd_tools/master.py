@@ -1,0 +1,143 @@
+"""A private ROS master for a stage, a client or a test, and clean shutdown of what it started."""
+import contextlib
+import os
+import signal
+import socket
+import subprocess
+import time
+
+START_TIMEOUT_S = 30.0
+PARAM_SERVER_GRACE_S = 1.0  # the parameter server answers a little after the port opens
+
+
+def free_port():
+    with socket.socket() as s:
+        s.bind(("localhost", 0))
+        return s.getsockname()[1]
+
+
+def master_uri(port):
+    return "http://localhost:%d" % port
+
+
+def port_open(port):
+    with socket.socket() as s:
+        return s.connect_ex(("localhost", port)) == 0
+
+
+def stop_group(proc, timeout):
+    """SIGINT a process group (roslaunch/roscore shut down cleanly on it), SIGKILL if it hangs."""
+    with contextlib.suppress(ProcessLookupError):
+        os.killpg(proc.pid, signal.SIGINT)
+    try:
+        proc.wait(timeout=timeout)
+    except subprocess.TimeoutExpired:
+        with contextlib.suppress(ProcessLookupError):
+            os.killpg(proc.pid, signal.SIGKILL)
+        proc.wait()
+
+
+def master_online(env=None):
+    """Whether a master answers at ROS_MASTER_URI of `env` (default: this process's)."""
+    import rosgraph
+    uri = (env or os.environ).get("ROS_MASTER_URI")
+    return bool(uri) and rosgraph.is_master_online(uri)
+
+
+@contextlib.contextmanager
+def private_master():
+    """A roscore on a free port; yields a copy of os.environ whose ROS_MASTER_URI points to it.
+    The master (and whatever it started) is stopped on exit."""
+    port = free_port()
+    env = dict(os.environ, ROS_MASTER_URI=master_uri(port))
+    core = subprocess.Popen(["roscore", "-p", str(port)], env=env, stdout=subprocess.DEVNULL,
+                            stderr=subprocess.DEVNULL, start_new_session=True)
+    try:
+        deadline = time.time() + START_TIMEOUT_S
+        while not port_open(port):
+            if core.poll() is not None:
+                raise RuntimeError("roscore exited at start (port %d)" % port)
+            if time.time() > deadline:
+                raise RuntimeError("roscore did not come up on port %d" % port)
+            time.sleep(0.2)
+        time.sleep(PARAM_SERVER_GRACE_S)
+        yield env
+    finally:
+        stop_group(core, 15)
+
+
+@contextlib.contextmanager
+def master_for_this_process():
+    """The master of ROS_MASTER_URI when one answers, else a private one that this process (and
+    what it starts) uses until the block ends."""
+    if master_online():
+        yield os.environ
+        return
+    previous = os.environ.get("ROS_MASTER_URI")
+    with private_master() as env:
+        os.environ["ROS_MASTER_URI"] = env["ROS_MASTER_URI"]
+        try:
+            yield os.environ
+        finally:
+            if previous is None:
+                os.environ.pop("ROS_MASTER_URI", None)
+            else:
+                os.environ["ROS_MASTER_URI"] = previous
+
+
+@contextlib.contextmanager
+def background_launch(cmd, env, stdout=subprocess.DEVNULL):
+    """A roslaunch (or any command) in the background, in a session of its own, for the block."""
+    print("[lfd] $ %s &" % " ".join(cmd), flush=True)
+    proc = subprocess.Popen(cmd, env=env, start_new_session=True, stdout=stdout)
+    try:
+        yield proc
+    finally:
+        stop_group(proc, 20)
+
+
+@contextlib.contextmanager
+def graph_for_this_process(launch_args, attach):
+    """With `attach`, the nodes running at ROS_MASTER_URI (an error when no master answers); else a
+    private master with `roslaunch <launch_args>` on it, used by this process until the block ends
+    (never another run's master that happens to answer on the default port)."""
+    if attach:
+        if not master_online():
+            raise RuntimeError("no ROS master answers at %s (--attach)" % os.environ.get("ROS_MASTER_URI"))
+        yield
+        return
+    previous = os.environ.get("ROS_MASTER_URI")
+    with private_master() as env:
+        os.environ["ROS_MASTER_URI"] = env["ROS_MASTER_URI"]
+        try:
+            with background_launch(["roslaunch"] + list(launch_args), env):
+                yield
+        finally:
+            os.environ.pop("ROS_MASTER_URI", None)
+            if previous is not None:
+                os.environ["ROS_MASTER_URI"] = previous
+
+
+def wait_for_param(name, timeout):
+    """Waits until the parameter exists (e.g. /use_sim_time, which rospy reads once, at init)."""
+    import rosgraph
+    master, deadline = rosgraph.Master("/lfd_tools_probe"), time.time() + timeout
+    while not master.hasParam(name):
+        if time.time() > deadline:
+            raise RuntimeError("parameter %s never set (is the launch running?)" % name)
+        time.sleep(0.2)
+
+
+def service_proxies(node_name, services, timeout=120.0):
+    """Starts this process's rospy node and returns {name: ServiceProxy} once every service of
+    {name: type} answers. Ctrl-C raises KeyboardInterrupt (signals stay Python's)."""
+    import rospy
+    rospy.init_node(node_name, anonymous=True, disable_signals=True)
+    proxies = {}
+    for name, typ in services.items():
+        try:
+            rospy.wait_for_service(name, timeout=timeout)
+        except rospy.ROSException:
+            raise RuntimeError("service %s did not come up within %.0f s" % (name, timeout))
+        proxies[name] = rospy.ServiceProxy(name, typ)
+    return proxies
