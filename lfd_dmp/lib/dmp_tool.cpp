@@ -4,6 +4,7 @@
 #include "lfd_dmp/trajectory_csv.hpp"
 
 #include <lfd_core/dmp_generalization.hpp>
+#include <lfd_core/safe_paths.hpp>
 
 #include <cmath>
 #include <cstdlib>
@@ -18,10 +19,11 @@ namespace {
 
 constexpr const char* kUsage =
     "usage:\n"
-    "  dmp_tool learn   --csv demo.csv --out skill.json [--task NAME] [--basis N]\n"
+    "  dmp_tool learn   --csv demo.csv --out skill.json [--task NAME] [--basis N] [--overwrite]\n"
     "                   [--time-column NAME] [--gripper-column NAME]\n"
     "  dmp_tool rollout --library skill.json --out traj.csv [--segment I] [--demo J | "
     "--generalize]\n"
+    "                   [--overwrite]\n"
     "                   [--start x,y,..] [--goal x,y,..] [--start-quat w,x,y,z] [--goal-quat "
     "w,x,y,z]\n"
     "                   [--start-gripper v] [--goal-gripper v] [--tau s] [--dt s] [--duration s]\n"
@@ -82,9 +84,11 @@ std::optional<double> optNumber(const Options& o, const std::string& key) {
 
 int learn(const std::vector<std::string>& args, std::ostream& out) {
   const Options o =
-      parse(args, {"--csv", "--out", "--task", "--basis", "--time-column", "--gripper-column"}, {});
+      parse(args, {"--csv", "--out", "--task", "--basis", "--time-column", "--gripper-column"},
+            {"--overwrite"});
   const std::string csv = required(o, "--csv");
-  const std::string path = required(o, "--out");
+  const bool overwrite = o.count("--overwrite") > 0;
+  const std::string path = lfd::checkOutputFile(required(o, "--out"), {}, overwrite, {csv});
   CsvColumns cols;
   if (o.count("--time-column")) cols.time = o.at("--time-column");
   if (o.count("--gripper-column")) cols.gripper = o.at("--gripper-column");
@@ -114,7 +118,7 @@ int learn(const std::vector<std::string>& args, std::ostream& out) {
   seg.name = "segment_0";
   seg.demos.push_back(std::move(skill));
   lib.segments.push_back(std::move(seg));
-  saveSkillLibrary(lib, path);
+  saveSkillLibrary(lib, path, overwrite);
   out << "learned a DMP from " << traj.demo.times.size() << " samples ("
       << traj.demo.positions.cols() << " position dims"
       << (traj.demo.quaternions.cols() ? ", orientation" : "")
@@ -127,9 +131,12 @@ int rollout(const std::vector<std::string>& args, std::ostream& out) {
                           {"--library", "--out", "--segment", "--demo", "--start", "--goal",
                            "--start-quat", "--goal-quat", "--start-gripper", "--goal-gripper",
                            "--tau", "--dt", "--duration", "--goal-filter"},
-                          {"--generalize"});
-  const SkillLibrary lib = loadSkillLibrary(required(o, "--library"));
-  const std::string path = required(o, "--out");
+                          {"--generalize", "--overwrite"});
+  const std::string library_path = required(o, "--library");
+  const bool overwrite = o.count("--overwrite") > 0;
+  const std::string path =
+      lfd::checkOutputFile(required(o, "--out"), {}, overwrite, {library_path});
+  const SkillLibrary lib = loadSkillLibrary(library_path);
   const int seg_index = static_cast<int>(optNumber(o, "--segment").value_or(0));
   if (seg_index < 0 || seg_index >= static_cast<int>(lib.segments.size())) {
     throw UsageError("--segment " + std::to_string(seg_index) + " out of range (library has " +
@@ -191,7 +198,7 @@ int rollout(const std::vector<std::string>& args, std::ostream& out) {
     for (Eigen::Index d = 0; d < traj.positions.cols(); ++d)
       names.push_back("p" + std::to_string(d));
   }
-  writeTrajectoryCsv(path, traj, names);
+  writeTrajectoryCsv(path, traj, names, overwrite);
   out << "rolled out " << traj.times.size() << " steps -> " << path << "\n";
   return 0;
 }

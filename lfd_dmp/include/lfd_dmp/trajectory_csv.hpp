@@ -23,8 +23,9 @@ struct CsvTrajectory {
 /// header, ragged row, non-numeric or non-finite value, partial quaternion columns).
 CsvTrajectory readTrajectoryCsv(const std::string& path, const CsvColumns& columns = {});
 
-/// Writes t, the position columns, qw,qx,qy,qz (if any) and gripper (if any).
+/// Writes t, the position columns, qw,qx,qy,qz (if any) and gripper (if any), atomically; an
+/// existing file is kept (std::invalid_argument) unless `overwrite`.
 void writeTrajectoryCsv(const std::string& path, const lfd::SegmentTrajectory& trajectory,
-                        const std::vector<std::string>& position_names);
+                        const std::vector<std::string>& position_names, bool overwrite);
 
 }  // namespace lfd_dmp
