@@ -28,7 +28,13 @@ constexpr const char* kUsage =
     "w,x,y,z]\n"
     "                   [--start-gripper v] [--goal-gripper v] [--tau s] [--dt s] [--duration s]\n"
     "                   [--goal-filter rate]\n"
-    "  dmp_tool info    --library skill.json\n";
+    "  dmp_tool info    --library skill.json\n"
+    "limits: --basis in [2, 1000]; a rollout holds at most 1000000 samples (duration / dt)\n";
+
+// Bounds of one command (a CLI has no parameter server; the learner's are ~limits in
+// config/learner.yaml): work and memory stay bounded whatever the arguments.
+constexpr int kMaxBasis = 1000;                   // as ~limits/max_num_basis
+constexpr double kMaxRolloutSamples = 1000000.0;  // 1000 s at 1 ms: ~120 MB of rows
 
 struct UsageError : std::runtime_error {
   using std::runtime_error::runtime_error;
@@ -99,6 +105,9 @@ int learn(const std::vector<std::string>& args, std::ostream& out) {
   lib.position_names = traj.position_names;
   if (const auto basis = optNumber(o, "--basis")) {
     if (*basis != std::floor(*basis)) throw UsageError("--basis must be an integer");
+    if (*basis > kMaxBasis || *basis < 2) {
+      throw UsageError("--basis must be in [2, " + std::to_string(kMaxBasis) + "] (the limit)");
+    }
     lib.dmp_parameters.num_basis = static_cast<int>(*basis);
   }
   lib.generalization_parameters = traj.demo.positions.cols() > 0 ? "goal_position" : "none";
@@ -185,6 +194,11 @@ int rollout(const std::vector<std::string>& args, std::ostream& out) {
                        std::to_string(seg.demos.size()) + " demos)");
     }
     dmp = seg.demos[static_cast<size_t>(demo)].dmp;
+  }
+  const double samples = ro.duration.value_or(ro.tau.value_or(dmp.tau)) / ro.dt;
+  if (!(samples <= kMaxRolloutSamples)) {
+    throw UsageError("the rollout would hold " + std::to_string(samples) +
+                     " samples (duration / dt), over the limit of 1000000");
   }
   lfd::SegmentTrajectory traj;
   try {

@@ -94,6 +94,10 @@ CsvTrajectory readTrajectoryCsv(const std::string& path, const CsvColumns& colum
   while (std::getline(in, line)) {
     ++line_no;
     if (trim(line).empty()) continue;
+    if (rows.size() >= columns.max_rows) {
+      throw std::runtime_error(path + ": more than " + std::to_string(columns.max_rows) +
+                               " data rows (the row limit)");
+    }
     const std::vector<std::string> fields = splitCsv(line);
     if (fields.size() != header.size()) {
       throw std::runtime_error(path + ": line " + std::to_string(line_no) + " has " +
@@ -109,6 +113,10 @@ CsvTrajectory readTrajectoryCsv(const std::string& path, const CsvColumns& colum
       if (fields[c].empty() || end == begin || *end != '\0' || !std::isfinite(v)) {
         throw std::runtime_error(path + ": line " + std::to_string(line_no) + ", column \"" +
                                  header[c] + "\": \"" + fields[c] + "\" is not a finite number");
+      }
+      if (std::abs(v) > columns.max_abs_value) {
+        throw std::runtime_error(path + ": line " + std::to_string(line_no) + ", column \"" +
+                                 header[c] + "\": " + fields[c] + " is beyond +-1e100");
       }
       row[c] = v;
     }
