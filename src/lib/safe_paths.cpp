@@ -47,7 +47,6 @@ bool isInside(const fs::path& resolved, const fs::path& root) {
 // `resolved` is canonical (symlinks followed), so a link out of a root does not pass.
 void checkRoots(const std::string& path, const fs::path& resolved, const PathPolicy& policy) {
   if (policy.allowed_roots.empty()) return;
-  if (hasParentReference(path)) refuse(path, "'..' is not allowed in request paths");
   std::string roots;
   for (const std::string& root : policy.allowed_roots) {
     const fs::path r = fs::weakly_canonical(fs::absolute(expandHome(root)));
@@ -55,6 +54,12 @@ void checkRoots(const std::string& path, const fs::path& resolved, const PathPol
     roots += (roots.empty() ? "" : ", ") + r.string();
   }
   refuse(path, "outside the allowed roots (allowed_roots: " + roots + ")");
+}
+
+// Checked first: a request path with ".." is refused whether or not its target exists.
+void checkParentReferences(const std::string& path, const PathPolicy& policy) {
+  if (!policy.allowed_roots.empty() && hasParentReference(path))
+    refuse(path, "'..' is not allowed in request paths");
 }
 
 const char* typeName(mode_t mode) {
@@ -69,6 +74,7 @@ const char* typeName(mode_t mode) {
 
 std::string checkInputFile(const std::string& path, const PathPolicy& policy) {
   if (path.empty()) throw std::invalid_argument("empty file path");
+  checkParentReferences(path, policy);
   struct stat st {};
   if (::stat(path.c_str(), &st) != 0) refuse(path, std::strerror(errno));
   if (!S_ISREG(st.st_mode)) refuse(path, std::string(typeName(st.st_mode)) + ", not a regular file");
@@ -80,6 +86,7 @@ std::string checkInputFile(const std::string& path, const PathPolicy& policy) {
 std::string checkOutputFile(const std::string& path, const PathPolicy& policy, bool overwrite,
                             const std::vector<std::string>& inputs) {
   if (path.empty()) throw std::invalid_argument("empty output path");
+  checkParentReferences(path, policy);
   const fs::path absolute = fs::absolute(path);
   if (!absolute.has_filename()) refuse(path, "names a folder, not a file");
   const fs::path folder = absolute.parent_path();
