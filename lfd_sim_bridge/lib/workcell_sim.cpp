@@ -559,7 +559,8 @@ void WorkcellSim::reset(const std::map<std::string, double>& posture, bool reset
 
 void WorkcellSim::checkObjectPose(const std::string& object, const Pose& pose) const {
   if (std::none_of(objects_.begin(), objects_.end(), [&](const auto& o) { return o.first == object; }))
-    throw std::invalid_argument("unknown object '" + object + "'");
+    throw std::invalid_argument("unknown object '" + object.substr(0, 64) +
+                                (object.size() > 64 ? "...'" : "'"));
   for (int i = 0; i < 3; ++i) {
     const double v = pose.position[i];
     if (!std::isfinite(v)) throw std::invalid_argument("non-finite position for " + object);
