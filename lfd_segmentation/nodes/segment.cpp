@@ -259,6 +259,10 @@ int main(int argc, char** argv) {
     std::cerr << "segment: error: " << e.what() << "\n";
     out = {{"success", false}, {"error", e.what()}};
     status = 1;
+    // A command line that did not parse still names its --output: the error goes there, where
+    // the caller reads the answer (not a stale file of an earlier run).
+    for (int k = 1; options.output.empty() && k + 1 < argc; ++k)
+      if (std::string(argv[k]) == "--output") options.output = argv[k + 1];
   }
   const std::string text = out.dump(1);
   if (!options.output.empty()) {

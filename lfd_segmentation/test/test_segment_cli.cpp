@@ -44,6 +44,7 @@ std::size_t write_demo_csv(const std::string& path, int n, unsigned seed) {
 
 nlohmann::json run_cli(const std::string& args, int* status, const std::string& prefix = "") {
   const std::string out = (temp_dir() / "out.json").string();
+  fs::remove(out);  // a run that writes nothing must not be judged by the previous JSON
   const std::string cmd =
       prefix + std::string(SEGMENT_CLI) + " " + args + " --output " + out + " 2>/dev/null";
   const int rc = std::system(cmd.c_str());
@@ -189,6 +190,50 @@ TEST(SegmentCli, RefusesAPipeAndNeverWritesOverAnInput) {
     EXPECT_EQ(status, 1) << bad;
     EXPECT_FALSE(j["success"].get<bool>()) << bad;
   }
+}
+
+
+// Property test of the CLI (issue 12): 40 seeded random command lines of extreme values and bad
+// files. Each run ends (under `timeout`) with exit 0 and a result or exit 1 and an error in the JSON,
+// never a crash, and the input CSV keeps its bytes. About 2 s.
+TEST(SegmentCli, RandomExtremeCommandLinesGiveAResultOrAClearError) {
+  const fs::path dir = temp_dir() / "fuzz";
+  fs::create_directories(dir);
+  const std::string csv = (dir / "demo.csv").string();
+  write_demo_csv(csv, 400, 5);
+  const std::string fifo = (dir / "pipe.csv").string();
+  ::mkfifo(fifo.c_str(), 0600);
+  std::ifstream before_in(csv);
+  const std::string before((std::istreambuf_iterator<char>(before_in)), {});
+  const std::vector<std::string> files = {csv, csv, fifo, dir.string(), "/dev/null",
+                                          (dir / "missing.csv").string(), "''"};
+  const std::vector<std::string> flags = {"--rate", "--threshold", "--min-segment-seconds",
+                                          "--window-seconds", "--num-changepoints", "--threads"};
+  const std::vector<std::string> values = {"0", "-1", "0.5", "2", "1e300", "-1e300", "1e-300",
+                                           "inf", "nan", "99999999999", "x", "''"};
+  std::mt19937 rng(12);
+  for (int k = 0; k < 40; ++k) {
+    std::string args;
+    const int n_files = 1 + static_cast<int>(rng() % 3);
+    for (int f = 0; f < n_files; ++f) args += " " + files[rng() % files.size()];
+    for (int f = static_cast<int>(rng() % 3); f > 0; --f)
+      args += " " + flags[rng() % flags.size()] + " " + values[rng() % values.size()];
+    if (rng() % 3 == 0) args += " --sensor-columns touch";
+    int status = -1;
+    nlohmann::json j;
+    try {
+      j = run_cli(args, &status, "timeout 20 ");
+    } catch (const std::exception& e) {
+      ADD_FAILURE() << args << ": no JSON (" << e.what() << ")";
+      continue;
+    }
+    EXPECT_TRUE(status == 0 || status == 1) << args << " exit " << status;
+    EXPECT_EQ(j["success"].get<bool>(), status == 0) << args;
+    if (status != 0) EXPECT_FALSE(j["error"].get<std::string>().empty()) << args;
+    std::ifstream after_in(csv);
+    ASSERT_EQ(std::string((std::istreambuf_iterator<char>(after_in)), {}), before) << args;
+  }
+  fs::remove_all(dir);
 }
 
 }  // namespace

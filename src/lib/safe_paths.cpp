@@ -99,10 +99,13 @@ std::string checkOutputFile(const std::string& path, const PathPolicy& policy, b
   struct stat out {};
   const bool exists = ::stat(resolved.c_str(), &out) == 0;
   for (const std::string& input : inputs) {
+    if (input.empty()) continue;  // names no file
     struct stat in {};
     const bool same_inode = exists && ::stat(input.c_str(), &in) == 0 &&
                             in.st_dev == out.st_dev && in.st_ino == out.st_ino;
-    if (same_inode || fs::weakly_canonical(fs::absolute(input)) == resolved) {
+    std::error_code ec;
+    const fs::path input_path = fs::weakly_canonical(fs::absolute(input, ec), ec);
+    if (same_inode || (!ec && input_path == resolved)) {
       refuse(path, "is one of the request's inputs; refusing to overwrite it");
     }
   }
