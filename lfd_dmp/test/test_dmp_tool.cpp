@@ -208,13 +208,6 @@ TEST(DmpTool, BadInputGivesClearErrors) {
 }
 
 
-// catkin_add_gtest links gtest without gtest_main (and the static gtest_main archive is then simply
-// not pulled in by the standalone build).
-int main(int argc, char** argv) {
-  ::testing::InitGoogleTest(&argc, argv);
-  return RUN_ALL_TESTS();
-}
-
 std::string fileText(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
@@ -274,3 +267,10 @@ TEST(DmpTool, RefusesANamedPipeWithoutBlocking) {
 }
 
 }  // namespace
+
+// catkin_add_gtest links gtest without gtest_main (and the static gtest_main archive is then simply
+// not pulled in by the standalone build).
+int main(int argc, char** argv) {
+  ::testing::InitGoogleTest(&argc, argv);
+  return RUN_ALL_TESTS();
+}
