@@ -74,8 +74,7 @@ class Learner {
                                     std::to_string(max_bags_) + " (~limits/max_bags)");
       }
       for (const auto& b : bags) lfd::checkInputFile(b, paths_);
-      const std::string output =
-          lfd::checkOutputFile(req.output_path, paths_, req.overwrite, bags);
+      const std::string output = lfd::checkOutputFile(req.output_path, paths_, req.overwrite, bags);
       std::vector<lfd_dmp::DemoRecording> demos;
       for (const auto& b : bags) {
         demos.push_back(lfd_dmp::readDemoBag(b, topics_));

@@ -107,9 +107,10 @@ TEST(DmpTool, LearnsWithHundredsOfBasisFunctions) {
     std::ostringstream dt;
     dt.precision(17);
     dt << 2.0 / 1199;
-    ASSERT_EQ(run({"rollout", "--library", json, "--out", traj_csv, "--dt", dt.str(), "--overwrite"},
-                  &out, &err),
-              0)
+    ASSERT_EQ(
+        run({"rollout", "--library", json, "--out", traj_csv, "--dt", dt.str(), "--overwrite"},
+            &out, &err),
+        0)
         << err;
     const lfd_dmp::CsvTrajectory again = lfd_dmp::readTrajectoryCsv(traj_csv);
     const lfd_dmp::CsvTrajectory demo = lfd_dmp::readTrajectoryCsv(csv);
@@ -206,7 +207,6 @@ TEST(DmpTool, BadInputGivesClearErrors) {
       2);
   for (const auto& p : {csv, json, good_csv}) std::remove(p.c_str());
 }
-
 
 std::string fileText(const std::string& path) {
   std::ifstream in(path, std::ios::binary);

@@ -7,8 +7,8 @@
 #include "lfd_dmp/skill_library.hpp"
 #include "lfd_dmp/trajectory_csv.hpp"
 
-#include <gtest/gtest.h>
 #include <fcntl.h>
+#include <gtest/gtest.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -60,6 +60,7 @@ class DmpToolFuzz : public ::testing::Test {
 TEST_F(DmpToolFuzz, RandomExtremeCommandsGiveAResultOrAClearError) {
   constexpr int kCommands = 1500;
   std::mt19937 rng(12);
+  // clang-format off
   const std::vector<std::string> numbers = {
       "0", "-1", "1", "2", "0.005", "1e-12", "1e-300", "1e300", "-1e300", "nan", "inf", "-inf",
       "300", "1001", "4294967296", "", "abc", "1,2", "0.7,0.02,0.85", "1,2,3,4", "0,0,0,0",
@@ -72,6 +73,7 @@ TEST_F(DmpToolFuzz, RandomExtremeCommandsGiveAResultOrAClearError) {
                                                  "--goal", "--start-quat", "--goal-quat",
                                                  "--start-gripper", "--goal-gripper", "--tau",
                                                  "--dt", "--duration", "--goal-filter"};
+  // clang-format on
   const std::string csv_bytes = readAll(csv_), library_bytes = readAll(library_);
   auto pick = [&](const std::vector<std::string>& v) { return v[rng() % v.size()]; };
   const auto t0 = std::chrono::steady_clock::now();

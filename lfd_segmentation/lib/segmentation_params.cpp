@@ -41,7 +41,9 @@ std::string number(double v) {
   return out.str();
 }
 
-std::string seconds(double s) { return number(s) + " s"; }
+std::string seconds(double s) {
+  return number(s) + " s";
+}
 
 TopicConfig parse_topic(const YAML::Node& node, std::size_t index) {
   const std::string where = "topics[" + std::to_string(index) + "]";
@@ -203,13 +205,13 @@ SegmentationParams load_params_file(const std::string& path) {
 void check_seconds_override(double value, const std::string& key, const RequestLimits& limits) {
   if (value == 0) return;  // 0 = keep the parameter
   if (!std::isfinite(value) || value > limits.max_demo_seconds) {
-    throw std::invalid_argument(key + " = " + seconds(value) + " is not a duration a demo can have (limit " +
+    throw std::invalid_argument(key + " = " + seconds(value) +
+                                " is not a duration a demo can have (limit " +
                                 seconds(limits.max_demo_seconds) + ", limits/max_demo_seconds)");
   }
 }
 
-void check_demos_fit(const SegmentationParams& params,
-                     const std::vector<lfd::FeatureMatrix>& demos,
+void check_demos_fit(const SegmentationParams& params, const std::vector<lfd::FeatureMatrix>& demos,
                      const std::vector<std::string>& sources) {
   const RequestLimits& lim = params.limits;
   std::size_t total = 0;
@@ -227,9 +229,10 @@ void check_demos_fit(const SegmentationParams& params,
     if (rows < 2) continue;
     const double length = m.time_at(m.rows() - 1) - m.time_at(0);
     if (params.window_seconds > 0 && params.window_seconds >= length) {
-      throw std::invalid_argument("window_seconds = " + seconds(params.window_seconds) +
-                                  " is not shorter than '" + source + "' (" + seconds(length) +
-                                  "): the window covers the whole demo, no changepoint can be found");
+      throw std::invalid_argument(
+          "window_seconds = " + seconds(params.window_seconds) + " is not shorter than '" + source +
+          "' (" + seconds(length) +
+          "): the window covers the whole demo, no changepoint can be found");
     }
   }
   if (total > lim.max_total_samples) {
@@ -246,16 +249,17 @@ void check_streams(const std::vector<lfd::Stream>& streams, const std::string& s
     if (!s.time.empty()) {
       const auto [first, last] = std::minmax_element(s.time.begin(), s.time.end());
       if (*last - *first > limits.max_demo_seconds) {
-        throw std::invalid_argument(
-            "'" + source + "': " + s.name + " has stamps " + seconds(*last - *first) +
-            " apart (first " + seconds(*first) + ", last " + seconds(*last) + "), over the limit of " +
-            seconds(limits.max_demo_seconds) + " (limits/max_demo_seconds)");
+        throw std::invalid_argument("'" + source + "': " + s.name + " has stamps " +
+                                    seconds(*last - *first) + " apart (first " + seconds(*first) +
+                                    ", last " + seconds(*last) + "), over the limit of " +
+                                    seconds(limits.max_demo_seconds) +
+                                    " (limits/max_demo_seconds)");
       }
     }
     for (std::size_t k = 0; k < s.values.size(); ++k) {
       if (std::abs(s.values[k]) > limits.max_abs_value) {
-        throw std::invalid_argument("'" + source + "': " + s.name + " = " + number(s.values[k]) + " at t = " +
-                                    seconds(k < s.time.size() ? s.time[k] : 0.0) +
+        throw std::invalid_argument("'" + source + "': " + s.name + " = " + number(s.values[k]) +
+                                    " at t = " + seconds(k < s.time.size() ? s.time[k] : 0.0) +
                                     " is beyond +-" + number(limits.max_abs_value) +
                                     " (limits/max_abs_value): distances would overflow");
       }

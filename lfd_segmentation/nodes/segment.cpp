@@ -191,8 +191,7 @@ nlohmann::json run(const Options& o) {
       if (demos.empty() && o.states.empty()) states = demo.state_features;
       demos.push_back(std::move(demo.matrix));
     } else {
-      demos.push_back(
-          lfd_segmentation::read_csv_features(f, o.time_column, o.rate, params.limits));
+      demos.push_back(lfd_segmentation::read_csv_features(f, o.time_column, o.rate, params.limits));
       if (demos.back().time.empty())
         throw std::invalid_argument(
             "CSV file '" + f +

@@ -137,7 +137,6 @@ TEST(CsvFeatures, ParsesHeaderTimeAndRejectsRaggedRows) {
   EXPECT_EQ(rated.time, (std::vector<double>{0.0}));
 }
 
-
 // Issue 12: a 10M-row CSV took 1.9 GB and no result in 300 s; +-1e308 overflowed the distances.
 TEST(CsvFeatures, LimitsStopTheReadAndNameRowAndColumn) {
   const std::string csv = (temp_dir() / "limits.csv").string();
@@ -179,7 +178,8 @@ TEST(SegmentCli, RefusesAPipeAndNeverWritesOverAnInput) {
   write_demo_csv(csv, 300, 3);
   std::ifstream before_in(csv);
   const std::string before((std::istreambuf_iterator<char>(before_in)), {});
-  const std::string cmd = std::string(SEGMENT_CLI) + " " + csv + " --output " + csv + " 2>/dev/null";
+  const std::string cmd =
+      std::string(SEGMENT_CLI) + " " + csv + " --output " + csv + " 2>/dev/null";
   EXPECT_NE(std::system(cmd.c_str()), 0);
   std::ifstream after_in(csv);
   EXPECT_EQ(std::string((std::istreambuf_iterator<char>(after_in)), {}), before);
@@ -192,10 +192,9 @@ TEST(SegmentCli, RefusesAPipeAndNeverWritesOverAnInput) {
   }
 }
 
-
 // Property test of the CLI (issue 12): 40 seeded random command lines of extreme values and bad
-// files. Each run ends (under `timeout`) with exit 0 and a result or exit 1 and an error in the JSON,
-// never a crash, and the input CSV keeps its bytes. About 2 s.
+// files. Each run ends (under `timeout`) with exit 0 and a result or exit 1 and an error in the
+// JSON, never a crash, and the input CSV keeps its bytes. About 2 s.
 TEST(SegmentCli, RandomExtremeCommandLinesGiveAResultOrAClearError) {
   const fs::path dir = temp_dir() / "fuzz";
   fs::create_directories(dir);
@@ -205,12 +204,13 @@ TEST(SegmentCli, RandomExtremeCommandLinesGiveAResultOrAClearError) {
   ::mkfifo(fifo.c_str(), 0600);
   std::ifstream before_in(csv);
   const std::string before((std::istreambuf_iterator<char>(before_in)), {});
-  const std::vector<std::string> files = {csv, csv, fifo, dir.string(), "/dev/null",
-                                          (dir / "missing.csv").string(), "''"};
-  const std::vector<std::string> flags = {"--rate", "--threshold", "--min-segment-seconds",
-                                          "--window-seconds", "--num-changepoints", "--threads"};
-  const std::vector<std::string> values = {"0", "-1", "0.5", "2", "1e300", "-1e300", "1e-300",
-                                           "inf", "nan", "99999999999", "x", "''"};
+  const std::vector<std::string> files = {
+      csv, csv, fifo, dir.string(), "/dev/null", (dir / "missing.csv").string(), "''"};
+  const std::vector<std::string> flags = {
+      "--rate",           "--threshold",        "--min-segment-seconds",
+      "--window-seconds", "--num-changepoints", "--threads"};
+  const std::vector<std::string> values = {"0",      "-1",  "0.5", "2",           "1e300", "-1e300",
+                                           "1e-300", "inf", "nan", "99999999999", "x",     "''"};
   std::mt19937 rng(12);
   for (int k = 0; k < 40; ++k) {
     std::string args;

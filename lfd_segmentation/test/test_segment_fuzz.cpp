@@ -5,8 +5,8 @@
 // error or a sane result (changepoints inside the demo, finite times), no request may take long,
 // the bags keep their bytes, and a valid request succeeds at the end. 200 requests, seed 12;
 // about 1 s.
-#include <gtest/gtest.h>
 #include <fcntl.h>
+#include <gtest/gtest.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -58,19 +58,19 @@ TEST(SegmentServiceFuzz, RandomExtremeRequestsGiveAResultOrAClearError) {
   const std::string fifo = (dir / "pipe.bag").string();
   ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
   std::vector<std::string> paths = good;
-  for (const std::string& p : {late_bag, huge_bag, corrupt, fifo, dir.string(),
-                               std::string("/dev/zero"), std::string(""),
-                               (dir / "missing.bag").string(), (dir / ".." / "x.bag").string(),
-                               (dir / std::string(4000, 'b')).string(), std::string("/etc/passwd"),
-                               good[0] + "," + good[1]})
+  for (const std::string& p :
+       {late_bag, huge_bag, corrupt, fifo, dir.string(), std::string("/dev/zero"), std::string(""),
+        (dir / "missing.bag").string(), (dir / ".." / "x.bag").string(),
+        (dir / std::string(4000, 'b')).string(), std::string("/etc/passwd"),
+        good[0] + "," + good[1]})
     paths.push_back(p);
   std::vector<std::string> bytes;
   for (const std::string& g : good) bytes.push_back(readAll(g));
 
   const double inf = std::numeric_limits<double>::infinity();
   const double nan = std::numeric_limits<double>::quiet_NaN();
-  const std::vector<double> numbers = {0, -1, 0.5, 1, 2, 3, 60, 1e300, -1e300, 1e-300, inf, -inf,
-                                       nan};
+  const std::vector<double> numbers = {0,     -1,     0.5,    1,   2,    3,  60,
+                                       1e300, -1e300, 1e-300, inf, -inf, nan};
   const std::vector<int> counts = {0, -1, 1, 2, 16, 17, 1000000, std::numeric_limits<int>::max()};
   std::mt19937 rng(12);
   auto pick = [&](const auto& v) { return v[rng() % v.size()]; };

@@ -171,7 +171,6 @@ TEST_F(SegmentService, FeaturesThatDifferBetweenDemos) {
   expect_error(call({good_bags(1)[0], bag("other_touch", o)}), "features differ");
 }
 
-
 // Issue 12: a named pipe as a bag path blocked the node in open() forever. If the code under test
 // blocks, the test opens the pipe's other end itself so it can fail instead of hanging.
 TEST_F(SegmentService, NamedPipeIsRefusedAtOnce) {
@@ -234,8 +233,8 @@ TEST_F(SegmentService, ValuesThatWouldOverflowDistancesAreRefused) {
 // Issue 12: inf or 1e300 min_segment_seconds and a window as long as the demo returned success with
 // 0 changepoints.
 TEST_F(SegmentService, DurationsNoDemoCanHaveAreClearErrors) {
-  for (double bad : {std::numeric_limits<double>::infinity(), 1e300,
-                     std::numeric_limits<double>::quiet_NaN()}) {
+  for (double bad :
+       {std::numeric_limits<double>::infinity(), 1e300, std::numeric_limits<double>::quiet_NaN()}) {
     lfd_msgs::Segment::Request request;
     request.min_segment_seconds = bad;
     expect_error(call(good_bags(2), request), "limits/max_demo_seconds");

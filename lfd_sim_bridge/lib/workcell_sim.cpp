@@ -558,7 +558,8 @@ void WorkcellSim::reset(const std::map<std::string, double>& posture, bool reset
 }
 
 void WorkcellSim::checkObjectPose(const std::string& object, const Pose& pose) const {
-  if (std::none_of(objects_.begin(), objects_.end(), [&](const auto& o) { return o.first == object; }))
+  if (std::none_of(objects_.begin(), objects_.end(),
+                   [&](const auto& o) { return o.first == object; }))
     throw std::invalid_argument("unknown object '" + object.substr(0, 64) +
                                 (object.size() > 64 ? "...'" : "'"));
   for (int i = 0; i < 3; ++i) {
@@ -566,9 +567,9 @@ void WorkcellSim::checkObjectPose(const std::string& object, const Pose& pose) c
     if (!std::isfinite(v)) throw std::invalid_argument("non-finite position for " + object);
     if (v < config_.workspace_min[i] || v > config_.workspace_max[i]) {
       std::ostringstream msg;
-      msg << "position of " << object << " (" << "xyz"[i] << " = " << v
-          << " m) is outside the workspace [" << config_.workspace_min[i] << ", "
-          << config_.workspace_max[i] << "] m (workspace_min / workspace_max)";
+      msg << "position of " << object << " ("
+          << "xyz"[i] << " = " << v << " m) is outside the workspace [" << config_.workspace_min[i]
+          << ", " << config_.workspace_max[i] << "] m (workspace_min / workspace_max)";
       throw std::invalid_argument(msg.str());
     }
   }

@@ -36,11 +36,11 @@
 #include <trajectory_msgs/JointTrajectory.h>
 
 #include <algorithm>
-#include <utility>
 #include <cmath>
 #include <map>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "lfd_sim_bridge/workcell_sim.hpp"
@@ -87,7 +87,8 @@ lfd_sim::WorkcellConfig loadConfig(ros::NodeHandle& pnh) {
   c.quaternion_tolerance = param(pnh, "quaternion_tolerance", c.quaternion_tolerance);
   for (const auto& [key, bound] : {std::pair{"workspace_min", &c.workspace_min},
                                    std::pair{"workspace_max", &c.workspace_max}}) {
-    const std::vector<double> v = param(pnh, key, std::vector<double>(bound->begin(), bound->end()));
+    const std::vector<double> v =
+        param(pnh, key, std::vector<double>(bound->begin(), bound->end()));
     if (v.size() != 3) throw std::invalid_argument(std::string("~") + key + " needs [x, y, z]");
     std::copy(v.begin(), v.end(), bound->begin());
   }

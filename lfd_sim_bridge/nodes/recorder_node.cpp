@@ -173,9 +173,9 @@ class Recorder {
   static std::string reportRecovered(const std::vector<lfd_sim_bridge::RecoveredBag>& found) {
     std::string text;
     for (const auto& r : found) {
-      const std::string line = "crashed recording kept as " + r.active +
-                               (r.recovered.empty() ? " (" + r.error + ")"
-                                                    : ", reindexed into " + r.recovered);
+      const std::string line =
+          "crashed recording kept as " + r.active +
+          (r.recovered.empty() ? " (" + r.error + ")" : ", reindexed into " + r.recovered);
       ROS_WARN("recorder: %s", line.c_str());
       text += "; " + line;
     }

@@ -71,11 +71,11 @@ DemoBag::DemoBag(const std::string& bag_path, lfd_msgs::DemoMetadata metadata,
   const std::string active = bag_path + ".active";
   const int fd = ::open(active.c_str(), O_CREAT | O_EXCL | O_WRONLY, 0644);
   if (fd < 0) {
-    throw std::runtime_error(errno == EEXIST ? "'" + active +
-                                                   "' exists (a crashed recording?); it is kept: "
-                                                   "choose another bag_path"
-                                             : "cannot create '" + active +
-                                                   "': " + std::strerror(errno));
+    throw std::runtime_error(errno == EEXIST
+                                 ? "'" + active +
+                                       "' exists (a crashed recording?); it is kept: "
+                                       "choose another bag_path"
+                                 : "cannot create '" + active + "': " + std::strerror(errno));
   }
   ::close(fd);
   try {
@@ -143,7 +143,8 @@ std::vector<RecoveredBag> recoverCrashedBags(const std::string& folder, const st
   for (const fs::directory_entry& e : fs::directory_iterator(folder, ec)) {
     const std::string name = e.path().filename().string();
     const std::string suffix = ".bag.active";
-    if (name.size() <= suffix.size() || name.compare(name.size() - suffix.size(), suffix.size(), suffix) != 0)
+    if (name.size() <= suffix.size() ||
+        name.compare(name.size() - suffix.size(), suffix.size(), suffix) != 0)
       continue;
     if (!e.is_regular_file() || e.path().string() == skip) continue;
     RecoveredBag r;
@@ -159,8 +160,8 @@ std::vector<RecoveredBag> recoverCrashedBags(const std::string& folder, const st
     const fs::path work = fs::path(folder) / (".reindex_" + std::to_string(::getpid()));
     fs::create_directories(work, ec);
     const std::string copy = (work / fs::path(r.active).filename()).string();
-    const std::string cmd = "rosbag reindex --quiet --output-dir " + shellQuoted(work.string()) + " " +
-                            shellQuoted(r.active) + " >/dev/null 2>&1";
+    const std::string cmd = "rosbag reindex --quiet --output-dir " + shellQuoted(work.string()) +
+                            " " + shellQuoted(r.active) + " >/dev/null 2>&1";
     if (std::system(cmd.c_str()) == 0 && fs::exists(copy)) {
       r.recovered = bag + ".recovered";
       fs::rename(copy, r.recovered, ec);

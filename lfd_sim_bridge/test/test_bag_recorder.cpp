@@ -137,7 +137,6 @@ TEST_F(BagRecorderTest, BadPathsAreRejected) {
       << "an existing bag must never be overwritten";
 }
 
-
 // Issue 12: starting a recording to the path of a crashed one truncated the crashed `.active`.
 TEST_F(BagRecorderTest, AnExistingActiveFileIsNeverTruncated) {
   fs::create_directories(dir_);
@@ -146,7 +145,8 @@ TEST_F(BagRecorderTest, AnExistingActiveFileIsNeverTruncated) {
   EXPECT_THROW(lfd_sim_bridge::DemoBag(path, lfd_msgs::DemoMetadata(), ros::Time(1.0)),
                std::runtime_error);
   std::ifstream in(path + ".active");
-  EXPECT_EQ(std::string(std::istreambuf_iterator<char>(in), {}), "the only copy of a demonstration");
+  EXPECT_EQ(std::string(std::istreambuf_iterator<char>(in), {}),
+            "the only copy of a demonstration");
 }
 
 // Issue 12: after kill -9 the last 0.77 s of a demo were lost. A child records 10 topics at 200 Hz

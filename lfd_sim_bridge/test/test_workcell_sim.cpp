@@ -6,8 +6,8 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
-#include <string>
 #include <stdexcept>
+#include <string>
 #include <vector>
 
 #include "lfd_sim_bridge/trajectory_interpolator.hpp"
@@ -331,7 +331,6 @@ TEST(WorkcellSim, SetObjectPoseThenItRestsOnTheTable) {
   sim.reset({}, true);
   EXPECT_NEAR(sim.readState().object_poses[0].position[0], 0.78, 1e-9);
 }
-
 
 std::string refusal(const std::function<void()>& f) {
   try {

@@ -77,7 +77,8 @@ std::string checkInputFile(const std::string& path, const PathPolicy& policy) {
   checkParentReferences(path, policy);
   struct stat st {};
   if (::stat(path.c_str(), &st) != 0) refuse(path, std::strerror(errno));
-  if (!S_ISREG(st.st_mode)) refuse(path, std::string(typeName(st.st_mode)) + ", not a regular file");
+  if (!S_ISREG(st.st_mode))
+    refuse(path, std::string(typeName(st.st_mode)) + ", not a regular file");
   const fs::path resolved = fs::canonical(path);
   checkRoots(path, resolved, policy);
   return resolved.string();
@@ -101,15 +102,16 @@ std::string checkOutputFile(const std::string& path, const PathPolicy& policy, b
   for (const std::string& input : inputs) {
     if (input.empty()) continue;  // names no file
     struct stat in {};
-    const bool same_inode = exists && ::stat(input.c_str(), &in) == 0 &&
-                            in.st_dev == out.st_dev && in.st_ino == out.st_ino;
+    const bool same_inode = exists && ::stat(input.c_str(), &in) == 0 && in.st_dev == out.st_dev &&
+                            in.st_ino == out.st_ino;
     std::error_code ec;
     const fs::path input_path = fs::weakly_canonical(fs::absolute(input, ec), ec);
     if (same_inode || (!ec && input_path == resolved)) {
       refuse(path, "is one of the request's inputs; refusing to overwrite it");
     }
   }
-  if (exists && !S_ISREG(out.st_mode)) refuse(path, std::string("exists and is ") + typeName(out.st_mode));
+  if (exists && !S_ISREG(out.st_mode))
+    refuse(path, std::string("exists and is ") + typeName(out.st_mode));
   if (exists && !overwrite) refuse(path, "exists; set overwrite to replace it");
   return resolved.string();
 }

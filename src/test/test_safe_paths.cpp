@@ -7,8 +7,8 @@
 #include <unistd.h>
 
 #include <filesystem>
-#include <functional>
 #include <fstream>
+#include <functional>
 #include <iterator>
 #include <stdexcept>
 
@@ -51,8 +51,7 @@ std::string errorOf(const std::function<void()>& f) {
 TEST_F(SafePaths, InputMustBeAnExistingRegularFile) {
   const std::string file = write(dir_ / "root" / "a.bag", "x");
   EXPECT_EQ(lfd::checkInputFile(file), fs::canonical(file).string());
-  EXPECT_NE(errorOf([&] { lfd::checkInputFile((dir_ / "missing").string()); })
-                .find("No such file"),
+  EXPECT_NE(errorOf([&] { lfd::checkInputFile((dir_ / "missing").string()); }).find("No such file"),
             std::string::npos);
   EXPECT_NE(errorOf([&] { lfd::checkInputFile(dir_.string()); }).find("directory"),
             std::string::npos);
@@ -88,8 +87,9 @@ TEST_F(SafePaths, RootsAndParentReferences) {
             std::string::npos);
   EXPECT_NO_THROW(lfd::checkOutputFile((dir_ / "root" / "new.json").string(), rooted(), false));
   // "~" is $HOME.
-  EXPECT_NE(errorOf([&] { lfd::checkInputFile(inside, lfd::PathPolicy{{"~/lfd_no_such_root"}}); })
-                .find(std::string(std::getenv("HOME"))),
+  EXPECT_NE(errorOf([&] {
+              lfd::checkInputFile(inside, lfd::PathPolicy{{"~/lfd_no_such_root"}});
+            }).find(std::string(std::getenv("HOME"))),
             std::string::npos);
 }
 
@@ -107,8 +107,9 @@ TEST_F(SafePaths, OutputIsNeverAnInputAndKeepsExistingFiles) {
             std::string::npos);
   EXPECT_NE(errorOf([&] { lfd::checkOutputFile(hard.string(), {}, false); }).find("exists"),
             std::string::npos);
-  EXPECT_NE(errorOf([&] { lfd::checkOutputFile((dir_ / "nofolder" / "x").string(), {}, false); })
-                .find("does not exist"),
+  EXPECT_NE(errorOf([&] {
+              lfd::checkOutputFile((dir_ / "nofolder" / "x").string(), {}, false);
+            }).find("does not exist"),
             std::string::npos);
   EXPECT_NE(errorOf([&] { lfd::checkOutputFile(dir_.string() + "/", {}, true); }).find("folder"),
             std::string::npos);

@@ -12,8 +12,8 @@ namespace lfd_dmp {
 struct CsvColumns {
   std::string time;                 ///< empty: "t", "time" or "stamp" if present, else column 0
   std::string gripper = "gripper";  ///< used when present
-  std::size_t max_rows = 1000000;    ///< data rows read at most (a 10M-row file took 1.9 GB)
-  double max_abs_value = 1e100;      ///< |value| accepted (squares must not overflow)
+  std::size_t max_rows = 1000000;   ///< data rows read at most (a 10M-row file took 1.9 GB)
+  double max_abs_value = 1e100;     ///< |value| accepted (squares must not overflow)
 };
 
 struct CsvTrajectory {

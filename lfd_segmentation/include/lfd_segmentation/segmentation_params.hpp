@@ -28,12 +28,12 @@ struct TopicConfig {
 /// Bounds on one request (config `limits:`): whatever a client sends, a request takes bounded
 /// memory and time and is refused, naming the limit's key, when it asks for more.
 struct RequestLimits {
-  std::size_t max_bags = 32;               ///< bag paths (or CSV files) per request
-  double max_demo_seconds = 120.0;         ///< time span of one demo's stamps (s)
+  std::size_t max_bags = 32;                 ///< bag paths (or CSV files) per request
+  double max_demo_seconds = 120.0;           ///< time span of one demo's stamps (s)
   std::size_t max_samples_per_demo = 12000;  ///< rows after resampling (span x rate)
-  std::size_t max_total_samples = 60000;   ///< rows summed over the request's demos
-  std::size_t max_csv_rows = 100000;       ///< data rows of one CSV file
-  double max_abs_value = 1e100;            ///< |feature value|; squares must not overflow
+  std::size_t max_total_samples = 60000;     ///< rows summed over the request's demos
+  std::size_t max_csv_rows = 100000;         ///< data rows of one CSV file
+  double max_abs_value = 1e100;              ///< |feature value|; squares must not overflow
 };
 
 struct SegmentationParams {
@@ -66,8 +66,7 @@ void check_seconds_override(double value, const std::string& key, const RequestL
 /// Refuses demos the parameters cannot segment: a window as long as the demo (the answer would be
 /// "0 changepoints" for a reason that is not in the data; the pipeline refuses a minimum segment
 /// over half a demo itself), and demos over the sample limits.
-void check_demos_fit(const SegmentationParams& params,
-                     const std::vector<lfd::FeatureMatrix>& demos,
+void check_demos_fit(const SegmentationParams& params, const std::vector<lfd::FeatureMatrix>& demos,
                      const std::vector<std::string>& sources);
 
 /// Refuses raw streams whose stamps span more than limits/max_demo_seconds (one message stamped
