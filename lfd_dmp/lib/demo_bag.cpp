@@ -1,5 +1,7 @@
 #include "lfd_dmp/demo_bag.hpp"
 
+#include <lfd_core/safe_paths.hpp>
+
 #include <geometry_msgs/PoseStamped.h>
 #include <rosbag/bag.h>
 #include <rosbag/view.h>
@@ -15,8 +17,9 @@ namespace lfd_dmp {
 DemoRecording readDemoBag(const std::string& path, const DemoBagTopics& topics) {
   rosbag::Bag bag;
   try {
+    lfd::checkInputFile(path);  // a FIFO would block bag.open forever
     bag.open(path, rosbag::bagmode::Read);
-  } catch (const rosbag::BagException& e) {
+  } catch (const std::exception& e) {
     throw std::runtime_error("cannot open bag " + path + ": " + e.what());
   }
   std::vector<double> t;

@@ -4,6 +4,7 @@
 #include "lfd_dmp/trajectory_csv.hpp"
 
 #include <lfd_core/dmp_generalization.hpp>
+#include <lfd_core/safe_paths.hpp>
 
 #include <cmath>
 #include <cstdlib>
@@ -18,15 +19,22 @@ namespace {
 
 constexpr const char* kUsage =
     "usage:\n"
-    "  dmp_tool learn   --csv demo.csv --out skill.json [--task NAME] [--basis N]\n"
+    "  dmp_tool learn   --csv demo.csv --out skill.json [--task NAME] [--basis N] [--overwrite]\n"
     "                   [--time-column NAME] [--gripper-column NAME]\n"
     "  dmp_tool rollout --library skill.json --out traj.csv [--segment I] [--demo J | "
     "--generalize]\n"
+    "                   [--overwrite]\n"
     "                   [--start x,y,..] [--goal x,y,..] [--start-quat w,x,y,z] [--goal-quat "
     "w,x,y,z]\n"
     "                   [--start-gripper v] [--goal-gripper v] [--tau s] [--dt s] [--duration s]\n"
     "                   [--goal-filter rate]\n"
-    "  dmp_tool info    --library skill.json\n";
+    "  dmp_tool info    --library skill.json\n"
+    "limits: --basis in [2, 1000]; a rollout holds at most 1000000 samples (duration / dt)\n";
+
+// Bounds of one command (a CLI has no parameter server; the learner's are ~limits in
+// config/learner.yaml): work and memory stay bounded whatever the arguments.
+constexpr int kMaxBasis = 1000;                   // as ~limits/max_num_basis
+constexpr double kMaxRolloutSamples = 1000000.0;  // 1000 s at 1 ms: ~120 MB of rows
 
 struct UsageError : std::runtime_error {
   using std::runtime_error::runtime_error;
@@ -82,9 +90,11 @@ std::optional<double> optNumber(const Options& o, const std::string& key) {
 
 int learn(const std::vector<std::string>& args, std::ostream& out) {
   const Options o =
-      parse(args, {"--csv", "--out", "--task", "--basis", "--time-column", "--gripper-column"}, {});
+      parse(args, {"--csv", "--out", "--task", "--basis", "--time-column", "--gripper-column"},
+            {"--overwrite"});
   const std::string csv = required(o, "--csv");
-  const std::string path = required(o, "--out");
+  const bool overwrite = o.count("--overwrite") > 0;
+  const std::string path = lfd::checkOutputFile(required(o, "--out"), {}, overwrite, {csv});
   CsvColumns cols;
   if (o.count("--time-column")) cols.time = o.at("--time-column");
   if (o.count("--gripper-column")) cols.gripper = o.at("--gripper-column");
@@ -95,6 +105,9 @@ int learn(const std::vector<std::string>& args, std::ostream& out) {
   lib.position_names = traj.position_names;
   if (const auto basis = optNumber(o, "--basis")) {
     if (*basis != std::floor(*basis)) throw UsageError("--basis must be an integer");
+    if (*basis > kMaxBasis || *basis < 2) {
+      throw UsageError("--basis must be in [2, " + std::to_string(kMaxBasis) + "] (the limit)");
+    }
     lib.dmp_parameters.num_basis = static_cast<int>(*basis);
   }
   lib.generalization_parameters = traj.demo.positions.cols() > 0 ? "goal_position" : "none";
@@ -114,7 +127,7 @@ int learn(const std::vector<std::string>& args, std::ostream& out) {
   seg.name = "segment_0";
   seg.demos.push_back(std::move(skill));
   lib.segments.push_back(std::move(seg));
-  saveSkillLibrary(lib, path);
+  saveSkillLibrary(lib, path, overwrite);
   out << "learned a DMP from " << traj.demo.times.size() << " samples ("
       << traj.demo.positions.cols() << " position dims"
       << (traj.demo.quaternions.cols() ? ", orientation" : "")
@@ -127,9 +140,12 @@ int rollout(const std::vector<std::string>& args, std::ostream& out) {
                           {"--library", "--out", "--segment", "--demo", "--start", "--goal",
                            "--start-quat", "--goal-quat", "--start-gripper", "--goal-gripper",
                            "--tau", "--dt", "--duration", "--goal-filter"},
-                          {"--generalize"});
-  const SkillLibrary lib = loadSkillLibrary(required(o, "--library"));
-  const std::string path = required(o, "--out");
+                          {"--generalize", "--overwrite"});
+  const std::string library_path = required(o, "--library");
+  const bool overwrite = o.count("--overwrite") > 0;
+  const std::string path =
+      lfd::checkOutputFile(required(o, "--out"), {}, overwrite, {library_path});
+  const SkillLibrary lib = loadSkillLibrary(library_path);
   const int seg_index = static_cast<int>(optNumber(o, "--segment").value_or(0));
   if (seg_index < 0 || seg_index >= static_cast<int>(lib.segments.size())) {
     throw UsageError("--segment " + std::to_string(seg_index) + " out of range (library has " +
@@ -179,6 +195,11 @@ int rollout(const std::vector<std::string>& args, std::ostream& out) {
     }
     dmp = seg.demos[static_cast<size_t>(demo)].dmp;
   }
+  const double samples = ro.duration.value_or(ro.tau.value_or(dmp.tau)) / ro.dt;
+  if (!(samples <= kMaxRolloutSamples)) {
+    throw UsageError("the rollout would hold " + std::to_string(samples) +
+                     " samples (duration / dt), over the limit of 1000000");
+  }
   lfd::SegmentTrajectory traj;
   try {
     traj = dmp.rollout(ro);
@@ -191,7 +212,7 @@ int rollout(const std::vector<std::string>& args, std::ostream& out) {
     for (Eigen::Index d = 0; d < traj.positions.cols(); ++d)
       names.push_back("p" + std::to_string(d));
   }
-  writeTrajectoryCsv(path, traj, names);
+  writeTrajectoryCsv(path, traj, names, overwrite);
   out << "rolled out " << traj.times.size() << " steps -> " << path << "\n";
   return 0;
 }

@@ -1,5 +1,7 @@
 #include "lfd_dmp/skill_library.hpp"
 
+#include <lfd_core/safe_paths.hpp>
+
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -309,21 +311,16 @@ SkillLibrary skillLibraryFromJson(const json& j) {
   return lib;
 }
 
-void saveSkillLibrary(const SkillLibrary& library, const std::string& path) {
-  const std::string tmp = path + ".tmp";
-  {
-    std::ofstream out(tmp);
-    if (!out) throw std::runtime_error("cannot write skill library " + tmp);
-    out << toJson(library).dump(2) << "\n";
-    if (!out) throw std::runtime_error("failed writing skill library " + tmp);
-  }
-  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
-    std::remove(tmp.c_str());
-    throw std::runtime_error("cannot move " + tmp + " to " + path);
-  }
+void saveSkillLibrary(const SkillLibrary& library, const std::string& path, bool overwrite) {
+  lfd::writeTextAtomically(path, overwrite, toJson(library).dump(2) + "\n");
 }
 
 SkillLibrary loadSkillLibrary(const std::string& path) {
+  try {
+    lfd::checkInputFile(path);  // a FIFO would block the read forever
+  } catch (const std::invalid_argument& e) {
+    throw std::runtime_error(std::string("cannot open skill library: ") + e.what());
+  }
   std::ifstream in(path);
   if (!in) throw std::runtime_error("cannot open skill library " + path);
   json j;

@@ -1,5 +1,7 @@
 #include "lfd_dmp/trajectory_csv.hpp"
 
+#include <lfd_core/safe_paths.hpp>
+
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
@@ -36,6 +38,11 @@ int findColumn(const std::vector<std::string>& header, const std::string& name) 
 }  // namespace
 
 CsvTrajectory readTrajectoryCsv(const std::string& path, const CsvColumns& columns) {
+  try {
+    lfd::checkInputFile(path);  // a FIFO would block the read forever
+  } catch (const std::invalid_argument& e) {
+    throw std::runtime_error(std::string("cannot open CSV file: ") + e.what());
+  }
   std::ifstream in(path);
   if (!in) throw std::runtime_error("cannot open CSV file " + path);
   std::string line;
@@ -87,6 +94,10 @@ CsvTrajectory readTrajectoryCsv(const std::string& path, const CsvColumns& colum
   while (std::getline(in, line)) {
     ++line_no;
     if (trim(line).empty()) continue;
+    if (rows.size() >= columns.max_rows) {
+      throw std::runtime_error(path + ": more than " + std::to_string(columns.max_rows) +
+                               " data rows (the row limit)");
+    }
     const std::vector<std::string> fields = splitCsv(line);
     if (fields.size() != header.size()) {
       throw std::runtime_error(path + ": line " + std::to_string(line_no) + " has " +
@@ -102,6 +113,10 @@ CsvTrajectory readTrajectoryCsv(const std::string& path, const CsvColumns& colum
       if (fields[c].empty() || end == begin || *end != '\0' || !std::isfinite(v)) {
         throw std::runtime_error(path + ": line " + std::to_string(line_no) + ", column \"" +
                                  header[c] + "\": \"" + fields[c] + "\" is not a finite number");
+      }
+      if (std::abs(v) > columns.max_abs_value) {
+        throw std::runtime_error(path + ": line " + std::to_string(line_no) + ", column \"" +
+                                 header[c] + "\": " + fields[c] + " is beyond +-1e100");
       }
       row[c] = v;
     }
@@ -128,14 +143,13 @@ CsvTrajectory readTrajectoryCsv(const std::string& path, const CsvColumns& colum
 }
 
 void writeTrajectoryCsv(const std::string& path, const lfd::SegmentTrajectory& traj,
-                        const std::vector<std::string>& position_names) {
+                        const std::vector<std::string>& position_names, bool overwrite) {
   if (static_cast<Eigen::Index>(position_names.size()) != traj.positions.cols()) {
     throw std::runtime_error("writeTrajectoryCsv: " + std::to_string(position_names.size()) +
                              " position names for " + std::to_string(traj.positions.cols()) +
                              " position columns");
   }
-  std::ofstream out(path);
-  if (!out) throw std::runtime_error("cannot write CSV file " + path);
+  std::ostringstream out;
   out << "t";
   for (const auto& n : position_names) out << "," << n;
   const bool quat = traj.quaternions.cols() == 4;
@@ -152,7 +166,7 @@ void writeTrajectoryCsv(const std::string& path, const lfd::SegmentTrajectory& t
     if (grip) out << "," << traj.gripper[k];
     out << "\n";
   }
-  if (!out) throw std::runtime_error("failed writing CSV file " + path);
+  lfd::writeTextAtomically(path, overwrite, out.str());
 }
 
 }  // namespace lfd_dmp

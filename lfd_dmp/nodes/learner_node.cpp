@@ -2,12 +2,16 @@
 // them at the validated changepoints, learns one DMP set per segment per demo and writes the
 // skill library. Thin adapter over lfd_dmp::learnSkillLibrary / readDemoBag.
 // Private parameters (config/learner.yaml): ~pose_topic, ~gripper_topic, ~gripper_joint,
-// ~num_basis, ~smoothing_sigma.
+// ~num_basis, ~smoothing_sigma, ~allowed_roots, ~limits/{max_bags, max_num_basis,
+// max_demo_seconds, max_samples_per_demo}. Paths: bags must be regular files inside the roots, the
+// library is written atomically, never over a bag, and over an existing file only with overwrite.
 #include "lfd_dmp/demo_bag.hpp"
 #include "lfd_dmp/skill_learner.hpp"
 
 #include <lfd_msgs/LearnSkills.h>
 #include <ros/ros.h>
+
+#include <lfd_core/safe_paths.hpp>
 
 #include <chrono>
 
@@ -25,12 +29,18 @@ class Learner {
       ROS_WARN("learner: ~smoothing_sigma %.3f < 0: smoothing off", smoothing_sigma_);
       smoothing_sigma_ = 0.0;
     }
+    pnh.param("allowed_roots", paths_.allowed_roots, paths_.allowed_roots);
+    pnh.param("limits/max_bags", max_bags_, max_bags_);
+    pnh.param("limits/max_num_basis", max_num_basis_, max_num_basis_);
+    pnh.param("limits/max_demo_seconds", max_demo_seconds_, max_demo_seconds_);
+    pnh.param("limits/max_samples_per_demo", max_samples_per_demo_, max_samples_per_demo_);
   }
 
   bool learn(lfd_msgs::LearnSkills::Request& req, lfd_msgs::LearnSkills::Response& res) {
     const auto t0 = std::chrono::steady_clock::now();
     try {
       if (req.output_path.empty()) throw std::invalid_argument("output_path is empty");
+      checkCounts(req);
       std::vector<std::string> bags;
       std::vector<std::vector<double>> cps;
       if (!req.segmentations.empty()) {
@@ -59,8 +69,17 @@ class Learner {
         }
       }
       if (bags.empty()) throw std::invalid_argument("no demonstrations given");
+      if (static_cast<int>(bags.size()) > max_bags_) {
+        throw std::invalid_argument(std::to_string(bags.size()) + " bags, over the limit of " +
+                                    std::to_string(max_bags_) + " (~limits/max_bags)");
+      }
+      for (const auto& b : bags) lfd::checkInputFile(b, paths_);
+      const std::string output = lfd::checkOutputFile(req.output_path, paths_, req.overwrite, bags);
       std::vector<lfd_dmp::DemoRecording> demos;
-      for (const auto& b : bags) demos.push_back(lfd_dmp::readDemoBag(b, topics_));
+      for (const auto& b : bags) {
+        demos.push_back(lfd_dmp::readDemoBag(b, topics_));
+        checkDemoSize(demos.back(), b);
+      }
       lfd_dmp::LearnOptions opt;
       opt.task = req.task;
       opt.features = req.selected_features;
@@ -68,10 +87,10 @@ class Learner {
       opt.params.num_basis = req.num_basis > 0 ? req.num_basis : num_basis_;
       opt.smoothing_sigma = smoothing_sigma_;
       const lfd_dmp::LearnOutcome out = lfd_dmp::learnSkillLibrary(demos, cps, opt);
-      lfd_dmp::saveSkillLibrary(out.library, req.output_path);
+      lfd_dmp::saveSkillLibrary(out.library, output, req.overwrite);
       res.success = true;
       res.warnings = out.warnings;
-      res.library_path = req.output_path;
+      res.library_path = output;
       res.num_segments = static_cast<uint32_t>(out.library.segments.size());
       res.num_demos = static_cast<uint32_t>(out.demos_used);
       for (const auto& w : out.warnings) ROS_WARN("learner: %s", w.c_str());
@@ -87,7 +106,36 @@ class Learner {
   }
 
  private:
+  void checkCounts(const lfd_msgs::LearnSkills::Request& req) const {
+    if (req.num_basis > max_num_basis_) {
+      throw std::invalid_argument("num_basis " + std::to_string(req.num_basis) +
+                                  " is over the limit of " + std::to_string(max_num_basis_) +
+                                  " (~limits/max_num_basis)");
+    }
+  }
+
+  // One message stamped hours late would make a demo hours long (and its DMP meaningless).
+  void checkDemoSize(const lfd_dmp::DemoRecording& demo, const std::string& bag) const {
+    const auto n = demo.times.size();
+    const double span = n ? demo.times[n - 1] - demo.times[0] : 0.0;
+    if (span > max_demo_seconds_) {
+      throw std::invalid_argument(bag + ": poses span " + std::to_string(span) +
+                                  " s, over the limit of " + std::to_string(max_demo_seconds_) +
+                                  " s (~limits/max_demo_seconds)");
+    }
+    if (static_cast<double>(n) > max_samples_per_demo_) {
+      throw std::invalid_argument(bag + ": " + std::to_string(n) + " poses, over the limit of " +
+                                  std::to_string(max_samples_per_demo_) +
+                                  " (~limits/max_samples_per_demo)");
+    }
+  }
+
   lfd_dmp::DemoBagTopics topics_;
+  lfd::PathPolicy paths_;
+  int max_bags_ = 32;
+  int max_num_basis_ = 1000;
+  double max_demo_seconds_ = 120.0;
+  int max_samples_per_demo_ = 30000;
   int num_basis_ = lfd::DmpParameters().num_basis;
   double smoothing_sigma_ = 0.0;
 };

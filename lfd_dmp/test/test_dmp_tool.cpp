@@ -5,11 +5,16 @@
 
 #include <gtest/gtest.h>
 
+#include <fcntl.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <future>
+#include <iterator>
 #include <sstream>
 
 namespace {
@@ -74,7 +79,8 @@ TEST(DmpTool, LearnThenRolloutToANewGoal) {
   std::ostringstream dt;
   dt.precision(17);
   dt << 2.0 / 399;
-  ASSERT_EQ(run({"rollout", "--library", json, "--out", traj_csv, "--dt", dt.str()}), 0);
+  ASSERT_EQ(run({"rollout", "--library", json, "--out", traj_csv, "--dt", dt.str(), "--overwrite"}),
+            0);
   const lfd_dmp::CsvTrajectory again = lfd_dmp::readTrajectoryCsv(traj_csv);
   const lfd_dmp::CsvTrajectory demo = lfd_dmp::readTrajectoryCsv(csv);
   ASSERT_EQ(again.demo.positions.rows(), demo.demo.positions.rows());
@@ -101,7 +107,10 @@ TEST(DmpTool, LearnsWithHundredsOfBasisFunctions) {
     std::ostringstream dt;
     dt.precision(17);
     dt << 2.0 / 1199;
-    ASSERT_EQ(run({"rollout", "--library", json, "--out", traj_csv, "--dt", dt.str()}, &out, &err), 0)
+    ASSERT_EQ(
+        run({"rollout", "--library", json, "--out", traj_csv, "--dt", dt.str(), "--overwrite"},
+            &out, &err),
+        0)
         << err;
     const lfd_dmp::CsvTrajectory again = lfd_dmp::readTrajectoryCsv(traj_csv);
     const lfd_dmp::CsvTrajectory demo = lfd_dmp::readTrajectoryCsv(csv);
@@ -129,7 +138,7 @@ TEST(DmpTool, GeneralizesAcrossDemosOfALibrary) {
   }
   const std::string json = tempPath("two.json");
   const std::string traj_csv = tempPath("gen.csv");
-  lfd_dmp::saveSkillLibrary(lib, json);
+  lfd_dmp::saveSkillLibrary(lib, json, false);
   std::string out, err;
   ASSERT_EQ(run({"rollout", "--library", json, "--out", traj_csv, "--generalize", "--goal",
                  "0.65,0.0,0.8", "--start", "0.3,0,0.8"},
@@ -144,7 +153,7 @@ TEST(DmpTool, GeneralizesAcrossDemosOfALibrary) {
   EXPECT_NEAR(traj.demo.positions.col(2).maxCoeff(), 0.9, 0.01);
   // Far outside the demos: still rolls out but warns.
   ASSERT_EQ(run({"rollout", "--library", json, "--out", traj_csv, "--generalize", "--goal",
-                 "1.5,0.4,0.8"},
+                 "1.5,0.4,0.8", "--overwrite"},
                 &out, &err),
             0);
   EXPECT_NE(out.find("warning"), std::string::npos);
@@ -197,6 +206,64 @@ TEST(DmpTool, BadInputGivesClearErrors) {
       run({"rollout", "--library", json, "--out", tempPath("o.csv"), "--segment", "3"}, &out, &err),
       2);
   for (const auto& p : {csv, json, good_csv}) std::remove(p.c_str());
+}
+
+std::string fileText(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+// Issue 12: an existing output was silently replaced, even when it was the command's own input.
+TEST(DmpTool, KeepsAnExistingOutputUnlessOverwrite) {
+  const std::string csv = writeDemoCsv("keep.csv", 0.6, 100);
+  const std::string json = tempPath("keep.json");
+  { std::ofstream(json) << "precious\n"; }
+  std::string out, err;
+  EXPECT_EQ(run({"learn", "--csv", csv, "--out", json}, &out, &err), 1);
+  EXPECT_NE(err.find("exists; set overwrite"), std::string::npos) << err;
+  EXPECT_EQ(fileText(json), "precious\n");
+  ASSERT_EQ(run({"learn", "--csv", csv, "--out", json, "--overwrite"}, &out, &err), 0) << err;
+  EXPECT_EQ(lfd_dmp::loadSkillLibrary(json).segments.size(), 1u);
+  for (const auto& p : {csv, json}) std::remove(p.c_str());
+}
+
+TEST(DmpTool, NeverWritesOverItsInput) {
+  const std::string csv = writeDemoCsv("self.csv", 0.6, 100);
+  const std::string before = fileText(csv);
+  std::string out, err;
+  EXPECT_EQ(run({"learn", "--csv", csv, "--out", csv, "--overwrite"}, &out, &err), 1);
+  EXPECT_NE(err.find("one of the request's inputs"), std::string::npos) << err;
+  const std::string json = tempPath("self.json");
+  ASSERT_EQ(run({"learn", "--csv", csv, "--out", json}), 0);
+  const std::string library = fileText(json);
+  EXPECT_EQ(run({"rollout", "--library", json, "--out", json, "--overwrite"}, &out, &err), 1);
+  EXPECT_NE(err.find("one of the request's inputs"), std::string::npos) << err;
+  EXPECT_EQ(fileText(csv), before);
+  EXPECT_EQ(fileText(json), library);
+  for (const auto& p : {csv, json}) std::remove(p.c_str());
+}
+
+// A named pipe as input blocked open() forever; it must be refused at once. Should the code under
+// test block, the test opens the pipe's other end itself, so it fails instead of hanging.
+int runGuarded(const std::vector<std::string>& args, const std::string& fifo, std::string* err) {
+  auto done = std::async(std::launch::async, [&] { return run(args, nullptr, err); });
+  if (done.wait_for(std::chrono::seconds(10)) == std::future_status::timeout) {
+    const int fd = ::open(fifo.c_str(), O_WRONLY | O_NONBLOCK);  // releases a blocked reader
+    if (fd >= 0) ::close(fd);
+    ADD_FAILURE() << "blocked on the named pipe";
+  }
+  return done.get();
+}
+
+TEST(DmpTool, RefusesANamedPipeWithoutBlocking) {
+  const std::string fifo = tempPath("pipe.csv");
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  std::string err;
+  EXPECT_EQ(runGuarded({"learn", "--csv", fifo, "--out", tempPath("pipe.json")}, fifo, &err), 1);
+  EXPECT_NE(err.find("named pipe"), std::string::npos) << err;
+  EXPECT_EQ(runGuarded({"info", "--library", fifo}, fifo, &err), 1);
+  EXPECT_NE(err.find("named pipe"), std::string::npos) << err;
+  std::remove(fifo.c_str());
 }
 
 }  // namespace

@@ -74,7 +74,7 @@ std::string loadError(const nlohmann::json& j) {
 TEST(SkillLibrary, RoundTripKeepsEverything) {
   const SkillLibrary lib = makeLibrary();
   const std::string path = tempPath("lib.json");
-  lfd_dmp::saveSkillLibrary(lib, path);
+  lfd_dmp::saveSkillLibrary(lib, path, false);
   const SkillLibrary back = lfd_dmp::loadSkillLibrary(path);
   EXPECT_EQ(lfd_dmp::toJson(back), lfd_dmp::toJson(lib));
   EXPECT_EQ(back.task, "grasp");

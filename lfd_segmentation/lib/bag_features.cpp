@@ -5,6 +5,7 @@
 #include <rosbag/view.h>
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <map>
 #include <memory>
@@ -13,6 +14,7 @@
 #include <stdexcept>
 
 #include "lfd_core/ros_message_reader.hpp"
+#include "lfd_core/safe_paths.hpp"
 
 namespace lfd_segmentation {
 
@@ -140,6 +142,7 @@ class TopicReader {
 
 void open_bag(rosbag::Bag& bag, const std::string& path) {
   try {
+    lfd::checkInputFile(path);  // a FIFO or device would block bag.open forever
     bag.open(path, rosbag::bagmode::Read);
   } catch (const std::exception& e) {
     throw std::runtime_error("cannot open bag '" + path + "': " + e.what());
@@ -242,9 +245,22 @@ std::vector<lfd::Stream> read_bag_streams(const std::string& path,
 }
 
 DemoFeatures read_bag_features(const std::string& path, const std::vector<TopicConfig>& topics,
-                               double rate) {
+                               double rate, const RequestLimits& limits) {
   std::vector<FeatureRole> roles;
   const std::vector<lfd::Stream> streams = read_bag_streams(path, topics, &roles);
+  check_streams(streams, path, limits);
+  double start = -INFINITY, end = INFINITY;  // the span resample() keeps: where all streams overlap
+  for (const lfd::Stream& s : streams) {
+    if (s.time.empty()) continue;
+    start = std::max(start, s.time.front());
+    end = std::min(end, s.time.back());
+  }
+  if (end > start && (end - start) * rate + 1 > static_cast<double>(limits.max_samples_per_demo)) {
+    throw std::invalid_argument("bag '" + path + "': " + std::to_string(end - start) + " s at " +
+                                std::to_string(rate) + " Hz is over the limit of " +
+                                std::to_string(limits.max_samples_per_demo) +
+                                " samples per demo (limits/max_samples_per_demo)");
+  }
   DemoFeatures demo;
   demo.source = path;
   try {

@@ -1,8 +1,12 @@
 #include "lfd_segmentation/csv_features.hpp"
 
+#include "lfd_core/safe_paths.hpp"
+
 #include <cerrno>
+#include <cmath>
 #include <cstdlib>
 #include <fstream>
+#include <sstream>
 #include <stdexcept>
 #include <vector>
 
@@ -32,7 +36,12 @@ std::vector<std::string> split(const std::string& line) {
 }  // namespace
 
 lfd::FeatureMatrix read_csv_features(const std::string& path, const std::string& time_column,
-                                     double rate) {
+                                     double rate, const RequestLimits& limits) {
+  try {
+    lfd::checkInputFile(path);  // a FIFO would block the read forever
+  } catch (const std::invalid_argument& e) {
+    throw std::invalid_argument(std::string("cannot open CSV file: ") + e.what());
+  }
   std::ifstream in(path);
   if (!in) throw std::invalid_argument("cannot open CSV file '" + path + "'");
   std::string line;
@@ -65,9 +74,15 @@ lfd::FeatureMatrix read_csv_features(const std::string& path, const std::string&
 
   std::vector<double> values;  // row-major while reading
   std::vector<double> time;
+  std::size_t rows_read = 0;
   while (std::getline(in, line)) {
     ++line_number;
     if (trim(line).empty()) continue;
+    if (++rows_read > limits.max_csv_rows) {
+      throw std::invalid_argument("CSV file '" + path + "' has more than " +
+                                  std::to_string(limits.max_csv_rows) +
+                                  " data rows (limits/max_csv_rows)");
+    }
     const char* p = line.c_str();
     std::size_t column = 0;
     while (true) {
@@ -84,6 +99,14 @@ lfd::FeatureMatrix read_csv_features(const std::string& path, const std::string&
       if (column >= header.size()) {
         throw std::invalid_argument("CSV file '" + path + "' line " + std::to_string(line_number) +
                                     " has more than " + std::to_string(header.size()) + " columns");
+      }
+      if (std::isfinite(v) && std::abs(v) > limits.max_abs_value) {
+        std::ostringstream text;
+        text << v << " is beyond +-" << limits.max_abs_value;
+        throw std::invalid_argument("CSV file '" + path + "' line " + std::to_string(line_number) +
+                                    ", column " + std::to_string(column + 1) + " ('" +
+                                    header[column] + "'): " + text.str() +
+                                    " (limits/max_abs_value): distances would overflow");
       }
       (static_cast<int>(column) == time_index ? time : values).push_back(v);
       ++column;

@@ -1,8 +1,10 @@
 #include "lfd_segmentation/segment_service.hpp"
 
 #include <chrono>
+#include <cmath>
 #include <stdexcept>
 
+#include "lfd_core/safe_paths.hpp"
 #include "lfd_segmentation/bag_features.hpp"
 
 namespace lfd_segmentation {
@@ -13,6 +15,7 @@ SegmentationParams apply_overrides(const SegmentationParams& params,
   if (!request.combination.empty()) {
     p.pipeline.segmentation.combination = lfd::parse_profile_combination(request.combination);
   }
+  if (std::isnan(request.threshold)) throw std::invalid_argument("threshold is NaN");
   if (request.threshold > 0) {
     if (request.threshold > 1) {
       throw std::invalid_argument("threshold T must be in (0,1], got " +
@@ -20,8 +23,17 @@ SegmentationParams apply_overrides(const SegmentationParams& params,
     }
     p.pipeline.relevance.threshold = request.threshold;
   }
+  check_seconds_override(request.min_segment_seconds, "min_segment_seconds", params.limits);
+  check_seconds_override(request.window_seconds, "window_seconds", params.limits);
   if (request.min_segment_seconds > 0) p.min_segment_seconds = request.min_segment_seconds;
   if (request.window_seconds > 0) p.window_seconds = request.window_seconds;
+  const std::size_t max_changepoints = p.pipeline.segmentation.max_changepoints;
+  if (request.num_changepoints > 0 &&
+      static_cast<std::size_t>(request.num_changepoints) > max_changepoints) {
+    throw std::invalid_argument("num_changepoints " + std::to_string(request.num_changepoints) +
+                                " is over the limit of " + std::to_string(max_changepoints) +
+                                " (max_changepoints)");
+  }
   if (request.num_changepoints > 0)
     p.pipeline.segmentation.num_changepoints = request.num_changepoints;
   return p;
@@ -72,13 +84,28 @@ void handle_segment_request(const SegmentationParams& params,
     if (request.bag_paths.empty()) {
       throw std::invalid_argument("empty request: give at least one bag path");
     }
+    if (request.bag_paths.size() > params.limits.max_bags) {
+      throw std::invalid_argument(std::to_string(request.bag_paths.size()) +
+                                  " bag paths, over the limit of " +
+                                  std::to_string(params.limits.max_bags) + " (limits/max_bags)");
+    }
     const SegmentationParams p = apply_overrides(params, request);
+    for (const std::string& path : request.bag_paths) {
+      for (const std::string& part : demo_parts(path)) {
+        try {
+          lfd::checkInputFile(part, p.paths);
+        } catch (const std::invalid_argument& e) {
+          throw std::invalid_argument(std::string("cannot open bag: ") + e.what());
+        }
+      }
+    }
     std::vector<DemoFeatures> demos;
     std::vector<lfd::FeatureMatrix> matrices;
     for (const std::string& path : request.bag_paths) {
-      demos.push_back(read_bag_features(path, p.topics, p.rate));
+      demos.push_back(read_bag_features(path, p.topics, p.rate, p.limits));
       matrices.push_back(demos.back().matrix);
     }
+    check_demos_fit(p, matrices, request.bag_paths);
     const lfd::SegmentationPipelineResult result = lfd::run_segmentation_pipeline(
         matrices, demos[0].sensor_features, p.pipeline_config(), demos[0].state_features);
     response.warnings = result.warnings;

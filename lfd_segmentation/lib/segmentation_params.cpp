@@ -1,6 +1,8 @@
 #include "lfd_segmentation/segmentation_params.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <sstream>
 #include <stdexcept>
 
 namespace lfd_segmentation {
@@ -24,6 +26,23 @@ double non_negative(double value, const std::string& key) {
                                 std::to_string(value));
   }
   return value;
+}
+
+double positive(double value, const std::string& key) {
+  if (!(value > 0) || !std::isfinite(value)) {
+    throw std::invalid_argument("segmentation parameter '" + key + "' must be > 0 and finite");
+  }
+  return value;
+}
+
+std::string number(double v) {
+  std::ostringstream out;
+  out << v;
+  return out.str();
+}
+
+std::string seconds(double s) {
+  return number(s) + " s";
 }
 
 TopicConfig parse_topic(const YAML::Node& node, std::size_t index) {
@@ -151,6 +170,19 @@ SegmentationParams params_from_yaml(const YAML::Node& root) {
     throw std::invalid_argument(
         "segmentation parameter 'clasp/min_window' counts samples; give clasp/min_window_seconds");
 
+  const YAML::Node limits = root["limits"];
+  auto& lim = p.limits;
+  lim.max_bags = get<std::size_t>(limits, "max_bags", lim.max_bags);
+  lim.max_demo_seconds = positive(get<double>(limits, "max_demo_seconds", lim.max_demo_seconds),
+                                  "limits/max_demo_seconds");
+  lim.max_samples_per_demo =
+      get<std::size_t>(limits, "max_samples_per_demo", lim.max_samples_per_demo);
+  lim.max_total_samples = get<std::size_t>(limits, "max_total_samples", lim.max_total_samples);
+  lim.max_csv_rows = get<std::size_t>(limits, "max_csv_rows", lim.max_csv_rows);
+  lim.max_abs_value =
+      positive(get<double>(limits, "max_abs_value", lim.max_abs_value), "limits/max_abs_value");
+  p.paths.allowed_roots = get<std::vector<std::string>>(root, "allowed_roots", {});
+
   const YAML::Node topics = root["topics"];
   if (topics) {
     if (!topics.IsSequence())
@@ -168,6 +200,71 @@ SegmentationParams load_params_file(const std::string& path) {
     throw std::invalid_argument("cannot read segmentation parameters '" + path + "': " + e.what());
   }
   return params_from_yaml(root);
+}
+
+void check_seconds_override(double value, const std::string& key, const RequestLimits& limits) {
+  if (value == 0) return;  // 0 = keep the parameter
+  if (!std::isfinite(value) || value > limits.max_demo_seconds) {
+    throw std::invalid_argument(key + " = " + seconds(value) +
+                                " is not a duration a demo can have (limit " +
+                                seconds(limits.max_demo_seconds) + ", limits/max_demo_seconds)");
+  }
+}
+
+void check_demos_fit(const SegmentationParams& params, const std::vector<lfd::FeatureMatrix>& demos,
+                     const std::vector<std::string>& sources) {
+  const RequestLimits& lim = params.limits;
+  std::size_t total = 0;
+  for (std::size_t d = 0; d < demos.size(); ++d) {
+    const lfd::FeatureMatrix& m = demos[d];
+    const std::string& source = d < sources.size() ? sources[d] : "demo " + std::to_string(d);
+    const std::size_t rows = static_cast<std::size_t>(m.rows());
+    if (rows > lim.max_samples_per_demo) {
+      throw std::invalid_argument("'" + source + "' has " + std::to_string(rows) +
+                                  " samples after resampling, over the limit of " +
+                                  std::to_string(lim.max_samples_per_demo) +
+                                  " (limits/max_samples_per_demo)");
+    }
+    total += rows;
+    if (rows < 2) continue;
+    const double length = m.time_at(m.rows() - 1) - m.time_at(0);
+    if (params.window_seconds > 0 && params.window_seconds >= length) {
+      throw std::invalid_argument(
+          "window_seconds = " + seconds(params.window_seconds) + " is not shorter than '" + source +
+          "' (" + seconds(length) +
+          "): the window covers the whole demo, no changepoint can be found");
+    }
+  }
+  if (total > lim.max_total_samples) {
+    throw std::invalid_argument("the request's demos hold " + std::to_string(total) +
+                                " samples after resampling, over the limit of " +
+                                std::to_string(lim.max_total_samples) +
+                                " (limits/max_total_samples)");
+  }
+}
+
+void check_streams(const std::vector<lfd::Stream>& streams, const std::string& source,
+                   const RequestLimits& limits) {
+  for (const lfd::Stream& s : streams) {
+    if (!s.time.empty()) {
+      const auto [first, last] = std::minmax_element(s.time.begin(), s.time.end());
+      if (*last - *first > limits.max_demo_seconds) {
+        throw std::invalid_argument("'" + source + "': " + s.name + " has stamps " +
+                                    seconds(*last - *first) + " apart (first " + seconds(*first) +
+                                    ", last " + seconds(*last) + "), over the limit of " +
+                                    seconds(limits.max_demo_seconds) +
+                                    " (limits/max_demo_seconds)");
+      }
+    }
+    for (std::size_t k = 0; k < s.values.size(); ++k) {
+      if (std::abs(s.values[k]) > limits.max_abs_value) {
+        throw std::invalid_argument("'" + source + "': " + s.name + " = " + number(s.values[k]) +
+                                    " at t = " + seconds(k < s.time.size() ? s.time[k] : 0.0) +
+                                    " is beyond +-" + number(limits.max_abs_value) +
+                                    " (limits/max_abs_value): distances would overflow");
+      }
+    }
+  }
 }
 
 }  // namespace lfd_segmentation

@@ -5,11 +5,13 @@
 // validation). Bags use the topics/roles of --config; CSV columns are state features except the
 // --sensor-columns.
 #include <chrono>
+#include <cmath>
 #include <fstream>
 #include <iostream>
 #include <sstream>
 #include <stdexcept>
 
+#include "lfd_core/safe_paths.hpp"
 #include "lfd_segmentation/bag_features.hpp"
 #include "lfd_segmentation/csv_features.hpp"
 #include "lfd_segmentation/segmentation_json.hpp"
@@ -138,7 +140,8 @@ Options parse_args(int argc, char** argv) {
     }
   }
   if (o.files.empty()) throw std::invalid_argument(std::string("no input files\n") + kUsage);
-  if (o.min_seconds < 0 || o.window_seconds < 0 || o.rate < 0) {
+  if (!(o.min_seconds >= 0) || !(o.window_seconds >= 0) || !(o.rate >= 0) ||
+      !std::isfinite(o.rate)) {
     throw std::invalid_argument("--min-segment-seconds, --window-seconds and --rate must be >= 0");
   }
   return o;
@@ -160,8 +163,14 @@ nlohmann::json run(const Options& o) {
       throw std::invalid_argument("--threshold must be in (0,1]");
     params.pipeline.relevance.threshold = o.threshold;
   }
+  lfd_segmentation::check_seconds_override(o.min_seconds, "--min-segment-seconds", params.limits);
+  lfd_segmentation::check_seconds_override(o.window_seconds, "--window-seconds", params.limits);
   if (o.min_seconds > 0) params.min_segment_seconds = o.min_seconds;
   if (o.window_seconds > 0) params.window_seconds = o.window_seconds;
+  if (o.files.size() > params.limits.max_bags) {
+    throw std::invalid_argument(std::to_string(o.files.size()) + " files, over the limit of " +
+                                std::to_string(params.limits.max_bags) + " (limits/max_bags)");
+  }
   if (o.threads >= 0) params.pipeline.threads = static_cast<int>(o.threads);
   lfd::SegmentationPipelineConfig config = params.pipeline_config();
   if (o.num_changepoints > 0)
@@ -177,12 +186,12 @@ nlohmann::json run(const Options& o) {
   for (const std::string& f : o.files) {
     if (bags) {
       lfd_segmentation::DemoFeatures demo =
-          lfd_segmentation::read_bag_features(f, params.topics, params.rate);
+          lfd_segmentation::read_bag_features(f, params.topics, params.rate, params.limits);
       if (demos.empty() && o.sensors.empty()) sensors = demo.sensor_features;
       if (demos.empty() && o.states.empty()) states = demo.state_features;
       demos.push_back(std::move(demo.matrix));
     } else {
-      demos.push_back(lfd_segmentation::read_csv_features(f, o.time_column, o.rate));
+      demos.push_back(lfd_segmentation::read_csv_features(f, o.time_column, o.rate, params.limits));
       if (demos.back().time.empty())
         throw std::invalid_argument(
             "CSV file '" + f +
@@ -190,6 +199,7 @@ nlohmann::json run(const Options& o) {
             "rate with --rate, the time parameters are in seconds");
     }
   }
+  lfd_segmentation::check_demos_fit(params, demos, o.files);
   const double load_time = seconds_since(start);
   lfd_segmentation::JsonOptions json_options;
   json_options.profiles = o.profiles;
@@ -248,13 +258,20 @@ int main(int argc, char** argv) {
     std::cerr << "segment: error: " << e.what() << "\n";
     out = {{"success", false}, {"error", e.what()}};
     status = 1;
+    // A command line that did not parse still names its --output: the error goes there, where
+    // the caller reads the answer (not a stale file of an earlier run).
+    for (int k = 1; options.output.empty() && k + 1 < argc; ++k)
+      if (std::string(argv[k]) == "--output") options.output = argv[k + 1];
   }
   const std::string text = out.dump(1);
   if (!options.output.empty()) {
-    std::ofstream file(options.output);
-    file << text << "\n";
-    if (!file) {
-      std::cerr << "segment: cannot write " << options.output << "\n";
+    // A result file: replaced on every run (scripts rerun into their folder), but atomically and
+    // never over one of the inputs.
+    try {
+      lfd::writeTextAtomically(lfd::checkOutputFile(options.output, {}, true, options.files), true,
+                               text + "\n");
+    } catch (const std::exception& e) {
+      std::cerr << "segment: cannot write the output: " << e.what() << "\n";
       return 1;
     }
   } else {

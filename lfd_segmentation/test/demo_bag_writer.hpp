@@ -30,6 +30,8 @@ struct DemoBagOptions {
   bool with_touch = true;
   bool nan_in_twist = false;      ///< one NaN sample in /ee_twist
   bool constant_gripper = false;  ///< gripper never moves
+  double late_twist_seconds = 0;  ///< > 0: one more /ee_twist stamped this long after the end
+  double huge_twist = 0;          ///< != 0: one /ee_twist sample with this (finite) value
   std::string touch_name = "r_touch_left";
 };
 
@@ -63,7 +65,14 @@ inline void write_demo_bag(const std::string& path, const DemoBagOptions& o = {}
     twist.twist.angular.z = 0.01 * noise(rng);
     if (o.nan_in_twist && i == samples / 2)
       twist.twist.linear.x = std::numeric_limits<double>::quiet_NaN();
+    if (o.huge_twist != 0 && i == samples / 3) twist.twist.linear.x = o.huge_twist;
     bag.write("/ee_twist", stamp, twist);
+    if (o.late_twist_seconds > 0 && i == samples - 1) {
+      const ros::Time late(t + o.late_twist_seconds);
+      twist.header.stamp = late;
+      bag.write("/ee_twist", late, twist);
+      twist.header.stamp = stamp;
+    }
 
     geometry_msgs::PoseStamped pose;
     pose.header = twist.header;

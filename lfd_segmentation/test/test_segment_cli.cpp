@@ -5,8 +5,11 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <nlohmann/json.hpp>
 #include <random>
+
+#include <sys/stat.h>
 
 #include "lfd_segmentation/csv_features.hpp"
 
@@ -39,10 +42,11 @@ std::size_t write_demo_csv(const std::string& path, int n, unsigned seed) {
   return grasp;
 }
 
-nlohmann::json run_cli(const std::string& args, int* status) {
+nlohmann::json run_cli(const std::string& args, int* status, const std::string& prefix = "") {
   const std::string out = (temp_dir() / "out.json").string();
+  fs::remove(out);  // a run that writes nothing must not be judged by the previous JSON
   const std::string cmd =
-      std::string(SEGMENT_CLI) + " " + args + " --output " + out + " 2>/dev/null";
+      prefix + std::string(SEGMENT_CLI) + " " + args + " --output " + out + " 2>/dev/null";
   const int rc = std::system(cmd.c_str());
   *status = WEXITSTATUS(rc);
   std::ifstream in(out);
@@ -131,6 +135,105 @@ TEST(CsvFeatures, ParsesHeaderTimeAndRejectsRaggedRows) {
   EXPECT_THROW(lfd_segmentation::read_csv_features(csv, "time"), std::invalid_argument);
   const auto rated = lfd_segmentation::read_csv_features(csv, "", 10.0);
   EXPECT_EQ(rated.time, (std::vector<double>{0.0}));
+}
+
+// Issue 12: a 10M-row CSV took 1.9 GB and no result in 300 s; +-1e308 overflowed the distances.
+TEST(CsvFeatures, LimitsStopTheReadAndNameRowAndColumn) {
+  const std::string csv = (temp_dir() / "limits.csv").string();
+  {
+    std::ofstream out(csv);
+    out << "time,a,b\n";
+    for (int i = 0; i < 50; ++i) out << 0.02 * i << "," << i << ",1\n";
+  }
+  lfd_segmentation::RequestLimits limits;
+  limits.max_csv_rows = 10;
+  try {
+    lfd_segmentation::read_csv_features(csv, "", 0.0, limits);
+    ADD_FAILURE() << "50 rows read under a 10-row limit";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("limits/max_csv_rows"), std::string::npos) << e.what();
+  }
+  std::ofstream(csv) << "time,a,b\n0,1,2\n0.1,1,-1e308\n0.2,1,4\n";
+  try {
+    lfd_segmentation::read_csv_features(csv);
+    ADD_FAILURE() << "-1e308 accepted";
+  } catch (const std::invalid_argument& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("line 3, column 3 ('b')"), std::string::npos) << what;
+    EXPECT_NE(what.find("limits/max_abs_value"), std::string::npos) << what;
+  }
+}
+
+TEST(SegmentCli, RefusesAPipeAndNeverWritesOverAnInput) {
+  const fs::path dir = temp_dir();
+  const std::string fifo = (dir / "pipe.csv").string();
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  int status = -1;
+  // `timeout` turns a hang on the old code into a failure instead of a stuck test.
+  auto j = run_cli(fifo, &status, "timeout 20 ");
+  EXPECT_EQ(status, 1);
+  EXPECT_NE(j["error"].get<std::string>().find("named pipe"), std::string::npos) << j.dump();
+  fs::remove(fifo);
+  const std::string csv = (dir / "input.csv").string();
+  write_demo_csv(csv, 300, 3);
+  std::ifstream before_in(csv);
+  const std::string before((std::istreambuf_iterator<char>(before_in)), {});
+  const std::string cmd =
+      std::string(SEGMENT_CLI) + " " + csv + " --output " + csv + " 2>/dev/null";
+  EXPECT_NE(std::system(cmd.c_str()), 0);
+  std::ifstream after_in(csv);
+  EXPECT_EQ(std::string((std::istreambuf_iterator<char>(after_in)), {}), before);
+  // Durations no demo can have, and a window longer than the demo (6 s), are errors.
+  for (const std::string bad : {"--min-segment-seconds inf", "--min-segment-seconds 1e300",
+                                "--window-seconds 1e300", "--window-seconds 60"}) {
+    j = run_cli(csv + " " + bad, &status);
+    EXPECT_EQ(status, 1) << bad;
+    EXPECT_FALSE(j["success"].get<bool>()) << bad;
+  }
+}
+
+// Property test of the CLI (issue 12): 40 seeded random command lines of extreme values and bad
+// files. Each run ends (under `timeout`) with exit 0 and a result or exit 1 and an error in the
+// JSON, never a crash, and the input CSV keeps its bytes. About 2 s.
+TEST(SegmentCli, RandomExtremeCommandLinesGiveAResultOrAClearError) {
+  const fs::path dir = temp_dir() / "fuzz";
+  fs::create_directories(dir);
+  const std::string csv = (dir / "demo.csv").string();
+  write_demo_csv(csv, 400, 5);
+  const std::string fifo = (dir / "pipe.csv").string();
+  ::mkfifo(fifo.c_str(), 0600);
+  std::ifstream before_in(csv);
+  const std::string before((std::istreambuf_iterator<char>(before_in)), {});
+  const std::vector<std::string> files = {
+      csv, csv, fifo, dir.string(), "/dev/null", (dir / "missing.csv").string(), "''"};
+  const std::vector<std::string> flags = {
+      "--rate",           "--threshold",        "--min-segment-seconds",
+      "--window-seconds", "--num-changepoints", "--threads"};
+  const std::vector<std::string> values = {"0",      "-1",  "0.5", "2",           "1e300", "-1e300",
+                                           "1e-300", "inf", "nan", "99999999999", "x",     "''"};
+  std::mt19937 rng(12);
+  for (int k = 0; k < 40; ++k) {
+    std::string args;
+    const int n_files = 1 + static_cast<int>(rng() % 3);
+    for (int f = 0; f < n_files; ++f) args += " " + files[rng() % files.size()];
+    for (int f = static_cast<int>(rng() % 3); f > 0; --f)
+      args += " " + flags[rng() % flags.size()] + " " + values[rng() % values.size()];
+    if (rng() % 3 == 0) args += " --sensor-columns touch";
+    int status = -1;
+    nlohmann::json j;
+    try {
+      j = run_cli(args, &status, "timeout 20 ");
+    } catch (const std::exception& e) {
+      ADD_FAILURE() << args << ": no JSON (" << e.what() << ")";
+      continue;
+    }
+    EXPECT_TRUE(status == 0 || status == 1) << args << " exit " << status;
+    EXPECT_EQ(j["success"].get<bool>(), status == 0) << args;
+    if (status != 0) EXPECT_FALSE(j["error"].get<std::string>().empty()) << args;
+    std::ifstream after_in(csv);
+    ASSERT_EQ(std::string((std::istreambuf_iterator<char>(after_in)), {}), before) << args;
+  }
+  fs::remove_all(dir);
 }
 
 }  // namespace

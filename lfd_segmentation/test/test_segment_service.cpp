@@ -2,8 +2,15 @@
 // success=false + a precise error (or a warning), and a good request finds the grasp.
 #include <gtest/gtest.h>
 
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <chrono>
 #include <filesystem>
 #include <fstream>
+#include <future>
+#include <limits>
 
 #include "demo_bag_writer.hpp"
 #include "lfd_segmentation/segment_service.hpp"
@@ -162,6 +169,88 @@ TEST_F(SegmentService, FeaturesThatDifferBetweenDemos) {
   DemoBagOptions o;
   o.touch_name = "r_touch_palm";
   expect_error(call({good_bags(1)[0], bag("other_touch", o)}), "features differ");
+}
+
+// Issue 12: a named pipe as a bag path blocked the node in open() forever. If the code under test
+// blocks, the test opens the pipe's other end itself so it can fail instead of hanging.
+TEST_F(SegmentService, NamedPipeIsRefusedAtOnce) {
+  const std::string fifo = (dir_ / "pipe.bag").string();
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  auto answer = std::async(std::launch::async, [&] { return call({good_bags(1)[0], fifo}); });
+  if (answer.wait_for(std::chrono::seconds(10)) == std::future_status::timeout) {
+    const int fd = ::open(fifo.c_str(), O_WRONLY);  // releases the blocked reader
+    ::close(fd);
+    ADD_FAILURE() << "a named pipe blocked the request";
+  }
+  expect_error(answer.get(), "named pipe");
+  fs::remove(fifo);
+}
+
+TEST_F(SegmentService, PathsOutsideTheRootsOrWithParentReferencesAreRefused) {
+  lfd_segmentation::SegmentationParams rooted = params_;
+  rooted.paths.allowed_roots = {(dir_ / "root").string()};
+  fs::create_directories(dir_ / "root");
+  const std::string inside = (dir_ / "root" / "good0.bag").string();
+  fs::copy_file(good_bags(1)[0], inside, fs::copy_options::overwrite_existing);
+  lfd_msgs::Segment::Request request;
+  lfd_msgs::Segment::Response r;
+  request.bag_paths = {inside, good_bags(2)[1]};
+  lfd_segmentation::handle_segment_request(rooted, request, r);
+  expect_error(r, "allowed_roots");
+  request.bag_paths = {inside, (dir_ / "root" / ".." / "root" / "good0.bag").string()};
+  lfd_segmentation::handle_segment_request(rooted, request, r);
+  expect_error(r, "'..'");
+}
+
+TEST_F(SegmentService, TooManyBagsAreRefusedNamingTheLimit) {
+  lfd_segmentation::SegmentationParams small = params_;
+  small.limits.max_bags = 2;
+  lfd_msgs::Segment::Request request;
+  request.bag_paths = good_bags(3);
+  lfd_msgs::Segment::Response r;
+  lfd_segmentation::handle_segment_request(small, request, r);
+  expect_error(r, "limits/max_bags");
+}
+
+// Issue 12: one message stamped 20,000 s late made the service unresponsive for over 90 s.
+TEST_F(SegmentService, AMessageStampedHoursLateIsRefusedFast) {
+  DemoBagOptions o;
+  o.late_twist_seconds = 20000;
+  const auto r = call({good_bags(1)[0], bag("late", o)});
+  expect_error(r, "limits/max_demo_seconds");
+  EXPECT_NE(r.error.find("/ee_twist"), std::string::npos) << r.error;
+  EXPECT_LT(r.elapsed, 5.0);
+}
+
+TEST_F(SegmentService, ValuesThatWouldOverflowDistancesAreRefused) {
+  DemoBagOptions o;
+  o.huge_twist = -1e308;
+  const auto r = call({good_bags(1)[0], bag("huge", o)});
+  expect_error(r, "limits/max_abs_value");
+  EXPECT_NE(r.error.find("/ee_twist/twist/linear/x"), std::string::npos) << r.error;
+}
+
+// Issue 12: inf or 1e300 min_segment_seconds and a window as long as the demo returned success with
+// 0 changepoints.
+TEST_F(SegmentService, DurationsNoDemoCanHaveAreClearErrors) {
+  for (double bad :
+       {std::numeric_limits<double>::infinity(), 1e300, std::numeric_limits<double>::quiet_NaN()}) {
+    lfd_msgs::Segment::Request request;
+    request.min_segment_seconds = bad;
+    expect_error(call(good_bags(2), request), "limits/max_demo_seconds");
+    request = {};
+    request.window_seconds = bad;
+    expect_error(call(good_bags(2), request), "limits/max_demo_seconds");
+  }
+  lfd_msgs::Segment::Request request;
+  request.window_seconds = 60.0;  // within the limit, longer than the 7 s demos
+  expect_error(call(good_bags(2), request), "covers the whole demo");
+  request = {};
+  request.threshold = std::numeric_limits<double>::quiet_NaN();
+  expect_error(call(good_bags(2), request), "threshold");
+  request = {};
+  request.num_changepoints = 1000000;
+  expect_error(call(good_bags(2), request), "max_changepoints");
 }
 
 }  // namespace

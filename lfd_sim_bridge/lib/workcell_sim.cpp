@@ -24,6 +24,7 @@ struct WorkcellSim::Actuated {
   double command = 0.0;     // target after velocity limiting, what the PD tracks
   double command_velocity = 0.0;
   bool warned_out_of_range = false;
+  bool warned_velocity = false;
   bool effort_from_config = false, velocity_from_config = false;
 };
 
@@ -355,7 +356,22 @@ void WorkcellSim::setTrajectory(const JointTrajectory& trajectory, double start_
     start[j] = actuated_[index[j]].command;
   }
   const double t0 = std::max(start_time, d_->time);
-  trajectory_ = std::make_unique<TrajectoryInterpolator>(trajectory, t0, start);
+  JointTrajectory limited = trajectory;
+  for (TrajectoryPoint& p : limited.points) {
+    for (size_t j = 0; j < p.velocities.size(); ++j) {
+      Actuated& a = actuated_[index[j]];
+      const double v = std::clamp(p.velocities[j], -a.limit.velocity, a.limit.velocity);
+      if (v != p.velocities[j] && !a.warned_velocity) {
+        a.warned_velocity = true;
+        std::ostringstream msg;
+        msg << "trajectory velocity " << p.velocities[j] << " for joint " << a.name
+            << " is beyond its limit " << a.limit.velocity << "; clamping (warned once per joint)";
+        log(LogLevel::kWarn, msg.str());
+      }
+      p.velocities[j] = v;
+    }
+  }
+  trajectory_ = std::make_unique<TrajectoryInterpolator>(limited, t0, start);
   trajectory_to_actuated_ = index;
   last_trajectory_ = trajectory;
   last_trajectory_stamp_ = start_time;
@@ -541,20 +557,39 @@ void WorkcellSim::reset(const std::map<std::string, double>& posture, bool reset
   mj_forward(m_, d_);
 }
 
+void WorkcellSim::checkObjectPose(const std::string& object, const Pose& pose) const {
+  if (std::none_of(objects_.begin(), objects_.end(),
+                   [&](const auto& o) { return o.first == object; }))
+    throw std::invalid_argument("unknown object '" + object.substr(0, 64) +
+                                (object.size() > 64 ? "...'" : "'"));
+  for (int i = 0; i < 3; ++i) {
+    const double v = pose.position[i];
+    if (!std::isfinite(v)) throw std::invalid_argument("non-finite position for " + object);
+    if (v < config_.workspace_min[i] || v > config_.workspace_max[i]) {
+      std::ostringstream msg;
+      msg << "position of " << object << " ("
+          << "xyz"[i] << " = " << v << " m) is outside the workspace [" << config_.workspace_min[i]
+          << ", " << config_.workspace_max[i] << "] m (workspace_min / workspace_max)";
+      throw std::invalid_argument(msg.str());
+    }
+  }
+  const auto& q = pose.orientation;
+  const double norm = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+  if (!(std::abs(norm - 1.0) <= config_.quaternion_tolerance)) {
+    std::ostringstream msg;
+    msg << "orientation of " << object << " has norm " << norm << ", not a unit quaternion within "
+        << config_.quaternion_tolerance << " (quaternion_tolerance)";
+    throw std::invalid_argument(msg.str());
+  }
+}
+
 void WorkcellSim::setObjectPose(const std::string& object, const Pose& pose) {
+  checkObjectPose(object, pose);
   auto it = std::find_if(objects_.begin(), objects_.end(),
                          [&](const auto& o) { return o.first == object; });
-  if (it == objects_.end()) throw std::invalid_argument("unknown object '" + object + "'");
-  for (double v : pose.position) {
-    if (!std::isfinite(v)) throw std::invalid_argument("non-finite position for " + object);
-  }
   mjtNum quat[4] = {pose.orientation[0], pose.orientation[1], pose.orientation[2],
                     pose.orientation[3]};
-  const mjtNum norm = std::sqrt(mju_dot(quat, quat, 4));
-  if (!std::isfinite(norm) || norm < 1e-6) {
-    throw std::invalid_argument("orientation of " + object + " is not a valid quaternion");
-  }
-  mju_scl(quat, quat, 1.0 / norm, 4);
+  mju_scl(quat, quat, 1.0 / std::sqrt(mju_dot(quat, quat, 4)), 4);
   const int jnt = m_->body_jntadr[it->second];
   const int qadr = m_->jnt_qposadr[jnt], vadr = m_->jnt_dofadr[jnt];
   for (int i = 0; i < 3; ++i) d_->qpos[qadr + i] = pose.position[i];

@@ -40,6 +40,7 @@
 #include <map>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "lfd_sim_bridge/workcell_sim.hpp"
@@ -49,7 +50,6 @@ namespace {
 // [helper D] Sensor publisher queues: a recorder that falls behind a fast sim for a moment must
 // receive every sample later rather than lose it (the default of 10 dropped samples under load).
 constexpr uint32_t kSensorQueue = 2000;
-constexpr uint32_t kMaxStepsPerCall = 1000000;  // 1000 s of sim time: a service must return
 
 template <typename T>
 T param(ros::NodeHandle& pnh, const std::string& name, const T& fallback) {
@@ -84,6 +84,14 @@ lfd_sim::WorkcellConfig loadConfig(ros::NodeHandle& pnh) {
   c.objects = param(pnh, "objects", c.objects);
   c.max_abs_velocity = param(pnh, "max_abs_velocity", c.max_abs_velocity);
   c.touch_time_constant = param(pnh, "touch_time_constant", c.touch_time_constant);
+  c.quaternion_tolerance = param(pnh, "quaternion_tolerance", c.quaternion_tolerance);
+  for (const auto& [key, bound] : {std::pair{"workspace_min", &c.workspace_min},
+                                   std::pair{"workspace_max", &c.workspace_max}}) {
+    const std::vector<double> v =
+        param(pnh, key, std::vector<double>(bound->begin(), bound->end()));
+    if (v.size() != 3) throw std::invalid_argument(std::string("~") + key + " needs [x, y, z]");
+    std::copy(v.begin(), v.end(), bound->begin());
+  }
   c.noise_seed = static_cast<uint64_t>(param(pnh, "noise_seed", 1));
   lfd_sim::SensorNoise& n = c.noise;
   n.joint_position = param(pnh, "noise/joint_position", 0.0);
@@ -186,6 +194,7 @@ class BridgeNode {
     publish_every_ = std::max<long>(1, std::lround(1.0 / (publish_rate * dt)));
     clock_every_ = std::max<long>(1, std::lround(1.0 / (clock_rate * dt)));
     paused_ = param(pnh, "start_paused", false);
+    max_steps_per_call_ = param(pnh, "max_steps_per_call", max_steps_per_call_);
     rtf_report_period_ = param(pnh, "rtf_report_period", 30.0);
     if (!param(pnh, "headless", true)) {
       ROS_WARN(
@@ -454,26 +463,12 @@ class BridgeNode {
         throw std::invalid_argument("object_names and poses differ in length");
       }
       // Check every entry before moving anything, so a bad request changes nothing.
-      for (const std::string& name : req.object_names) {
-        if (std::find(state_.object_names.begin(), state_.object_names.end(), name) ==
-            state_.object_names.end()) {
-          throw std::invalid_argument("unknown object '" + name + "'");
-        }
-      }
       std::vector<lfd_sim::Pose> poses(req.poses.size());
       for (size_t i = 0; i < req.poses.size(); ++i) {
         const geometry_msgs::Pose& p = req.poses[i];
         poses[i].position = {p.position.x, p.position.y, p.position.z};
         poses[i].orientation = {p.orientation.w, p.orientation.x, p.orientation.y, p.orientation.z};
-        const double norm =
-            std::sqrt(p.orientation.w * p.orientation.w + p.orientation.x * p.orientation.x +
-                      p.orientation.y * p.orientation.y + p.orientation.z * p.orientation.z);
-        if (!std::isfinite(p.position.x + p.position.y + p.position.z) || !std::isfinite(norm) ||
-            norm < 1e-6) {
-          throw std::invalid_argument("pose of '" + req.object_names[i] +
-                                      "' is not finite or "
-                                      "has a zero quaternion");
-        }
+        sim_->checkObjectPose(req.object_names[i], poses[i]);
       }
       for (size_t i = 0; i < poses.size(); ++i) sim_->setObjectPose(req.object_names[i], poses[i]);
       publishState();
@@ -502,9 +497,11 @@ class BridgeNode {
       res.message = "the simulation is running; pause it (/bridge/pause) before stepping";
       return true;
     }
-    if (req.steps > kMaxStepsPerCall) {
+    // One call holds the only thread: a bounded step keeps /bridge/pause and the rest served.
+    if (req.steps > static_cast<uint32_t>(std::max(0, max_steps_per_call_))) {
       res.success = false;
-      res.message = "at most " + std::to_string(kMaxStepsPerCall) + " steps per call";
+      res.message = std::to_string(req.steps) + " steps is over the limit of " +
+                    std::to_string(max_steps_per_call_) + " per call (~max_steps_per_call)";
       return true;
     }
     for (uint32_t i = 0; i < req.steps; ++i) stepOnce();
@@ -527,6 +524,7 @@ class BridgeNode {
   double report_sim_ = 0.0;
   long publish_every_ = 5, clock_every_ = 5;
   long step_count_ = 0;
+  int max_steps_per_call_ = 10000;
   bool paused_ = false;
   ros::Time last_clock_, last_tf_;
   ThrottledErrors errors_;

@@ -8,6 +8,7 @@
 #include <chrono>
 #include <condition_variable>
 #include <csignal>
+#include <filesystem>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -69,6 +70,9 @@ class Recorder {
     const int queue_size = pnh.param("queue_size", 100000);
     settle_timeout_ = pnh.param("settle_timeout", 1.0);
     connect_timeout_ = pnh.param("connect_timeout", 5.0);
+    max_unflushed_ = pnh.param("max_unflushed_seconds", max_unflushed_);
+    for (const std::string& folder : pnh.param("recovery_folders", std::vector<std::string>{}))
+      reportRecovered(lfd_sim_bridge::recoverCrashedBags(folder));
     for (const TopicSpec& spec : topics_) {
       ros::SubscribeOptions opts;
       // Full callback type: the connection header (latching, callerid) comes with each message.
@@ -165,6 +169,19 @@ class Recorder {
                names.c_str());
   }
 
+  // Logs each recovered crash and returns it as text for the service answer ("" if none).
+  static std::string reportRecovered(const std::vector<lfd_sim_bridge::RecoveredBag>& found) {
+    std::string text;
+    for (const auto& r : found) {
+      const std::string line =
+          "crashed recording kept as " + r.active +
+          (r.recovered.empty() ? " (" + r.error + ")" : ", reindexed into " + r.recovered);
+      ROS_WARN("recorder: %s", line.c_str());
+      text += "; " + line;
+    }
+    return text;
+  }
+
   bool onStart(lfd_msgs::StartRecording::Request& req, lfd_msgs::StartRecording::Response& res) {
     // Publishers that appeared after start-up (e.g. the bridge started after the recorder).
     waitForConnections(2.0, true);
@@ -176,11 +193,15 @@ class Recorder {
     }
     const ros::Time start =
         req.metadata.header.stamp.isZero() ? ros::Time::now() : req.metadata.header.stamp;
+    // A crash of an earlier recorder left `.active` bags in this folder: keep and reindex them.
+    const std::string recovered = reportRecovered(lfd_sim_bridge::recoverCrashedBags(
+        std::filesystem::path(req.bag_path).parent_path().string()));
     try {
-      bag_ = std::make_unique<lfd_sim_bridge::DemoBag>(req.bag_path, req.metadata, start);
+      bag_ = std::make_unique<lfd_sim_bridge::DemoBag>(req.bag_path, req.metadata, start,
+                                                       ros::Duration(max_unflushed_));
     } catch (const std::exception& e) {
       res.success = false;
-      res.message = e.what();
+      res.message = e.what() + recovered;
       ROS_ERROR("recorder: %s", e.what());
       return true;
     }
@@ -188,7 +209,7 @@ class Recorder {
     // Latched topics (e.g. /tf_static) were sent once, before this demo: repeat them at its start.
     for (const auto& [topic, event] : latched_) bag_->write(topic, start, event);
     res.success = true;
-    res.message = "recording " + req.bag_path;
+    res.message = "recording " + req.bag_path + recovered;
     ROS_INFO("recorder: start %s at t=%.3f", req.bag_path.c_str(), start.toSec());
     return true;
   }
@@ -275,6 +296,7 @@ class Recorder {
   double settle_timeout_ = 1.0;
   std::vector<ros::Subscriber> subscribers_;
   double connect_timeout_ = 5.0;  // s of wall time, at start-up
+  double max_unflushed_ = 0.1;    // s of bag time a kill -9 may lose (chunk closed this often)
   ros::NodeHandle service_nh_;
   ros::CallbackQueue service_queue_;
   std::unique_ptr<ros::AsyncSpinner> service_spinner_;

@@ -1,6 +1,11 @@
 #include "lfd_sim_bridge/bag_recorder.hpp"
 
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <cerrno>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <sstream>
@@ -11,6 +16,8 @@
 
 namespace lfd_sim_bridge {
 namespace {
+
+constexpr uint32_t kChunkThreshold = 768 * 1024;  // rosbag's default, between forced closes
 
 // First field line of a ROS message definition (comments and blank lines skipped).
 std::string firstFieldLine(const std::string& definition) {
@@ -49,8 +56,8 @@ bool headerStampOf(const topic_tools::ShapeShifter& msg, ros::Time* stamp) {
 }
 
 DemoBag::DemoBag(const std::string& bag_path, lfd_msgs::DemoMetadata metadata,
-                 const ros::Time& start)
-    : path_(bag_path), start_(start) {
+                 const ros::Time& start, const ros::Duration& max_unflushed)
+    : path_(bag_path), start_(start), max_unflushed_(max_unflushed), chunk_start_(start) {
   namespace fs = std::filesystem;
   if (bag_path.empty() || fs::path(bag_path).is_relative())
     throw std::runtime_error("bag path must be absolute, got '" + bag_path + "'");
@@ -60,6 +67,17 @@ DemoBag::DemoBag(const std::string& bag_path, lfd_msgs::DemoMetadata metadata,
   fs::create_directories(fs::path(bag_path).parent_path(), ec);
   if (ec) throw std::runtime_error("cannot create folder for '" + bag_path + "': " + ec.message());
   if (fs::exists(bag_path)) throw std::runtime_error("bag '" + bag_path + "' already exists");
+  // O_EXCL: rosbag's Write mode truncates, and an existing .active is a crashed recording.
+  const std::string active = bag_path + ".active";
+  const int fd = ::open(active.c_str(), O_CREAT | O_EXCL | O_WRONLY, 0644);
+  if (fd < 0) {
+    throw std::runtime_error(errno == EEXIST
+                                 ? "'" + active +
+                                       "' exists (a crashed recording?); it is kept: "
+                                       "choose another bag_path"
+                                 : "cannot create '" + active + "': " + std::strerror(errno));
+  }
+  ::close(fd);
   try {
     bag_.open(bag_path + ".active", rosbag::bagmode::Write);
   } catch (const rosbag::BagException& e) {
@@ -86,7 +104,15 @@ DemoBag::~DemoBag() {
 bool DemoBag::write(const std::string& topic, const ros::Time& stamp,
                     const ros::MessageEvent<const topic_tools::ShapeShifter>& event) {
   if (!open_ || stamp < start_) return false;
+  // Closing the chunk writes it to the file (rosbag seeks, which flushes stdio): what a kill -9
+  // can lose is the open chunk, so it never spans more than max_unflushed of bag time.
+  const bool close_chunk = stamp - chunk_start_ >= max_unflushed_;
+  if (close_chunk) bag_.setChunkThreshold(0);
   bag_.write(topic, stamp, event.getConstMessage(), event.getConnectionHeaderPtr());
+  if (close_chunk) {
+    bag_.setChunkThreshold(kChunkThreshold);
+    chunk_start_ = stamp;
+  }
   ++written_;
   ++per_topic_[topic];
   return true;
@@ -98,6 +124,55 @@ void DemoBag::close() {
   bag_.close();
   if (std::rename((path_ + ".active").c_str(), path_.c_str()) != 0)
     throw std::runtime_error("cannot rename '" + path_ + ".active' to '" + path_ + "'");
+}
+
+namespace {
+
+std::string shellQuoted(const std::string& s) {
+  std::string out = "'";
+  for (char c : s) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return out + "'";
+}
+
+}  // namespace
+
+std::vector<RecoveredBag> recoverCrashedBags(const std::string& folder, const std::string& skip) {
+  namespace fs = std::filesystem;
+  std::vector<RecoveredBag> found;
+  std::error_code ec;
+  for (const fs::directory_entry& e : fs::directory_iterator(folder, ec)) {
+    const std::string name = e.path().filename().string();
+    const std::string suffix = ".bag.active";
+    if (name.size() <= suffix.size() ||
+        name.compare(name.size() - suffix.size(), suffix.size(), suffix) != 0)
+      continue;
+    if (!e.is_regular_file() || e.path().string() == skip) continue;
+    RecoveredBag r;
+    const std::string bag = e.path().string().substr(0, e.path().string().size() - 7);
+    r.active = bag + ".crashed";
+    if (fs::exists(r.active) || std::rename(e.path().c_str(), r.active.c_str()) != 0) {
+      r.active = e.path().string();
+      r.error = "cannot rename it to .crashed; left in place";
+      found.push_back(r);
+      continue;
+    }
+    // rosbag reindex rewrites a copy in --output-dir and leaves the crashed file as it is.
+    const fs::path work = fs::path(folder) / (".reindex_" + std::to_string(::getpid()));
+    fs::create_directories(work, ec);
+    const std::string copy = (work / fs::path(r.active).filename()).string();
+    const std::string cmd = "rosbag reindex --quiet --output-dir " + shellQuoted(work.string()) +
+                            " " + shellQuoted(r.active) + " >/dev/null 2>&1";
+    if (std::system(cmd.c_str()) == 0 && fs::exists(copy)) {
+      r.recovered = bag + ".recovered";
+      fs::rename(copy, r.recovered, ec);
+      if (ec) r.error = "reindexed but cannot move it: " + ec.message(), r.recovered.clear();
+    } else {
+      r.error = "rosbag reindex failed (is python3-rosbag installed?)";
+    }
+    fs::remove_all(work, ec);
+    found.push_back(r);
+  }
+  return found;
 }
 
 }  // namespace lfd_sim_bridge

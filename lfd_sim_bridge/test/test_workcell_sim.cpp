@@ -5,7 +5,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <stdexcept>
+#include <string>
 #include <vector>
 
 #include "lfd_sim_bridge/trajectory_interpolator.hpp"
@@ -328,6 +330,62 @@ TEST(WorkcellSim, SetObjectPoseThenItRestsOnTheTable) {
   // reset with objects returns them to the model's initial poses.
   sim.reset({}, true);
   EXPECT_NEAR(sim.readState().object_poses[0].position[0], 0.78, 1e-9);
+}
+
+std::string refusal(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const std::invalid_argument& e) {
+    return e.what();
+  }
+  return "";
+}
+
+// Issue 12: x = 1e11 was accepted and the bridge then reset on every physics step; a non-unit
+// quaternion far from 1 was silently normalized.
+TEST(WorkcellSim, ObjectPosesOutsideTheWorkspaceOrNonUnitAreRefused) {
+  LogCounter logs;
+  lfd_sim::WorkcellSim sim(kModel, readyConfig(), logs.sink());
+  lfd_sim::Pose p;
+  p.position = {1e11, 0.0, 0.9};
+  EXPECT_NE(refusal([&] { sim.setObjectPose("stick", p); }).find("workspace"), std::string::npos);
+  p.position = {0.5, -0.3, 0.86};
+  p.orientation = {2.0, 0, 0, 0};
+  EXPECT_NE(refusal([&] { sim.setObjectPose("stick", p); }).find("quaternion_tolerance"),
+            std::string::npos);
+  p.orientation = {1.005, 0, 0, 0};  // within the tolerance: normalized
+  EXPECT_NO_THROW(sim.setObjectPose("stick", p));
+  EXPECT_NEAR(sim.readState().object_poses[0].orientation[0], 1.0, 1e-12);
+  p.position = {1e11, 0.0, 0.9};
+  p.orientation = {1, 0, 0, 0};
+  EXPECT_THROW(sim.checkObjectPose("box", p), std::invalid_argument);
+  sim.step(500);
+  EXPECT_EQ(sim.divergenceCount(), 0);
+}
+
+// Issue 12: /joint_trajectory velocities of 1.7e308 swung the elbow between its limits.
+TEST(WorkcellSim, TrajectoryVelocitiesAreClampedToTheJointLimit) {
+  LogCounter logs;
+  lfd_sim::WorkcellSim sim(kModel, readyConfig(), logs.sink());
+  sim.step(200);
+  const double q0 = sim.jointTarget("R_ELBOW_P");
+  lfd_sim::JointTrajectory traj;
+  traj.joint_names = {"R_ELBOW_P"};
+  traj.points = {{0.5, {q0 + 0.1}, {1.7e308}}, {1.0, {q0 + 0.2}, {-1.7e308}}};
+  sim.setTrajectory(traj);
+  EXPECT_GE(logs.warnings, 1);
+  EXPECT_NE(logs.last.find("clamping"), std::string::npos) << logs.last;
+  double lo = q0, hi = q0;
+  for (int k = 0; k < 1500; ++k) {
+    sim.step();
+    lo = std::min(lo, sim.jointTarget("R_ELBOW_P"));
+    hi = std::max(hi, sim.jointTarget("R_ELBOW_P"));
+  }
+  // Hermite segments with the clamped 2 rad/s overshoot the 0.2 rad move by a fraction of it, not
+  // by a swing to the joint limits.
+  EXPECT_GT(lo, q0 - 0.3);
+  EXPECT_LT(hi, q0 + 0.5);
+  EXPECT_NEAR(sim.jointTarget("R_ELBOW_P"), q0 + 0.2, 1e-9);
 }
 
 TEST(WorkcellSim, RecoversFromDivergenceWithoutCrashing) {

@@ -74,9 +74,11 @@ lfd::SegmentDmp segmentDmpFromJson(const nlohmann::json& j, const lfd::DmpParame
 /// Throws std::runtime_error naming the JSON location on any problem.
 SkillLibrary skillLibraryFromJson(const nlohmann::json& j);
 
-/// Writes pretty-printed JSON (atomically: temp file + rename). Throws std::runtime_error.
-void saveSkillLibrary(const SkillLibrary& library, const std::string& path);
-/// Throws std::runtime_error with the file name and the JSON location of the problem.
+/// Writes pretty-printed JSON atomically (lfd::writeFileAtomically). An existing file is kept
+/// (std::invalid_argument) unless `overwrite`. Throws std::runtime_error on I/O errors.
+void saveSkillLibrary(const SkillLibrary& library, const std::string& path, bool overwrite);
+/// Only regular files are read (a FIFO is refused, never opened). Throws std::runtime_error with
+/// the file name and the JSON location of the problem, std::invalid_argument for a bad path.
 SkillLibrary loadSkillLibrary(const std::string& path);
 
 }  // namespace lfd_dmp

@@ -12,6 +12,8 @@ namespace lfd_dmp {
 struct CsvColumns {
   std::string time;                 ///< empty: "t", "time" or "stamp" if present, else column 0
   std::string gripper = "gripper";  ///< used when present
+  std::size_t max_rows = 1000000;   ///< data rows read at most (a 10M-row file took 1.9 GB)
+  double max_abs_value = 1e100;     ///< |value| accepted (squares must not overflow)
 };
 
 struct CsvTrajectory {
@@ -23,8 +25,9 @@ struct CsvTrajectory {
 /// header, ragged row, non-numeric or non-finite value, partial quaternion columns).
 CsvTrajectory readTrajectoryCsv(const std::string& path, const CsvColumns& columns = {});
 
-/// Writes t, the position columns, qw,qx,qy,qz (if any) and gripper (if any).
+/// Writes t, the position columns, qw,qx,qy,qz (if any) and gripper (if any), atomically; an
+/// existing file is kept (std::invalid_argument) unless `overwrite`.
 void writeTrajectoryCsv(const std::string& path, const lfd::SegmentTrajectory& trajectory,
-                        const std::vector<std::string>& position_names);
+                        const std::vector<std::string>& position_names, bool overwrite);
 
 }  // namespace lfd_dmp

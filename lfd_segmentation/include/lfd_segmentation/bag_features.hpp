@@ -36,9 +36,10 @@ std::vector<lfd::Stream> read_bag_streams(const std::string& path,
                                           const std::vector<TopicConfig>& topics,
                                           std::vector<FeatureRole>* roles = nullptr);
 
-/// read_bag_streams + resampling at `rate` Hz (errors name the bag).
+/// read_bag_streams + resampling at `rate` Hz (errors name the bag). Streams over `limits`
+/// (time span, |value|) are refused before resampling (check_streams).
 DemoFeatures read_bag_features(const std::string& path, const std::vector<TopicConfig>& topics,
-                               double rate);
+                               double rate, const RequestLimits& limits = RequestLimits());
 
 /// Every topic of the bag(s) with its type, message count and numeric fields (paths as they are
 /// written in the configuration's `fields`). Throws std::runtime_error for unreadable bags.

@@ -6,14 +6,18 @@
 #include <string>
 
 #include "lfd_core/time_series.hpp"
+#include "lfd_segmentation/segmentation_params.hpp"
 
 namespace lfd_segmentation {
 
 /// `time_column`: a column name, or "" to use a column named time, t, timestamp or stamp when
 /// present. Throws std::invalid_argument (file, line and column named) for an unreadable file,
 /// a missing header, ragged rows, unparsable cells or a missing time column that was asked for.
-/// NaN/Inf cells are kept so that the pipeline can report them by feature.
+/// NaN/Inf cells are kept so that the pipeline can report them by feature. Over `limits` (data
+/// rows, finite |values| whose squares would overflow the distances) the read stops at once with
+/// the limit's key, the line and the column.
 lfd::FeatureMatrix read_csv_features(const std::string& path, const std::string& time_column = "",
-                                     double rate = 0.0);
+                                     double rate = 0.0,
+                                     const RequestLimits& limits = RequestLimits());
 
 }  // namespace lfd_segmentation

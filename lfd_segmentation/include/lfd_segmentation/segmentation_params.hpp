@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "lfd_core/safe_paths.hpp"
 #include "lfd_core/segmentation_pipeline.hpp"
 #include "lfd_core/time_series.hpp"
 
@@ -24,7 +25,21 @@ struct TopicConfig {
   lfd::Interpolation interpolation = lfd::Interpolation::kLinear;
 };
 
+/// Bounds on one request (config `limits:`): whatever a client sends, a request takes bounded
+/// memory and time and is refused, naming the limit's key, when it asks for more.
+struct RequestLimits {
+  std::size_t max_bags = 32;                 ///< bag paths (or CSV files) per request
+  double max_demo_seconds = 120.0;           ///< time span of one demo's stamps (s)
+  std::size_t max_samples_per_demo = 12000;  ///< rows after resampling (span x rate)
+  std::size_t max_total_samples = 60000;     ///< rows summed over the request's demos
+  std::size_t max_csv_rows = 100000;         ///< data rows of one CSV file
+  double max_abs_value = 1e100;              ///< |feature value|; squares must not overflow
+};
+
 struct SegmentationParams {
+  RequestLimits limits;
+  /// Roots the service's bag paths must lie in (config `allowed_roots`; the CLI ignores them).
+  lfd::PathPolicy paths;
   double rate = 50.0;  ///< Hz of the common clock
   std::vector<TopicConfig> topics;
   double min_segment_seconds = 0.0;  ///< 0 = automatic
@@ -43,6 +58,22 @@ struct SegmentationParams {
 /// std::invalid_argument with the offending key on bad values (and for the ground-truth topic).
 SegmentationParams params_from_yaml(const YAML::Node& root);
 SegmentationParams load_params_file(const std::string& path);
+
+/// Refuses a request-level time override that is not a finite positive number of seconds within
+/// limits/max_demo_seconds (NaN, inf, 1e300). `key` names the field in the message.
+void check_seconds_override(double value, const std::string& key, const RequestLimits& limits);
+
+/// Refuses demos the parameters cannot segment: a window as long as the demo (the answer would be
+/// "0 changepoints" for a reason that is not in the data; the pipeline refuses a minimum segment
+/// over half a demo itself), and demos over the sample limits.
+void check_demos_fit(const SegmentationParams& params, const std::vector<lfd::FeatureMatrix>& demos,
+                     const std::vector<std::string>& sources);
+
+/// Refuses raw streams whose stamps span more than limits/max_demo_seconds (one message stamped
+/// hours late would otherwise be resampled into millions of rows) or hold |values| above
+/// limits/max_abs_value. Fast: one pass, before anything is allocated.
+void check_streams(const std::vector<lfd::Stream>& streams, const std::string& source,
+                   const RequestLimits& limits);
 
 /// The topic that must never be read by the segmenter (ground truth for evaluation only).
 constexpr const char* kGroundTruthTopic = "/lfd/phase";

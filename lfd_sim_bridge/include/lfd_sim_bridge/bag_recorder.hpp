@@ -1,12 +1,16 @@
 // One demonstration bag: generic (ShapeShifter) messages stamped with their header time, written to
 // `<path>.active` and renamed to `<path>` on close, like `rosbag record` does, so a bag that exists
-// under its final name is always complete.
+// under its final name is always complete. Crash safety: an existing `.active` (a crashed
+// recording, maybe the only copy of a demo) is never opened for writing, and the open chunk is
+// closed every `max_unflushed` of bag time, so a kill -9 loses at most about that much data;
+// recoverCrashedBags() reindexes what a crash left behind.
 #pragma once
 
 #include <cstdint>
 #include <map>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include <lfd_msgs/DemoMetadata.h>
 #include <ros/message_event.h>
@@ -24,7 +28,8 @@ class DemoBag {
  public:
   // Opens `<bag_path>.active` (creating parent folders) and writes `metadata` on /lfd/metadata at
   // `start`. Throws std::runtime_error with the reason when the bag cannot be created.
-  DemoBag(const std::string& bag_path, lfd_msgs::DemoMetadata metadata, const ros::Time& start);
+  DemoBag(const std::string& bag_path, lfd_msgs::DemoMetadata metadata, const ros::Time& start,
+          const ros::Duration& max_unflushed = ros::Duration(0.1));
   ~DemoBag();  // closes (and renames) if still open, so no data is lost on error paths
 
   DemoBag(const DemoBag&) = delete;
@@ -47,9 +52,24 @@ class DemoBag {
   std::string path_;
   ros::Time start_;
   rosbag::Bag bag_;
+  ros::Duration max_unflushed_;
+  ros::Time chunk_start_;
   bool open_ = false;
   uint64_t written_ = 0;
   std::map<std::string, uint64_t> per_topic_;
 };
+
+// One crashed recording found by recoverCrashedBags.
+struct RecoveredBag {
+  std::string active;     // the crash's `<name>.bag.active`, now renamed `<name>.bag.crashed`
+  std::string recovered;  // `<name>.bag.recovered`: reindexed, readable (empty if it failed)
+  std::string error;      // why the reindex failed
+};
+
+// Every `*.bag.active` in `folder` except `skip`: each is kept (renamed `.crashed`, so it is
+// found once) and reindexed with `rosbag reindex` into `<name>.bag.recovered`. Neither name ends
+// in .bag, so datasets never count a partial demonstration as a complete one.
+std::vector<RecoveredBag> recoverCrashedBags(const std::string& folder,
+                                             const std::string& skip = "");
 
 }  // namespace lfd_sim_bridge

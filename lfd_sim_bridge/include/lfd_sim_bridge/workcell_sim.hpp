@@ -77,6 +77,12 @@ struct WorkcellConfig {
   uint64_t noise_seed = 1;
   // Divergence: any |qvel| above this (rad/s, m/s) counts as a blow-up and triggers a reset.
   double max_abs_velocity = 200.0;
+  // Where objects may be placed (world frame, m): outside it an object falls forever and the
+  // divergence check resets the sim on every step.
+  std::array<double, 3> workspace_min{-3.0, -3.0, -0.5};
+  std::array<double, 3> workspace_max{3.0, 3.0, 3.0};
+  // |norm - 1| of a commanded quaternion that is normalized; beyond it the pose is refused.
+  double quaternion_tolerance = 0.01;
 };
 
 struct Pose {
@@ -125,6 +131,8 @@ class WorkcellSim {
   // Streamed targets; cancels any running trajectory.
   void setJointTargets(const std::vector<std::string>& names, const std::vector<double>& positions);
   // Replaces the current trajectory. It starts at max(start_time, now) (start_time <= 0 = now).
+  // Waypoint velocities beyond a joint's velocity limit are clamped to it (warned once per joint):
+  // a Hermite segment with 1e308 rad/s would swing the joint between its position limits.
   // A repeat of the running trajectory with the same start_time > 0 is ignored, so senders may
   // resend a stamped trajectory (ROS can drop the first messages of a new connection).
   void setTrajectory(const JointTrajectory& trajectory, double start_time = 0.0);
@@ -140,6 +148,9 @@ class WorkcellSim {
   // initial poses if reset_objects. Sim time keeps running (never goes backwards).
   void reset(const std::map<std::string, double>& posture = {}, bool reset_objects = false);
   void setObjectPose(const std::string& object, const Pose& pose_in_world);
+  // Throws std::invalid_argument (naming the object and the bound) unless `object` exists and the
+  // pose is finite, inside the workspace and its quaternion unit within quaternion_tolerance.
+  void checkObjectPose(const std::string& object, const Pose& pose_in_world) const;
 
   // --- readings ---
   WorkcellState readState();  // noisy if config.noise is non-zero

@@ -1,0 +1,166 @@
+#include "lfd_core/safe_paths.hpp"
+
+#include <fcntl.h>
+#include <stdio.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <stdexcept>
+
+namespace lfd {
+namespace {
+
+namespace fs = std::filesystem;
+
+[[noreturn]] void refuse(const std::string& path, const std::string& why) {
+  throw std::invalid_argument("path '" + path + "': " + why);
+}
+
+std::string expandHome(const std::string& root) {
+  if (root.empty() || root[0] != '~') return root;
+  const char* home = std::getenv("HOME");
+  if (!home || !*home) throw std::invalid_argument("allowed root '" + root + "' needs $HOME");
+  return std::string(home) + root.substr(1);
+}
+
+bool hasParentReference(const std::string& path) {
+  for (const fs::path& part : fs::path(path)) {
+    if (part == "..") return true;
+  }
+  return false;
+}
+
+bool isInside(const fs::path& resolved, const fs::path& root) {
+  auto r = root.begin();
+  auto p = resolved.begin();
+  for (; r != root.end(); ++r, ++p) {
+    if (r->empty()) continue;  // a trailing separator
+    if (p == resolved.end() || *p != *r) return false;
+  }
+  return true;
+}
+
+// `resolved` is canonical (symlinks followed), so a link out of a root does not pass.
+void checkRoots(const std::string& path, const fs::path& resolved, const PathPolicy& policy) {
+  if (policy.allowed_roots.empty()) return;
+  std::string roots;
+  for (const std::string& root : policy.allowed_roots) {
+    const fs::path r = fs::weakly_canonical(fs::absolute(expandHome(root)));
+    if (isInside(resolved, r)) return;
+    roots += (roots.empty() ? "" : ", ") + r.string();
+  }
+  refuse(path, "outside the allowed roots (allowed_roots: " + roots + ")");
+}
+
+// Checked first: a request path with ".." is refused whether or not its target exists.
+void checkParentReferences(const std::string& path, const PathPolicy& policy) {
+  if (!policy.allowed_roots.empty() && hasParentReference(path))
+    refuse(path, "'..' is not allowed in request paths");
+}
+
+const char* typeName(mode_t mode) {
+  if (S_ISDIR(mode)) return "a directory";
+  if (S_ISFIFO(mode)) return "a named pipe (FIFO)";
+  if (S_ISCHR(mode) || S_ISBLK(mode)) return "a device";
+  if (S_ISSOCK(mode)) return "a socket";
+  return "not a regular file";
+}
+
+}  // namespace
+
+std::string checkInputFile(const std::string& path, const PathPolicy& policy) {
+  if (path.empty()) throw std::invalid_argument("empty file path");
+  checkParentReferences(path, policy);
+  struct stat st {};
+  if (::stat(path.c_str(), &st) != 0) refuse(path, std::strerror(errno));
+  if (!S_ISREG(st.st_mode))
+    refuse(path, std::string(typeName(st.st_mode)) + ", not a regular file");
+  const fs::path resolved = fs::canonical(path);
+  checkRoots(path, resolved, policy);
+  return resolved.string();
+}
+
+std::string checkOutputFile(const std::string& path, const PathPolicy& policy, bool overwrite,
+                            const std::vector<std::string>& inputs) {
+  if (path.empty()) throw std::invalid_argument("empty output path");
+  checkParentReferences(path, policy);
+  const fs::path absolute = fs::absolute(path);
+  if (!absolute.has_filename()) refuse(path, "names a folder, not a file");
+  const fs::path folder = absolute.parent_path();
+  struct stat dir {};
+  if (::stat(folder.c_str(), &dir) != 0 || !S_ISDIR(dir.st_mode)) {
+    refuse(path, "its folder " + folder.string() + " does not exist");
+  }
+  const fs::path resolved = fs::canonical(folder) / absolute.filename();
+  checkRoots(path, resolved, policy);
+  struct stat out {};
+  const bool exists = ::stat(resolved.c_str(), &out) == 0;
+  for (const std::string& input : inputs) {
+    if (input.empty()) continue;  // names no file
+    struct stat in {};
+    const bool same_inode = exists && ::stat(input.c_str(), &in) == 0 && in.st_dev == out.st_dev &&
+                            in.st_ino == out.st_ino;
+    std::error_code ec;
+    const fs::path input_path = fs::weakly_canonical(fs::absolute(input, ec), ec);
+    if (same_inode || (!ec && input_path == resolved)) {
+      refuse(path, "is one of the request's inputs; refusing to overwrite it");
+    }
+  }
+  if (exists && !S_ISREG(out.st_mode))
+    refuse(path, std::string("exists and is ") + typeName(out.st_mode));
+  if (exists && !overwrite) refuse(path, "exists; set overwrite to replace it");
+  return resolved.string();
+}
+
+void writeFileAtomically(const std::string& path, bool overwrite,
+                         const std::function<void(const std::string& temp_path)>& write) {
+  const fs::path target = fs::absolute(path);
+  std::string temp =
+      (target.parent_path() / ("." + target.filename().string() + ".tmp.XXXXXX")).string();
+  const int fd = ::mkstemp(temp.data());
+  if (fd < 0) refuse(path, std::string("cannot create a temporary file: ") + std::strerror(errno));
+  ::fchmod(fd, 0644);  // mkstemp's 0600 would hide outputs from other users
+  ::close(fd);
+  try {
+    write(temp);
+    const int sync_fd = ::open(temp.c_str(), O_RDONLY);
+    if (sync_fd >= 0) {  // the data reaches the disk before the name points at it
+      ::fsync(sync_fd);
+      ::close(sync_fd);
+    }
+    int rc = 0;
+    if (overwrite) {
+      rc = ::rename(temp.c_str(), target.c_str());
+    } else {
+      // No-clobber rename: a file created since the checks is kept, never replaced.
+      rc = ::renameat2(AT_FDCWD, temp.c_str(), AT_FDCWD, target.c_str(), RENAME_NOREPLACE);
+      if (rc != 0 && errno == EINVAL) {  // a file system without RENAME_NOREPLACE
+        rc = ::link(temp.c_str(), target.c_str());
+        if (rc == 0) ::unlink(temp.c_str());
+      }
+    }
+    if (rc != 0) {
+      refuse(path, errno == EEXIST ? "exists; set overwrite to replace it"
+                                   : std::string("cannot move the finished file in place: ") +
+                                         std::strerror(errno));
+    }
+  } catch (...) {
+    ::unlink(temp.c_str());
+    throw;
+  }
+}
+
+void writeTextAtomically(const std::string& path, bool overwrite, const std::string& text) {
+  writeFileAtomically(path, overwrite, [&](const std::string& temp) {
+    FILE* f = std::fopen(temp.c_str(), "w");
+    if (!f) refuse(path, std::string("cannot write: ") + std::strerror(errno));
+    const bool ok = std::fwrite(text.data(), 1, text.size(), f) == text.size();
+    if (std::fclose(f) != 0 || !ok) refuse(path, "write failed (disk full?)");
+  });
+}
+
+}  // namespace lfd

@@ -1,0 +1,141 @@
+// Safe paths (issue 12): regular-file inputs, roots, "..", no output over an input, atomic writes
+// that keep an existing file unless asked to overwrite.
+#include "lfd_core/safe_paths.hpp"
+
+#include <gtest/gtest.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <iterator>
+#include <stdexcept>
+
+namespace {
+
+namespace fs = std::filesystem;
+
+class SafePaths : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::path(::testing::TempDir()) / ("lfd_safe_paths_" + std::to_string(::getpid()));
+    fs::remove_all(dir_);
+    fs::create_directories(dir_ / "root" / "sub");
+    fs::create_directories(dir_ / "outside");
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  std::string write(const fs::path& p, const std::string& text) {
+    std::ofstream(p) << text;
+    return p.string();
+  }
+  static std::string read(const std::string& p) {
+    std::ifstream in(p);
+    return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  }
+  lfd::PathPolicy rooted() const { return lfd::PathPolicy{{(dir_ / "root").string()}}; }
+
+  fs::path dir_;
+};
+
+std::string errorOf(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const std::invalid_argument& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST_F(SafePaths, InputMustBeAnExistingRegularFile) {
+  const std::string file = write(dir_ / "root" / "a.bag", "x");
+  EXPECT_EQ(lfd::checkInputFile(file), fs::canonical(file).string());
+  EXPECT_NE(errorOf([&] { lfd::checkInputFile((dir_ / "missing").string()); }).find("No such file"),
+            std::string::npos);
+  EXPECT_NE(errorOf([&] { lfd::checkInputFile(dir_.string()); }).find("directory"),
+            std::string::npos);
+  EXPECT_NE(errorOf([&] { lfd::checkInputFile("/dev/zero"); }).find("device"), std::string::npos);
+  EXPECT_NE(errorOf([&] { lfd::checkInputFile(""); }).find("empty"), std::string::npos);
+}
+
+// A FIFO made open() block forever in the nodes; stat refuses it without opening it.
+TEST_F(SafePaths, NamedPipeIsRefusedWithoutBlocking) {
+  const std::string fifo = (dir_ / "root" / "pipe.bag").string();
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  EXPECT_NE(errorOf([&] { lfd::checkInputFile(fifo); }).find("named pipe"), std::string::npos);
+  EXPECT_NE(errorOf([&] { lfd::checkOutputFile(fifo, {}, true); }).find("named pipe"),
+            std::string::npos);
+}
+
+TEST_F(SafePaths, RootsAndParentReferences) {
+  const std::string inside = write(dir_ / "root" / "sub" / "a.bag", "x");
+  const std::string outside = write(dir_ / "outside" / "b.bag", "x");
+  EXPECT_NO_THROW(lfd::checkInputFile(inside, rooted()));
+  EXPECT_NE(errorOf([&] { lfd::checkInputFile(outside, rooted()); }).find("allowed_roots"),
+            std::string::npos);
+  const std::string dotdot = (dir_ / "root" / "sub" / ".." / "sub" / "a.bag").string();
+  EXPECT_NE(errorOf([&] { lfd::checkInputFile(dotdot, rooted()); }).find("'..'"),
+            std::string::npos);
+  EXPECT_NO_THROW(lfd::checkInputFile(dotdot));  // no roots (a CLI): ".." is the user's business
+  // A symlink inside the root that points out of it does not pass.
+  const fs::path link = dir_ / "root" / "link.bag";
+  fs::create_symlink(outside, link);
+  EXPECT_NE(errorOf([&] { lfd::checkInputFile(link.string(), rooted()); }).find("allowed_roots"),
+            std::string::npos);
+  EXPECT_NE(errorOf([&] { lfd::checkOutputFile(outside, rooted(), true); }).find("allowed_roots"),
+            std::string::npos);
+  EXPECT_NO_THROW(lfd::checkOutputFile((dir_ / "root" / "new.json").string(), rooted(), false));
+  // "~" is $HOME.
+  EXPECT_NE(errorOf([&] {
+              lfd::checkInputFile(inside, lfd::PathPolicy{{"~/lfd_no_such_root"}});
+            }).find(std::string(std::getenv("HOME"))),
+            std::string::npos);
+}
+
+TEST_F(SafePaths, OutputIsNeverAnInputAndKeepsExistingFiles) {
+  const std::string bag = write(dir_ / "root" / "demo.bag", "demo");
+  EXPECT_NE(errorOf([&] { lfd::checkOutputFile(bag, {}, true, {bag}); }).find("inputs"),
+            std::string::npos);
+  // The same file through another spelling or a hard link.
+  const std::string spelled = (dir_ / "root" / "sub" / ".." / "demo.bag").string();
+  EXPECT_NE(errorOf([&] { lfd::checkOutputFile(spelled, {}, true, {bag}); }).find("inputs"),
+            std::string::npos);
+  const fs::path hard = dir_ / "root" / "hard.json";
+  fs::create_hard_link(bag, hard);
+  EXPECT_NE(errorOf([&] { lfd::checkOutputFile(hard.string(), {}, true, {bag}); }).find("inputs"),
+            std::string::npos);
+  EXPECT_NE(errorOf([&] { lfd::checkOutputFile(hard.string(), {}, false); }).find("exists"),
+            std::string::npos);
+  EXPECT_NE(errorOf([&] {
+              lfd::checkOutputFile((dir_ / "nofolder" / "x").string(), {}, false);
+            }).find("does not exist"),
+            std::string::npos);
+  EXPECT_NE(errorOf([&] { lfd::checkOutputFile(dir_.string() + "/", {}, true); }).find("folder"),
+            std::string::npos);
+}
+
+TEST_F(SafePaths, AtomicWriteKeepsOrReplaces) {
+  const std::string out = write(dir_ / "root" / "lib.json", "old");
+  EXPECT_NE(errorOf([&] { lfd::writeTextAtomically(out, false, "new"); }).find("exists"),
+            std::string::npos);
+  EXPECT_EQ(read(out), "old");
+  lfd::writeTextAtomically(out, true, "new");
+  EXPECT_EQ(read(out), "new");
+  // A failing writer leaves the old file and no temporary behind.
+  EXPECT_THROW(lfd::writeFileAtomically(out, true,
+                                        [](const std::string& temp) {
+                                          std::ofstream(temp) << "half";
+                                          throw std::runtime_error("writer failed");
+                                        }),
+               std::runtime_error);
+  EXPECT_EQ(read(out), "new");
+  std::size_t files = 0;
+  for (const auto& e : fs::directory_iterator(dir_ / "root")) files += e.is_regular_file();
+  EXPECT_EQ(files, 1u);
+  const std::string fresh = (dir_ / "root" / "fresh.json").string();
+  lfd::writeTextAtomically(fresh, false, "first");
+  EXPECT_EQ(read(fresh), "first");
+}
+
+}  // namespace
