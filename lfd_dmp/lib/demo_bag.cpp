@@ -1,11 +1,14 @@
 #include "lfd_dmp/demo_bag.hpp"
+#include "lfd_dmp/demo_scene.hpp"
 
 #include <lfd_core/safe_paths.hpp>
 
 #include <geometry_msgs/PoseStamped.h>
+#include <lfd_msgs/DemoMetadata.h>
 #include <rosbag/bag.h>
 #include <rosbag/view.h>
 #include <sensor_msgs/JointState.h>
+#include <tf2_msgs/TFMessage.h>
 
 #include <algorithm>
 #include <cmath>
@@ -13,6 +16,37 @@
 #include <vector>
 
 namespace lfd_dmp {
+namespace {
+
+void addTransforms(const tf2_msgs::TFMessage& msg, StaticTransforms* tf) {
+  for (const geometry_msgs::TransformStamped& t : msg.transforms) {
+    const auto& r = t.transform.rotation;
+    const auto& p = t.transform.translation;
+    Eigen::Isometry3d iso = Eigen::Isometry3d::Identity();
+    iso.translation() = Eigen::Vector3d(p.x, p.y, p.z);
+    const Eigen::Quaterniond q(r.w, r.x, r.y, r.z);
+    if (q.norm() < 1e-6) continue;  // not a transform; lookups that need it fail by name
+    iso.linear() = q.normalized().toRotationMatrix();
+    tf->add(t.header.frame_id, t.child_frame_id, iso);
+  }
+}
+
+// The metadata's scene in the poses' frame (empty if the bag records none).
+std::optional<lfd::Scene> sceneOf(const std::string& path, const std::string& extra_json,
+                                  const StaticTransforms& tf, const std::string& pose_frame) {
+  const std::optional<SceneRecord> record = sceneFromMetadata(extra_json);
+  if (!record) return std::nullopt;
+  if (record->frame == pose_frame || pose_frame.empty()) return record->scene;
+  try {
+    return transformScene(record->scene, tf.lookup(pose_frame, record->frame));
+  } catch (const std::runtime_error& e) {
+    throw std::runtime_error(path + ": the scene is in '" + record->frame + "', the poses in '" +
+                             pose_frame + "': " + e.what() +
+                             " (the bag needs /tf_static: config/recorder.yaml)");
+  }
+}
+
+}  // namespace
 
 DemoRecording readDemoBag(const std::string& path, const DemoBagTopics& topics) {
   rosbag::Bag bag;
@@ -25,9 +59,22 @@ DemoRecording readDemoBag(const std::string& path, const DemoBagTopics& topics) 
   std::vector<double> t;
   std::vector<std::array<double, 7>> poses;
   std::vector<double> grip_t, grip_v;
-  rosbag::View view(bag, rosbag::TopicQuery(std::vector<std::string>{topics.pose, topics.gripper}));
+  std::string frame, extra_json;
+  StaticTransforms tf;
+  rosbag::View view(bag, rosbag::TopicQuery(std::vector<std::string>{
+                             topics.pose, topics.gripper, topics.metadata, topics.tf_static}));
   for (const rosbag::MessageInstance& m : view) {
-    if (m.getTopic() == topics.pose) {
+    if (m.getTopic() == topics.metadata) {
+      if (const auto meta = m.instantiate<lfd_msgs::DemoMetadata>()) extra_json = meta->extra_json;
+    } else if (m.getTopic() == topics.tf_static) {
+      if (const auto msg = m.instantiate<tf2_msgs::TFMessage>()) {
+        try {
+          addTransforms(*msg, &tf);
+        } catch (const std::runtime_error& e) {
+          throw std::runtime_error(path + ": " + topics.tf_static + ": " + e.what());
+        }
+      }
+    } else if (m.getTopic() == topics.pose) {
       const auto msg = m.instantiate<geometry_msgs::PoseStamped>();
       if (!msg) throw std::runtime_error(path + ": " + topics.pose + " is not geometry_msgs/PoseStamped");
       const double stamp = msg->header.stamp.toSec();
@@ -41,6 +88,7 @@ DemoRecording readDemoBag(const std::string& path, const DemoBagTopics& topics) 
         }
       }
       if (!t.empty() && stamp <= t.back()) continue;  // duplicate / out-of-order stamp
+      if (t.empty()) frame = msg->header.frame_id;
       t.push_back(stamp);
       poses.push_back(row);
     } else {
@@ -63,6 +111,15 @@ DemoRecording readDemoBag(const std::string& path, const DemoBagTopics& topics) 
   }
   DemoRecording rec;
   rec.id = path;
+  rec.frame = frame;
+  if (!extra_json.empty()) {
+    try {
+      rec.scene = sceneOf(path, extra_json, tf, frame);
+    } catch (const std::runtime_error& e) {
+      const std::string what = e.what();
+      throw std::runtime_error(what.rfind(path, 0) == 0 ? what : path + ": " + what);
+    }
+  }
   const Eigen::Index m = static_cast<Eigen::Index>(t.size());
   rec.times = Eigen::Map<Eigen::VectorXd>(t.data(), m);
   rec.positions.resize(m, 3);

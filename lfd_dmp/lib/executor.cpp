@@ -2,39 +2,23 @@
 
 #include <algorithm>
 #include <cmath>
-#include <map>
 #include <sstream>
-#include <stdexcept>
 
 namespace lfd_dmp {
 namespace {
 
-Eigen::Quaterniond yawRotation(double yaw) {
-  return Eigen::Quaterniond(Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()));
-}
+// IK is solved in pieces of this many samples, so a cancel is seen within ~1 ms of work.
+constexpr size_t kIkChunk = 250;
 
-// Wraps yaw into (-period/2, period/2]: a stick is symmetric under pi, the closed fist under pi/2.
-double wrapYaw(double yaw, double period) {
-  while (yaw > period / 2) yaw -= period;
-  while (yaw <= -period / 2) yaw += period;
-  return yaw;
-}
-
-Eigen::Vector3d pushDirection(const TaskSituation& s) {
-  Eigen::Vector3d d = s.goal_position - s.object_position;
-  d.z() = 0.0;
-  if (d.norm() < 1e-3)
-    throw std::invalid_argument("the goal is within 1 mm of the object in xy: no push direction");
-  return d.normalized();
-}
-
-std::string vec(const Eigen::VectorXd& v) {
+std::string vec(const Eigen::Vector3d& v) {
   std::ostringstream o;
   o.precision(3);
-  o << "(";
-  for (int i = 0; i < v.size(); ++i) o << (i ? ", " : "") << v[i];
-  o << ")";
+  o << "(" << v.x() << ", " << v.y() << ", " << v.z() << ")";
   return o.str();
+}
+
+Eigen::Matrix3d yawMatrix(double yaw) {
+  return Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix();
 }
 
 // Per demo id: concatenated goal parameters of every segment (the task's via-points), for the demos
@@ -59,123 +43,107 @@ std::map<std::string, Eigen::VectorXd> allSegmentParameters(const SkillLibrary& 
   return out;
 }
 
-// A shorter stroke does not fix its direction: 1 mm of tremor at 2 cm is already 3 degrees.
-constexpr double kMinHeadingLength = 0.02;  // m
-
-Eigen::Matrix3d yawMatrix(double yaw) {
-  return Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix();
-}
-
-// The task frame of a plan: the new heading and, per demo id, the demo's own heading of the frame
-// segment (demos whose heading is undefined are left out with a warning).
-struct TaskFrame {
-  double yaw = 0.0;
-  std::map<std::string, double> demo_yaw;
-};
-
-TaskFrame taskFrame(const SkillLibrary& library, const std::vector<SegmentTarget>& targets,
-                    const Eigen::Vector3d& tcp_start, const std::string& segment,
-                    std::vector<std::string>* warnings) {
-  size_t k = 0;
-  while (k < targets.size() && targets[k].name != segment) ++k;
-  if (k == targets.size())
-    throw std::invalid_argument("task frame segment '" + segment +
-                                "' is not a segment of the task goal model");
-  TaskFrame frame;
-  const Eigen::Vector3d from = k == 0 ? tcp_start : targets[k - 1].position;
-  try {
-    frame.yaw = headingYaw(from, targets[k].position, kMinHeadingLength);
-  } catch (const std::invalid_argument& e) {
-    throw std::invalid_argument("task frame: the new '" + segment + "' segment: " + e.what());
-  }
-  for (const DemoSkill& d : library.segments[k].demos) {
-    if (!d.dmp.position || d.dmp.position->dims() != 3) continue;
+// The heading frame a segment is generalized in: the new scene's heading and each demo's own.
+HeadingFrame headingFrame(const SkillLibrary& lib, const SegmentSkills& seg,
+                          const lfd::Scene& scene, const lfd::FrameOptions& frames,
+                          std::vector<std::string>* warnings) {
+  HeadingFrame h;
+  h.object = seg.goal->heading_object;
+  h.yaw = lfd::sceneHeading(scene, h.object, frames);
+  for (const DemoSkill& d : seg.demos) {
+    const auto it = lib.demo_scenes.find(d.demo_id);
+    if (it == lib.demo_scenes.end()) continue;
     try {
-      const Eigen::Vector3d a = d.dmp.position->start(), b = d.dmp.position->goal();
-      frame.demo_yaw[d.demo_id] = headingYaw(a, b, kMinHeadingLength);
+      h.demo_yaw[d.demo_id] = lfd::sceneHeading(it->second.scene, h.object, frames);
     } catch (const std::invalid_argument& e) {
-      warnings->push_back("demo " + d.demo_id + " left out of the task frame: " + e.what());
+      warnings->push_back("segment '" + seg.name + "': demo " + d.demo_id +
+                          " left out of the heading frame: " + e.what());
     }
   }
-  if (frame.demo_yaw.empty())
-    throw std::invalid_argument("task frame: no demo has a defined '" + segment + "' heading");
-  return frame;
+  if (h.demo_yaw.empty())
+    throw std::invalid_argument("segment '" + seg.name + "': no demo has a heading of '" +
+                                h.object + "' (the library's demo_scenes)");
+  return h;
+}
+
+// Distance of a goal from the convex hull of the demos' goal positions, and the allowed margin.
+void demoRange(const SegmentSkills& seg, const ExecutorOptions& options, SegmentTarget* t) {
+  Eigen::MatrixXd points(3, static_cast<Eigen::Index>(seg.demos.size()));
+  double diameter = 0.0;
+  for (size_t j = 0; j < seg.demos.size(); ++j) {
+    points.col(static_cast<Eigen::Index>(j)) = seg.demos[j].dmp.position->goal();
+    for (size_t i = 0; i < j; ++i)
+      diameter = std::max(diameter, (points.col(static_cast<Eigen::Index>(i)) -
+                                     points.col(static_cast<Eigen::Index>(j)))
+                                        .norm());
+  }
+  t->range_distance = lfd::convexHullDistance(points, t->goal.position);
+  t->range_margin =
+      std::max(options.generalization.range_margin * diameter, options.min_range_margin);
+}
+
+void checkLibrary(const SkillLibrary& library) {
+  if (library.segments.empty()) throw std::invalid_argument("the skill library has no segments");
+  if (library.generalization_parameters != "goal_position")
+    throw std::invalid_argument("unsupported generalization_parameters '" +
+                                library.generalization_parameters + "' (need goal_position)");
+  for (const SegmentSkills& seg : library.segments) {
+    if (!seg.goal)
+      throw std::invalid_argument(
+          "segment '" + seg.name +
+          "' of the skill library has no learned goal (learned without the demos' scenes): "
+          "relearn it from bags whose metadata holds the scene");
+    if (seg.demos.empty())
+      throw std::invalid_argument("segment '" + seg.name + "' has no demonstration");
+    for (const DemoSkill& d : seg.demos)
+      if (!d.dmp.position || d.dmp.position->dims() != 3)
+        throw std::invalid_argument("segment '" + seg.name + "' has no 3-D position DMP");
+  }
+}
+
+// Refuses a goal outside the demonstrated range unless extrapolation is allowed.
+void checkRange(const std::vector<SegmentTarget>& targets, bool allow, ExecutionPlan* plan) {
+  const SegmentTarget* worst = nullptr;
+  for (const SegmentTarget& t : targets) {
+    plan->extrapolation_distance = std::max(plan->extrapolation_distance, t.range_distance);
+    if (t.range_distance > t.range_margin &&
+        (!worst || t.range_distance - t.range_margin > worst->range_distance - worst->range_margin))
+      worst = &t;
+  }
+  if (!worst) return;
+  plan->outside_demo_range = true;
+  std::ostringstream m;
+  m.precision(3);
+  m << "segment '" << worst->name << "' goal " << vec(worst->goal.position) << " lies "
+    << worst->range_distance << " m from the demonstrated goals (allowed " << worst->range_margin
+    << " m: ~generalization/range_margin x their spread, at least ~min_range_margin)";
+  if (!allow)
+    throw OutsideDemoRange(m.str() + "; outside the demonstrated range (set allow_extrapolation "
+                                     "to run it anyway)",
+                           plan->extrapolation_distance);
+  plan->warnings.push_back(m.str() + "; extrapolated (allow_extrapolation)");
+}
+
+// Samples of one generalized segment appended to the plan (each later segment starts where the
+// previous ended: its duplicate first sample is skipped).
+void appendRollout(const lfd::SegmentTrajectory& traj, bool first, double t_offset,
+                   const Eigen::Quaterniond& hold, std::optional<double> gripper,
+                   ExecutionPlan* plan) {
+  for (Eigen::Index k = first ? 0 : 1; k < traj.times.size(); ++k) {
+    TcpPose p;
+    p.position = traj.positions.row(k).transpose();
+    p.orientation = traj.quaternions.cols() == 4
+                        ? Eigen::Quaterniond(traj.quaternions(k, 0), traj.quaternions(k, 1),
+                                             traj.quaternions(k, 2), traj.quaternions(k, 3))
+                              .normalized()
+                        : hold;
+    plan->times.push_back(t_offset + traj.times[k]);
+    plan->poses.push_back(p);
+    plan->gripper.push_back(traj.gripper.size() ? traj.gripper[k] : gripper.value_or(0.0));
+  }
 }
 
 }  // namespace
-
-double headingYaw(const Eigen::Vector3d& from, const Eigen::Vector3d& to, double min_length) {
-  const Eigen::Vector2d d = (to - from).head<2>();
-  if (!d.allFinite() || !(d.norm() >= min_length)) {
-    std::ostringstream m;
-    m << "its start and goal are " << d.norm() << " m apart in xy (heading needs >= " << min_length
-      << " m)";
-    throw std::invalid_argument(m.str());
-  }
-  return std::atan2(d.y(), d.x());
-}
-
-GoalReference parseGoalReference(const std::string& s) {
-  if (s == "object") return GoalReference::kObject;
-  if (s == "goal") return GoalReference::kGoal;
-  if (s == "start") return GoalReference::kStart;
-  throw std::invalid_argument("unknown goal reference '" + s + "' (object | goal | start)");
-}
-
-OrientationRule parseOrientationRule(const std::string& s) {
-  if (s == "object_yaw") return OrientationRule::kObjectYaw;
-  if (s == "goal_yaw") return OrientationRule::kGoalYaw;
-  if (s == "push_yaw") return OrientationRule::kPushYaw;
-  if (s == "start") return OrientationRule::kStart;
-  if (s == "learned") return OrientationRule::kLearned;
-  throw std::invalid_argument("unknown orientation rule '" + s +
-                              "' (object_yaw | goal_yaw | push_yaw | start | learned)");
-}
-
-std::vector<SegmentTarget> segmentTargets(const TaskGoalModel& model,
-                                          const TaskSituation& situation, const TcpPose& start,
-                                          const Eigen::Quaterniond& gripper_orientation) {
-  std::vector<SegmentTarget> targets;
-  const Eigen::Quaterniond grip = gripper_orientation.normalized();
-  for (const SegmentGoalRule& rule : model.segments) {
-    SegmentTarget t;
-    t.name = rule.name;
-    t.frame = rule.frame;
-    switch (rule.reference) {
-      case GoalReference::kObject:
-        t.position = situation.object_position;
-        break;
-      case GoalReference::kGoal:
-        t.position = situation.goal_position;
-        break;
-      case GoalReference::kStart:
-        t.position = start.position;
-        break;
-    }
-    t.position += rule.offset;
-    if (rule.along_push != 0.0) t.position += rule.along_push * pushDirection(situation);
-    switch (rule.orientation) {
-      case OrientationRule::kObjectYaw:
-        t.orientation = yawRotation(wrapYaw(situation.object_yaw, M_PI)) * grip;
-        break;
-      case OrientationRule::kGoalYaw:
-        t.orientation = yawRotation(wrapYaw(situation.goal_yaw, M_PI)) * grip;
-        break;
-      case OrientationRule::kPushYaw: {
-        const Eigen::Vector3d d = pushDirection(situation);
-        t.orientation = yawRotation(std::atan2(d.y(), d.x())) * grip;
-        break;
-      }
-      case OrientationRule::kStart:
-        t.orientation = start.orientation.normalized();
-        break;
-      case OrientationRule::kLearned:
-        break;
-    }
-    targets.push_back(t);
-  }
-  return targets;
-}
 
 std::vector<GripperEvent> gripperEvents(const std::vector<double>& values, double fraction,
                                         double hysteresis, double min_range) {
@@ -200,61 +168,89 @@ std::vector<GripperEvent> gripperEvents(const std::vector<double>& values, doubl
   return events;
 }
 
+std::vector<SegmentTarget> segmentTargets(const SkillLibrary& library, const lfd::Scene& scene,
+                                          const TcpPose& start, const ExecutorOptions& options,
+                                          std::vector<std::string>* warnings) {
+  checkLibrary(library);
+  std::vector<SegmentTarget> targets;
+  for (const SegmentSkills& seg : library.segments) {
+    const lfd::SegmentGoalModel& g = *seg.goal;
+    SegmentTarget t;
+    t.name = seg.name;
+    t.frames = g.position_frame.name() + " / " + g.orientation_frame.name();
+    try {
+      t.goal = lfd::segmentGoal(g, scene, start, options.frames);
+      if (options.heading_frames && !g.heading_object.empty()) {
+        t.heading = headingFrame(library, seg, scene, options.frames, warnings);
+        t.frames += " (heading:" + g.heading_object + ")";
+      }
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument("segment '" + seg.name + "' (goal frames " + t.frames +
+                                  "): " + e.what());
+    }
+    demoRange(seg, options, &t);
+    targets.push_back(t);
+  }
+  return targets;
+}
+
 TaskPlanner::TaskPlanner(const lfd::CartesianToJoints& ik) : ik_(ik) {}
 
 ExecutionPlan TaskPlanner::plan(const SkillLibrary& library,
                                 const std::vector<SegmentTarget>& targets,
                                 const Eigen::VectorXd& q_start, std::optional<double> gripper_start,
-                                const ExecutorOptions& options) {
+                                const ExecutorOptions& options,
+                                const std::function<bool()>& cancelled) {
+  auto poll = [&](const std::string& where) {
+    if (cancelled && cancelled()) throw PlanningCancelled("cancelled while planning (" + where + ")");
+  };
   if (library.segments.empty()) throw std::invalid_argument("the skill library has no segments");
   if (targets.size() != library.segments.size()) {
     std::ostringstream m;
     m << "the skill library '" << library.task << "' has " << library.segments.size()
-      << " segments but the task goal model gives " << targets.size()
-      << " segment goals (was the task segmented into the expected phases?)";
+      << " segments but " << targets.size() << " segment goals were given";
     throw std::invalid_argument(m.str());
   }
-  if (library.generalization_parameters != "goal_position")
-    throw std::invalid_argument("unsupported generalization_parameters '" +
-                                library.generalization_parameters + "' (need goal_position)");
   if (q_start.size() != chain().dof())
     throw std::invalid_argument("start joint vector has " + std::to_string(q_start.size()) +
                                 " values, the IK chain has " + std::to_string(chain().dof()));
-  if (!(options.dt > 0.0) || !(options.duration_scale > 0.0))
-    throw std::invalid_argument("dt and duration_scale must be > 0");
+  if (!(options.dt > 0.0) || !(options.duration_scale > 0.0) ||
+      !std::isfinite(options.duration_scale))
+    throw std::invalid_argument("dt and duration_scale must be finite and > 0");
 
+  ExecutionPlan plan;
+  checkRange(targets, options.allow_extrapolation, &plan);
   const auto all_params = allSegmentParameters(library);
-  const bool use_all = options.all_segment_goals && all_params.size() >= 1;
+  const bool use_all = options.all_segment_goals && !all_params.empty();
   Eigen::VectorXd all_query;
   if (use_all) {
     all_query.resize(3 * static_cast<Eigen::Index>(targets.size()));
-    for (size_t s = 0; s < targets.size(); ++s) all_query.segment<3>(3 * s) = targets[s].position;
+    for (size_t s = 0; s < targets.size(); ++s)
+      all_query.segment<3>(3 * s) = targets[s].goal.position;
   }
 
-  ExecutionPlan plan;
   plan.joint_names = chain().jointNames();
   plan.dt = options.dt;
   const TcpPose start = forward(q_start);
-  std::map<std::string, TaskFrame> frames;  // by frame segment name
-  for (const SegmentTarget& t : targets)
-    if (!t.frame.empty() && !frames.count(t.frame))
-      frames[t.frame] = taskFrame(library, targets, start.position, t.frame, &plan.warnings);
   Eigen::Vector3d position = start.position;
   Eigen::Quaterniond orientation = start.orientation;
   Eigen::Vector3d velocity = Eigen::Vector3d::Zero();
   std::optional<double> gripper = gripper_start;
   double t_offset = 0.0;
+  double samples = 0.0;
 
   for (size_t s = 0; s < library.segments.size(); ++s) {
+    poll("segment " + library.segments[s].name);
     const SegmentSkills& seg = library.segments[s];
     const SegmentTarget& target = targets[s];
     std::vector<lfd::SegmentDmp> dmps;
     std::vector<Eigen::VectorXd> params;
     PlannedSegment planned;
-    planned.name = seg.name.empty() ? target.name : seg.name;
-    const TaskFrame* frame = target.frame.empty() ? nullptr : &frames.at(target.frame);
+    planned.name = seg.name;
+    planned.frames = target.frames;
+    const HeadingFrame* heading = target.heading ? &*target.heading : nullptr;
     for (const DemoSkill& d : seg.demos) {
-      if (frame && !frame->demo_yaw.count(d.demo_id)) continue;
+      if (heading && !heading->demo_yaw.count(d.demo_id)) continue;
       if (use_all) {
         const auto it = all_params.find(d.demo_id);
         if (it == all_params.end()) continue;
@@ -262,90 +258,77 @@ ExecutionPlan TaskPlanner::plan(const SkillLibrary& library,
       } else {
         params.push_back(d.parameters);
       }
-      dmps.push_back(frame ? d.dmp.rotated(yawMatrix(-frame->demo_yaw.at(d.demo_id))) : d.dmp);
+      dmps.push_back(heading ? d.dmp.rotated(yawMatrix(-heading->demo_yaw.at(d.demo_id))) : d.dmp);
       planned.demos.push_back(d.demo_id);
     }
     if (dmps.empty())
-      throw std::invalid_argument("segment " + std::to_string(s) + " has no usable demonstration");
-    if (!dmps.front().position || dmps.front().position->dims() != 3)
-      throw std::invalid_argument("segment " + std::to_string(s) + " has no 3-D position DMP");
-    const Eigen::VectorXd query = use_all ? all_query : Eigen::VectorXd(target.position);
+      throw std::invalid_argument("segment '" + seg.name + "' has no usable demonstration");
+    const Eigen::VectorXd query = use_all ? all_query : Eigen::VectorXd(target.goal.position);
     lfd::GeneralizationResult gen =
         lfd::generalizeSegment(dmps, params, query, options.generalization);
-    if (frame) gen.dmp = gen.dmp.rotated(yawMatrix(frame->yaw));
-    if (gen.outside_demo_range) {
-      planned.outside_demo_range = true;
-      plan.warnings.push_back("segment " + planned.name + ": " + gen.warning);
-    }
+    if (heading) gen.dmp = gen.dmp.rotated(yawMatrix(heading->yaw));
 
     lfd::SegmentRolloutOptions ro;
     ro.dt = options.dt;
     ro.tau = gen.dmp.tau * options.duration_scale;
+    // Refuse before allocating: the rollout, IK and trajectory all grow with the samples.
+    samples += *ro.tau / options.dt;
+    if (!(samples <= static_cast<double>(options.max_samples))) {
+      std::ostringstream m;
+      m << "the plan would have over " << options.max_samples << " samples ("
+        << t_offset + *ro.tau << " s at dt " << options.dt
+        << " s): over the limit (~limits/max_plan_seconds; duration_scale "
+        << options.duration_scale << ")";
+      throw std::invalid_argument(m.str());
+    }
     ro.start_position = Eigen::VectorXd(position);
-    ro.goal_position = Eigen::VectorXd(target.position);
+    ro.goal_position = Eigen::VectorXd(target.goal.position);
     ro.start_velocity = Eigen::VectorXd(velocity);
     if (gen.dmp.orientation) {
       ro.start_orientation = orientation;
       ro.start_angular_velocity = Eigen::Vector3d::Zero();
-      if (target.orientation) ro.goal_orientation = *target.orientation;
+      ro.goal_orientation = target.goal.orientation;
     }
     if (gen.dmp.gripper && gripper) ro.start_gripper = *gripper;
     const lfd::SegmentTrajectory traj = gen.dmp.rollout(ro);
 
     planned.begin = plan.times.size();
     planned.duration = *ro.tau;
-    planned.goal.position = target.position;
-    planned.goal.orientation =
-        target.orientation ? *target.orientation
-                           : (gen.dmp.orientation ? gen.dmp.orientation->goal() : orientation);
-    const Eigen::Index n = traj.times.size();
-    // Each later segment starts where the previous ended: skip its duplicate first sample.
-    for (Eigen::Index k = (s == 0 ? 0 : 1); k < n; ++k) {
-      TcpPose p;
-      p.position = traj.positions.row(k).transpose();
-      p.orientation = traj.quaternions.cols() == 4
-                          ? Eigen::Quaterniond(traj.quaternions(k, 0), traj.quaternions(k, 1),
-                                               traj.quaternions(k, 2), traj.quaternions(k, 3))
-                                .normalized()
-                          : orientation;
-      plan.times.push_back(t_offset + traj.times[k]);
-      plan.poses.push_back(p);
-      plan.gripper.push_back(traj.gripper.size() ? traj.gripper[k] : (gripper ? *gripper : 0.0));
-    }
+    planned.goal = target.goal;
+    appendRollout(traj, s == 0, t_offset, orientation, gripper, &plan);
     planned.end = plan.times.size();
     t_offset = plan.times.back();
     position = plan.poses.back().position;
     orientation = plan.poses.back().orientation;
-    velocity = traj.velocities.row(n - 1).transpose();
-    if (traj.gripper.size()) gripper = traj.gripper[n - 1];
+    velocity = traj.velocities.row(traj.velocities.rows() - 1).transpose();
+    if (traj.gripper.size()) gripper = traj.gripper[traj.gripper.size() - 1];
     plan.segments.push_back(planned);
   }
 
-  // Reachability of the WHOLE path before anything moves.
-  std::vector<lfd::TimedPose> samples(plan.poses.size());
-  for (size_t k = 0; k < samples.size(); ++k) samples[k] = {plan.times[k], plan.poses[k]};
-  lfd::JointPath path;
-  try {
-    path = ik_.convert(samples, q_start);
-  } catch (const std::runtime_error& e) {
-    // Name the segment the failing time belongs to.
-    std::string where;
-    const std::string msg = e.what();
-    const auto at = msg.find("t=");
-    if (at != std::string::npos) {
-      const double t = std::atof(msg.c_str() + at + 2);
-      for (const PlannedSegment& ps : plan.segments)
-        if (t <= plan.times[ps.end - 1] + 1e-9) {
-          where = " in segment '" + ps.name + "' (goal " + vec(ps.goal.position) + " in base_link)";
-          break;
-        }
+  // Reachability of the WHOLE path before anything moves, in pieces (a cancel is seen between).
+  Eigen::VectorXd seed = q_start;
+  plan.joints.reserve(plan.poses.size());
+  for (const PlannedSegment& ps : plan.segments) {
+    for (size_t a = ps.begin; a < ps.end; a += kIkChunk) {
+      poll("IK of segment " + ps.name);
+      std::vector<lfd::TimedPose> samples;
+      for (size_t k = a; k < std::min(ps.end, a + kIkChunk); ++k)
+        samples.push_back({plan.times[k], plan.poses[k]});
+      lfd::JointPath path;
+      try {
+        path = ik_.convert(samples, seed);
+      } catch (const std::exception& e) {
+        throw std::runtime_error("unreachable in segment '" + ps.name + "' (goal " +
+                                 vec(ps.goal.position) + "): " + e.what());
+      }
+      plan.max_ik_position_error = std::max(plan.max_ik_position_error, path.max_position_error);
+      plan.max_ik_orientation_error =
+          std::max(plan.max_ik_orientation_error, path.max_orientation_error);
+      plan.max_speed_ratio = std::max(plan.max_speed_ratio, path.max_speed_ratio);
+      for (Eigen::VectorXd& q : path.positions) plan.joints.push_back(std::move(q));
+      seed = plan.joints.back();
     }
-    throw std::runtime_error("unreachable" + where + ": " + msg);
   }
-  plan.joints = std::move(path.positions);
-  plan.max_ik_position_error = path.max_position_error;
-  plan.max_ik_orientation_error = path.max_orientation_error;
-  plan.max_speed_ratio = path.max_speed_ratio;
   plan.gripper_events = gripperEvents(plan.gripper, options.gripper_threshold_fraction,
                                       options.gripper_hysteresis, options.gripper_min_range);
   return plan;

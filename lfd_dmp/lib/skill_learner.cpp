@@ -52,6 +52,53 @@ DemoRecording smoothed(const DemoRecording& rec, double sigma, std::vector<std::
   return out;
 }
 
+lfd::Pose poseAt(const DemoRecording& rec, Eigen::Index i) {
+  lfd::Pose p;
+  p.position = rec.positions.row(i).transpose();
+  if (rec.quaternions.cols() == 4)
+    p.orientation = Eigen::Quaterniond(rec.quaternions(i, 0), rec.quaternions(i, 1),
+                                       rec.quaternions(i, 2), rec.quaternions(i, 3))
+                        .normalized();
+  return p;
+}
+
+// Every demo has a scene, or none does (then nothing is learned about goals); all in one frame.
+bool checkScenes(const std::vector<DemoRecording>& demos, std::string* frame) {
+  size_t with = 0;
+  std::string without;
+  for (const DemoRecording& d : demos) {
+    if (d.scene)
+      ++with;
+    else
+      without += (without.empty() ? "" : ", ") + d.id;
+    if (d.frame != demos.front().frame)
+      throw std::invalid_argument("demo " + d.id + " has its poses in '" + d.frame + "', demo " +
+                                  demos.front().id + " in '" + demos.front().frame + "'");
+  }
+  if (with > 0 && with < demos.size())
+    throw std::invalid_argument("demos without a scene (objects and goal in their metadata): " +
+                                without + "; the segment goals are learned from every demo's scene");
+  *frame = demos.front().frame.empty() ? "base_link" : demos.front().frame;
+  return with > 0;
+}
+
+// Where each segment of each used demo started and ended, with the demo's scene.
+struct DemoEnds {
+  lfd::Scene scene;
+  lfd::Pose start;
+  std::vector<lfd::Pose> bounds;  // segment boundaries: num_segments + 1 poses
+};
+
+void learnGoals(const std::vector<DemoEnds>& ends, const lfd::FrameSelectionOptions& options,
+                SkillLibrary* lib) {
+  for (size_t s = 0; s < lib->segments.size(); ++s) {
+    std::vector<lfd::SegmentDemoEnds> demos;
+    for (const DemoEnds& e : ends)
+      demos.push_back({e.scene, e.start, e.bounds[s], e.bounds[s + 1]});
+    lib->segments[s].goal = lfd::learnSegmentGoal(demos, options);
+  }
+}
+
 }  // namespace
 
 LearnOutcome learnSkillLibrary(const std::vector<DemoRecording>& demos,
@@ -64,6 +111,8 @@ LearnOutcome learnSkillLibrary(const std::vector<DemoRecording>& demos,
                                 " changepoint lists");
   }
   options.params.validate();
+  std::string frame;
+  const bool with_scenes = checkScenes(demos, &frame);
   if (!(options.smoothing_sigma >= 0.0) || !std::isfinite(options.smoothing_sigma))
     throw std::invalid_argument("learnSkillLibrary: smoothing_sigma must be a finite value >= 0");
   // Majority vote on the number of segments (ties: fewer segments).
@@ -92,6 +141,8 @@ LearnOutcome learnSkillLibrary(const std::vector<DemoRecording>& demos,
   lib.smoothing_sigma = options.smoothing_sigma;
   lib.position_names = {"x", "y", "z"};
   lib.generalization_parameters = "goal_position";
+  lib.cartesian_frame = frame;
+  std::vector<DemoEnds> ends;
   for (size_t s = 0; s < num_segments; ++s) {
     SegmentSkills seg;
     seg.index = static_cast<int>(s);
@@ -128,6 +179,12 @@ LearnOutcome learnSkillLibrary(const std::vector<DemoRecording>& demos,
       bounds.push_back(idx);
     }
     bounds.push_back(m - 1);
+    if (with_scenes) {
+      DemoEnds e{*rec.scene, poseAt(rec, 0), {}};
+      for (Eigen::Index b : bounds) e.bounds.push_back(poseAt(rec, b));
+      lib.demo_scenes[rec.id] = {e.scene, e.start};
+      ends.push_back(std::move(e));
+    }
     for (size_t s = 0; s < num_segments; ++s) {
       const Eigen::Index a = bounds[s], b = bounds[s + 1];
       DemoSkill skill;
@@ -152,6 +209,12 @@ LearnOutcome learnSkillLibrary(const std::vector<DemoRecording>& demos,
   if (outcome.demos_used == 0) {
     throw std::invalid_argument("learnSkillLibrary: no demonstration could be used");
   }
+  if (with_scenes)
+    learnGoals(ends, options.frames, &lib);
+  else
+    outcome.warnings.push_back(
+        "no demonstration has a scene (objects and goal in its metadata): no segment goals were "
+        "learned, the executor cannot reproduce this library");
   return outcome;
 }
 

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <limits>
 #include <sstream>
 #include <stdexcept>
 
@@ -101,6 +102,107 @@ Eigen::Quaterniond quaternion(const json& j, const std::string& where) {
   return Eigen::Quaterniond(v[0], v[1], v[2], v[3]).normalized();
 }
 
+json poseJson(const lfd::Pose& p) {
+  return json{{"position", vectorJson(p.position)}, {"orientation", quaternionJson(p.orientation)}};
+}
+
+lfd::Pose poseFromJson(const json& j, const std::string& where) {
+  lfd::Pose p;
+  p.position = bounded(vector(member(j, "position", where), where + ".position", 3),
+                       kMaxPositionMagnitude, where + ".position", "position");
+  p.orientation = quaternion(member(j, "orientation", where), where + ".orientation");
+  return p;
+}
+
+// A spread may be infinite (the frame is undefined in some demo): JSON null.
+json spreadJson(double v) {
+  return std::isfinite(v) ? json(v) : json(nullptr);
+}
+
+double spreadFromJson(const json& j, const std::string& where) {
+  if (j.is_null()) return std::numeric_limits<double>::infinity();
+  const double v = number(j, where);
+  if (v < 0.0) fail(where, "a spread must be >= 0");
+  return v;
+}
+
+lfd::SceneFrame frameFromJson(const json& j, const std::string& where) {
+  try {
+    return lfd::SceneFrame::parse(text(j, where));
+  } catch (const std::invalid_argument& e) {
+    fail(where, e.what());
+  }
+}
+
+json goalJson(const lfd::SegmentGoalModel& g) {
+  json candidates = json::array();
+  for (const lfd::FrameSpread& c : g.candidates)
+    candidates.push_back(json{{"frame", c.frame.name()},
+                              {"position_spread_m", spreadJson(c.position_m)},
+                              {"orientation_spread_rad", spreadJson(c.orientation_rad)}});
+  return json{{"position",
+               {{"frame", g.position_frame.name()},
+                {"offset", vectorJson(g.position_offset)},
+                {"spread_m", spreadJson(g.position_spread)}}},
+              {"orientation",
+               {{"frame", g.orientation_frame.name()},
+                {"offset", quaternionJson(g.orientation_offset)},
+                {"spread_rad", spreadJson(g.orientation_spread)}}},
+              {"heading", {{"object", g.heading_object}, {"spread_rad", spreadJson(g.heading_spread)}}},
+              {"candidates", candidates}};
+}
+
+lfd::SegmentGoalModel goalFromJson(const json& j, const std::string& w) {
+  lfd::SegmentGoalModel g;
+  const json& p = member(j, "position", w);
+  g.position_frame = frameFromJson(member(p, "frame", w + ".position"), w + ".position.frame");
+  g.position_offset = bounded(vector(member(p, "offset", w + ".position"), w + ".position.offset", 3),
+                              kMaxPositionMagnitude, w + ".position.offset", "position");
+  g.position_spread = spreadFromJson(member(p, "spread_m", w + ".position"), w + ".position.spread_m");
+  const json& o = member(j, "orientation", w);
+  g.orientation_frame =
+      frameFromJson(member(o, "frame", w + ".orientation"), w + ".orientation.frame");
+  g.orientation_offset =
+      quaternion(member(o, "offset", w + ".orientation"), w + ".orientation.offset");
+  g.orientation_spread =
+      spreadFromJson(member(o, "spread_rad", w + ".orientation"), w + ".orientation.spread_rad");
+  const json& h = member(j, "heading", w);
+  g.heading_object = text(member(h, "object", w + ".heading"), w + ".heading.object");
+  g.heading_spread = spreadFromJson(member(h, "spread_rad", w + ".heading"), w + ".heading.spread_rad");
+  if (j.contains("candidates")) {
+    const json& c = j["candidates"];
+    if (!c.is_array()) fail(w + ".candidates", "expected an array");
+    for (size_t i = 0; i < c.size(); ++i) {
+      const std::string wc = w + ".candidates[" + std::to_string(i) + "]";
+      g.candidates.push_back({frameFromJson(member(c[i], "frame", wc), wc + ".frame"),
+                              spreadFromJson(member(c[i], "position_spread_m", wc), wc),
+                              spreadFromJson(member(c[i], "orientation_spread_rad", wc), wc)});
+    }
+  }
+  return g;
+}
+
+json sceneJson(const std::string& id, const DemoScene& d) {
+  json objects = json::object();
+  for (const auto& [name, pose] : d.scene.objects) objects[name] = poseJson(pose);
+  return json{{"demo_id", id},
+              {"start", poseJson(d.start)},
+              {"objects", objects},
+              {"goal", poseJson(d.scene.goal)}};
+}
+
+std::pair<std::string, DemoScene> sceneFromJson(const json& j, const std::string& w) {
+  DemoScene d;
+  const std::string id = text(member(j, "demo_id", w), w + ".demo_id");
+  d.start = poseFromJson(member(j, "start", w), w + ".start");
+  d.scene.goal = poseFromJson(member(j, "goal", w), w + ".goal");
+  const json& objects = member(j, "objects", w);
+  if (!objects.is_object()) fail(w + ".objects", "expected an object of named poses");
+  for (const auto& [name, pose] : objects.items())
+    d.scene.objects[name] = poseFromJson(pose, w + ".objects." + name);
+  return {id, d};
+}
+
 }  // namespace
 
 json toJson(const lfd::DmpParameters& p) {
@@ -152,8 +254,12 @@ json toJson(const SkillLibrary& lib) {
                            {"parameters", vectorJson(d.parameters)},
                            {"dmp", toJson(d.dmp)}});
     }
-    segments.push_back(json{{"index", seg.index}, {"name", seg.name}, {"demos", demos}});
+    json j{{"index", seg.index}, {"name", seg.name}, {"demos", demos}};
+    if (seg.goal) j["goal"] = goalJson(*seg.goal);
+    segments.push_back(j);
   }
+  json scenes = json::array();
+  for (const auto& [id, scene] : lib.demo_scenes) scenes.push_back(sceneJson(id, scene));
   return json{{"format", kSkillLibraryFormat},
               {"version", lib.version},
               {"task", lib.task},
@@ -162,6 +268,8 @@ json toJson(const SkillLibrary& lib) {
               {"position_names", lib.position_names},
               {"dmp_parameters", toJson(lib.dmp_parameters)},
               {"smoothing_sigma", lib.smoothing_sigma},
+              {"cartesian_frame", lib.cartesian_frame},
+              {"demo_scenes", scenes},
               {"segments", segments}};
 }
 
@@ -247,6 +355,11 @@ SkillLibrary skillLibraryFromJson(const json& j) {
     fail("format", "expected \"" + std::string(kSkillLibraryFormat) + "\", got \"" + format + "\"");
   }
   const double version = number(member(j, "version", root), "version");
+  if (version == 1) {
+    fail("version", "version 1 has no learned segment goals (they were rules in the executor's "
+                    "config): relearn the library with this build (learn_skills.py or "
+                    "/learner/learn)");
+  }
   if (version != kSkillLibraryVersion) {
     fail("version", "unsupported version " + std::to_string(static_cast<int>(version)) +
                         " (this build reads version " + std::to_string(kSkillLibraryVersion) + ")");
@@ -271,6 +384,13 @@ SkillLibrary skillLibraryFromJson(const json& j) {
     lib.smoothing_sigma = number(j["smoothing_sigma"], "smoothing_sigma");
     if (!(lib.smoothing_sigma >= 0.0)) fail("smoothing_sigma", "must be >= 0 (s)");
   }
+  lib.cartesian_frame = text(member(j, "cartesian_frame", root), "cartesian_frame");
+  if (j.contains("demo_scenes")) {
+    const json& scenes = j["demo_scenes"];
+    if (!scenes.is_array()) fail("demo_scenes", "expected an array");
+    for (size_t i = 0; i < scenes.size(); ++i)
+      lib.demo_scenes.insert(sceneFromJson(scenes[i], "demo_scenes[" + std::to_string(i) + "]"));
+  }
   const json& segments = member(j, "segments", root);
   if (!segments.is_array()) fail("segments", "expected an array");
   for (size_t s = 0; s < segments.size(); ++s) {
@@ -278,6 +398,7 @@ SkillLibrary skillLibraryFromJson(const json& j) {
     SegmentSkills seg;
     seg.index = static_cast<int>(number(member(segments[s], "index", ws), ws + ".index"));
     seg.name = text(member(segments[s], "name", ws), ws + ".name");
+    if (segments[s].contains("goal")) seg.goal = goalFromJson(segments[s]["goal"], ws + ".goal");
     const json& demos = member(segments[s], "demos", ws);
     if (!demos.is_array()) fail(ws + ".demos", "expected an array");
     long param_dims = -1;

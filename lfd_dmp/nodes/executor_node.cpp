@@ -1,30 +1,30 @@
-// executor_node: reproduces a learned task toward a new goal (paper III, reproduction).
-//   service ~execute (lfd_msgs/ExecuteTask)  plan (generalize + roll out + IK-check) then stream
-//   service ~cancel  (std_srvs/Trigger)      stops a running execution (the arm holds its target)
-//   topic   ~progress (std_msgs/Float64)     fraction of the planned samples streamed
-//   topics  /executor/planned_path, /executor/executed_path (nav_msgs/Path, base_link),
+// executor_node: reproduces a learned task in a new scene (paper III, reproduction).
+//   action  ~execute (lfd_msgs/ExecuteTaskAction; /executor/execute): plan (learned segment goals,
+//           generalization, rollout, IK check of the whole path), then one stamped trajectory
+//   out     /joint_trajectory (trajectory_msgs/JointTrajectory, header.stamp = sim time it starts)
+//           /gripper/command (lfd_msgs/GripperCommand, header.stamp = sim time it takes effect)
+//           /executor/planned_path, /executor/executed_path (nav_msgs/Path, Cartesian frame),
 //           /executor/segment_markers (visualization_msgs/MarkerArray)
-//   out     /joint_command (sensor_msgs/JointState), /gripper/command (lfd_msgs/GripperCommand)
-//   in      /joint_states, /gripper/state, /ee_pose
-// The logic is lfd_dmp::TaskPlanner (lib/executor.cpp); this file is ROS I/O and sim-time pacing.
+//   in      /joint_states, /gripper/state, tf (the scene's frames)
+// It knows no simulator: any driver of those topics runs it, on its clock (/clock in simulation).
+// Every wait is bounded in wall time (a clock that stops fails the goal instead of hanging it), and
+// a preemption or cancel is served at any moment (planning, moving, settling).
+// The logic is lfd_dmp::TaskPlanner (lib/executor.cpp); this file is ROS I/O and monitoring.
 // Parameters: config/executor.yaml (loaded by launch/reproduce.launch).
+#include "lfd_dmp/execution_request.hpp"
 #include "lfd_dmp/executor.hpp"
-#include "lfd_core/robot_setup.hpp"
-#include "lfd_sim_bridge/pose_msg.hpp"
+#include "lfd_dmp/plan_messages.hpp"
 
-#include <lfd_msgs/ExecuteTask.h>
-#include <lfd_msgs/GripperCommand.h>
-#include <lfd_sim_bridge/demo_tasks.hpp>
+#include <lfd_core/robot_setup.hpp>
+#include <lfd_core/safe_paths.hpp>
+#include <lfd_msgs/ExecuteTaskAction.h>
 
-#include <geometry_msgs/PoseStamped.h>
-#include <nav_msgs/Path.h>
+#include <actionlib/server/simple_action_server.h>
 #include <ros/ros.h>
 #include <sensor_msgs/JointState.h>
-#include <std_msgs/Float64.h>
-#include <std_srvs/Trigger.h>
-#include <visualization_msgs/MarkerArray.h>
+#include <tf2_ros/buffer.h>
+#include <tf2_ros/transform_listener.h>
 
-#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <map>
@@ -33,63 +33,62 @@
 
 namespace {
 
-double yawOf(const geometry_msgs::Quaternion& q) {
-  return std::atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z));
+using ActionServer = actionlib::SimpleActionServer<lfd_msgs::ExecuteTaskAction>;
+using Clock = std::chrono::steady_clock;
+
+class Preempted : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+double wallSince(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
 }
 
-// YAML numbers may be ints or doubles; anything else is a configuration error.
-double number(XmlRpc::XmlRpcValue& v, const std::string& what) {
-  if (v.getType() == XmlRpc::XmlRpcValue::TypeDouble) return static_cast<double>(v);
-  if (v.getType() == XmlRpc::XmlRpcValue::TypeInt) return static_cast<int>(v);
-  throw std::runtime_error("executor: ~tasks: " + what + " must be a number");
+template <typename T>
+T param(ros::NodeHandle& pnh, const std::string& key, const T& fallback) {
+  T v;
+  return pnh.getParam(key, v) ? v : fallback;
 }
 
-std::string text(XmlRpc::XmlRpcValue& v, const std::string& what) {
-  if (v.getType() != XmlRpc::XmlRpcValue::TypeString)
-    throw std::runtime_error("executor: ~tasks: " + what + " must be a string");
-  return static_cast<std::string>(v);
+Eigen::Vector3d vectorParam(ros::NodeHandle& pnh, const std::string& key,
+                            const Eigen::Vector3d& fallback) {
+  std::vector<double> v;
+  if (!pnh.getParam(key, v)) return fallback;
+  if (v.size() != 3) throw std::runtime_error("executor: ~" + key + " needs 3 numbers");
+  return Eigen::Vector3d(v[0], v[1], v[2]);
 }
 
-bool finitePose(const geometry_msgs::Pose& p) {
-  for (double v : {p.position.x, p.position.y, p.position.z, p.orientation.w, p.orientation.x,
-                   p.orientation.y, p.orientation.z})
-    if (!std::isfinite(v)) return false;
-  return true;
-}
+// Sim time must move while a motion runs; `timeout` wall seconds without progress is a failure
+// (a paused or dead clock), never a hang.
+class ClockWatch {
+ public:
+  explicit ClockWatch(double timeout) : timeout_(timeout) {}
+  void check(const ros::Time& now) {
+    if (now > last_) {
+      last_ = now;
+      since_ = Clock::now();
+    } else if (wallSince(since_) > timeout_) {
+      throw std::runtime_error(
+          "sim time stopped at t=" + std::to_string(now.toSec()) + " s for " +
+          std::to_string(timeout_) +
+          " s of wall time (~clock_timeout): the robot driver is paused or gone; a lockstep client "
+          "must step the simulation while the goal is active");
+    }
+  }
+
+ private:
+  double timeout_;
+  ros::Time last_;
+  Clock::time_point since_ = Clock::now();
+};
 
 class Executor {
  public:
-  Executor(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh) {
-    pnh.param<std::string>("tasks_file", tasks_file_, "");
-    pnh.param<std::string>("library_dir", library_dir_, "");
-    std::string robot_file;
-    pnh.param<std::string>("robot_file", robot_file, "");
-    robot_ = lfd::loadRobotSetup(robot_file);
-    pnh.param("dt", options_.dt, options_.dt);
-    pnh.param("all_segment_goals", options_.all_segment_goals, options_.all_segment_goals);
-    pnh.param("gripper/threshold_fraction", options_.gripper_threshold_fraction,
-              options_.gripper_threshold_fraction);
-    pnh.param("gripper/hysteresis", options_.gripper_hysteresis, options_.gripper_hysteresis);
-    pnh.param("gripper/min_range", options_.gripper_min_range, options_.gripper_min_range);
-    pnh.param("gripper/open_opening", open_opening_, open_opening_);
-    pnh.param("gripper/close_opening", close_opening_, close_opening_);
-    pnh.param("gripper/close_effort", close_effort_, close_effort_);
-    pnh.param("gripper/joint", gripper_joint_, gripper_joint_);
-    pnh.param("generalization/bandwidth", options_.generalization.bandwidth, 0.0);
-    pnh.param("generalization/local_linear", options_.generalization.local_linear,
-              options_.generalization.local_linear);
-    pnh.param("generalization/range_margin", options_.generalization.range_margin,
-              options_.generalization.range_margin);
-    pnh.param("settle_time", settle_time_, settle_time_);
-    pnh.param("clock_timeout", clock_timeout_, clock_timeout_);
-    std::vector<double> b;
-    if (pnh.getParam("base_link_in_world", b) && b.size() == 3)
-      base_in_world_ = Eigen::Vector3d(b[0], b[1], b[2]);
-    loadGoalModels(pnh);
-
-    joint_pub_ = nh.advertise<sensor_msgs::JointState>("/joint_command", 10);
+  Executor(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh), tf_listener_(tf_buffer_) {
+    loadParameters(pnh);
+    trajectory_pub_ = nh.advertise<trajectory_msgs::JointTrajectory>("/joint_trajectory", 10);
     gripper_pub_ = nh.advertise<lfd_msgs::GripperCommand>("/gripper/command", 10);
-    progress_pub_ = pnh.advertise<std_msgs::Float64>("progress", 10);
     planned_pub_ = nh.advertise<nav_msgs::Path>("/executor/planned_path", 1, true);
     executed_pub_ = nh.advertise<nav_msgs::Path>("/executor/executed_path", 1, true);
     marker_pub_ =
@@ -97,350 +96,411 @@ class Executor {
     const auto hints = ros::TransportHints().tcpNoDelay();
     joint_sub_ = nh.subscribe("/joint_states", 5, &Executor::onJoints, this, hints);
     gripper_sub_ = nh.subscribe("/gripper/state", 5, &Executor::onGripper, this, hints);
-    ee_sub_ = nh.subscribe("/ee_pose", 5, &Executor::onEePose, this, hints);
-    execute_srv_ = pnh.advertiseService("execute", &Executor::execute, this);
-    cancel_srv_ = pnh.advertiseService("cancel", &Executor::cancel, this);
-    ROS_INFO("executor: ready (%zu task goal models, dt %.4f s)", models_.size(), options_.dt);
+    server_ = std::make_unique<ActionServer>(
+        pnh, "execute", [this](const lfd_msgs::ExecuteTaskGoalConstPtr& g) { execute(*g); }, false);
+    server_->start();
+    ROS_INFO("executor: ready (action %s/execute, dt %.4f s)", pnh.getNamespace().c_str(),
+             options_.dt);
   }
 
  private:
-  void loadGoalModels(ros::NodeHandle& pnh) {
-    XmlRpc::XmlRpcValue tasks;
-    if (!pnh.getParam("tasks", tasks) || tasks.getType() != XmlRpc::XmlRpcValue::TypeStruct)
-      throw std::runtime_error("executor: ~tasks (per-task segment goal rules) is missing");
-    for (auto& [task, spec] : tasks) {
-      lfd_dmp::TaskGoalModel model;
-      model.task = task;
-      if (spec.getType() != XmlRpc::XmlRpcValue::TypeStruct || !spec.hasMember("segments") ||
-          spec["segments"].getType() != XmlRpc::XmlRpcValue::TypeArray)
-        throw std::runtime_error("executor: ~tasks/" + task + "/segments must be a list");
-      XmlRpc::XmlRpcValue& segs = spec["segments"];
-      for (int i = 0; i < segs.size(); ++i) {
-        XmlRpc::XmlRpcValue& s = segs[i];
-        const std::string where = task + ".segments[" + std::to_string(i) + "]";
-        if (s.getType() != XmlRpc::XmlRpcValue::TypeStruct || !s.hasMember("name") ||
-            !s.hasMember("reference") || !s.hasMember("orientation"))
-          throw std::runtime_error("executor: ~tasks: " + where +
-                                   " needs name, reference and orientation");
-        lfd_dmp::SegmentGoalRule r;
-        r.name = text(s["name"], where + ".name");
-        r.reference = lfd_dmp::parseGoalReference(text(s["reference"], where + ".reference"));
-        r.orientation =
-            lfd_dmp::parseOrientationRule(text(s["orientation"], where + ".orientation"));
-        if (s.hasMember("offset")) {
-          if (s["offset"].getType() != XmlRpc::XmlRpcValue::TypeArray || s["offset"].size() != 3)
-            throw std::runtime_error("executor: ~tasks: " + where + ".offset needs 3 numbers");
-          for (int k = 0; k < 3; ++k) r.offset[k] = number(s["offset"][k], where + ".offset");
-        }
-        if (s.hasMember("along_push")) r.along_push = number(s["along_push"], where);
-        if (s.hasMember("frame")) r.frame = text(s["frame"], where + ".frame");
-        model.segments.push_back(r);
-      }
-      for (const auto& r : model.segments) {
-        bool known = r.frame.empty();
-        for (const auto& other : model.segments) known = known || other.name == r.frame;
-        if (!known)
-          throw std::runtime_error("executor: ~tasks: " + task + "." + r.name + ".frame '" +
-                                   r.frame + "' names no segment of the task");
-      }
-      models_[task] = model;
+  // ---- configuration ---------------------------------------------------------------------------
+  void loadParameters(ros::NodeHandle& pnh) {
+    library_dir_ = param<std::string>(pnh, "library_dir", "");
+    robot_ = lfd::loadRobotSetup(param<std::string>(pnh, "robot_file", ""));
+    options_.dt = param(pnh, "dt", options_.dt);
+    options_.all_segment_goals = param(pnh, "all_segment_goals", options_.all_segment_goals);
+    options_.heading_frames = param(pnh, "heading_frames", options_.heading_frames);
+    options_.frames.min_heading_length =
+        param(pnh, "min_heading_length", options_.frames.min_heading_length);
+    options_.gripper_threshold_fraction =
+        param(pnh, "gripper/threshold_fraction", options_.gripper_threshold_fraction);
+    options_.gripper_hysteresis = param(pnh, "gripper/hysteresis", options_.gripper_hysteresis);
+    options_.gripper_min_range = param(pnh, "gripper/min_range", options_.gripper_min_range);
+    auto& gen = options_.generalization;
+    gen.bandwidth = param(pnh, "generalization/bandwidth", 0.0);
+    gen.local_linear = param(pnh, "generalization/local_linear", gen.local_linear);
+    gen.range_margin = param(pnh, "generalization/range_margin", gen.range_margin);
+    options_.min_range_margin =
+        param(pnh, "generalization/min_range_margin", options_.min_range_margin);
+    settle_time_ = param(pnh, "settle_time", settle_time_);
+    clock_timeout_ = param(pnh, "clock_timeout", clock_timeout_);
+    motion_lead_ = param(pnh, "motion_lead", motion_lead_);
+    connect_timeout_ = param(pnh, "connect_timeout", connect_timeout_);
+    trajectory_period_ = param(pnh, "trajectory_period", trajectory_period_);
+    feedback_period_ = param(pnh, "feedback_period", feedback_period_);
+    paths_.allowed_roots = param(pnh, "allowed_roots", paths_.allowed_roots);
+    limits_.min_duration_scale = param(pnh, "limits/min_duration_scale", limits_.min_duration_scale);
+    limits_.max_duration_scale = param(pnh, "limits/max_duration_scale", limits_.max_duration_scale);
+    limits_.max_plan_seconds = param(pnh, "limits/max_plan_seconds", limits_.max_plan_seconds);
+    limits_.quaternion_tolerance =
+        param(pnh, "limits/quaternion_tolerance", limits_.quaternion_tolerance);
+    limits_.workspace_min = vectorParam(pnh, "limits/workspace_min", limits_.workspace_min);
+    limits_.workspace_max = vectorParam(pnh, "limits/workspace_max", limits_.workspace_max);
+    limits_.max_objects = param(pnh, "limits/max_objects", static_cast<int>(limits_.max_objects));
+    limits_.max_name_length =
+        param(pnh, "limits/max_name_length", static_cast<int>(limits_.max_name_length));
+    lfd_dmp::checkLimits(limits_);
+    if (!(options_.dt > 0.0) || !(settle_time_ >= 0.0) || !(clock_timeout_ > 0.0) ||
+        !(motion_lead_ >= 0.0) || !(trajectory_period_ > 0.0))
+      throw std::runtime_error("executor: dt, clock_timeout, trajectory_period must be > 0 and "
+                               "settle_time, motion_lead >= 0");
+    options_.max_samples = static_cast<size_t>(limits_.max_plan_seconds / options_.dt);
+  }
+
+  // The IK chain on the robot model, built once (the URDF is on the parameter server).
+  lfd_dmp::TaskPlanner& planner() {
+    if (!planner_) {
+      std::string urdf;
+      if (!nh_.getParam("/robot_description", urdf))
+        throw std::runtime_error("/robot_description is not set (the robot's URDF)");
+      planner_ = std::make_unique<lfd_dmp::TaskPlanner>(lfd::makeCartesianToJoints(urdf, robot_));
     }
+    return *planner_;
   }
 
-  // Lazily: the URDF and tasks.yaml are needed only once the sim is up.
-  void ensurePlanner(const std::string& task) {
-    if (planners_.count(task)) return;
-    std::string urdf;
-    if (!nh_.getParam("/robot_description", urdf))
-      throw std::runtime_error("/robot_description is not set (launch sim.launch)");
-    const lfd_sim_bridge::demo::TaskSetup setup =
-        lfd_sim_bridge::demo::loadTaskSetup(tasks_file_, task, "sim");
-    planners_[task] =
-        std::make_unique<lfd_dmp::TaskPlanner>(lfd::makeCartesianToJoints(urdf, robot_));
-    gripper_orientation_[task] = task == "push" ? setup.push_orientation : setup.grasp_orientation;
+  std::string cartesianFrame() const {
+    return robot_.cartesian_frame.empty() ? robot_.base_link : robot_.cartesian_frame;
   }
 
-  std::string resolveLibrary(const std::string& s) const {
-    if (s.find('/') != std::string::npos || s.size() > 5 && s.substr(s.size() - 5) == ".json")
-      return s;
-    if (library_dir_.empty())
+  // ---- the request -----------------------------------------------------------------------------
+  std::string libraryPath(const std::string& s) const {
+    lfd_dmp::checkNameLength(s, "library", limits_);
+    if (s.empty()) throw std::invalid_argument("library is empty (a path or a name)");
+    if (s.find('/') != std::string::npos || (s.size() > 5 && s.substr(s.size() - 5) == ".json"))
+      return lfd::checkInputFile(s, paths_);
+    if (library_dir_.empty() || s == "." || s == "..")
       throw std::invalid_argument("'" + s + "' is not a path and ~library_dir is not set");
-    return library_dir_ + "/" + s + ".json";
+    return lfd::checkInputFile(library_dir_ + "/" + s + ".json", paths_);
   }
 
-  bool execute(lfd_msgs::ExecuteTask::Request& req, lfd_msgs::ExecuteTask::Response& res) {
-    bool expected = false;
-    if (!busy_.compare_exchange_strong(expected, true)) {
-      res.success = false;
-      res.error = "busy: another execution is running (call ~cancel first)";
-      ROS_WARN("executor: %s", res.error.c_str());
-      return true;
+  // A pose of the request in the Cartesian frame, checked.
+  lfd::Pose scenePose(const geometry_msgs::PoseStamped& ps, const std::string& what) {
+    const auto& p = ps.pose.position;
+    const auto& q = ps.pose.orientation;
+    const lfd::Pose raw = lfd_dmp::checkedPose(Eigen::Vector3d(p.x, p.y, p.z),
+                                               Eigen::Vector4d(q.w, q.x, q.y, q.z), what, limits_);
+    lfd_dmp::checkNameLength(ps.header.frame_id, what + " frame", limits_);
+    if (ps.header.frame_id.empty())
+      throw std::invalid_argument(what + " has no header.frame_id (e.g. world)");
+    const lfd::Pose out = lfd::toPose(transform(cartesianFrame(), ps.header.frame_id) *
+                                      lfd::toIsometry(raw));
+    lfd_dmp::checkInWorkspace(out, what, limits_);
+    return out;
+  }
+
+  // The pose of `source` in `target` from tf, waited for at most ~connect_timeout of WALL time
+  // (tf's own timeouts run on sim time, which a paused simulation never advances).
+  Eigen::Isometry3d transform(const std::string& target, const std::string& source) {
+    std::string why;
+    const auto t0 = Clock::now();
+    while (!tf_buffer_.canTransform(target, source, ros::Time(0), &why)) {
+      if (wallSince(t0) > connect_timeout_ || !ros::ok())
+        throw std::invalid_argument("no transform from '" + source + "' to '" + target +
+                                    "' on tf: " + why);
+      ros::WallDuration(0.01).sleep();
     }
-    cancel_ = false;
+    const geometry_msgs::Transform t =
+        tf_buffer_.lookupTransform(target, source, ros::Time(0)).transform;
+    Eigen::Isometry3d iso = Eigen::Isometry3d::Identity();
+    iso.translation() = Eigen::Vector3d(t.translation.x, t.translation.y, t.translation.z);
+    iso.linear() = Eigen::Quaterniond(t.rotation.w, t.rotation.x, t.rotation.y, t.rotation.z)
+                       .normalized()
+                       .toRotationMatrix();
+    return iso;
+  }
+
+  lfd::Scene scene(const lfd_msgs::ExecuteTaskGoal& goal) {
+    lfd_dmp::checkObjectNames(goal.object_names, goal.object_poses.size(), limits_);
+    lfd::Scene s;
+    for (size_t i = 0; i < goal.object_names.size(); ++i)
+      s.objects[goal.object_names[i]] =
+          scenePose(goal.object_poses[i], "object '" + goal.object_names[i] + "'");
+    s.goal = scenePose(goal.goal, "goal");
+    return s;
+  }
+
+  // The chain's joints now (and the gripper opening, when reported), waited for at most
+  // ~connect_timeout of wall time.
+  Eigen::VectorXd currentJoints(std::optional<double>* gripper) {
+    const auto& names = planner().chain().jointNames();
+    Eigen::VectorXd q(names.size());
+    const auto t0 = Clock::now();
+    for (;;) {
+      {
+        std::lock_guard<std::mutex> lock(mutex_);
+        size_t found = 0;
+        for (size_t i = 0; i < names.size(); ++i) {
+          const auto it = joints_.find(names[i]);
+          if (it == joints_.end()) break;
+          q[static_cast<Eigen::Index>(i)] = it->second;
+          ++found;
+        }
+        *gripper = gripper_;
+        if (found == names.size()) return q;
+      }
+      if (wallSince(t0) > connect_timeout_)
+        throw std::runtime_error("no /joint_states for the IK chain's joints (" + names.front() +
+                                 ", ...) within ~connect_timeout");
+      ros::WallDuration(0.01).sleep();
+    }
+  }
+
+  // ---- the action ------------------------------------------------------------------------------
+  void execute(const lfd_msgs::ExecuteTaskGoal& goal) {
+    const auto wall0 = Clock::now();
+    lfd_msgs::ExecuteTaskResult result;
     try {
-      run(req, res);
+      feedback_ = lfd_msgs::ExecuteTaskFeedback();
+      feedback_.state = lfd_msgs::ExecuteTaskFeedback::PLANNING;
+      server_->publishFeedback(feedback_);
+      lfd_dmp::ExecutorOptions opt = options_;
+      opt.duration_scale = lfd_dmp::checkedDurationScale(goal.duration_scale, limits_);
+      opt.allow_extrapolation = goal.allow_extrapolation;
+      const std::string path = libraryPath(goal.library);
+      const lfd_dmp::SkillLibrary library = lfd_dmp::loadSkillLibrary(path);
+      if (library.cartesian_frame != cartesianFrame())
+        throw std::invalid_argument("the library's poses are in '" + library.cartesian_frame +
+                                    "', the robot's Cartesian frame is '" + cartesianFrame() + "'");
+      const lfd::Scene s = scene(goal);
+      std::optional<double> gripper;
+      const Eigen::VectorXd q = currentJoints(&gripper);
+      std::vector<std::string> warnings;
+      const auto targets = lfd_dmp::segmentTargets(library, s, planner().forward(q), opt, &warnings);
+      for (const auto& t : targets)
+        result.extrapolation_distance = std::max(result.extrapolation_distance, t.range_distance);
+      lfd_dmp::ExecutionPlan plan = planner().plan(library, targets, q, gripper, opt, [this] {
+        return server_->isPreemptRequested() || !ros::ok();
+      });
+      plan.warnings.insert(plan.warnings.begin(), warnings.begin(), warnings.end());
+      describePlan(plan, wall0, &result);
+      ROS_INFO("executor: planned %s: %zu segments, %.2f s, IK residual %.2f mm, %.2f s wall",
+               library.task.c_str(), plan.segments.size(), plan.duration(),
+               plan.max_ik_position_error * 1e3, result.planning_time);
+      if (!goal.dry_run) run(plan, &result);
+      result.success = true;
+      server_->setSucceeded(result);
+    } catch (const lfd_dmp::PlanningCancelled& e) {
+      finish(&result, e.what(), true);
+    } catch (const Preempted& e) {
+      finish(&result, e.what(), true);
+    } catch (const lfd_dmp::OutsideDemoRange& e) {
+      result.extrapolation_distance = e.distance;
+      result.outside_demo_range = true;
+      finish(&result, e.what(), false);
     } catch (const std::exception& e) {
-      res.success = false;
-      res.error = e.what();
-      ROS_ERROR("executor: %s", e.what());
+      finish(&result, e.what(), false);
     }
-    busy_ = false;
-    return true;  // failures are in the response
   }
 
-  void run(lfd_msgs::ExecuteTask::Request& req, lfd_msgs::ExecuteTask::Response& res) {
-    const auto wall0 = std::chrono::steady_clock::now();
-    if (req.library.empty()) throw std::invalid_argument("library is empty");
-    if (!finitePose(req.object_pose) || !finitePose(req.goal))
-      throw std::invalid_argument("object_pose / goal contain NaN or infinity");
-    const lfd_dmp::SkillLibrary library = lfd_dmp::loadSkillLibrary(resolveLibrary(req.library));
-    const auto model = models_.find(library.task);
-    if (model == models_.end())
-      throw std::invalid_argument("no segment goal rules for task '" + library.task +
-                                  "' in ~tasks (config/executor.yaml)");
-    ensurePlanner(library.task);
-    lfd_dmp::TaskPlanner& planner = *planners_.at(library.task);
-
-    // Current state of the chain's joints.
-    Eigen::VectorXd q(planner.chain().dof());
-    std::optional<double> grip;
-    {
-      std::lock_guard<std::mutex> lock(mutex_);
-      for (int i = 0; i < q.size(); ++i) {
-        const auto it = joints_.find(planner.chain().jointNames()[i]);
-        if (it == joints_.end())
-          throw std::runtime_error("no /joint_states yet for joint " +
-                                   planner.chain().jointNames()[i]);
-        q[i] = it->second;
-      }
-      grip = gripper_;
+  void finish(lfd_msgs::ExecuteTaskResult* result, const std::string& error, bool preempted) {
+    result->success = false;
+    result->error = error;
+    if (preempted) {
+      ROS_WARN("executor: %s", error.c_str());
+      server_->setPreempted(*result, error);
+    } else {
+      ROS_ERROR("executor: %s", error.c_str());
+      server_->setAborted(*result, error);
     }
-    const lfd_dmp::TcpPose start = planner.forward(q);
-    lfd_dmp::TaskSituation situation;
-    situation.object_position =
-        Eigen::Vector3d(req.object_pose.position.x, req.object_pose.position.y,
-                        req.object_pose.position.z) -
-        base_in_world_;
-    situation.object_yaw = yawOf(req.object_pose.orientation);
-    situation.goal_position =
-        Eigen::Vector3d(req.goal.position.x, req.goal.position.y, req.goal.position.z) -
-        base_in_world_;
-    situation.goal_yaw = yawOf(req.goal.orientation);
-    const std::vector<lfd_dmp::SegmentTarget> targets = lfd_dmp::segmentTargets(
-        model->second, situation, start, gripper_orientation_.at(library.task));
+  }
 
-    lfd_dmp::ExecutorOptions opt = options_;
-    opt.duration_scale = req.duration_scale > 0.0 ? req.duration_scale : 1.0;
-    const lfd_dmp::ExecutionPlan plan = planner.plan(library, targets, q, grip, opt);
-    res.planning_time =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
-    res.planned_duration = plan.duration();
-    res.warnings = plan.warnings;
+  void describePlan(const lfd_dmp::ExecutionPlan& plan, Clock::time_point wall0,
+                    lfd_msgs::ExecuteTaskResult* result) {
+    result->planning_time = wallSince(wall0);
+    result->planned_duration = plan.duration();
+    result->warnings = plan.warnings;
+    result->extrapolation_distance = plan.extrapolation_distance;
+    result->outside_demo_range = plan.outside_demo_range;
     for (const auto& w : plan.warnings) ROS_WARN("executor: %s", w.c_str());
-    for (const auto& s : plan.segments) res.segment_names.push_back(s.name);
-    publishPlan(plan);
-    ROS_INFO(
-        "executor: planned %s: %zu segments, %.2f s, %zu samples, IK residual %.2f mm, "
-        "planning %.2f s wall",
-        library.task.c_str(), plan.segments.size(), plan.duration(), plan.times.size(),
-        plan.max_ik_position_error * 1e3, res.planning_time);
-    if (req.dry_run) {
-      res.success = true;
-      return;
-    }
-    stream(plan, res);
-    // Final error: measured TCP (FK of the joint states) against the planned end.
-    ros::Time settle_end = ros::Time::now() + ros::Duration(settle_time_);
-    while (ros::ok() && ros::Time::now() < settle_end) ros::WallDuration(0.001).sleep();
-    {
-      std::lock_guard<std::mutex> lock(mutex_);
-      for (int i = 0; i < q.size(); ++i) q[i] = joints_.at(planner.chain().jointNames()[i]);
-    }
-    const lfd_dmp::TcpPose end = planner.forward(q);
-    res.final_position_error = (end.position - plan.poses.back().position).norm();
-    res.final_orientation_error = end.orientation.angularDistance(plan.poses.back().orientation);
-    publishExecuted();
-    res.success = true;
-    ROS_INFO("executor: done in %.2f s sim (planned %.2f s), final TCP error %.1f mm / %.3f rad",
-             res.execution_time, res.planned_duration, res.final_position_error * 1e3,
-             res.final_orientation_error);
-  }
-
-  void stream(const lfd_dmp::ExecutionPlan& plan, lfd_msgs::ExecuteTask::Response& res) {
-    {
-      std::lock_guard<std::mutex> lock(mutex_);
-      executed_.poses.clear();
-      recording_ = true;
-    }
-    sensor_msgs::JointState cmd;
-    cmd.name = plan.joint_names;
-    const size_t n = plan.times.size();
-    size_t next_event = 0, segment = 0, last = 0;
-    const ros::Time t0 = ros::Time::now();
-    ros::Time last_advance = t0;
-    auto last_wall = std::chrono::steady_clock::now();
-    ros::Time segment_start = t0;
-    ROS_INFO("executor: segment 1/%zu '%s' (%.2f s)", plan.segments.size(),
-             plan.segments[0].name.c_str(), plan.segments[0].duration);
-    bool first = true;
-    while (true) {
-      if (!ros::ok()) throw std::runtime_error("shutting down");
-      if (cancel_) {
-        recording_ = false;
-        throw std::runtime_error(
-            "cancelled at t=" + std::to_string((ros::Time::now() - t0).toSec()) +
-            " s in segment '" + plan.segments[segment].name + "'");
-      }
-      const ros::Time now = ros::Time::now();
-      const double elapsed = (now - t0).toSec();
-      size_t k = std::min(n - 1, static_cast<size_t>(std::max(0.0, elapsed / plan.dt)));
-      if (first || k > last) {
-        first = false;
-        cmd.header.stamp = now;
-        cmd.position.assign(plan.joints[k].data(), plan.joints[k].data() + plan.joints[k].size());
-        joint_pub_.publish(cmd);
-        while (next_event < plan.gripper_events.size() &&
-               plan.gripper_events[next_event].sample <= k) {
-          sendGripper(plan.gripper_events[next_event].close, now);
-          ++next_event;
-        }
-        while (segment + 1 < plan.segments.size() && k >= plan.segments[segment + 1].begin) {
-          res.segment_durations.push_back((now - segment_start).toSec());
-          segment_start = now;
-          ++segment;
-          ROS_INFO("executor: segment %zu/%zu '%s' (%.2f s)", segment + 1, plan.segments.size(),
-                   plan.segments[segment].name.c_str(), plan.segments[segment].duration);
-        }
-        std_msgs::Float64 p;
-        p.data = n > 1 ? static_cast<double>(k) / (n - 1) : 1.0;
-        progress_pub_.publish(p);
-        last = k;
-        if (k + 1 >= n) break;
-      }
-      if (now > last_advance) {
-        last_advance = now;
-        last_wall = std::chrono::steady_clock::now();
-      } else if (std::chrono::duration<double>(std::chrono::steady_clock::now() - last_wall)
-                     .count() > clock_timeout_) {
-        recording_ = false;
-        throw std::runtime_error("sim time did not advance for " + std::to_string(clock_timeout_) +
-                                 " s of wall time (is the bridge paused?)");
-      }
-      ros::WallDuration(0.0002).sleep();
-    }
-    const ros::Time t_end = ros::Time::now();
-    res.segment_durations.push_back((t_end - segment_start).toSec());
-    res.execution_time = (t_end - t0).toSec();
-    recording_ = false;
-  }
-
-  void sendGripper(bool close, const ros::Time& stamp) {
-    lfd_msgs::GripperCommand g;
-    g.header.stamp = stamp;
-    g.position = close ? close_opening_ : open_opening_;
-    g.max_effort = close ? close_effort_ : 0.0;
-    gripper_pub_.publish(g);
-    ROS_INFO("executor: gripper %s", close ? "close" : "open");
-  }
-
-  bool cancel(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& res) {
-    res.success = busy_.load();
-    res.message = res.success ? "cancelling the running execution" : "nothing is running";
-    cancel_ = true;
-    return true;
-  }
-
-  void publishPlan(const lfd_dmp::ExecutionPlan& plan) {
-    nav_msgs::Path path;
-    path.header.frame_id = "base_link";
-    path.header.stamp = ros::Time::now();
-    // Every 10th sample is plenty for rviz.
-    for (size_t k = 0; k < plan.poses.size(); k += 10) {
-      geometry_msgs::PoseStamped ps;
-      ps.header = path.header;
-      ps.pose = lfd_sim_bridge::toPoseMsg(plan.poses[k]);
-      path.poses.push_back(ps);
-    }
-    planned_pub_.publish(path);
-    visualization_msgs::MarkerArray markers;
-    visualization_msgs::Marker clear;
-    clear.action = visualization_msgs::Marker::DELETEALL;
-    markers.markers.push_back(clear);
-    int id = 0;
     for (const auto& s : plan.segments) {
-      for (int which = 0; which < 3; ++which) {
-        visualization_msgs::Marker m;
-        m.header = path.header;
-        m.ns = which == 0 ? "segment_goals" : which == 1 ? "segment_labels" : "segment_starts";
-        m.id = id++;
-        m.type = which == 1 ? visualization_msgs::Marker::TEXT_VIEW_FACING
-                            : visualization_msgs::Marker::SPHERE;
-        m.pose = which == 2 ? lfd_sim_bridge::toPoseMsg(plan.poses[s.begin])
-                            : lfd_sim_bridge::toPoseMsg(s.goal);
-        if (which == 1) m.pose.position.z += 0.05;
-        m.scale.x = m.scale.y = m.scale.z = which == 1 ? 0.03 : which == 0 ? 0.025 : 0.015;
-        m.color.a = 1.0;
-        m.color.r = which == 0 ? 1.0 : 0.9;
-        m.color.g = which == 2 ? 0.8 : 0.9;
-        m.color.b = which == 1 ? 0.9 : 0.1;
-        m.text = s.name;
-        markers.markers.push_back(m);
+      result->segment_names.push_back(s.name);
+      result->segment_frames.push_back(s.frames);
+      result->segment_durations.push_back(s.duration);
+    }
+    const ros::Time now = ros::Time::now();
+    planned_pub_.publish(lfd_dmp::plannedPath(plan, cartesianFrame(), now));
+    marker_pub_.publish(lfd_dmp::segmentMarkers(plan, cartesianFrame(), now));
+  }
+
+  // ---- the motion ------------------------------------------------------------------------------
+  void waitForDriver(const ros::Publisher& pub) {
+    const auto t0 = Clock::now();
+    while (pub.getNumSubscribers() == 0) {
+      if (wallSince(t0) > connect_timeout_ || !ros::ok())
+        throw std::runtime_error("nobody subscribes to " + pub.getTopic() +
+                                 " (is the robot driver running?)");
+      ros::WallDuration(0.01).sleep();
+    }
+  }
+
+  void run(const lfd_dmp::ExecutionPlan& plan, lfd_msgs::ExecuteTaskResult* result) {
+    waitForDriver(trajectory_pub_);
+    if (!plan.gripper_events.empty()) waitForDriver(gripper_pub_);
+    // The whole motion is sent ahead, stamped on the driver's clock: it runs at sim time whatever
+    // the load, and a lockstep client only has to step.
+    const ros::Time t0 = ros::Time::now() + ros::Duration(motion_lead_);
+    trajectory_pub_.publish(lfd_dmp::toJointTrajectory(plan, t0, trajectory_period_));
+    for (const lfd_dmp::GripperEvent& e : plan.gripper_events)
+      gripper_pub_.publish(
+          lfd_dmp::gripperCommand(e.close, robot_.gripper, t0 + ros::Duration(plan.times[e.sample])));
+    result->motion_start = t0;
+    executed_ = nav_msgs::Path();
+    feedback_.motion_start = t0;
+    feedback_.planned_duration = plan.duration();
+    setState(lfd_msgs::ExecuteTaskFeedback::MOVING, plan);
+    const ros::Time t_end = t0 + ros::Duration(plan.duration());
+    ClockWatch watch(clock_timeout_);
+    ros::Time reached;
+    for (;;) {
+      const ros::Time now = ros::Time::now();
+      if (server_->isPreemptRequested() || !ros::ok()) stop(plan, t0, now);
+      watch.check(now);
+      const ros::Time measured = track(plan, t0);
+      if (now >= t_end) {
+        if (feedback_.state != lfd_msgs::ExecuteTaskFeedback::SETTLING)
+          setState(lfd_msgs::ExecuteTaskFeedback::SETTLING, plan);
+        if (reached.isZero() && measured >= t_end &&
+            feedback_.tcp_position_error <= robot_.ik_tolerance.position &&
+            feedback_.tcp_orientation_error <= robot_.ik_tolerance.orientation)
+          reached = measured;
+        if (now >= t_end + ros::Duration(settle_time_)) break;
+      }
+      ros::WallDuration(0.001).sleep();
+    }
+    if (reached.isZero()) {
+      reached = ros::Time::now();
+      result->warnings.push_back("the TCP did not come within the IK tolerance of its final pose "
+                                 "in ~settle_time");
+    }
+    result->execution_time = (reached - t0).toSec();
+    result->final_position_error = feedback_.tcp_position_error;
+    result->final_orientation_error = feedback_.tcp_orientation_error;
+    executed_pub_.publish(executed_);
+    ROS_INFO("executor: done in %.2f s sim (planned %.2f s), final TCP error %.1f mm / %.3f rad",
+             result->execution_time, plan.duration(), result->final_position_error * 1e3,
+             result->final_orientation_error);
+  }
+
+  // Holds the arm where the plan is now and keeps the gripper as the plan has it now (a later
+  // stamped command would still fire otherwise), then ends the goal as preempted.
+  [[noreturn]] void stop(const lfd_dmp::ExecutionPlan& plan, const ros::Time& t0,
+                         const ros::Time& now) {
+    const size_t k = sampleAt(plan, t0, now);
+    trajectory_pub_.publish(lfd_dmp::holdTrajectory(plan.joint_names, plan.joints[k], now));
+    const lfd_dmp::GripperEvent* last = nullptr;
+    for (const lfd_dmp::GripperEvent& e : plan.gripper_events)
+      if (!last || e.sample <= k) last = &e;
+    if (last) gripper_pub_.publish(lfd_dmp::gripperCommand(last->close, robot_.gripper, now));
+    executed_pub_.publish(executed_);
+    throw Preempted("preempted at t=" + std::to_string((now - t0).toSec()) +
+                    " s of the motion, in segment '" + segmentAt(plan, k).name +
+                    "'; the arm holds there");
+  }
+
+  static size_t sampleAt(const lfd_dmp::ExecutionPlan& plan, const ros::Time& t0,
+                         const ros::Time& t) {
+    const double elapsed = (t - t0).toSec();
+    if (!(elapsed > 0.0)) return 0;
+    return std::min(plan.times.size() - 1, static_cast<size_t>(elapsed / plan.dt));
+  }
+
+  static const lfd_dmp::PlannedSegment& segmentAt(const lfd_dmp::ExecutionPlan& plan, size_t k) {
+    for (const auto& s : plan.segments)
+      if (k < s.end) return s;
+    return plan.segments.back();
+  }
+
+  // The measured TCP against the plan at the latest joint state (into feedback_, published every
+  // ~feedback_period and at each new segment); returns that joint state's stamp.
+  ros::Time track(const lfd_dmp::ExecutionPlan& plan, const ros::Time& t0) {
+    Eigen::VectorXd q(plan.joint_names.size());
+    ros::Time stamp;
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      for (size_t i = 0; i < plan.joint_names.size(); ++i)
+        q[static_cast<Eigen::Index>(i)] = joints_.at(plan.joint_names[i]);
+      stamp = last_joint_stamp_;
+    }
+    if (stamp != tracked_stamp_) {
+      tracked_stamp_ = stamp;
+      const size_t k = sampleAt(plan, t0, stamp);
+      const lfd::Pose tcp = planner().forward(q);
+      feedback_.tcp_position_error = (tcp.position - plan.poses[k].position).norm();
+      feedback_.tcp_orientation_error = tcp.orientation.angularDistance(plan.poses[k].orientation);
+      feedback_.progress = plan.duration() > 0 ? std::min(1.0, (stamp - t0).toSec() / plan.duration())
+                                               : 1.0;
+      feedback_.progress = std::max(0.0, feedback_.progress);
+      const auto& seg = segmentAt(plan, k);
+      feedback_.segment_index = static_cast<uint32_t>(&seg - plan.segments.data());
+      recordExecuted(tcp, stamp);
+      if (feedback_.segment != seg.name || wallSince(last_feedback_) > feedback_period_) {
+        feedback_.segment = seg.name;
+        publishFeedback();
       }
     }
-    marker_pub_.publish(markers);
+    return stamp;
   }
 
-  void publishExecuted() {
-    std::lock_guard<std::mutex> lock(mutex_);
-    executed_.header.frame_id = "base_link";
-    executed_.header.stamp = ros::Time::now();
-    executed_pub_.publish(executed_);
+  void setState(uint8_t state, const lfd_dmp::ExecutionPlan& plan) {
+    feedback_.state = state;
+    if (feedback_.segment.empty()) feedback_.segment = plan.segments.front().name;
+    publishFeedback();
   }
 
+  void publishFeedback() {
+    server_->publishFeedback(feedback_);
+    last_feedback_ = Clock::now();
+  }
+
+  void recordExecuted(const lfd::Pose& tcp, const ros::Time& stamp) {
+    if (!executed_.poses.empty() && (stamp - executed_.poses.back().header.stamp).toSec() < 0.02)
+      return;
+    geometry_msgs::PoseStamped ps;
+    ps.header.frame_id = executed_.header.frame_id = cartesianFrame();
+    ps.header.stamp = executed_.header.stamp = stamp;
+    ps.pose = lfd_dmp::toPoseMsg(tcp);
+    executed_.poses.push_back(ps);
+    if (executed_.poses.size() % 25 == 0) executed_pub_.publish(executed_);
+  }
+
+  // ---- robot state -----------------------------------------------------------------------------
   void onJoints(const sensor_msgs::JointState::ConstPtr& msg) {
     std::lock_guard<std::mutex> lock(mutex_);
     for (size_t i = 0; i < msg->name.size() && i < msg->position.size(); ++i)
-      joints_[msg->name[i]] = msg->position[i];
+      if (std::isfinite(msg->position[i])) joints_[msg->name[i]] = msg->position[i];
+    last_joint_stamp_ = msg->header.stamp;
   }
 
   void onGripper(const sensor_msgs::JointState::ConstPtr& msg) {
     std::lock_guard<std::mutex> lock(mutex_);
     for (size_t i = 0; i < msg->name.size() && i < msg->position.size(); ++i)
-      if (msg->name[i] == gripper_joint_) gripper_ = msg->position[i];
-  }
-
-  void onEePose(const geometry_msgs::PoseStamped::ConstPtr& msg) {
-    if (!recording_) return;
-    std::lock_guard<std::mutex> lock(mutex_);
-    if (!executed_.poses.empty() &&
-        (msg->header.stamp - executed_.poses.back().header.stamp).toSec() < 0.02)
-      return;
-    executed_.poses.push_back(*msg);
-    if (executed_.poses.size() % 25 == 0) {
-      executed_.header.frame_id = "base_link";
-      executed_.header.stamp = msg->header.stamp;
-      executed_pub_.publish(executed_);
-    }
+      if (msg->name[i] == robot_.gripper.joint && std::isfinite(msg->position[i]))
+        gripper_ = msg->position[i];
   }
 
   ros::NodeHandle nh_;
-  std::string tasks_file_, library_dir_, gripper_joint_ = "R_GRIPPER";
-  lfd_dmp::ExecutorOptions options_;
+  std::string library_dir_;
   lfd::RobotSetup robot_;
-  double open_opening_ = 0.08, close_opening_ = 0.0, close_effort_ = 20.0;
-  double settle_time_ = 0.5, clock_timeout_ = 5.0;
-  Eigen::Vector3d base_in_world_{0.0, 0.0, 0.85};
-  std::map<std::string, lfd_dmp::TaskGoalModel> models_;
-  std::map<std::string, std::unique_ptr<lfd_dmp::TaskPlanner>> planners_;
-  std::map<std::string, Eigen::Quaterniond> gripper_orientation_;
-  ros::Publisher joint_pub_, gripper_pub_, progress_pub_, planned_pub_, executed_pub_, marker_pub_;
-  ros::Subscriber joint_sub_, gripper_sub_, ee_sub_;
-  ros::ServiceServer execute_srv_, cancel_srv_;
+  lfd::PathPolicy paths_;
+  lfd_dmp::ExecutorOptions options_;
+  lfd_dmp::RequestLimits limits_;
+  double settle_time_ = 0.5, clock_timeout_ = 5.0, motion_lead_ = 0.1, connect_timeout_ = 5.0;
+  double trajectory_period_ = 0.01, feedback_period_ = 0.05;
+  std::unique_ptr<lfd_dmp::TaskPlanner> planner_;
+  tf2_ros::Buffer tf_buffer_;
+  tf2_ros::TransformListener tf_listener_;
+  ros::Publisher trajectory_pub_, gripper_pub_, planned_pub_, executed_pub_, marker_pub_;
+  ros::Subscriber joint_sub_, gripper_sub_;
+  std::unique_ptr<ActionServer> server_;
+  lfd_msgs::ExecuteTaskFeedback feedback_;
+  Clock::time_point last_feedback_;
+  ros::Time tracked_stamp_;
+  nav_msgs::Path executed_;
   std::mutex mutex_;
   std::map<std::string, double> joints_;
+  ros::Time last_joint_stamp_;
   std::optional<double> gripper_;
-  nav_msgs::Path executed_;
-  std::atomic<bool> busy_{false}, cancel_{false}, recording_{false};
 };
 
 }  // namespace
@@ -450,7 +510,8 @@ int main(int argc, char** argv) {
   ros::NodeHandle nh, pnh("~");
   try {
     Executor executor(nh, pnh);
-    // Several threads: state callbacks and ~cancel run while ~execute streams.
+    // Several threads: the action's goal thread plans and monitors while state callbacks and
+    // cancel requests keep arriving.
     ros::AsyncSpinner spinner(4);
     spinner.start();
     ros::waitForShutdown();

@@ -1,6 +1,7 @@
 // Executor logic without ROS: segment goal rules, gripper thresholding, segment sequencing of the
 // planned path, and refusal of unreachable goals / mismatched libraries before anything moves.
 #include "lfd_dmp/executor.hpp"
+#include "lfd_dmp/skill_learner.hpp"
 
 #include <gtest/gtest.h>
 
@@ -120,67 +121,6 @@ TEST(GripperEvents, NoChatterInsideTheHysteresisAndNothingForAConstantGripper) {
   EXPECT_FALSE(reopen[1].close);
 }
 
-TEST(SegmentTargets, GraspAndPushRulesFollowTheSituation) {
-  lfd_dmp::TaskGoalModel grasp;
-  grasp.segments = {{"approach",
-                     lfd_dmp::GoalReference::kObject,
-                     {0, 0, 0.005},
-                     0.0,
-                     lfd_dmp::OrientationRule::kObjectYaw},
-                    {"move",
-                     lfd_dmp::GoalReference::kGoal,
-                     {0, 0, 0.005},
-                     0.0,
-                     lfd_dmp::OrientationRule::kGoalYaw}};
-  lfd_dmp::TaskSituation s;
-  s.object_position = {0.5, -0.3, -0.035};
-  s.object_yaw = 0.2 + M_PI;  // a stick is symmetric: the wrist takes the small yaw
-  s.goal_position = {0.4, -0.2, 0.1};
-  s.goal_yaw = -0.3;
-  lfd_dmp::TcpPose start;
-  const auto t = lfd_dmp::segmentTargets(grasp, s, start, Eigen::Quaterniond::Identity());
-  ASSERT_EQ(t.size(), 2u);
-  EXPECT_NEAR((t[0].position - Eigen::Vector3d(0.5, -0.3, -0.03)).norm(), 0.0, 1e-12);
-  EXPECT_NEAR((t[1].position - Eigen::Vector3d(0.4, -0.2, 0.105)).norm(), 0.0, 1e-12);
-  ASSERT_TRUE(t[0].orientation && t[1].orientation);
-  EXPECT_NEAR(t[0].orientation->angularDistance(
-                  Eigen::Quaterniond(Eigen::AngleAxisd(0.2, Eigen::Vector3d::UnitZ()))),
-              0.0, 1e-9);
-  EXPECT_NEAR(Eigen::AngleAxisd(*t[1].orientation).angle(), 0.3, 1e-9);
-
-  lfd_dmp::TaskGoalModel push;
-  push.segments = {
-      {"approach",
-       lfd_dmp::GoalReference::kObject,
-       {0, 0, 0},
-       -0.072,
-       lfd_dmp::OrientationRule::kPushYaw},
-      {"push",
-       lfd_dmp::GoalReference::kGoal,
-       {0, 0, 0},
-       -0.052,
-       lfd_dmp::OrientationRule::kPushYaw,
-       "push"},
-      {"return", lfd_dmp::GoalReference::kStart, {0, 0, 0}, 0.0, lfd_dmp::OrientationRule::kStart}};
-  s.object_position = {0.5, -0.16, -0.01};
-  s.goal_position = {0.5, -0.30, -0.01};  // push along -y
-  start.position = {0.3, -0.3, 0.1};
-  const auto p = lfd_dmp::segmentTargets(push, s, start, Eigen::Quaterniond::Identity());
-  ASSERT_EQ(p.size(), 3u);
-  EXPECT_NEAR((p[0].position - Eigen::Vector3d(0.5, -0.16 + 0.072, -0.01)).norm(), 0.0, 1e-12);
-  EXPECT_NEAR((p[1].position - Eigen::Vector3d(0.5, -0.30 + 0.052, -0.01)).norm(), 0.0, 1e-12);
-  EXPECT_NEAR((p[2].position - start.position).norm(), 0.0, 1e-12);
-  EXPECT_EQ(p[0].frame, "");
-  EXPECT_EQ(p[1].frame, "push");
-  EXPECT_NEAR((*p[0].orientation * Eigen::Vector3d::UnitX() - Eigen::Vector3d(0, -1, 0)).norm(),
-              0.0, 1e-9);
-  s.goal_position = s.object_position;
-  EXPECT_THROW(lfd_dmp::segmentTargets(push, s, start, Eigen::Quaterniond::Identity()),
-               std::invalid_argument);
-  EXPECT_THROW(lfd_dmp::parseGoalReference("table"), std::invalid_argument);
-  EXPECT_THROW(lfd_dmp::parseOrientationRule("sideways"), std::invalid_argument);
-}
-
 // The planner's IK: the chain with default options, pulled toward the home posture.
 lfd::CartesianToJoints converter(const lfd::KinematicChain& chain, const Eigen::VectorXd& home) {
   lfd::CartesianToJoints ik(chain);
@@ -195,9 +135,16 @@ class PlannerTest : public ::testing::Test {
     home_ = planner_.forward(q0_);
     lib_ = library(home_);
   }
+  lfd_dmp::SegmentTarget target(const std::string& name, const Eigen::Vector3d& p) const {
+    lfd_dmp::SegmentTarget t;
+    t.name = name;
+    t.goal.position = p;
+    t.goal.orientation = home_.orientation;
+    return t;
+  }
   std::vector<lfd_dmp::SegmentTarget> targets(const Eigen::Vector3d& grasp,
                                               const Eigen::Vector3d& goal) const {
-    return {{"approach", grasp, home_.orientation}, {"move", goal, home_.orientation}};
+    return {target("approach", grasp), target("move", goal)};
   }
   lfd::KinematicChain chain_;
   Eigen::VectorXd q0_;
@@ -309,39 +256,189 @@ double strokeDeviation(const lfd_dmp::ExecutionPlan& plan, const Eigen::Vector3d
   return worst;
 }
 
-TEST_F(PlannerTest, TaskFrameKeepsAPushStraightInANewDirection) {
+TEST_F(PlannerTest, HeadingFrameKeepsAPushStraightInANewDirection) {
   const lfd_dmp::SkillLibrary lib = pushLibrary(home_);
   // A direction no demo pushed in: 29 degrees clockwise from +x.
   const Eigen::Vector3d contact = home_.position + Eigen::Vector3d(0.03, 0.0, -0.05);
   const Eigen::Vector3d end = contact + 0.1 * Eigen::Vector3d(std::cos(-0.5), std::sin(-0.5), 0);
-  std::vector<lfd_dmp::SegmentTarget> t = {{"approach", contact, home_.orientation, ""},
-                                           {"push", end, home_.orientation, "push"}};
+  std::vector<lfd_dmp::SegmentTarget> t = {target("approach", contact), target("push", end)};
+  lfd_dmp::HeadingFrame heading;  // the demos' own headings: +x, -y, +x+y
+  heading.object = "box";
+  heading.yaw = -0.5;
+  heading.demo_yaw = {{"push_0", 0.0}, {"push_1", -M_PI / 2}, {"push_2", M_PI / 4}};
   lfd_dmp::ExecutorOptions opt;
   opt.dt = 0.004;
+  opt.allow_extrapolation = true;  // the hand-made targets carry no range
   for (bool local_linear : {true, false}) {
     opt.generalization.local_linear = local_linear;
-    t[1].frame = "push";
+    t[1].heading = heading;
     const lfd_dmp::ExecutionPlan framed = planner_.plan(lib, t, q0_, std::nullopt, opt);
     EXPECT_LT(strokeDeviation(framed, contact, end), 0.001) << "local_linear " << local_linear;
     EXPECT_LT((framed.poses.back().position - end).norm(), 0.004);
-    t[1].frame.clear();
+    t[1].heading.reset();
     const lfd_dmp::ExecutionPlan world = planner_.plan(lib, t, q0_, std::nullopt, opt);
     if (!local_linear) {  // the convex mix of the demos' headings bends the stroke
       EXPECT_GT(strokeDeviation(world, contact, end), 0.005);
     }
   }
-  // A heading that is not defined, or a frame segment that does not exist: clear refusals.
-  const std::vector<lfd_dmp::SegmentTarget> no_stroke = {
-      {"approach", contact, home_.orientation, ""},
-      {"push", contact + Eigen::Vector3d(0.005, 0, 0.02), home_.orientation, "push"}};
-  try {
-    planner_.plan(lib, no_stroke, q0_, std::nullopt, opt);
-    FAIL() << "a push without a heading was planned";
-  } catch (const std::invalid_argument& e) {
-    EXPECT_NE(std::string(e.what()).find("heading"), std::string::npos) << e.what();
-  }
-  t[1].frame = "lift";
+  // No demo with a heading: a clear refusal.
+  heading.demo_yaw = {{"another_demo", 0.0}};
+  t[1].heading = heading;
   EXPECT_THROW(planner_.plan(lib, t, q0_, std::nullopt, opt), std::invalid_argument);
+}
+
+// A goal far from every demonstrated goal is refused before anything is planned, with the
+// distance; allowed, it is planned with a warning. Either way the distance is reported.
+TEST_F(PlannerTest, GoalsOutsideTheDemonstratedRangeAreRefusedUnlessAllowed) {
+  lfd_dmp::ExecutorOptions opt;
+  opt.dt = 0.01;
+  const Eigen::Vector3d grasp = home_.position + Eigen::Vector3d(0.02, 0.0, -0.045);
+  auto t = targets(grasp, grasp + Eigen::Vector3d(0.0, 0.05, 0.12));
+  t[1].range_distance = 0.2;
+  t[1].range_margin = 0.03;
+  try {
+    planner_.plan(lib_, t, q0_, 0.04, opt);
+    FAIL() << "a goal outside the demonstrated range was planned";
+  } catch (const lfd_dmp::OutsideDemoRange& e) {
+    EXPECT_DOUBLE_EQ(e.distance, 0.2);
+    const std::string msg = e.what();
+    EXPECT_NE(msg.find("segment 'move'"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("allow_extrapolation"), std::string::npos) << msg;
+  }
+  opt.allow_extrapolation = true;
+  const lfd_dmp::ExecutionPlan plan = planner_.plan(lib_, t, q0_, 0.04, opt);
+  EXPECT_TRUE(plan.outside_demo_range);
+  EXPECT_DOUBLE_EQ(plan.extrapolation_distance, 0.2);
+  ASSERT_FALSE(plan.warnings.empty());
+  EXPECT_NE(plan.warnings.back().find("extrapolated"), std::string::npos);
+  t[1].range_distance = 0.01;  // inside the margin: no flag, the distance still reported
+  const lfd_dmp::ExecutionPlan inside = planner_.plan(lib_, t, q0_, 0.04, opt);
+  EXPECT_FALSE(inside.outside_demo_range);
+  EXPECT_DOUBLE_EQ(inside.extrapolation_distance, 0.01);
+}
+
+// Issue 12: duration_scale 1000 took 1.36 GB. The plan is refused before anything is allocated,
+// naming the limit; planning can be cancelled between pieces of work.
+TEST_F(PlannerTest, LongPlansAreRefusedAndPlanningCanBeCancelled) {
+  lfd_dmp::ExecutorOptions opt;
+  opt.dt = 0.002;
+  opt.max_samples = 10000;  // 20 s at 500 Hz
+  opt.duration_scale = 1000.0;
+  const Eigen::Vector3d grasp = home_.position + Eigen::Vector3d(0.02, 0.0, -0.045);
+  const auto t = targets(grasp, grasp + Eigen::Vector3d(0.0, 0.05, 0.12));
+  try {
+    planner_.plan(lib_, t, q0_, 0.04, opt);
+    FAIL() << "a 4500 s plan was accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("max_plan_seconds"), std::string::npos) << e.what();
+  }
+  opt.duration_scale = 1.0;
+  int polls = 0;
+  EXPECT_THROW(planner_.plan(lib_, t, q0_, 0.04, opt, [&] { return ++polls > 3; }),
+               lfd_dmp::PlanningCancelled);
+  EXPECT_EQ(polls, 4);
+  EXPECT_NO_THROW(planner_.plan(lib_, t, q0_, 0.04, opt, [] { return false; }));
+}
+
+// Push demos recorded around the home pose, learned with their scenes: home -> behind the box
+// (2 s), push it 12-15 cm (2 s), home (2 s); each pushes in another direction.
+lfd_dmp::LearnOutcome learnedPushLibrary(const lfd_dmp::TcpPose& home) {
+  const double directions[4] = {0.0, -M_PI / 2, M_PI / 4, -M_PI / 4};
+  std::vector<lfd_dmp::DemoRecording> demos;
+  std::vector<std::vector<double>> cps;
+  for (int j = 0; j < 4; ++j) {
+    const Eigen::Vector3d u(std::cos(directions[j]), std::sin(directions[j]), 0.0);
+    const Eigen::Vector3d box = home.position + Eigen::Vector3d(0.06 + 0.01 * j, -0.02 * j, -0.06);
+    lfd_dmp::DemoRecording rec;
+    rec.id = "push_" + std::to_string(j);
+    rec.frame = "base_link";
+    lfd::Scene scene;
+    scene.objects["box"].position = box;
+    scene.goal.position = box + (0.12 + 0.01 * j) * u;
+    rec.scene = scene;
+    const Eigen::Vector3d via[4] = {home.position, box - 0.072 * u, scene.goal.position - 0.052 * u,
+                                    home.position};
+    const int m = 601;
+    rec.times = Eigen::VectorXd::LinSpaced(m, 0.0, 6.0);
+    rec.positions.resize(m, 3);
+    rec.quaternions.resize(m, 4);
+    for (int k = 0; k < m; ++k) {
+      const double t = rec.times[k];
+      const int s = std::min(2, static_cast<int>(t / 2.0));
+      const double u_s = minJerk(std::clamp((t - 2.0 * s) / 2.0, 0.0, 1.0));
+      rec.positions.row(k) = (via[s] + u_s * (via[s + 1] - via[s])).transpose();
+      rec.quaternions.row(k) << home.orientation.w(), home.orientation.x(), home.orientation.y(),
+          home.orientation.z();
+    }
+    demos.push_back(rec);
+    cps.push_back({2.0, 4.0});
+  }
+  lfd_dmp::LearnOptions opt;
+  opt.task = "push";
+  opt.segment_names = {"approach", "push", "return"};
+  opt.params.num_basis = 20;
+  return lfd_dmp::learnSkillLibrary(demos, cps, opt);
+}
+
+TEST_F(PlannerTest, SegmentGoalsFollowTheFramesLearnedFromTheDemos) {
+  const lfd_dmp::LearnOutcome learned = learnedPushLibrary(home_);
+  const lfd_dmp::SkillLibrary& lib = learned.library;
+  EXPECT_EQ(lib.segments[0].goal->position_frame.name(), "heading:box");
+  EXPECT_EQ(lib.segments[1].goal->position_frame.name(), "goal_heading:box");
+  EXPECT_EQ(lib.segments[1].goal->heading_object, "box");  // the stroke follows the box's way
+  EXPECT_EQ(lib.segments[0].goal->heading_object, "");
+  // A new scene, pushing in a direction no demo pushed in.
+  lfd::Scene scene;
+  const Eigen::Vector3d box = home_.position + Eigen::Vector3d(0.07, -0.03, -0.06);
+  const Eigen::Vector3d u(std::cos(-0.3), std::sin(-0.3), 0.0);
+  scene.objects["box"].position = box;
+  scene.goal.position = box + 0.11 * u;
+  lfd_dmp::ExecutorOptions opt;
+  opt.dt = 0.004;
+  std::vector<std::string> warnings;
+  const auto t = lfd_dmp::segmentTargets(lib, scene, home_, opt, &warnings);
+  ASSERT_EQ(t.size(), 3u);
+  EXPECT_LT((t[0].goal.position - (box - 0.072 * u)).norm(), 1e-6);
+  EXPECT_LT((t[1].goal.position - (scene.goal.position - 0.052 * u)).norm(), 1e-6);
+  EXPECT_LT((t[2].goal.position - home_.position).norm(), 1e-6);
+  EXPECT_EQ(t[1].frames.rfind("goal_heading:box / ", 0), 0u) << t[1].frames;
+  EXPECT_NE(t[1].frames.find("(heading:box)"), std::string::npos) << t[1].frames;
+  ASSERT_TRUE(t[1].heading.has_value());
+  EXPECT_NEAR(t[1].heading->yaw, -0.3, 1e-9);
+  EXPECT_EQ(t[1].heading->demo_yaw.size(), 4u);
+  EXPECT_LT(t[0].range_distance, t[0].range_margin);  // inside the demonstrated range
+  const lfd_dmp::ExecutionPlan plan = planner_.plan(lib, t, q0_, std::nullopt, opt);
+  EXPECT_LT((plan.poses[plan.segments[1].end - 1].position - t[1].goal.position).norm(), 0.004);
+  EXPECT_LT(strokeDeviation(plan, t[0].goal.position, t[1].goal.position), 0.002);
+  // A scene without the box, or with the box on its goal, is refused naming the segment.
+  lfd::Scene no_box = scene;
+  no_box.objects.clear();
+  try {
+    lfd_dmp::segmentTargets(lib, no_box, home_, opt, &warnings);
+    FAIL() << "goals were computed without the box";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("segment 'approach'"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("no object 'box'"), std::string::npos) << e.what();
+  }
+  lfd::Scene there = scene;
+  there.goal.position = box;
+  EXPECT_THROW(lfd_dmp::segmentTargets(lib, there, home_, opt, &warnings), std::invalid_argument);
+  // Far away: outside the range (reported), refused by plan() unless allowed.
+  lfd::Scene far = scene;
+  far.objects["box"].position += Eigen::Vector3d(0.5, 0.0, 0.0);
+  far.goal.position += Eigen::Vector3d(0.5, 0.0, 0.0);
+  const auto tf = lfd_dmp::segmentTargets(lib, far, home_, opt, &warnings);
+  EXPECT_GT(tf[0].range_distance, 0.4);
+  EXPECT_THROW(planner_.plan(lib, tf, q0_, std::nullopt, opt), lfd_dmp::OutsideDemoRange);
+  // A library learned without scenes cannot be executed: relearn.
+  lfd_dmp::SkillLibrary no_goals = lib;
+  no_goals.segments[1].goal.reset();
+  try {
+    lfd_dmp::segmentTargets(no_goals, scene, home_, opt, &warnings);
+    FAIL() << "a library without learned goals was accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("relearn"), std::string::npos) << e.what();
+  }
 }
 
 }  // namespace

@@ -1,8 +1,11 @@
 // Learner: cutting demos at changepoints into per-segment DMPs, and reading demo bags.
 #include "lfd_dmp/demo_bag.hpp"
+#include "lfd_dmp/demo_scene.hpp"
 #include "lfd_dmp/skill_learner.hpp"
 
 #include <geometry_msgs/PoseStamped.h>
+#include <lfd_msgs/DemoMetadata.h>
+#include <tf2_msgs/TFMessage.h>
 #include <rosbag/bag.h>
 #include <sensor_msgs/JointState.h>
 
@@ -15,10 +18,16 @@
 
 namespace {
 
-// Approach (0..2 s), grasp-and-lift (2..4 s), return (4..5 s); gripper closes around 2 s.
+// Approach (0..2 s), grasp-and-carry (2..4 s), return (4..5 s); gripper closes around 2 s. The
+// scene: the stick at the object, the goal where it is carried (its x mirrors the object's).
 lfd_dmp::DemoRecording recording(const std::string& id, double object_x, double hz = 100.0) {
   lfd_dmp::DemoRecording rec;
   rec.id = id;
+  rec.frame = "base_link";
+  lfd::Scene scene;
+  scene.objects["stick"].position = Eigen::Vector3d(object_x, 0.0, 0.8);
+  scene.goal.position = Eigen::Vector3d(1.1 - object_x, 0.1, 1.0);
+  rec.scene = scene;
   const int m = static_cast<int>(5.0 * hz) + 1;
   rec.times = Eigen::VectorXd::LinSpaced(m, 10.0, 15.0);  // bag time does not start at 0
   rec.positions.resize(m, 3);
@@ -31,7 +40,7 @@ lfd_dmp::DemoRecording recording(const std::string& id, double object_x, double 
   for (int i = 0; i < m; ++i) {
     const double t = rec.times[i] - 10.0;
     const Eigen::Vector3d home(0.3, -0.2, 0.9), object(object_x, 0.0, 0.8),
-        lifted(object_x, 0.1, 1.0);
+        lifted(1.1 - object_x, 0.1, 1.0);
     Eigen::Vector3d p = home + (object - home) * mj(t / 2.0);
     if (t > 2.0) p = object + (lifted - object) * mj((t - 2.0) / 2.0);
     if (t > 4.0) p = lifted + (home - lifted) * mj(t - 4.0);
@@ -76,6 +85,38 @@ TEST(SkillLearner, CutsDemosAtChangepointsIntoSegmentDmps) {
   EXPECT_NEAR(traj.gripper[traj.gripper.size() - 1], 0.02, 1e-3);
   // Consecutive segments join at the same sample.
   EXPECT_EQ(lib.segments[0].demos[0].end_time, lib.segments[1].demos[0].start_time);
+  // Where each segment ends was learned from the scenes: at the stick, at the goal, back home.
+  ASSERT_TRUE(lib.segments[0].goal && lib.segments[1].goal && lib.segments[2].goal);
+  EXPECT_EQ(lib.segments[0].goal->position_frame.name(), "object:stick");
+  EXPECT_LT(lib.segments[0].goal->position_offset.norm(), 1e-9);
+  EXPECT_EQ(lib.segments[1].goal->position_frame.name(), "goal");
+  EXPECT_TRUE(lib.segments[2].goal->position_frame.name() == "base" ||
+              lib.segments[2].goal->position_frame.name() == "start");
+  EXPECT_LT(lib.segments[2].goal->position_spread, 1e-9);
+  EXPECT_EQ(lib.cartesian_frame, "base_link");
+  ASSERT_EQ(lib.demo_scenes.size(), 2u);  // the used demos' scenes, for heading frames
+  EXPECT_LT((lib.demo_scenes.at("b.bag").start.position - Eigen::Vector3d(0.3, -0.2, 0.9)).norm(),
+            1e-9);
+}
+
+TEST(SkillLearner, ScenesForSomeDemosOnlyOrMixedFramesAreRefused) {
+  std::vector<lfd_dmp::DemoRecording> demos = {recording("a.bag", 0.6), recording("b.bag", 0.7)};
+  const std::vector<std::vector<double>> cps = {{12.0, 14.0}, {12.0, 14.0}};
+  lfd_dmp::LearnOptions opt;
+  demos[1].scene.reset();
+  try {
+    lfd_dmp::learnSkillLibrary(demos, cps, opt);
+    FAIL() << "a library was learned with a scene for one demo of two";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("b.bag"), std::string::npos) << e.what();
+  }
+  demos[0].scene.reset();  // no scene at all: the DMPs, no goals, and a warning saying so
+  const auto out = lfd_dmp::learnSkillLibrary(demos, cps, opt);
+  EXPECT_FALSE(out.library.segments[0].goal.has_value());
+  ASSERT_EQ(out.warnings.size(), 1u);
+  EXPECT_NE(out.warnings[0].find("cannot reproduce"), std::string::npos) << out.warnings[0];
+  demos[1].frame = "world";
+  EXPECT_THROW(lfd_dmp::learnSkillLibrary(demos, cps, opt), std::invalid_argument);
 }
 
 // A teleoperated demo: the same motion plus 10 Hz, 3 mm tremor. Without smoothing the DMPs replay
@@ -165,34 +206,56 @@ TEST(SkillLearner, RejectsUnusableInput) {
   }
 }
 
+// A demo bag as the recorder writes it: poses, gripper, and optionally the metadata (scene) and
+// the static transform world -> base_link (base_link 0.85 m up).
+void writeBag(const std::string& path, const lfd_dmp::DemoRecording& rec,
+              const std::string& extra_json, bool tf_static) {
+  rosbag::Bag bag(path, rosbag::bagmode::Write);
+  const ros::Time t0(rec.times[0]);
+  if (!extra_json.empty()) {
+    lfd_msgs::DemoMetadata meta;
+    meta.header.stamp = t0;
+    meta.extra_json = extra_json;
+    bag.write("/lfd/metadata", t0, meta);
+  }
+  if (tf_static) {
+    tf2_msgs::TFMessage tf;
+    geometry_msgs::TransformStamped t;
+    t.header.frame_id = "world";
+    t.child_frame_id = "base_link";
+    t.transform.translation.z = 0.85;
+    t.transform.rotation.w = 1.0;
+    tf.transforms.push_back(t);
+    bag.write("/tf_static", t0, tf);
+  }
+  for (Eigen::Index i = 0; i < rec.times.size(); ++i) {
+    geometry_msgs::PoseStamped p;
+    p.header.stamp = ros::Time(rec.times[i]);
+    p.header.frame_id = "base_link";
+    p.pose.position.x = rec.positions(i, 0);
+    p.pose.position.y = rec.positions(i, 1);
+    p.pose.position.z = rec.positions(i, 2);
+    p.pose.orientation.w = rec.quaternions(i, 0);
+    p.pose.orientation.x = rec.quaternions(i, 1);
+    p.pose.orientation.y = rec.quaternions(i, 2);
+    p.pose.orientation.z = rec.quaternions(i, 3);
+    bag.write("/ee_pose", p.header.stamp, p);
+    if (i % 2 == 0) {  // gripper at half the rate: interpolated onto the pose stamps
+      sensor_msgs::JointState js;
+      js.header.stamp = p.header.stamp;
+      js.name = {"R_GRIPPER"};
+      js.position = {rec.gripper[i]};
+      bag.write("/gripper/state", js.header.stamp, js);
+    }
+  }
+  bag.close();
+}
+
 TEST(DemoBag, ReadsPosesAndInterpolatesTheGripper) {
   const std::string path =
       ::testing::TempDir() + "/lfd_dmp_demo_" + std::to_string(::getpid()) + ".bag";
   const lfd_dmp::DemoRecording rec = recording(path, 0.6, 50.0);
-  {
-    rosbag::Bag bag(path, rosbag::bagmode::Write);
-    for (Eigen::Index i = 0; i < rec.times.size(); ++i) {
-      geometry_msgs::PoseStamped p;
-      p.header.stamp = ros::Time(rec.times[i]);
-      p.header.frame_id = "base_link";
-      p.pose.position.x = rec.positions(i, 0);
-      p.pose.position.y = rec.positions(i, 1);
-      p.pose.position.z = rec.positions(i, 2);
-      p.pose.orientation.w = rec.quaternions(i, 0);
-      p.pose.orientation.x = rec.quaternions(i, 1);
-      p.pose.orientation.y = rec.quaternions(i, 2);
-      p.pose.orientation.z = rec.quaternions(i, 3);
-      bag.write("/ee_pose", p.header.stamp, p);
-      if (i % 2 == 0) {  // gripper at half the rate: interpolated onto the pose stamps
-        sensor_msgs::JointState js;
-        js.header.stamp = p.header.stamp;
-        js.name = {"R_GRIPPER"};
-        js.position = {rec.gripper[i]};
-        bag.write("/gripper/state", js.header.stamp, js);
-      }
-    }
-    bag.close();
-  }
+  writeBag(path, rec, "", false);
   const lfd_dmp::DemoRecording back = lfd_dmp::readDemoBag(path);
   ASSERT_EQ(back.times.size(), rec.times.size());
   EXPECT_LT((back.times - rec.times).cwiseAbs().maxCoeff(), 1e-6);
@@ -200,8 +263,78 @@ TEST(DemoBag, ReadsPosesAndInterpolatesTheGripper) {
   EXPECT_LT((back.quaternions - rec.quaternions).cwiseAbs().maxCoeff(), 1e-12);
   ASSERT_EQ(back.gripper.size(), rec.gripper.size());
   EXPECT_LT((back.gripper - rec.gripper).cwiseAbs().maxCoeff(), 2e-3);
+  EXPECT_EQ(back.frame, "base_link");
+  EXPECT_FALSE(back.scene.has_value());  // no metadata: no scene (and no error)
   std::remove(path.c_str());
   EXPECT_THROW(lfd_dmp::readDemoBag(path), std::runtime_error);
+}
+
+// The scene of the metadata (the "scene" block, or the older object/object_start/goal fields) is
+// brought from the world into the poses' frame with the bag's /tf_static.
+TEST(DemoBag, ReadsTheSceneIntoThePosesFrame) {
+  const std::string path =
+      ::testing::TempDir() + "/lfd_dmp_scene_" + std::to_string(::getpid()) + ".bag";
+  const lfd_dmp::DemoRecording rec = recording(path, 0.6, 50.0);
+  const std::string scene =
+      R"({"scene": {"frame": "world", "objects": {"box": {"position": [0.5, -0.3, 0.84],)"
+      R"( "orientation": [1, 0, 0, 0]}}, "goal": {"position": [0.6, -0.3, 0.84]}, "joints": {}},)"
+      R"( "object": "stick", "object_start": {"position": [0, 0, 0]}, "goal": {"position": [0, 0, 0]}})";
+  writeBag(path, rec, scene, true);
+  lfd_dmp::DemoRecording back = lfd_dmp::readDemoBag(path);
+  ASSERT_TRUE(back.scene.has_value());
+  ASSERT_EQ(back.scene->objects.count("box"), 1u);  // the scene block first
+  EXPECT_LT((back.scene->objects.at("box").position - Eigen::Vector3d(0.5, -0.3, -0.01)).norm(),
+            1e-12);
+  EXPECT_NEAR(back.scene->goal.position.z(), -0.01, 1e-12);
+  const std::string legacy =
+      R"({"object": "stick", "frame": "world", "object_start": {"position": [0.4, -0.2, 0.815],)"
+      R"( "orientation": [0.995, 0, 0, 0.0998]}, "goal": {"position": [0.5, -0.3, 0.95],)"
+      R"( "orientation": [1, 0, 0, 0]}, "table_top": 0.8})";
+  writeBag(path, rec, legacy, true);
+  back = lfd_dmp::readDemoBag(path);
+  ASSERT_TRUE(back.scene.has_value());
+  EXPECT_NEAR(back.scene->objects.at("stick").position.z(), -0.035, 1e-12);
+  EXPECT_NEAR(back.scene->objects.at("stick").orientation.norm(), 1.0, 1e-12);  // normalized
+  // A scene in the world without the transform to the poses' frame: an error that says so.
+  writeBag(path, rec, legacy, false);
+  try {
+    lfd_dmp::readDemoBag(path);
+    FAIL() << "a world scene was read without world -> base_link";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("/tf_static"), std::string::npos) << e.what();
+  }
+  // A malformed scene names the field.
+  writeBag(path, rec, R"({"scene": {"objects": {"box": {"position": [1, 2]}}, "goal": {}}})", true);
+  try {
+    lfd_dmp::readDemoBag(path);
+    FAIL() << "a malformed scene was read";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("scene.objects.box.position"), std::string::npos)
+        << e.what();
+  }
+  std::remove(path.c_str());
+}
+
+TEST(DemoScene, StaticTransformsChainAndRefuseWhatDoesNotConnect) {
+  lfd_dmp::StaticTransforms tf;
+  Eigen::Isometry3d up = Eigen::Isometry3d::Identity();
+  up.translation().z() = 0.85;
+  Eigen::Isometry3d turned = Eigen::Isometry3d::Identity();
+  turned.linear() = Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  turned.translation().x() = 0.1;
+  tf.add("world", "base_link", up);
+  tf.add("base_link", "chest", turned);
+  const Eigen::Isometry3d world_in_chest = tf.lookup("chest", "world");
+  EXPECT_NEAR((world_in_chest * Eigen::Vector3d(0.1, 1.0, 0.85) - Eigen::Vector3d(1, 0, 0)).norm(), 0.0, 1e-12);
+  EXPECT_TRUE(tf.lookup("world", "world").isApprox(Eigen::Isometry3d::Identity()));
+  EXPECT_THROW(tf.lookup("world", "camera"), std::runtime_error);
+  EXPECT_THROW(tf.add("a", "a", up), std::runtime_error);
+  EXPECT_FALSE(lfd_dmp::sceneFromMetadata(R"({"seed": 3})").has_value());
+  EXPECT_THROW(lfd_dmp::sceneFromMetadata("{not json"), std::runtime_error);
+  EXPECT_THROW(lfd_dmp::sceneFromMetadata(
+                   R"({"object": "s", "object_start": {"position": [0, 0, 0],)"
+                   R"( "orientation": [0, 0, 0, 0]}, "goal": {"position": [0, 0, 0]}})"),
+               std::runtime_error);
 }
 
 }  // namespace

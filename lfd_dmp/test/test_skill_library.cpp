@@ -49,7 +49,27 @@ SkillLibrary makeLibrary() {
       skill.parameters = skill.dmp.position->goal();
       seg.demos.push_back(skill);
     }
+    lfd::SegmentGoalModel goal;
+    goal.position_frame = lfd::SceneFrame::parse(s == 0 ? "object:stick" : "goal");
+    goal.position_offset = Eigen::Vector3d(0.01, 0.0, 0.005);
+    goal.position_spread = 0.004;
+    goal.orientation_frame = lfd::SceneFrame::parse("heading:stick");
+    goal.orientation_offset = Eigen::Quaterniond(Eigen::AngleAxisd(0.1, Eigen::Vector3d::UnitZ()));
+    goal.orientation_spread = 0.05;
+    goal.heading_object = s == 1 ? "stick" : "";
+    goal.heading_spread = 0.1;
+    goal.candidates = {{lfd::SceneFrame::parse("base"), 0.2, 0.3},
+                       {lfd::SceneFrame::parse("heading:stick"),
+                        std::numeric_limits<double>::infinity(), 0.05}};
+    seg.goal = goal;
     lib.segments.push_back(seg);
+  }
+  for (int d = 0; d < 2; ++d) {
+    lfd_dmp::DemoScene scene;
+    scene.start.position = Eigen::Vector3d(0.3, -0.3, 0.1);
+    scene.scene.objects["stick"].position = Eigen::Vector3d(0.5 + 0.1 * d, -0.2, -0.035);
+    scene.scene.goal.position = Eigen::Vector3d(0.4, -0.3, 0.1);
+    lib.demo_scenes["demo_" + std::to_string(d) + ".bag"] = scene;
   }
   return lib;
 }
@@ -80,6 +100,13 @@ TEST(SkillLibrary, RoundTripKeepsEverything) {
   EXPECT_EQ(back.task, "grasp");
   EXPECT_EQ(back.features, lib.features);
   EXPECT_EQ(back.smoothing_sigma, 0.05);
+  EXPECT_EQ(back.cartesian_frame, "base_link");
+  ASSERT_EQ(back.demo_scenes.size(), 2u);
+  EXPECT_EQ(back.demo_scenes.at("demo_1.bag").scene.objects.at("stick").position.x(), 0.6);
+  ASSERT_TRUE(back.segments[1].goal.has_value());
+  EXPECT_EQ(back.segments[1].goal->position_frame.name(), "goal");
+  EXPECT_EQ(back.segments[1].goal->heading_object, "stick");
+  EXPECT_TRUE(std::isinf(back.segments[1].goal->candidates[1].position_m));  // undefined frame
   ASSERT_EQ(back.segments.size(), 2u);
   EXPECT_EQ(back.segments[1].name, "move");
   const auto& a = lib.segments[1].demos[1].dmp;
@@ -103,8 +130,29 @@ TEST(SkillLibrary, ValidationNamesTheProblem) {
   EXPECT_EQ(loadError(good), "");
 
   nlohmann::json j = good;
-  j["version"] = 2;
-  EXPECT_NE(loadError(j).find("unsupported version 2"), std::string::npos) << loadError(j);
+  j["version"] = 3;
+  EXPECT_NE(loadError(j).find("unsupported version 3"), std::string::npos) << loadError(j);
+  j["version"] = 1;  // goals were hand-written rules then: relearn, never guess
+  EXPECT_NE(loadError(j).find("relearn"), std::string::npos) << loadError(j);
+
+  j = good;
+  j["segments"][0]["goal"]["position"]["frame"] = "table";
+  EXPECT_NE(loadError(j).find("segments[0].goal.position.frame: unknown frame 'table'"),
+            std::string::npos)
+      << loadError(j);
+  j = good;
+  j["segments"][1]["goal"]["orientation"]["offset"] = {0, 0, 0, 0};
+  EXPECT_NE(loadError(j).find("segments[1].goal.orientation.offset: quaternion has zero norm"),
+            std::string::npos)
+      << loadError(j);
+  j = good;
+  j["demo_scenes"][1]["objects"]["stick"]["position"][2] = 1e9;
+  EXPECT_NE(loadError(j).find("demo_scenes[1].objects.stick.position"), std::string::npos)
+      << loadError(j);
+  j = good;  // a library without learned goals still loads (dmp_tool's); the executor refuses it
+  j["segments"][0].erase("goal");
+  j.erase("demo_scenes");
+  EXPECT_EQ(loadError(j), "");
 
   j = good;
   j["format"] = "something_else";

@@ -1,5 +1,7 @@
 // Reads a demonstration bag (written by the recorder) into a DemoRecording: the end-effector pose
-// topic gives the time base (header stamps), the gripper opening is interpolated onto it.
+// topic gives the time base (header stamps) and the Cartesian frame (header frame_id), the gripper
+// opening is interpolated onto it, and the scene of the metadata (demo_scene.hpp) is brought into
+// the Cartesian frame with the bag's static transforms.
 #pragma once
 
 #include "lfd_dmp/skill_learner.hpp"
@@ -12,10 +14,13 @@ struct DemoBagTopics {
   std::string pose = "/ee_pose";               ///< geometry_msgs/PoseStamped (base_link)
   std::string gripper = "/gripper/state";      ///< sensor_msgs/JointState
   std::string gripper_joint = "R_GRIPPER";     ///< joint whose position is the opening
+  std::string metadata = "/lfd/metadata";      ///< lfd_msgs/DemoMetadata (extra_json: the scene)
+  std::string tf_static = "/tf_static";        ///< tf2_msgs/TFMessage
 };
 
 /// Throws std::runtime_error naming the bag and topic on missing/unusable data. Poses with
-/// non-increasing stamps are dropped (duplicates), NaN poses are an error.
+/// non-increasing stamps are dropped (duplicates), NaN poses are an error. A scene whose frame
+/// the static transforms do not connect to the poses' frame is an error; no scene is not.
 DemoRecording readDemoBag(const std::string& path, const DemoBagTopics& topics = {});
 
 }  // namespace lfd_dmp

@@ -1,87 +1,51 @@
-// Executor logic (ROS-free): turns a skill library and a new task situation into a checked joint
-// trajectory. Paper II-D / III: every segment's DMP is generalized from the demonstrations to the
-// segment's new goal, rolled out in sequence from the robot's current TCP pose (each segment starts
-// where the previous one ended), converted to joint targets by the core IK (warm-started, joint
-// limits, null-space posture; lfd_core's CartesianToJoints, shared with the demonstrator),
-// and the gripper DMP is thresholded into open/close commands. The whole path is checked by IK
-// BEFORE anything moves, so an unreachable goal is refused with the failing pose in the message.
-// executor_node.cpp only adds ROS I/O and sim-time streaming.
+// Executor logic (ROS-free): turns a skill library and a new scene into a checked joint path.
+// Paper II-D / III: every segment's goal is computed from the frame and offset the learner found
+// in the demonstrations (lfd_core task_frames: no rule per task), its DMP is generalized from the
+// demos to that goal (in the heading frame when the segment follows an object's way to the goal),
+// rolled out in sequence from the robot's current TCP pose (each segment starts where the previous
+// one ended), converted to joints by the core IK (lfd::CartesianToJoints, shared with the
+// demonstrator), and the gripper DMP is thresholded into open/close events. Everything is checked
+// BEFORE anything moves: a goal outside the demonstrated range or out of reach is refused with the
+// segment, distance or failing pose in the message. executor_node.cpp only adds ROS I/O.
 #pragma once
 
 #include "lfd_dmp/skill_library.hpp"
 
 #include <lfd_core/cartesian_path.hpp>
 #include <lfd_core/dmp_generalization.hpp>
+#include <lfd_core/task_frames.hpp>
 
 #include <Eigen/Geometry>
 
+#include <functional>
+#include <map>
 #include <optional>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
 namespace lfd_dmp {
 
-using TcpPose = lfd::Pose;  // position + unit quaternion, base_link
+using TcpPose = lfd::Pose;  // position + unit quaternion, in the library's Cartesian frame
 
-/// Which pose of the task situation a segment's goal is attached to.
-enum class GoalReference { kObject, kGoal, kStart };
-/// How the segment's goal orientation is chosen.
-enum class OrientationRule {
-  kObjectYaw,  ///< Rz(object yaw, symmetric: wrapped into (-pi/2, pi/2]) * gripper orientation
-  kGoalYaw,    ///< Rz(goal yaw, same wrap) * gripper orientation
-  kPushYaw,    ///< Rz(atan2 of the push direction) * gripper orientation (as the demonstrator)
-  kStart,      ///< the TCP orientation at the start of the execution
-  kLearned     ///< the generalized goal orientation of the demonstrations
-};
-
-/// Segment goal = reference position + offset (base_link axes) + along_push * d, where d is the
-/// horizontal unit direction from the object to its goal.
-struct SegmentGoalRule {
-  std::string name;
-  GoalReference reference = GoalReference::kGoal;
-  Eigen::Vector3d offset = Eigen::Vector3d::Zero();
-  double along_push = 0.0;
-  OrientationRule orientation = OrientationRule::kLearned;
-  std::string frame;  ///< SegmentTarget::frame
-};
-
-/// One rule per segment of the task's skill library, in order.
-struct TaskGoalModel {
-  std::string task;
-  std::vector<SegmentGoalRule> segments;
-};
-
-/// The new situation, in base_link.
-struct TaskSituation {
-  Eigen::Vector3d object_position = Eigen::Vector3d::Zero();
-  double object_yaw = 0.0;
-  Eigen::Vector3d goal_position = Eigen::Vector3d::Zero();
-  double goal_yaw = 0.0;
+/// Generalize a segment in a heading frame: each demo's DMP is rotated about z so that its own
+/// heading points along x, interpolated there, and rotated into the new heading. Why: a push
+/// stroke has the same shape in its own frame whatever its direction, while in the base frame the
+/// forcing terms of pushes in different directions point different ways and their mix bends it.
+struct HeadingFrame {
+  std::string object;
+  double yaw = 0.0;                        ///< the new scene's heading
+  std::map<std::string, double> demo_yaw;  ///< each demo's heading, by demo id
 };
 
 struct SegmentTarget {
   std::string name;
-  Eigen::Vector3d position = Eigen::Vector3d::Zero();
-  std::optional<Eigen::Quaterniond> orientation;  ///< empty: the learned (generalized) goal
-  /// Generalize in the heading frame of the named segment ("" = base_link): each demo's DMP is
-  /// rotated about z so that that segment's start->goal direction (in xy) points along x,
-  /// interpolated there, and rotated into the new heading of that segment. Why: a push stroke has
-  /// the same shape in its own frame whatever its direction, while in base_link the forcing terms
-  /// of pushes in different directions point different ways and their mix pushes the box sideways.
-  std::string frame;
+  TcpPose goal;
+  std::string frames;  ///< "<position frame> / <orientation frame>", for reports
+  std::optional<HeadingFrame> heading;
+  double range_distance = 0.0;  ///< m from the convex hull of the demos' goal positions
+  double range_margin = 0.0;    ///< m allowed before the goal counts as outside the demos' range
 };
-
-GoalReference parseGoalReference(const std::string& s);      ///< object | goal | start
-OrientationRule parseOrientationRule(const std::string& s);  ///< object_yaw | goal_yaw | ...
-
-/// Throws std::invalid_argument for a push-direction rule when object and goal coincide in xy.
-std::vector<SegmentTarget> segmentTargets(const TaskGoalModel& model,
-                                          const TaskSituation& situation, const TcpPose& start,
-                                          const Eigen::Quaterniond& gripper_orientation);
-
-/// Yaw of the horizontal direction from `from` to `to`; throws std::invalid_argument when their xy
-/// distance is below `min_length` (the heading is then undefined).
-double headingYaw(const Eigen::Vector3d& from, const Eigen::Vector3d& to, double min_length);
 
 /// A change of the thresholded gripper state at `sample` (close = true).
 struct GripperEvent {
@@ -99,36 +63,65 @@ struct ExecutorOptions {
   double dt = 0.002;              ///< s between planned samples (500 Hz)
   double duration_scale = 1.0;    ///< multiplies every generalized segment duration
   bool all_segment_goals = true;  ///< generalize over all segment goals (task via-points) of a demo
-  lfd::GeneralizationOptions generalization;
+  lfd::GeneralizationOptions generalization;  ///< range_margin: fraction of the demos' goal spread
+  double min_range_margin = 0.02;  ///< m: the smallest margin (demos that all end in one place)
+  bool allow_extrapolation = false;  ///< plan goals outside the demonstrated range anyway
+  lfd::FrameOptions frames;
+  bool heading_frames = true;  ///< generalize segments that follow a heading in its frame
+  size_t max_samples = 100000;  ///< planned samples (memory and time bound of one plan)
   double gripper_threshold_fraction = 0.5;
   double gripper_hysteresis = 0.05;
   double gripper_min_range = 0.005;
 };
 
+/// A goal outside the demonstrated range when extrapolation is not allowed.
+class OutsideDemoRange : public std::invalid_argument {
+ public:
+  OutsideDemoRange(const std::string& what, double distance)
+      : std::invalid_argument(what), distance(distance) {}
+  double distance;  ///< m, the largest distance of a segment goal from its demos' goals
+};
+
+/// Planning stopped because the caller cancelled it.
+class PlanningCancelled : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
 struct PlannedSegment {
   std::string name;
+  std::string frames;
   size_t begin = 0, end = 0;  ///< samples [begin, end)
   double duration = 0.0;      ///< s
   TcpPose goal;               ///< goal pose given to the DMP
   std::vector<std::string> demos;
-  bool outside_demo_range = false;
 };
 
 struct ExecutionPlan {
   std::vector<std::string> joint_names;
   double dt = 0.0;
   std::vector<double> times;            ///< s from the start
-  std::vector<TcpPose> poses;           ///< planned TCP poses (base_link)
+  std::vector<TcpPose> poses;           ///< planned TCP poses (Cartesian frame)
   std::vector<Eigen::VectorXd> joints;  ///< IK solution per sample
   std::vector<double> gripper;          ///< gripper DMP value per sample
   std::vector<GripperEvent> gripper_events;
   std::vector<PlannedSegment> segments;
   std::vector<std::string> warnings;
+  double extrapolation_distance = 0.0;  ///< m, largest SegmentTarget::range_distance
+  bool outside_demo_range = false;
   double max_ik_position_error = 0.0;
   double max_ik_orientation_error = 0.0;
   double max_speed_ratio = 0.0;  ///< worst |dq/dt| / velocity limit
   double duration() const { return times.empty() ? 0.0 : times.back(); }
 };
+
+/// The goal of every segment of `library` in `scene` for a task starting with the TCP at `start`:
+/// its learned frames and offsets, the heading frame it is generalized in, and its distance from
+/// the demonstrated goals. Throws std::invalid_argument when the library has no learned goals
+/// (relearn it) or the scene lacks what a frame needs (an object, a defined heading).
+std::vector<SegmentTarget> segmentTargets(const SkillLibrary& library, const lfd::Scene& scene,
+                                          const TcpPose& start, const ExecutorOptions& options,
+                                          std::vector<std::string>* warnings);
 
 class TaskPlanner {
  public:
@@ -139,11 +132,15 @@ class TaskPlanner {
   TcpPose forward(const Eigen::VectorXd& q) const { return ik_.forward(q); }
 
   /// q_start: current joints of the chain. gripper_start: measured gripper value (recorded
-  /// units), empty = the learned start. Throws std::invalid_argument on a library / target
-  /// mismatch and std::runtime_error (naming segment, time and pose) when IK fails on the path.
+  /// units), empty = the learned start. `cancelled` is polled between pieces of work (throws
+  /// PlanningCancelled when it returns true). Throws OutsideDemoRange (goal outside the demos'
+  /// range, unless options.allow_extrapolation), std::invalid_argument on a library / target
+  /// mismatch or a plan over options.max_samples, and std::runtime_error (naming segment, time
+  /// and pose) when IK fails on the path.
   ExecutionPlan plan(const SkillLibrary& library, const std::vector<SegmentTarget>& targets,
                      const Eigen::VectorXd& q_start, std::optional<double> gripper_start,
-                     const ExecutorOptions& options);
+                     const ExecutorOptions& options,
+                     const std::function<bool()>& cancelled = nullptr);
 
  private:
   lfd::CartesianToJoints ik_;

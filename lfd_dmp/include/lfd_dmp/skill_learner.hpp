@@ -5,6 +5,7 @@
 
 #include "lfd_dmp/skill_library.hpp"
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -17,6 +18,8 @@ struct DemoRecording {
   Eigen::MatrixXd positions;    ///< M x 3, end effector in base_link
   Eigen::MatrixXd quaternions;  ///< M x 4 (w, x, y, z)
   Eigen::VectorXd gripper;      ///< M gripper opening (empty if not recorded)
+  std::string frame;            ///< frame of the poses ("" = not recorded)
+  std::optional<lfd::Scene> scene;  ///< the demo's scene in that frame (none recorded: empty)
 };
 
 struct LearnOptions {
@@ -29,6 +32,8 @@ struct LearnOptions {
   /// s; Gaussian low-pass of every recorded pose before it is cut and learned (lfd::gaussianSmooth;
   /// 0 = off). Teleoperated demos carry tremor that the DMPs would otherwise replay.
   double smoothing_sigma = 0.0;
+  /// How each segment's goal frame is chosen from the demos' scenes (lfd_core task_frames).
+  lfd::FrameSelectionOptions frames;
 };
 
 struct LearnOutcome {
@@ -39,8 +44,11 @@ struct LearnOutcome {
 
 /// changepoint_times[i]: sorted changepoint times of demos[i] (same clock as its times).
 /// The number of segments is the most common changepoint count + 1; demos with another count are
-/// skipped with a warning (they were not segmented consistently). Throws std::invalid_argument on
-/// unusable input (no demos, changepoints outside a demo, a segment too short to learn, NaN).
+/// skipped with a warning (they were not segmented consistently). When the demos carry scenes, each
+/// segment's goal frame is learned from them (lfd::learnSegmentGoal) and the scenes are stored;
+/// without any scene the library has no goals (a warning: the executor cannot reproduce it).
+/// Throws std::invalid_argument on unusable input (no demos, changepoints outside a demo, a segment
+/// too short to learn, NaN, scenes for only some demos, poses in different frames).
 LearnOutcome learnSkillLibrary(const std::vector<DemoRecording>& demos,
                                const std::vector<std::vector<double>>& changepoint_times,
                                const LearnOptions& options);

@@ -2,13 +2,22 @@
 // learned on each demonstration with the task parameters (goal features) used to generalize.
 //
 // {
-//   "format": "lfd_skill_library", "version": 1, "task": "grasp",
+//   "format": "lfd_skill_library", "version": 2, "task": "grasp",
+//   "cartesian_frame": "base_link",                 // frame of every pose below
+//   "demo_scenes": [{"demo_id": "grasp_03.bag",      // the scene of each demo (learned goals)
+//                    "start": POSE, "objects": {"stick": POSE}, "goal": POSE}],
 //   "features": ["gripper_opening", "ee_speed", "ee_x"],          // features used to segment
 //   "generalization_parameters": "goal_position",
 //   "position_names": ["x", "y", "z"],
 //   "dmp_parameters": {"num_basis": 50, "alpha_x": 6.9, ...},
 //   "segments": [
 //     {"index": 0, "name": "approach",
+//      "goal": {"position": {"frame": "object:stick", "offset": [x, y, z], "spread_m": 0.008},
+//               "orientation": {"frame": "object:stick", "offset": [w, x, y, z],
+//                               "spread_rad": 0.04},
+//               "heading": {"object": "", "spread_rad": 1.2},   // "" = not generalized there
+//               "candidates": [{"frame": "base", "position_spread_m": 0.1,
+//                               "orientation_spread_rad": 0.2}, ...]},  // null = undefined
 //      "demos": [{"demo_id": "grasp_03.bag", "start_time": 0.0, "end_time": 4.1,
 //                 "parameters": [0.6, -0.1, 0.8],
 //                 "dmp": {"tau": 4.1,
@@ -19,20 +28,26 @@
 //                         "gripper": {"start": 0.08, "goal": 0.0, "start_velocity": 0.0,
 //                                     "weights": [N values]}}}]}]
 // }
+// POSE = {"position": [x, y, z], "orientation": [w, x, y, z]}. "goal" and "demo_scenes" are
+// optional (a library learned without scenes, e.g. by dmp_tool, has none; the executor refuses it).
 // Loading validates everything (format, version, shapes, finite numbers) and reports the exact
-// JSON location of the first problem.
+// JSON location of the first problem. Version 1 (goals written by hand in the executor's config)
+// is refused with a request to relearn.
 #pragma once
 
 #include <lfd_core/segment_dmp.hpp>
+#include <lfd_core/task_frames.hpp>
 
 #include <nlohmann/json.hpp>
 
+#include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
 namespace lfd_dmp {
 
-constexpr int kSkillLibraryVersion = 1;
+constexpr int kSkillLibraryVersion = 2;
 constexpr const char* kSkillLibraryFormat = "lfd_skill_library";
 
 /// The DMPs of one segment learned on one demonstration.
@@ -48,6 +63,13 @@ struct SegmentSkills {
   int index = 0;
   std::string name;  ///< e.g. "approach", or "segment_0"
   std::vector<DemoSkill> demos;
+  std::optional<lfd::SegmentGoalModel> goal;  ///< where the segment ends, learned from the scenes
+};
+
+/// Where a demonstration happened (Cartesian frame): its scene and the TCP pose when it started.
+struct DemoScene {
+  lfd::Scene scene;
+  lfd::Pose start;
 };
 
 struct SkillLibrary {
@@ -60,6 +82,8 @@ struct SkillLibrary {
   /// s; the Gaussian low-pass applied to the demos before learning (LearnOptions; 0 = none).
   /// Optional in the file (absent = 0, as written before it was recorded).
   double smoothing_sigma = 0.0;
+  std::string cartesian_frame = "base_link";  ///< frame of the poses (DMPs, scenes, goals)
+  std::map<std::string, DemoScene> demo_scenes;  ///< by demo_id
   std::vector<SegmentSkills> segments;
 };
 

@@ -1,0 +1,44 @@
+// An execution plan as the ROS messages a robot driver and rviz take: one joint trajectory
+// stamped with the sim time it starts, gripper commands stamped with the times they take effect,
+// the planned path and segment markers.
+#pragma once
+
+#include "lfd_dmp/executor.hpp"
+
+#include <lfd_core/robot_setup.hpp>
+#include <lfd_msgs/GripperCommand.h>
+
+#include <geometry_msgs/Pose.h>
+#include <nav_msgs/Path.h>
+#include <ros/time.h>
+#include <trajectory_msgs/JointTrajectory.h>
+#include <visualization_msgs/MarkerArray.h>
+
+#include <vector>
+
+namespace lfd_dmp {
+
+geometry_msgs::Pose toPoseMsg(const lfd::Pose& p);
+
+/// The planned joints every `period` s (and the last sample), velocities by central differences,
+/// header.stamp = `start`: the driver interpolates them on its clock from then on.
+trajectory_msgs::JointTrajectory toJointTrajectory(const ExecutionPlan& plan, const ros::Time& start,
+                                                   double period);
+
+/// A trajectory of one point that holds `q` from `stamp` on (a stop).
+trajectory_msgs::JointTrajectory holdTrajectory(const std::vector<std::string>& joints,
+                                                const Eigen::VectorXd& q, const ros::Time& stamp);
+
+/// The gripper command of one event (open / close), stamped with when it takes effect.
+lfd_msgs::GripperCommand gripperCommand(bool close, const lfd::GripperSetup& gripper,
+                                        const ros::Time& stamp);
+
+/// The planned TCP path (every 10th sample) in `frame`.
+nav_msgs::Path plannedPath(const ExecutionPlan& plan, const std::string& frame,
+                           const ros::Time& stamp);
+
+/// Spheres at each segment's start and goal, with its name.
+visualization_msgs::MarkerArray segmentMarkers(const ExecutionPlan& plan, const std::string& frame,
+                                               const ros::Time& stamp);
+
+}  // namespace lfd_dmp
