@@ -37,6 +37,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <deque>
 #include <map>
 #include <memory>
 #include <string>
@@ -280,6 +281,7 @@ class BridgeNode {
   }
 
   void stepOnce() {
+    applyDueGripperCommands();
     sim_->step();
     ++step_count_;
     if (step_count_ % clock_every_ == 0) publishClock();
@@ -428,9 +430,32 @@ class BridgeNode {
     }
   }
 
+  // A command stamped ahead of sim time takes effect at its stamp, to the physics step (a planned
+  // motion sends its gripper events in advance, so they happen on time whatever the load); a zero
+  // or past stamp, at once. A command drops the pending ones stamped after it (a stop cancels).
   void onGripper(const lfd_msgs::GripperCommand::ConstPtr& msg) {
+    while (!pending_gripper_.empty() && pending_gripper_.back().header.stamp > msg->header.stamp)
+      pending_gripper_.pop_back();
+    if (msg->header.stamp.toSec() <= sim_->time() + 0.5 * sim_->timestep())
+      applyGripper(*msg);
+    else if (pending_gripper_.size() >= kMaxPendingGripper)
+      errors_.report("gripper_command", "rejected /gripper/command: over " +
+                                            std::to_string(kMaxPendingGripper) + " pending");
+    else
+      pending_gripper_.push_back(*msg);  // stays sorted: every later one was dropped above
+  }
+
+  void applyDueGripperCommands() {
+    while (!pending_gripper_.empty() &&
+           pending_gripper_.front().header.stamp.toSec() <= sim_->time() + 0.5 * sim_->timestep()) {
+      applyGripper(pending_gripper_.front());
+      pending_gripper_.pop_front();
+    }
+  }
+
+  void applyGripper(const lfd_msgs::GripperCommand& msg) {
     try {
-      sim_->setGripper(msg->position, msg->max_effort);
+      sim_->setGripper(msg.position, msg.max_effort);
     } catch (const std::exception& e) {
       errors_.report("gripper_command", std::string("rejected /gripper/command: ") + e.what());
     }
@@ -446,6 +471,7 @@ class BridgeNode {
         posture[req.joint_names[i]] = req.positions[i];
       }
       sim_->reset(posture, req.reset_objects);
+      pending_gripper_.clear();  // a reset robot has no plan left
       publishState();
       res.success = true;
       res.message = "reset at t=" + std::to_string(sim_->time());
@@ -528,6 +554,8 @@ class BridgeNode {
   bool paused_ = false;
   ros::Time last_clock_, last_tf_;
   ThrottledErrors errors_;
+  static constexpr size_t kMaxPendingGripper = 1000;
+  std::deque<lfd_msgs::GripperCommand> pending_gripper_;  // stamped ahead, by stamp
   ros::Publisher clock_pub_, joint_state_pub_, gripper_state_pub_, wrench_pub_, touch_pub_,
       imu_pub_, ee_pose_pub_, ee_twist_pub_, tf_pub_;
   std::vector<ros::Publisher> object_pubs_;
