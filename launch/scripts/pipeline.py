@@ -11,9 +11,10 @@ its own (so one stage's /use_sim_time never leaks into the next):
              ground truth) and learn the skill library from the validated changepoints
              (/learner/learn) -> DIR/skills/<task>_<mode>.json
   reproduce  launch/reproduce.launch + lfd_dmp/scripts/reproduce_goals.py: per learned library,
-             reproduce every unseen goal of config/tasks.yaml (`unseen.<mode>`) in MuJoCo through
-             /executor/execute and judge the object's final pose with config/evaluation.yaml
-             `reproduction` (lfd_tools.judge) -> DIR/reproduction/<task>_<mode>.json
+             reproduce every unseen goal of the task (lfd_tools.tasks) in MuJoCo through the
+             /executor/execute action, the simulation stepped in lockstep on sim time, and judge
+             the object's final pose with config/evaluation.yaml `reproduction` (lfd_tools.judge)
+             -> DIR/reproduction/<task>_<mode>.json
   figures    no master: the paper's figures per dataset (skill map, correlation matrix, relevance
              histograms, ClaSP profile with the Kaiser filter, segmentation with its zones; from
              the first demonstration), the success-rate bars per method and dataset, and MuJoCo
@@ -66,7 +67,7 @@ import time
 
 import yaml
 from lfd_tools import config as lfd_config
-from lfd_tools import judge, report as records
+from lfd_tools import judge, report as records, tasks as lfd_tasks
 from lfd_tools.jobs import run_parallel, run_tool, split, workers
 from lfd_tools.master import background_launch, private_master
 from lfd_tools.processes import TAG_VAR, kill_tagged
@@ -225,9 +226,7 @@ def stage_learn(out, args, report):
 
 
 def goal_ids(task, mode, n):
-    with open(TASKS_FILE) as f:
-        unseen = yaml.safe_load(f)[task]["unseen"][mode]
-    return [e["id"] for e in spread(unseen, n)]
+    return [s["id"] for s in spread(lfd_tasks.unseen_scenes(task, mode), n)]
 
 
 def task_record(result_path, mode, task):
@@ -412,6 +411,17 @@ def write_report(out, report):
             lines.append("| %s | %s (%s) | %s | %s | %s |" % (
                 name, e.get("segments"), e.get("expected_segments"), e.get("demos_used"),
                 " ".join(str(c) for c in e.get("changepoint_counts", [])), notes))
+        lines += ["", "Segment goals learned from the demos' scenes: the frame in which each segment's end "
+                  "varies least, and that spread (RMS across the demos).", "",
+                  "| dataset | segment | position frame (spread) | orientation frame (spread) | heading |",
+                  "| --- | --- | --- | --- | --- |"]
+        for name, e in sorted(report["learning"].items()):
+            for g in e.get("segment_goals", []):
+                if g.get("position_frame") is None:
+                    continue
+                lines.append("| %s | %s | %s (%.1f mm) | %s (%.3f rad) | %s |" % (
+                    name, g["segment"], g["position_frame"], 1e3 * g["position_spread_m"],
+                    g["orientation_frame"], g["orientation_spread_rad"], g.get("heading_object") or "-"))
         lines.append("")
     for key, title in (("reproduction", "sim"), ("reproduction_teleop", "teleop")):
         if not report.get(key):
@@ -435,14 +445,16 @@ def write_report(out, report):
             if not e.get("goals"):
                 continue
             lines += ["%s, per goal:" % task, "",
-                      "| goal | result | object error | yaw error | TCP error | time ratio |",
-                      "| --- | --- | --- | --- | --- | --- |"]
+                      "| goal | result | object error | yaw error | TCP error | time ratio | planning | wall |",
+                      "| --- | --- | --- | --- | --- | --- | --- | --- |"]
+            sec = lambda v: "-" if v is None else "%.2f s" % v  # noqa: E731
             for g in e["goals"]:
-                lines.append("| %d | %s | %s | %s | %s | %s |" % (
+                lines.append("| %d | %s | %s | %s | %s | %s | %s | %s |" % (
                     g["id"], "ok" if g["success"] else "FAILED", mm(g["object_position_error_m"]),
                     "-" if g["object_yaw_error_rad"] is None else "%.3f rad" % g["object_yaw_error_rad"],
                     mm(g["tcp_position_error_m"]),
-                    "-" if g["time_ratio"] is None else "%.2f" % g["time_ratio"]))
+                    "-" if g["time_ratio"] is None else "%.3f" % g["time_ratio"],
+                    sec(g.get("planning_time_s")), sec(g.get("wall_time_s"))))
             lines.append("")
     if report.get("figures"):
         lines += ["## Figures", ""]

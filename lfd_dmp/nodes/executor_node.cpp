@@ -434,11 +434,13 @@ class Executor {
       const auto& seg = segmentAt(plan, k);
       feedback_.segment_index = static_cast<uint32_t>(&seg - plan.segments.data());
       recordExecuted(tcp, stamp);
-      if (feedback_.segment != seg.name || wallSince(last_feedback_) > feedback_period_) {
+      if (feedback_.segment != seg.name) {
         feedback_.segment = seg.name;
         publishFeedback();
       }
     }
+    // Also while nothing changes (a paused clock): a client that missed one still learns the state.
+    if (wallSince(last_feedback_) > feedback_period_) publishFeedback();
     return stamp;
   }
 

@@ -1,8 +1,9 @@
 // learner_node: service /learner/learn (lfd_msgs/LearnSkills). Reads the demonstration bags, cuts
-// them at the validated changepoints, learns one DMP set per segment per demo and writes the
-// skill library. Thin adapter over lfd_dmp::learnSkillLibrary / readDemoBag.
+// them at the validated changepoints, learns one DMP set per segment per demo and each segment's
+// goal frame from the demos' scenes, and writes the skill library. Thin adapter over
+// lfd_dmp::learnSkillLibrary / readDemoBag.
 // Private parameters (config/learner.yaml): ~pose_topic, ~gripper_topic, ~gripper_joint,
-// ~num_basis, ~smoothing_sigma, ~allowed_roots, ~limits/{max_bags, max_num_basis,
+// ~num_basis, ~smoothing_sigma, ~goal_frames/*, ~allowed_roots, ~limits/{max_bags, max_num_basis,
 // max_demo_seconds, max_samples_per_demo}. Paths: bags must be regular files inside the roots, the
 // library is written atomically, never over a bag, and over an existing file only with overwrite.
 #include "lfd_dmp/demo_bag.hpp"
@@ -34,6 +35,12 @@ class Learner {
     pnh.param("limits/max_num_basis", max_num_basis_, max_num_basis_);
     pnh.param("limits/max_demo_seconds", max_demo_seconds_, max_demo_seconds_);
     pnh.param("limits/max_samples_per_demo", max_samples_per_demo_, max_samples_per_demo_);
+    pnh.param("goal_frames/min_heading_length", frames_.frames.min_heading_length,
+              frames_.frames.min_heading_length);
+    pnh.param("goal_frames/heading_tolerance", frames_.heading_tolerance,
+              frames_.heading_tolerance);
+    pnh.param("goal_frames/min_motion_length", frames_.min_motion_length,
+              frames_.min_motion_length);
   }
 
   bool learn(lfd_msgs::LearnSkills::Request& req, lfd_msgs::LearnSkills::Response& res) {
@@ -86,6 +93,7 @@ class Learner {
       opt.segment_names = req.segment_names;
       opt.params.num_basis = req.num_basis > 0 ? req.num_basis : num_basis_;
       opt.smoothing_sigma = smoothing_sigma_;
+      opt.frames = frames_;
       const lfd_dmp::LearnOutcome out = lfd_dmp::learnSkillLibrary(demos, cps, opt);
       lfd_dmp::saveSkillLibrary(out.library, output, req.overwrite);
       res.success = true;
@@ -138,6 +146,7 @@ class Learner {
   int max_samples_per_demo_ = 30000;
   int num_basis_ = lfd::DmpParameters().num_basis;
   double smoothing_sigma_ = 0.0;
+  lfd::FrameSelectionOptions frames_;
 };
 
 }  // namespace

@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """The learning client: segment each task's demonstrations and learn its skill library.
 
-  learn_skills.py --dataset DIR [--mode sim] [--tasks grasp,push]
+  learn_skills.py --dataset DIR [--mode sim] [--tasks grasp,push (default: every task)]
                   [--changepoints segmentation|ground_truth] [--library-dir DIR]
                   [--library-name '{task}_{mode}.json'] [--attach] [--out FILE.json]
 
@@ -9,9 +9,11 @@ Bags: DIR/<mode>_<task>/*.bag (lfd_sim_bridge/scripts/generate_datasets.py). Cha
 `segmentation` (default) calls /segmentation/segment (the paper's method of config/segmentation.yaml);
 `ground_truth` uses the demonstrator's /lfd/phase boundaries (the start of each expected
 transition's `to` phase in config/evaluation.yaml) and is labelled as such in the output.
-/learner/learn learns the library from them, with the task's segment names (evaluation.yaml); the
-learner's majority vote on the changepoint counts decides the number of segments and whether the
-names fit (otherwise they are left unnamed, with its warning). Boundaries are never made up.
+/learner/learn learns the library from them, with the task's segment names
+(lfd_tools.tasks.segment_names); the learner's majority vote on the changepoint counts decides the
+number of segments and whether the names fit (otherwise they are left unnamed, with its warning).
+Boundaries are never made up. Each segment's goal frame is learned from the demos' scenes; the
+record lists, per segment, the frames chosen and their spread across the demos.
 
 Starts a private master with launch/learn.launch for the run, or with --attach uses the services
 running at ROS_MASTER_URI (the pipeline's learn stage, which runs learn.launch once).
@@ -20,12 +22,12 @@ after an error or Ctrl-C with what was done. A task whose learning fails is repo
 the other tasks still run. Exit status 0 only if every task was learned.
 """
 import argparse
+import json
 import os
 import sys
 
 from lfd_tools import bags as lfd_bags
-from lfd_tools import config as lfd_config
-from lfd_tools import master, report
+from lfd_tools import master, report, tasks
 
 
 def changepoints_from(services, source, bags, expected, record):
@@ -41,13 +43,31 @@ def changepoints_from(services, source, bags, expected, record):
     return list(seg.demos), list(seg.selected_features)
 
 
-def learn(services, evaluation, task, bags, source, library):
+def segment_goals(library):
+    """Per segment of a learned library: the goal frames chosen and their spread across the demos."""
+    with open(library) as f:
+        lib = json.load(f)
+    out = []
+    for seg in lib["segments"]:
+        g = seg.get("goal")
+        if g is None:
+            out.append({"segment": seg["name"], "position_frame": None})
+            continue
+        out.append({"segment": seg["name"],
+                    "position_frame": g["position"]["frame"], "position_spread_m": g["position"]["spread_m"],
+                    "orientation_frame": g["orientation"]["frame"],
+                    "orientation_spread_rad": g["orientation"]["spread_rad"],
+                    "heading_object": g["heading"]["object"] or None,
+                    "heading_spread_rad": g["heading"]["spread_rad"]})
+    return out
+
+
+def learn(services, task, bags, source, library):
     """Learns one library; returns its learning record (report.learning_record)."""
     from lfd_msgs.srv import LearnSkillsRequest
-    names = lfd_config.segment_names(evaluation, task)
+    names = tasks.segment_names(task)
     record = report.learning_record(task, len(names), bags, source)
-    demos, features = changepoints_from(services, source, bags,
-                                        lfd_config.expected_transitions(evaluation, task), record)
+    demos, features = changepoints_from(services, source, bags, tasks.expected_transitions(task), record)
     record["selected_features"] = features
     record["changepoint_counts"] = [len(d.changepoint_times) for d in demos]
     record["changepoint_times"] = [list(d.changepoint_times) for d in demos]
@@ -57,7 +77,8 @@ def learn(services, evaluation, task, bags, source, library):
     if not res.success:
         raise RuntimeError("learning %s failed: %s" % (task, res.error))
     record.update({"library": library, "segments": res.num_segments, "demos_used": res.num_demos,
-                   "learn_time_s": res.elapsed, "warnings": list(res.warnings)})
+                   "learn_time_s": res.elapsed, "warnings": list(res.warnings),
+                   "segment_goals": segment_goals(library)})
     return record
 
 
@@ -65,7 +86,7 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawTextHelpFormatter)
     ap.add_argument("--dataset", required=True, help="folder of the <mode>_<task> bag folders")
     ap.add_argument("--mode", default="sim", help="sim | teleop")
-    ap.add_argument("--tasks", default="grasp,push")
+    ap.add_argument("--tasks", default=None, help="comma-separated (default: every task)")
     ap.add_argument("--changepoints", choices=["segmentation", "ground_truth"], default="segmentation")
     ap.add_argument("--library-dir", default=None, help="default: <dataset>/skills_<changepoints>")
     ap.add_argument("--library-name", default="{task}_{mode}.json", help="{task} and {mode} are replaced")
@@ -77,7 +98,7 @@ def main():
     lib_dir = os.path.abspath(args.library_dir or os.path.join(dataset, "skills_" + args.changepoints))
     os.makedirs(lib_dir, exist_ok=True)
     out = args.out or os.path.join(lib_dir, "learning_%s.json" % args.mode)
-    evaluation = lfd_config.load_evaluation()
+    names = [t for t in args.tasks.split(",") if t] if args.tasks else tasks.names()
     from lfd_msgs.srv import LearnSkills, Segment
     services = {"/learner/learn": LearnSkills}
     if args.changepoints == "segmentation":
@@ -86,12 +107,12 @@ def main():
     with report.written_on_exit(out, results):
         with master.graph_for_this_process(["lfd_launch", "learn.launch", "output:=log"], args.attach):
             proxies = master.service_proxies("learn_skills", services)
-            for task in [t for t in args.tasks.split(",") if t]:
+            for task in names:
                 key = "%s_%s" % (args.mode, task)
                 library = os.path.join(lib_dir, args.library_name.format(task=task, mode=args.mode))
                 try:
                     bags = lfd_bags.list_bags(os.path.join(dataset, key))
-                    record = learn(proxies, evaluation, task, bags, args.changepoints, library)
+                    record = learn(proxies, task, bags, args.changepoints, library)
                 except RuntimeError as exc:
                     print("%-5s: ERROR %s" % (task, exc), flush=True)
                     results["learning"][key] = dict(report.learning_record(task, None, [], args.changepoints),
@@ -104,6 +125,13 @@ def main():
                 print("%-5s learn: %d segment(s) x %d demo(s), changepoints per demo %s -> %s"
                       % (task, record["segments"], record["demos_used"], record["changepoint_counts"],
                          library), flush=True)
+                for g in record["segment_goals"]:
+                    if g["position_frame"] is not None:
+                        print("%-5s   %-10s ends in %s (spread %.1f mm) / %s (%.3f rad)%s" % (
+                            task, g["segment"], g["position_frame"], 1e3 * g["position_spread_m"],
+                            g["orientation_frame"], g["orientation_spread_rad"],
+                            ", follows heading:" + g["heading_object"] if g["heading_object"] else ""),
+                            flush=True)
     return status
 
 

@@ -1,15 +1,24 @@
 #!/usr/bin/python3
-"""Reproduction of learned skill libraries toward the unseen goals of config/tasks.yaml, judged
-physically (DESIGN.md "How we judge it").
+"""Reproduction of learned skill libraries toward the unseen goals of each task, judged physically
+(DESIGN.md "How we judge it").
 
   reproduce_goals.py --library-dir DIR [--mode sim] [--tasks grasp,push]
                      [--library-name '{task}_{mode}.json'] [--goals 100,101] [--duration-scale 1]
-                     [--record-dir DIR] [--attach] [--out FILE.json]
+                     [--record-dir DIR] [--real-time] [--attach] [--out FILE.json]
 
-Per goal: /bridge/reset (robot posture + objects), /bridge/set_scene (the task's object at its
-start, the other objects parked), /executor/execute toward the goal; then the object's final pose
-is judged with the task's criteria of config/evaluation.yaml `reproduction` (lfd_tools.judge).
-Time ratio = executed time / mean demonstrated duration of the learned segments (same span).
+The scenes, the parked objects and what counts as success come from lfd_tools.tasks (nothing here
+is task-specific; --tasks defaults to every task). Per goal: /bridge/reset, /bridge/set_scene (the
+scene's objects at their start, the others parked), then the executor's action /executor/execute
+(lfd_msgs/ExecuteTaskAction) with the scene and the goal; the judged object's final pose is scored
+by lfd_tools.judge.
+
+Lockstep (default): the simulation is paused and this client steps it (/bridge/step) while the goal
+is active, from the motion start the action's feedback announces, so a goal costs its physics and
+planning, not its duration in wall time, and runs the same whatever the load. The executor knows no
+simulator: it follows sim time. --real-time leaves the bridge running (reproduce.launch
+real_time_factor:=1 paces it, for watching in rviz). Time ratio = executed time (sim) / mean
+demonstrated duration of the learned segments (same span).
+
 Starts a private master with launch/reproduce.launch for the run, or with --attach uses the nodes
 running at ROS_MASTER_URI (the pipeline's reproduce stage, which runs reproduce.launch once).
 Writes {"<reproduction key>": {task: record}} (lfd_tools.report.reproduction_record; the key is
@@ -17,33 +26,20 @@ Writes {"<reproduction key>": {task: record}} (lfd_tools.report.reproduction_rec
 with the goals done ("complete": false). Exit status 0 only if every goal was reached.
 """
 import argparse
+import gc
 import json
-import math
 import os
 import subprocess
 import sys
 import time
 
-from lfd_tools import config as lfd_config
-from lfd_tools import judge, master, report
+from lfd_tools import judge, master, report, tasks
 
-RECORDED_TOPICS = ["/joint_states", "/ee_pose", "/gripper/state", "/objects/stick/pose",
-                   "/objects/box/pose", "/executor/planned_path", "/executor/executed_path",
-                   "/executor/segment_markers"]
 SETTLE_BEFORE_S = 0.3  # sim s after placing the objects, before executing
 SETTLE_AFTER_S = 1.0   # sim s for the objects to come to rest before they are judged
-
-
-def pose_of(entry):
-    """geometry_msgs/Pose of a tasks.yaml [x, y, z, yaw]."""
-    from geometry_msgs.msg import Point, Pose, Quaternion
-    yaw = entry[3]
-    return Pose(position=Point(*entry[:3]),
-                orientation=Quaternion(w=math.cos(yaw / 2), x=0.0, y=0.0, z=math.sin(yaw / 2)))
-
-
-def yaw_of(q):
-    return math.atan2(2 * (q.w * q.z + q.x * q.y), 1 - 2 * (q.y * q.y + q.z * q.z))
+STEP_CHUNK = 50        # physics steps (1 ms) per /bridge/step call while a goal runs
+PLANNING_TIMEOUT_S = 120.0  # wall s for the executor to plan (it reports progress meanwhile)
+GOAL_TIMEOUT_S = 600.0      # wall s for a whole goal; then it is cancelled and reported
 
 
 def library_summary(path):
@@ -59,13 +55,30 @@ def library_summary(path):
     return (sum(full) / len(full) if full else None), len(full), len(lib["segments"])
 
 
+def pose_msg(p):
+    """geometry_msgs/Pose of a lfd_tools.tasks pose {position, orientation [w, x, y, z]}."""
+    from geometry_msgs.msg import Point, Pose, Quaternion
+    w, x, y, z = p["orientation"]
+    return Pose(position=Point(*p["position"]), orientation=Quaternion(w=w, x=x, y=y, z=z))
+
+
+def stamped(p, frame="world"):
+    from geometry_msgs.msg import PoseStamped
+    msg = PoseStamped(pose=pose_msg(p))
+    msg.header.frame_id = frame
+    return msg
+
+
 class BagRecording(object):
     """`rosbag record` of one reproduction (for snapshots and rviz replay); stopped by SIGINT so
     the bag is closed properly."""
 
-    def __init__(self, path):
+    def __init__(self, path, objects):
         self.path = path
-        self.proc = subprocess.Popen(["rosbag", "record", "-q", "-O", path] + RECORDED_TOPICS,
+        topics = ["/joint_states", "/ee_pose", "/gripper/state", "/executor/planned_path",
+                  "/executor/executed_path", "/executor/segment_markers"]
+        topics += ["/objects/%s/pose" % o for o in objects]
+        self.proc = subprocess.Popen(["rosbag", "record", "-q", "-O", path] + topics,
                                      stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
                                      start_new_session=True)
         time.sleep(1.5)  # wall time for rosbag to subscribe before anything moves
@@ -76,84 +89,160 @@ class BagRecording(object):
 
 
 class Cell(object):
-    """The simulated work cell and executor, through their services."""
+    """The work cell (the simulation's services) and the executor's action."""
 
-    def __init__(self, tasks_cfg, evaluation):
+    def __init__(self, objects, lockstep):
+        import actionlib
         import rospy
-        from lfd_msgs.srv import ExecuteTask, ResetSim, SetScene
-        self.rospy, self.tasks, self.evaluation = rospy, tasks_cfg, evaluation
+        from geometry_msgs.msg import PoseStamped
+        from lfd_msgs.msg import ExecuteTaskAction
+        from lfd_msgs.srv import ResetSim, SetScene, StepSim
+        from std_srvs.srv import SetBool
+        self.rospy, self.lockstep = rospy, lockstep
         master.wait_for_param("/use_sim_time", 120)  # rospy reads it once, at init
         self.srv = master.service_proxies("reproduce_goals", {
-            "/executor/execute": ExecuteTask, "/bridge/reset": ResetSim, "/bridge/set_scene": SetScene})
+            "/bridge/reset": ResetSim, "/bridge/set_scene": SetScene, "/bridge/pause": SetBool,
+            "/bridge/step": StepSim})
+        self.action = actionlib.SimpleActionClient("/executor/execute", ExecuteTaskAction)
+        if not self.action.wait_for_server(rospy.Duration(120)):
+            raise RuntimeError("the executor's action /executor/execute did not come up in 120 s")
+        self.poses = {}
+        self.subs = [rospy.Subscriber("/objects/%s/pose" % o, PoseStamped, self._on_pose, o,
+                                      queue_size=5) for o in objects]
+        self.srv["/bridge/pause"](data=lockstep)
+        self.sim_time = self.step(1) if lockstep else None
         while rospy.Time.now().is_zero():
-            time.sleep(0.05)
+            time.sleep(0.01)
 
-    def sleep_sim(self, seconds):
+    def _on_pose(self, msg, name):
+        self.poses[name] = msg
+
+    def step(self, steps):
+        r = self.srv["/bridge/step"](steps=steps)
+        if not r.success:
+            raise RuntimeError("/bridge/step: " + r.message)
+        self.sim_time = r.sim_time
+        return r.sim_time
+
+    def advance(self, seconds):
+        """Lets `seconds` of sim time pass: stepped in lockstep, waited for otherwise."""
+        if self.lockstep:
+            left = int(round(seconds * 1000))
+            while left > 0:
+                self.step(min(STEP_CHUNK * 10, left))
+                left -= STEP_CHUNK * 10
+            return
         end = self.rospy.Time.now() + self.rospy.Duration(seconds)
         while self.rospy.Time.now() < end and not self.rospy.is_shutdown():
             time.sleep(0.002)
 
-    def set_scene(self, obj, start):
+    def set_scene(self, scene, parked):
         r = self.srv["/bridge/reset"](joint_names=[], positions=[], reset_objects=True)
         if not r.success:
             raise RuntimeError("reset failed: " + r.message)
-        others = [c["object"] for c in self.evaluation["reproduction"].values() if c["object"] != obj]
-        s = self.srv["/bridge/set_scene"](object_names=[obj] + others,
-                                          poses=[pose_of(start)] + [pose_of(self.tasks["park"][o]) for o in others])
+        placed = dict(parked, **scene["objects"])
+        s = self.srv["/bridge/set_scene"](object_names=list(placed),
+                                          poses=[pose_msg(p) for p in placed.values()])
         if not s.success:
             raise RuntimeError("set_scene failed: " + s.message)
-        self.sleep_sim(SETTLE_BEFORE_S)
+        self.advance(SETTLE_BEFORE_S)
 
     def object_pose(self, name):
-        from geometry_msgs.msg import PoseStamped
-        return self.rospy.wait_for_message("/objects/%s/pose" % name, PoseStamped, timeout=30).pose
+        """The object's pose published at or after the current sim time (wall-bounded wait)."""
+        now = self.rospy.Time.now() if not self.lockstep else self.rospy.Time.from_sec(self.sim_time)
+        deadline = time.time() + 30
+        while time.time() < deadline:
+            msg = self.poses.get(name)
+            if msg is not None and msg.header.stamp >= now - self.rospy.Duration(1e-6):
+                return msg.pose
+            time.sleep(0.005)
+        raise RuntimeError("no /objects/%s/pose at the current sim time" % name)
 
-    def reproduce(self, task, entry, library, demo_duration, duration_scale, record_path=None):
-        """One unseen goal: a goal record (report.goal_record)."""
-        criteria = lfd_config.criteria_of(self.evaluation, task)
-        start, goal = entry[criteria["object"]], entry["goal"] if "goal" in entry else entry["target"]
-        self.set_scene(criteria["object"], start)
-        recording = BagRecording(record_path) if record_path else None
-        started = self.rospy.get_time()
-        try:
-            res = self.srv["/executor/execute"](library=library, object_pose=pose_of(start), goal=pose_of(goal),
-                                                duration_scale=duration_scale, dry_run=False)
-            self.sleep_sim(SETTLE_AFTER_S)
-        finally:
-            bag = recording.stop() if recording else None
-        p = self.object_pose(criteria["object"])
-        outcome = judge.physical_outcome(criteria, (p.position.x, p.position.y, p.position.z), goal[:3],
-                                         self.tasks["table_top"], yaw_of(p.orientation), goal[3])
-        g = report.goal_record(entry["id"], res, outcome, demo_duration=demo_duration)
-        if bag:  # sim times at which each segment's streaming ended (snapshots per segment)
-            t = started + max(0.0, res.execution_time - sum(res.segment_durations))
-            g["bag"], g["segment_end_times_s"] = bag, []
-            for d in res.segment_durations:
-                t += d
-                g["segment_end_times_s"].append(t)
-        return g
+    def execute(self, goal):
+        """Sends the goal and drives the simulation until it ends: (result, wall s). No rospy
+        timeout is used: they run on sim time, which stands still until this client steps."""
+        from actionlib import SimpleGoalState
+        from lfd_msgs.msg import ExecuteTaskFeedback
+        moving = []  # the motion's start, once the executor announces it
+
+        def on_feedback(fb):
+            if fb.state != ExecuteTaskFeedback.PLANNING and not moving:
+                moving.append(fb.motion_start)
+
+        started = time.time()
+        self.action.send_goal(goal, feedback_cb=on_feedback)
+        while self.action.simple_state != SimpleGoalState.DONE:
+            wall = time.time() - started
+            if wall > GOAL_TIMEOUT_S or (not moving and wall > PLANNING_TIMEOUT_S):
+                self.action.cancel_goal()
+                raise RuntimeError("the goal took over %.0f s of wall time; cancelled" % wall)
+            if self.lockstep and moving:
+                self.step(STEP_CHUNK)
+            else:
+                time.sleep(0.002)
+        result = self.action.get_result()
+        # Forget the finished goal now: the server keeps announcing its status for a while, and a
+        # handle that lingers until the garbage collector runs logs those as errors.
+        self.action.stop_tracking_goal()
+        gc.collect()
+        return result, time.time() - started
 
 
-def reproduce_task(cell, task, mode, library, goals, args, record):
-    """Reproduces every goal of a task into `record` (updated after each goal)."""
+def reproduce(cell, task, scene, library, demo_duration, args, record_path=None):
+    """One unseen scene: a goal record (report.goal_record)."""
+    from lfd_msgs.msg import ExecuteTaskGoal
+    criterion = tasks.success_criterion(task)
+    cell.set_scene(scene, tasks.parked(task))
+    recording = BagRecording(record_path, list(scene["objects"]) + list(tasks.parked(task))) \
+        if record_path else None
+    try:
+        goal = ExecuteTaskGoal(library=library, object_names=list(scene["objects"]),
+                               object_poses=[stamped(p) for p in scene["objects"].values()],
+                               goal=stamped(scene["goal"]), duration_scale=args.duration_scale,
+                               allow_extrapolation=args.allow_extrapolation)
+        res, wall = cell.execute(goal)
+        if res is None:
+            raise RuntimeError("the executor gave no result")
+        cell.advance(SETTLE_AFTER_S)
+    finally:
+        bag = recording.stop() if recording else None
+    p = cell.object_pose(criterion["object"])
+    object_pose = {"position": [p.position.x, p.position.y, p.position.z],
+                   "orientation": [p.orientation.w, p.orientation.x, p.orientation.y, p.orientation.z]}
+    outcome = judge.physical_outcome(criterion, object_pose["position"], scene["goal"]["position"],
+                                     tasks.table_top(), tasks.yaw_of(object_pose),
+                                     tasks.yaw_of(scene["goal"]))
+    g = report.goal_record(scene["id"], res, outcome, demo_duration=demo_duration, wall_time=wall)
+    if bag and res.success:  # sim times at which each segment ended (snapshots per segment)
+        t = res.motion_start.to_sec()
+        g["bag"], g["segment_end_times_s"] = bag, []
+        for d in res.segment_durations:
+            t += d
+            g["segment_end_times_s"].append(t)
+    return g
+
+
+def reproduce_task(cell, task, mode, library, scenes, args, record):
+    """Reproduces every scene of a task into `record` (updated after each goal)."""
     summary = library_summary(library)
     done = []
-    for n, entry in enumerate(goals, 1):
-        bag = (os.path.join(args.record_dir, "%s_%s_%d.bag" % (task, mode, entry["id"]))
+    for n, scene in enumerate(scenes, 1):
+        bag = (os.path.join(args.record_dir, "%s_%s_%d.bag" % (task, mode, scene["id"]))
                if args.record_dir and n == 1 else None)
         try:
-            g = cell.reproduce(task, entry, library, summary[0], args.duration_scale, bag)
+            g = reproduce(cell, task, scene, library, summary[0], args, bag)
         except (RuntimeError, cell.rospy.ServiceException) as exc:
             if cell.rospy.is_shutdown():
                 raise
-            g = report.goal_record(entry["id"], error=str(exc))  # this goal failed; try the next
+            g = report.goal_record(scene["id"], error=str(exc))  # this goal failed; try the next
         done.append(g)
         record.clear()
         record.update(report.reproduction_record(library, summary, done))
-        print("%-5s goal %3d (%d/%d): %-7s obj err %s  time ratio %s %s" % (
-            task, g["id"], n, len(goals), "OK" if g["success"] else "FAILED",
+        print("%-5s goal %3d (%d/%d): %-7s obj err %s  time ratio %s  wall %s %s" % (
+            task, g["id"], n, len(scenes), "OK" if g["success"] else "FAILED",
             "-" if g["object_position_error_m"] is None else "%.1f mm" % (1e3 * g["object_position_error_m"]),
-            "-" if g["time_ratio"] is None else "%.2f" % g["time_ratio"], g["error"]), flush=True)
+            "-" if g["time_ratio"] is None else "%.3f" % g["time_ratio"],
+            "-" if g["wall_time_s"] is None else "%.1f s" % g["wall_time_s"], g["error"]), flush=True)
 
 
 def main():
@@ -161,25 +250,36 @@ def main():
     ap.add_argument("--library-dir", required=True)
     ap.add_argument("--library-name", default="{task}_{mode}.json", help="{task} and {mode} are replaced")
     ap.add_argument("--mode", default="sim", help="unseen goal set (sim | teleop)")
-    ap.add_argument("--tasks", default="grasp,push")
+    ap.add_argument("--tasks", default=None, help="comma-separated (default: every task)")
     ap.add_argument("--goals", default="", help="comma-separated unseen ids (default all)")
     ap.add_argument("--duration-scale", type=float, default=1.0)
+    ap.add_argument("--allow-extrapolation", action="store_true",
+                    help="run goals outside the demonstrated range (reported either way)")
     ap.add_argument("--record-dir", default=None,
                     help="record the first goal of each task into a bag there (snapshots, rviz)")
+    ap.add_argument("--real-time", action="store_true",
+                    help="do not step the simulation: it runs on its own (launch it with real_time_factor:=1)")
     ap.add_argument("--out", default=None, help="default: <library-dir>/reproduction_<mode>.json")
     ap.add_argument("--attach", action="store_true",
                     help="use the nodes running at ROS_MASTER_URI (default: start a private master and the launch)")
     args = ap.parse_args()
     lib_dir = os.path.abspath(args.library_dir)
     out = args.out or os.path.join(lib_dir, "reproduction_%s.json" % args.mode)
-    tasks_cfg, evaluation = lfd_config.load_tasks(), lfd_config.load_evaluation()
+    names = [t for t in args.tasks.split(",") if t] if args.tasks else tasks.names()
     wanted = {int(g) for g in args.goals.split(",") if g}
+    scenes = {t: [s for s in tasks.unseen_scenes(t, args.mode) if not wanted or s["id"] in wanted]
+              for t in names}
+    objects = sorted({o for t in names for s in scenes[t] for o in s["objects"]} |
+                     {o for t in names for o in tasks.parked(t)})
     key = report.reproduction_key(args.mode)
     results, status = {key: {}}, 0
+    launch = ["lfd_launch", "reproduce.launch", "library_dir:=" + lib_dir]
+    if args.real_time:
+        launch.append("real_time_factor:=1.0")
     with report.written_on_exit(out, results):
-        with master.graph_for_this_process(["lfd_launch", "reproduce.launch", "library_dir:=" + lib_dir], args.attach):
-            cell = Cell(tasks_cfg, evaluation)
-            for task in [t for t in args.tasks.split(",") if t]:
+        with master.graph_for_this_process(launch, args.attach):
+            cell = Cell(objects, lockstep=not args.real_time)
+            for task in names:
                 record = results[key][task] = {}
                 library = os.path.join(lib_dir, args.library_name.format(task=task, mode=args.mode))
                 if not os.path.exists(library):
@@ -187,9 +287,8 @@ def main():
                                                              "no skill library %s: learn it first" % library))
                     status = 1
                     continue
-                goals = [e for e in tasks_cfg[task]["unseen"][args.mode] if not wanted or e["id"] in wanted]
-                reproduce_task(cell, task, args.mode, library, goals, args, record)
-                if not goals or record["successes"] < len(goals):
+                reproduce_task(cell, task, args.mode, library, scenes[task], args, record)
+                if not scenes[task] or record["successes"] < len(scenes[task]):
                     status = 1
     return status
 

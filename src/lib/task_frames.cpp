@@ -81,14 +81,17 @@ struct OffsetStats {
   Eigen::Vector3d mean_position = Eigen::Vector3d::Zero();
   Eigen::Quaterniond mean_orientation = Eigen::Quaterniond::Identity();
   double position_rms = kInf, orientation_rms = kInf;
+  double distance = kInf;  // mean distance of the segment end from the frame's origin
 };
 
 OffsetStats statistics(const std::vector<Pose>& offsets) {
   OffsetStats s;
   if (offsets.empty()) return s;
   std::vector<Eigen::Quaterniond> qs;
+  s.distance = 0.0;
   for (const Pose& o : offsets) {
     s.mean_position += o.position / static_cast<double>(offsets.size());
+    s.distance += o.position.norm() / static_cast<double>(offsets.size());
     qs.push_back(o.orientation);
   }
   s.mean_orientation = meanQuaternion(qs);
@@ -101,6 +104,17 @@ OffsetStats statistics(const std::vector<Pose>& offsets) {
   s.position_rms = std::sqrt(p2 / offsets.size());
   s.orientation_rms = std::sqrt(a2 / offsets.size());
   return s;
+}
+
+// The smaller spread wins. Frames that explain the demos equally (e.g. the goal's and the object's
+// orientation when every demo carried the object at its own yaw) are told apart by where the end
+// is: the frame whose origin it lies nearest to.
+bool better(double spread, double distance, double best_spread, double best_distance) {
+  if (!std::isfinite(spread)) return false;
+  if (!std::isfinite(best_spread)) return true;
+  const double tie = 1e-9 + 1e-6 * best_spread;
+  if (spread < best_spread - tie) return true;
+  return spread <= best_spread + tie && distance < best_distance;
 }
 
 // RMS angle between each demo's horizontal motion and the object's heading (infinite when either
@@ -227,24 +241,25 @@ SegmentGoalModel learnSegmentGoal(const std::vector<SegmentDemoEnds>& demos,
   Scene common;
   for (const std::string& name : commonObjects(demos)) common.objects[name] = Pose();
   SegmentGoalModel model;
-  double best_position = kInf, best_orientation = kInf;
+  OffsetStats best_position, best_orientation;
   for (const SceneFrame& frame : candidateFrames(common)) {
     const OffsetStats s = statistics(offsetsIn(frame, demos, options.frames));
     model.candidates.push_back({frame, s.position_rms, s.orientation_rms});
-    if (s.position_rms < best_position) {
-      best_position = s.position_rms;
+    if (better(s.position_rms, s.distance, best_position.position_rms, best_position.distance)) {
+      best_position = s;
       model.position_frame = frame;
       model.position_offset = s.mean_position;
     }
-    if (s.orientation_rms < best_orientation) {
-      best_orientation = s.orientation_rms;
+    if (better(s.orientation_rms, s.distance, best_orientation.orientation_rms,
+               best_orientation.distance)) {
+      best_orientation = s;
       model.orientation_frame = frame;
       model.orientation_offset = s.mean_orientation;
     }
   }
   // `base` is always defined, so both were chosen.
-  model.position_spread = best_position;
-  model.orientation_spread = best_orientation;
+  model.position_spread = best_position.position_rms;
+  model.orientation_spread = best_orientation.orientation_rms;
   double best_heading = kInf;
   for (const auto& [name, pose] : common.objects) {
     const double spread = headingSpread(name, demos, options);

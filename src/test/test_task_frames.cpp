@@ -87,7 +87,7 @@ TEST(TaskFrames, PushGoalsAreLearnedInTheFramesTheDemosImply) {
   EXPECT_EQ(push.heading_object, "box");  // the stroke follows the box's way to its goal
   EXPECT_LT(push.heading_spread, 0.05);
   const lfd::SegmentGoalModel ret = lfd::learnSegmentGoal(segs[2], opt);
-  EXPECT_TRUE(ret.position_frame.name() == "base" || ret.position_frame.name() == "start");
+  EXPECT_EQ(ret.position_frame.name(), "start");  // as still as the base frame, and nearer
   EXPECT_LT(ret.position_spread, 1e-9);
   // Every frame was tried and reported; the bystander's frames are candidates like the box's.
   EXPECT_EQ(approach.candidates.size(), 3u + 3u * 2u);
@@ -135,14 +135,15 @@ TEST(TaskFrames, GraspGoalsAreLearnedOnTheObjectAndTheGoal) {
   }
   const lfd::SegmentGoalModel m0 = lfd::learnSegmentGoal(approach, {});
   EXPECT_EQ(m0.position_frame.name(), "object:stick");
-  // The goal's yaw is the stick's in these demos: both frames see the same orientations.
-  EXPECT_TRUE(m0.orientation_frame.name() == "object:stick" || m0.orientation_frame.name() == "goal")
-      << m0.orientation_frame.name();
+  // The goal's yaw is the stick's in these demos: both frames see the same orientations, and the
+  // end lies at the stick.
+  EXPECT_EQ(m0.orientation_frame.name(), "object:stick");
   EXPECT_LT(m0.position_spread, 0.01);
   EXPECT_LT(m0.orientation_spread, 0.06);
   EXPECT_NEAR(m0.position_offset.z(), 0.005, 1e-9);
   const lfd::SegmentGoalModel m1 = lfd::learnSegmentGoal(move, {});
   EXPECT_EQ(m1.position_frame.name(), "goal");
+  EXPECT_EQ(m1.orientation_frame.name(), "goal");
   EXPECT_NEAR(m1.position_offset.z(), 0.005, 1e-9);
   // A spread is RMS about the mean: the chosen frame's is the smallest of all candidates.
   for (const lfd::FrameSpread& c : m1.candidates) EXPECT_GE(c.position_m, m1.position_spread);

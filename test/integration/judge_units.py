@@ -209,13 +209,15 @@ class DemoBagJudged(unittest.TestCase):
 
 
 class Response(object):
-    """An /executor/execute response as the records read it."""
+    """An /executor/execute result (lfd_msgs/ExecuteTaskResult) as the records read it."""
 
     def __init__(self, success=True, execution_time=12.0, planned_duration=10.0, error=""):
         self.success, self.error, self.warnings = success, error, []
         self.execution_time, self.planned_duration, self.planning_time = execution_time, planned_duration, 0.1
         self.final_position_error, self.final_orientation_error = 0.004, 0.02
         self.segment_durations = [4.0, 6.0]
+        self.segment_frames = ["object:stick / object:stick", "goal / goal"]
+        self.extrapolation_distance, self.outside_demo_range = 0.0, False
 
 
 class Records(unittest.TestCase):

@@ -43,9 +43,10 @@ def learning_record(task, expected_segments, bags, changepoint_source):
             "warnings": []}
 
 
-def goal_record(goal_id, response=None, outcome=None, error="", demo_duration=None):
-    """One unseen goal: the executor's response (None when it was never answered) and the physical
-    outcome of lfd_tools.judge.physical_outcome (None when the object was not judged)."""
+def goal_record(goal_id, response=None, outcome=None, error="", demo_duration=None, wall_time=None):
+    """One unseen goal: the executor's result (lfd_msgs/ExecuteTaskResult; None when it never
+    answered), the physical outcome of lfd_tools.judge.physical_outcome (None when the object was
+    not judged) and the goal's wall time (planning, stepping, judging)."""
     executed = bool(response is not None and response.success)
     outcome = outcome or {}
     g = {"id": goal_id, "executed": executed, "success": bool(executed and outcome.get("success")),
@@ -59,7 +60,11 @@ def goal_record(goal_id, response=None, outcome=None, error="", demo_duration=No
          "execution_time_s": response.execution_time if executed else None,
          "planned_duration_s": response.planned_duration if executed else None,
          "planning_time_s": response.planning_time if executed else None,
-         "segment_durations_s": list(response.segment_durations) if executed else []}
+         "segment_durations_s": list(response.segment_durations) if executed else [],
+         "segment_frames": list(response.segment_frames) if response is not None else [],
+         "extrapolation_distance_m": response.extrapolation_distance if response is not None else None,
+         "outside_demo_range": bool(response.outside_demo_range) if response is not None else None,
+         "wall_time_s": wall_time}
     g["time_ratio"] = g["execution_time_s"] / demo_duration if executed and demo_duration else None
     g["overhead_ratio"] = (g["execution_time_s"] / g["planned_duration_s"]
                            if executed and g["planned_duration_s"] else None)
@@ -78,6 +83,8 @@ def reproduction_record(library, library_summary, goals, error=None):
          "mean_object_position_error_m": mean([g["object_position_error_m"] for g in goals]),
          "mean_object_yaw_error_rad": mean([g["object_yaw_error_rad"] for g in goals]),
          "mean_tcp_position_error_m": mean([g["tcp_position_error_m"] for g in goals]),
+         "mean_planning_time_s": mean([g["planning_time_s"] for g in goals]),
+         "mean_wall_time_s": mean([g.get("wall_time_s") for g in goals]),
          "goals": goals}
     errors = sorted({g["error"] for g in goals if g["error"]})
     if error or (errors and not successes):
