@@ -33,22 +33,34 @@ void addTransforms(const tf2_msgs::TFMessage& msg, StaticTransforms* tf) {
 
 // The metadata's scene in the poses' frame (empty if the bag records none).
 std::optional<lfd::Scene> sceneOf(const std::string& path, const std::string& extra_json,
-                                  const StaticTransforms& tf, const std::string& pose_frame) {
+                                  const StaticTransforms& tf, const std::string& pose_frame,
+                                  const TransformLookup& fallback) {
   const std::optional<SceneRecord> record = sceneFromMetadata(extra_json);
   if (!record) return std::nullopt;
   if (record->frame == pose_frame || pose_frame.empty()) return record->scene;
+  std::string why;
   try {
     return transformScene(record->scene, tf.lookup(pose_frame, record->frame));
   } catch (const std::runtime_error& e) {
-    throw std::runtime_error(path + ": the scene is in '" + record->frame + "', the poses in '" +
-                             pose_frame + "': " + e.what() +
-                             " (the bag needs /tf_static: config/recorder.yaml)");
+    why = e.what();
   }
+  if (fallback) {
+    try {
+      return transformScene(record->scene, fallback(pose_frame, record->frame));
+    } catch (const std::runtime_error& e) {
+      why += "; tf: " + std::string(e.what());
+    }
+  }
+  throw std::runtime_error(path + ": the scene is in '" + record->frame + "', the poses in '" +
+                           pose_frame + "': " + why +
+                           " (record /tf_static, config/recorder.yaml, or publish the robot's "
+                           "tf: learn.launch runs robot_state_publisher)");
 }
 
 }  // namespace
 
-DemoRecording readDemoBag(const std::string& path, const DemoBagTopics& topics) {
+DemoRecording readDemoBag(const std::string& path, const DemoBagTopics& topics,
+                          const TransformLookup& fallback) {
   rosbag::Bag bag;
   try {
     lfd::checkInputFile(path);  // a FIFO would block bag.open forever
@@ -114,7 +126,7 @@ DemoRecording readDemoBag(const std::string& path, const DemoBagTopics& topics) 
   rec.frame = frame;
   if (!extra_json.empty()) {
     try {
-      rec.scene = sceneOf(path, extra_json, tf, frame);
+      rec.scene = sceneOf(path, extra_json, tf, frame, fallback);
     } catch (const std::runtime_error& e) {
       const std::string what = e.what();
       throw std::runtime_error(what.rfind(path, 0) == 0 ? what : path + ": " + what);

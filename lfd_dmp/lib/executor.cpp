@@ -121,7 +121,8 @@ void checkRange(const std::vector<SegmentTarget>& targets, bool allow, Execution
     throw OutsideDemoRange(m.str() + "; outside the demonstrated range (set allow_extrapolation "
                                      "to run it anyway)",
                            plan->extrapolation_distance);
-  plan->warnings.push_back(m.str() + "; extrapolated (allow_extrapolation)");
+  plan->warnings.push_back(m.str() + "; run anyway (allow_extrapolation), generalized by the "
+                                     "kernel average there");
 }
 
 // Samples of one generalized segment appended to the plan (each later segment starts where the
@@ -264,8 +265,12 @@ ExecutionPlan TaskPlanner::plan(const SkillLibrary& library,
     if (dmps.empty())
       throw std::invalid_argument("segment '" + seg.name + "' has no usable demonstration");
     const Eigen::VectorXd query = use_all ? all_query : Eigen::VectorXd(target.goal.position);
-    lfd::GeneralizationResult gen =
-        lfd::generalizeSegment(dmps, params, query, options.generalization);
+    // Outside the demonstrated range the local linear fit would extrapolate the motion's shape
+    // (a teleop approach from an undemonstrated side swept through the box); the kernel average
+    // is a convex mix of demonstrated shapes, only its end moves to the new goal.
+    lfd::GeneralizationOptions gen_options = options.generalization;
+    if (target.range_distance > target.range_margin) gen_options.local_linear = false;
+    lfd::GeneralizationResult gen = lfd::generalizeSegment(dmps, params, query, gen_options);
     if (heading) gen.dmp = gen.dmp.rotated(yawMatrix(heading->yaw));
 
     lfd::SegmentRolloutOptions ro;

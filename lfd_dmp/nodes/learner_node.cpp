@@ -11,6 +11,8 @@
 
 #include <lfd_msgs/LearnSkills.h>
 #include <ros/ros.h>
+#include <tf2_ros/buffer.h>
+#include <tf2_ros/transform_listener.h>
 
 #include <lfd_core/safe_paths.hpp>
 
@@ -20,7 +22,7 @@ namespace {
 
 class Learner {
  public:
-  explicit Learner(ros::NodeHandle& pnh) {
+  explicit Learner(ros::NodeHandle& pnh) : tf_listener_(tf_buffer_) {
     pnh.param<std::string>("pose_topic", topics_.pose, topics_.pose);
     pnh.param<std::string>("gripper_topic", topics_.gripper, topics_.gripper);
     pnh.param<std::string>("gripper_joint", topics_.gripper_joint, topics_.gripper_joint);
@@ -41,6 +43,7 @@ class Learner {
               frames_.heading_tolerance);
     pnh.param("goal_frames/min_motion_length", frames_.min_motion_length,
               frames_.min_motion_length);
+    pnh.param("tf_timeout", tf_timeout_, tf_timeout_);
   }
 
   bool learn(lfd_msgs::LearnSkills::Request& req, lfd_msgs::LearnSkills::Response& res) {
@@ -84,7 +87,10 @@ class Learner {
       const std::string output = lfd::checkOutputFile(req.output_path, paths_, req.overwrite, bags);
       std::vector<lfd_dmp::DemoRecording> demos;
       for (const auto& b : bags) {
-        demos.push_back(lfd_dmp::readDemoBag(b, topics_));
+        demos.push_back(lfd_dmp::readDemoBag(
+            b, topics_, [this](const std::string& target, const std::string& source) {
+              return liveTransform(target, source);
+            }));
         checkDemoSize(demos.back(), b);
       }
       lfd_dmp::LearnOptions opt;
@@ -114,6 +120,26 @@ class Learner {
   }
 
  private:
+  // A bag without /tf_static (recorded before it was): the live tf tree (e.g. the robot model's
+  // fixed world -> base_link from robot_state_publisher), waited for in WALL time.
+  Eigen::Isometry3d liveTransform(const std::string& target, const std::string& source) {
+    std::string why;
+    const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(tf_timeout_);
+    while (!tf_buffer_.canTransform(target, source, ros::Time(0), &why)) {
+      if (ros::WallTime::now() > deadline || !ros::ok())
+        throw std::runtime_error("no transform from '" + source + "' to '" + target + "' (" +
+                                 why + ")");
+      ros::WallDuration(0.01).sleep();
+    }
+    const auto t = tf_buffer_.lookupTransform(target, source, ros::Time(0)).transform;
+    Eigen::Isometry3d iso = Eigen::Isometry3d::Identity();
+    iso.translation() = Eigen::Vector3d(t.translation.x, t.translation.y, t.translation.z);
+    iso.linear() = Eigen::Quaterniond(t.rotation.w, t.rotation.x, t.rotation.y, t.rotation.z)
+                       .normalized()
+                       .toRotationMatrix();
+    return iso;
+  }
+
   void checkCounts(const lfd_msgs::LearnSkills::Request& req) const {
     if (req.num_basis > max_num_basis_) {
       throw std::invalid_argument("num_basis " + std::to_string(req.num_basis) +
@@ -147,6 +173,9 @@ class Learner {
   int num_basis_ = lfd::DmpParameters().num_basis;
   double smoothing_sigma_ = 0.0;
   lfd::FrameSelectionOptions frames_;
+  double tf_timeout_ = 2.0;
+  tf2_ros::Buffer tf_buffer_;
+  tf2_ros::TransformListener tf_listener_;
 };
 
 }  // namespace
@@ -158,6 +187,6 @@ int main(int argc, char** argv) {
   Learner learner(pnh);
   ros::ServiceServer srv = nh.advertiseService("/learner/learn", &Learner::learn, &learner);
   ROS_INFO("learner: ready on /learner/learn");
-  ros::spin();
+  ros::spin();  // tf arrives on the listener's own thread while a request waits for it
   return 0;
 }

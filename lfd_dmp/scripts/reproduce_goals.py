@@ -12,12 +12,11 @@ scene's objects at their start, the others parked), then the executor's action /
 (lfd_msgs/ExecuteTaskAction) with the scene and the goal; the judged object's final pose is scored
 by lfd_tools.judge.
 
-Lockstep (default): the simulation is paused and this client steps it (/bridge/step) while the goal
-is active, from the motion start the action's feedback announces, so a goal costs its physics and
-planning, not its duration in wall time, and runs the same whatever the load. The executor knows no
-simulator: it follows sim time. --real-time leaves the bridge running (reproduce.launch
-real_time_factor:=1 paces it, for watching in rviz). Time ratio = executed time (sim) / mean
-demonstrated duration of the learned segments (same span).
+Lockstep (default, lfd_tools.lockstep): the simulation is paused and stepped while the goal moves,
+so a goal costs its physics and planning, not its duration in wall time, and runs the same
+whatever the load. The executor knows no simulator: it follows sim time. --real-time leaves the
+bridge running, paced at wall-clock time (real_time_factor 1, for watching in rviz). Time ratio =
+executed time (sim) / mean demonstrated duration of the learned segments (same span).
 
 Starts a private master with launch/reproduce.launch for the run, or with --attach uses the nodes
 running at ROS_MASTER_URI (the pipeline's reproduce stage, which runs reproduce.launch once).
@@ -26,20 +25,16 @@ Writes {"<reproduction key>": {task: record}} (lfd_tools.report.reproduction_rec
 with the goals done ("complete": false). Exit status 0 only if every goal was reached.
 """
 import argparse
-import gc
 import json
 import os
 import subprocess
 import sys
 import time
 
-from lfd_tools import judge, master, report, tasks
+from lfd_tools import judge, lockstep, master, report, tasks
 
 SETTLE_BEFORE_S = 0.3  # sim s after placing the objects, before executing
 SETTLE_AFTER_S = 1.0   # sim s for the objects to come to rest before they are judged
-STEP_CHUNK = 50        # physics steps (1 ms) per /bridge/step call while a goal runs
-PLANNING_TIMEOUT_S = 120.0  # wall s for the executor to plan (it reports progress meanwhile)
-GOAL_TIMEOUT_S = 600.0      # wall s for a whole goal; then it is cancelled and reported
 
 
 def library_summary(path):
@@ -53,20 +48,6 @@ def library_summary(path):
             spans[d["demo_id"]] = (min(lo, d["start_time"]), max(hi, d["end_time"]))
     full = [hi - lo for lo, hi in spans.values()]
     return (sum(full) / len(full) if full else None), len(full), len(lib["segments"])
-
-
-def pose_msg(p):
-    """geometry_msgs/Pose of a lfd_tools.tasks pose {position, orientation [w, x, y, z]}."""
-    from geometry_msgs.msg import Point, Pose, Quaternion
-    w, x, y, z = p["orientation"]
-    return Pose(position=Point(*p["position"]), orientation=Quaternion(w=w, x=x, y=y, z=z))
-
-
-def stamped(p, frame="world"):
-    from geometry_msgs.msg import PoseStamped
-    msg = PoseStamped(pose=pose_msg(p))
-    msg.header.frame_id = frame
-    return msg
 
 
 class BagRecording(object):
@@ -88,130 +69,23 @@ class BagRecording(object):
         return self.path if os.path.exists(self.path) else None
 
 
-class Cell(object):
-    """The work cell (the simulation's services) and the executor's action."""
-
-    def __init__(self, objects, lockstep):
-        import actionlib
-        import rospy
-        from geometry_msgs.msg import PoseStamped
-        from lfd_msgs.msg import ExecuteTaskAction
-        from lfd_msgs.srv import ResetSim, SetScene, StepSim
-        from std_srvs.srv import SetBool
-        self.rospy, self.lockstep = rospy, lockstep
-        master.wait_for_param("/use_sim_time", 120)  # rospy reads it once, at init
-        self.srv = master.service_proxies("reproduce_goals", {
-            "/bridge/reset": ResetSim, "/bridge/set_scene": SetScene, "/bridge/pause": SetBool,
-            "/bridge/step": StepSim})
-        self.action = actionlib.SimpleActionClient("/executor/execute", ExecuteTaskAction)
-        if not self.action.wait_for_server(rospy.Duration(120)):
-            raise RuntimeError("the executor's action /executor/execute did not come up in 120 s")
-        self.poses = {}
-        self.subs = [rospy.Subscriber("/objects/%s/pose" % o, PoseStamped, self._on_pose, o,
-                                      queue_size=5) for o in objects]
-        self.srv["/bridge/pause"](data=lockstep)
-        self.sim_time = self.step(1) if lockstep else None
-        while rospy.Time.now().is_zero():
-            time.sleep(0.01)
-
-    def _on_pose(self, msg, name):
-        self.poses[name] = msg
-
-    def step(self, steps):
-        r = self.srv["/bridge/step"](steps=steps)
-        if not r.success:
-            raise RuntimeError("/bridge/step: " + r.message)
-        self.sim_time = r.sim_time
-        return r.sim_time
-
-    def advance(self, seconds):
-        """Lets `seconds` of sim time pass: stepped in lockstep, waited for otherwise."""
-        if self.lockstep:
-            left = int(round(seconds * 1000))
-            while left > 0:
-                self.step(min(STEP_CHUNK * 10, left))
-                left -= STEP_CHUNK * 10
-            return
-        end = self.rospy.Time.now() + self.rospy.Duration(seconds)
-        while self.rospy.Time.now() < end and not self.rospy.is_shutdown():
-            time.sleep(0.002)
-
-    def set_scene(self, scene, parked):
-        r = self.srv["/bridge/reset"](joint_names=[], positions=[], reset_objects=True)
-        if not r.success:
-            raise RuntimeError("reset failed: " + r.message)
-        placed = dict(parked, **scene["objects"])
-        s = self.srv["/bridge/set_scene"](object_names=list(placed),
-                                          poses=[pose_msg(p) for p in placed.values()])
-        if not s.success:
-            raise RuntimeError("set_scene failed: " + s.message)
-        self.advance(SETTLE_BEFORE_S)
-
-    def object_pose(self, name):
-        """The object's pose published at or after the current sim time (wall-bounded wait)."""
-        now = self.rospy.Time.now() if not self.lockstep else self.rospy.Time.from_sec(self.sim_time)
-        deadline = time.time() + 30
-        while time.time() < deadline:
-            msg = self.poses.get(name)
-            if msg is not None and msg.header.stamp >= now - self.rospy.Duration(1e-6):
-                return msg.pose
-            time.sleep(0.005)
-        raise RuntimeError("no /objects/%s/pose at the current sim time" % name)
-
-    def execute(self, goal):
-        """Sends the goal and drives the simulation until it ends: (result, wall s). No rospy
-        timeout is used: they run on sim time, which stands still until this client steps."""
-        from actionlib import SimpleGoalState
-        from lfd_msgs.msg import ExecuteTaskFeedback
-        moving = []  # the motion's start, once the executor announces it
-
-        def on_feedback(fb):
-            if fb.state != ExecuteTaskFeedback.PLANNING and not moving:
-                moving.append(fb.motion_start)
-
-        started = time.time()
-        self.action.send_goal(goal, feedback_cb=on_feedback)
-        while self.action.simple_state != SimpleGoalState.DONE:
-            wall = time.time() - started
-            if wall > GOAL_TIMEOUT_S or (not moving and wall > PLANNING_TIMEOUT_S):
-                self.action.cancel_goal()
-                raise RuntimeError("the goal took over %.0f s of wall time; cancelled" % wall)
-            if self.lockstep and moving:
-                self.step(STEP_CHUNK)
-            else:
-                time.sleep(0.002)
-        result = self.action.get_result()
-        # Forget the finished goal now: the server keeps announcing its status for a while, and a
-        # handle that lingers until the garbage collector runs logs those as errors.
-        self.action.stop_tracking_goal()
-        gc.collect()
-        return result, time.time() - started
-
-
 def reproduce(cell, task, scene, library, demo_duration, args, record_path=None):
     """One unseen scene: a goal record (report.goal_record)."""
-    from lfd_msgs.msg import ExecuteTaskGoal
     criterion = tasks.success_criterion(task)
-    cell.set_scene(scene, tasks.parked(task))
+    cell.set_scene(dict(tasks.parked(task), **scene["objects"]), SETTLE_BEFORE_S)
     recording = BagRecording(record_path, list(scene["objects"]) + list(tasks.parked(task))) \
         if record_path else None
     try:
-        goal = ExecuteTaskGoal(library=library, object_names=list(scene["objects"]),
-                               object_poses=[stamped(p) for p in scene["objects"].values()],
-                               goal=stamped(scene["goal"]), duration_scale=args.duration_scale,
-                               allow_extrapolation=args.allow_extrapolation)
-        res, wall = cell.execute(goal)
+        res, wall = cell.execute(lockstep.execute_goal(library, scene, args.duration_scale,
+                                                       args.allow_extrapolation))
         if res is None:
             raise RuntimeError("the executor gave no result")
         cell.advance(SETTLE_AFTER_S)
     finally:
         bag = recording.stop() if recording else None
-    p = cell.object_pose(criterion["object"])
-    object_pose = {"position": [p.position.x, p.position.y, p.position.z],
-                   "orientation": [p.orientation.w, p.orientation.x, p.orientation.y, p.orientation.z]}
-    outcome = judge.physical_outcome(criterion, object_pose["position"], scene["goal"]["position"],
-                                     tasks.table_top(), tasks.yaw_of(object_pose),
-                                     tasks.yaw_of(scene["goal"]))
+    final = cell.object_pose(criterion["object"])
+    outcome = judge.physical_outcome(criterion, final["position"], scene["goal"]["position"],
+                                     tasks.table_top(), tasks.yaw_of(final), tasks.yaw_of(scene["goal"]))
     g = report.goal_record(scene["id"], res, outcome, demo_duration=demo_duration, wall_time=wall)
     if bag and res.success:  # sim times at which each segment ended (snapshots per segment)
         t = res.motion_start.to_sec()
@@ -278,7 +152,7 @@ def main():
         launch.append("real_time_factor:=1.0")
     with report.written_on_exit(out, results):
         with master.graph_for_this_process(launch, args.attach):
-            cell = Cell(objects, lockstep=not args.real_time)
+            cell = lockstep.Cell(objects, lockstep=not args.real_time, node_name="reproduce_goals")
             for task in names:
                 record = results[key][task] = {}
                 library = os.path.join(lib_dir, args.library_name.format(task=task, mode=args.mode))

@@ -6,4 +6,5 @@
   judge    the one judge of segmentation success and of physical success (pure Python)
   bags     the bag and ground-truth readers (/lfd/phase, ground-truth files, demo outcomes)
   report   the result records the producers write and report.json holds
+  lockstep the work cell and the executor's action, the simulation stepped while a goal moves
 """

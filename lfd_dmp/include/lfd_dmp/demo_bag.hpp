@@ -6,6 +6,9 @@
 
 #include "lfd_dmp/skill_learner.hpp"
 
+#include <Eigen/Geometry>
+
+#include <functional>
 #include <string>
 
 namespace lfd_dmp {
@@ -18,9 +21,16 @@ struct DemoBagTopics {
   std::string tf_static = "/tf_static";        ///< tf2_msgs/TFMessage
 };
 
+/// The pose of frame `source` in frame `target` from elsewhere than the bag (the live tf tree);
+/// throws std::runtime_error when it has none.
+using TransformLookup =
+    std::function<Eigen::Isometry3d(const std::string& target, const std::string& source)>;
+
 /// Throws std::runtime_error naming the bag and topic on missing/unusable data. Poses with
-/// non-increasing stamps are dropped (duplicates), NaN poses are an error. A scene whose frame
-/// the static transforms do not connect to the poses' frame is an error; no scene is not.
-DemoRecording readDemoBag(const std::string& path, const DemoBagTopics& topics = {});
+/// non-increasing stamps are dropped (duplicates), NaN poses are an error. The scene is brought
+/// into the poses' frame with the bag's /tf_static, else with `fallback` (bags recorded before
+/// /tf_static was); neither connecting the frames is an error, no scene is not.
+DemoRecording readDemoBag(const std::string& path, const DemoBagTopics& topics = {},
+                          const TransformLookup& fallback = nullptr);
 
 }  // namespace lfd_dmp

@@ -1,0 +1,161 @@
+"""A client of the simulated work cell and the executor's action that drives the simulation in
+lockstep: the bridge stays paused, and the client steps it (/bridge/step) while a goal of
+/executor/execute moves, from the motion start the action's feedback announces. A goal then costs
+its physics and planning, not its duration in wall time, and runs the same whatever the load. The
+executor knows no simulator (it follows sim time); this client does.
+
+No rospy timeout is used while paused: rospy's run on sim time, which stands still until this
+client steps. Every wait here is bounded in wall time.
+"""
+import gc
+import time
+
+STEP_CHUNK = 50  # physics steps (1 ms) per /bridge/step call while a goal moves
+PLANNING_TIMEOUT_S = 120.0  # wall s for the executor to plan (it sends feedback meanwhile)
+GOAL_TIMEOUT_S = 600.0      # wall s for a whole goal; then it is cancelled
+
+
+def pose_msg(p):
+    """geometry_msgs/Pose of a lfd_tools.tasks pose {position, orientation [w, x, y, z]}."""
+    from geometry_msgs.msg import Point, Pose, Quaternion
+    w, x, y, z = p["orientation"]
+    return Pose(position=Point(*p["position"]), orientation=Quaternion(w=w, x=x, y=y, z=z))
+
+
+def stamped(p, frame="world"):
+    from geometry_msgs.msg import PoseStamped
+    msg = PoseStamped(pose=pose_msg(p))
+    msg.header.frame_id = frame
+    return msg
+
+
+def execute_goal(library, scene, duration_scale=1.0, allow_extrapolation=False, dry_run=False):
+    """An lfd_msgs/ExecuteTaskGoal for a scene {"objects": {name: pose}, "goal": pose} (world)."""
+    from lfd_msgs.msg import ExecuteTaskGoal
+    return ExecuteTaskGoal(library=library, object_names=list(scene["objects"]),
+                           object_poses=[stamped(p) for p in scene["objects"].values()],
+                           goal=stamped(scene["goal"]), duration_scale=duration_scale,
+                           allow_extrapolation=allow_extrapolation, dry_run=dry_run)
+
+
+class Cell(object):
+    """The work cell (the simulation's services, the objects' poses) and the executor's action.
+    `lockstep`: pause the bridge and step it; otherwise it runs on its own (e.g. paced at
+    real time for rviz). Starts this process's rospy node."""
+
+    def __init__(self, objects, lockstep=True, node_name="lockstep_client"):
+        import actionlib
+        import rospy
+        from geometry_msgs.msg import PoseStamped
+        from lfd_msgs.msg import ExecuteTaskAction
+        from lfd_msgs.srv import ResetSim, SetScene, StepSim
+        from std_srvs.srv import SetBool
+        from lfd_tools import master
+        self.rospy, self.lockstep = rospy, lockstep
+        master.wait_for_param("/use_sim_time", 120)  # rospy reads it once, at init
+        self.srv = master.service_proxies(node_name, {
+            "/bridge/reset": ResetSim, "/bridge/set_scene": SetScene, "/bridge/pause": SetBool,
+            "/bridge/step": StepSim})
+        self.action = actionlib.SimpleActionClient("/executor/execute", ExecuteTaskAction)
+        if not self.action.wait_for_server(rospy.Duration(120)):
+            raise RuntimeError("the executor's action /executor/execute did not come up in 120 s")
+        self.poses, self.feedback = {}, []
+        self.subs = [rospy.Subscriber("/objects/%s/pose" % o, PoseStamped, self._on_pose, o,
+                                      queue_size=5) for o in objects]
+        self.srv["/bridge/pause"](data=lockstep)
+        self.sim_time = self.step(1) if lockstep else None
+        while rospy.Time.now().is_zero():
+            time.sleep(0.01)
+
+    def _on_pose(self, msg, name):
+        self.poses[name] = msg
+
+    def step(self, steps):
+        r = self.srv["/bridge/step"](steps=steps)
+        if not r.success:
+            raise RuntimeError("/bridge/step: " + r.message)
+        self.sim_time = r.sim_time
+        return r.sim_time
+
+    def now(self):
+        return self.sim_time if self.lockstep else self.rospy.get_time()
+
+    def advance(self, seconds):
+        """Lets `seconds` of sim time pass: stepped in lockstep, waited for otherwise."""
+        if self.lockstep:
+            left = int(round(seconds * 1000))
+            while left > 0:
+                self.step(min(10 * STEP_CHUNK, left))
+                left -= 10 * STEP_CHUNK
+            return
+        end = self.rospy.get_time() + seconds
+        while self.rospy.get_time() < end and not self.rospy.is_shutdown():
+            time.sleep(0.002)
+
+    def set_scene(self, placed, settle):
+        """Resets the robot and the objects, places {name: pose}, lets them settle (sim s)."""
+        r = self.srv["/bridge/reset"](joint_names=[], positions=[], reset_objects=True)
+        if not r.success:
+            raise RuntimeError("reset failed: " + r.message)
+        s = self.srv["/bridge/set_scene"](object_names=list(placed),
+                                          poses=[pose_msg(p) for p in placed.values()])
+        if not s.success:
+            raise RuntimeError("set_scene failed: " + s.message)
+        self.advance(settle)
+
+    def object_pose(self, name):
+        """The object's pose published at or after the current sim time (wall-bounded wait)."""
+        now = self.now()
+        deadline = time.time() + 30
+        while time.time() < deadline:
+            msg = self.poses.get(name)
+            if msg is not None and msg.header.stamp.to_sec() >= now - 1e-6:
+                p, q = msg.pose.position, msg.pose.orientation
+                return {"position": [p.x, p.y, p.z], "orientation": [q.w, q.x, q.y, q.z]}
+            time.sleep(0.005)
+        raise RuntimeError("no /objects/%s/pose at the current sim time" % name)
+
+    def send(self, goal):
+        """Sends a goal; its feedback is collected in self.feedback."""
+        self.feedback = []
+        self.action.send_goal(goal, feedback_cb=self.feedback.append)
+
+    def moving(self):
+        """The feedback says the motion was sent (it starts at feedback.motion_start)."""
+        from lfd_msgs.msg import ExecuteTaskFeedback
+        return any(f.state != ExecuteTaskFeedback.PLANNING for f in self.feedback)
+
+    def done(self):
+        from actionlib import SimpleGoalState
+        return self.action.simple_state == SimpleGoalState.DONE
+
+    def drive(self, until=None, timeout=GOAL_TIMEOUT_S):
+        """Steps the simulation while the goal moves, until it is done (or `until()` is true):
+        True when it ended (or `until` held), False after `timeout` wall s."""
+        started = time.time()
+        while not self.done() and not (until and until()):
+            wall = time.time() - started
+            if wall > timeout or (not self.moving() and wall > PLANNING_TIMEOUT_S):
+                return False
+            if self.lockstep and self.moving():
+                self.step(STEP_CHUNK)
+            else:
+                time.sleep(0.002)
+        return True
+
+    def result(self):
+        """The finished goal's result and state; the goal is forgotten (the server keeps
+        announcing its status a while, which a lingering handle would log as errors)."""
+        result, state = self.action.get_result(), self.action.get_state()
+        self.action.stop_tracking_goal()
+        gc.collect()
+        return result, state
+
+    def execute(self, goal, timeout=GOAL_TIMEOUT_S):
+        """Sends the goal and drives it to its end: (result, wall s); cancelled after `timeout`."""
+        started = time.time()
+        self.send(goal)
+        if not self.drive(timeout=timeout):
+            self.action.cancel_goal()
+            raise RuntimeError("the goal took over %.0f s of wall time; cancelled" % (time.time() - started))
+        return self.result()[0], time.time() - started
