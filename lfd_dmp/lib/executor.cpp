@@ -298,10 +298,10 @@ ExecutionPlan TaskPlanner::plan(const SkillLibrary& library,
     const lfd::SegmentTrajectory traj = gen.dmp.rollout(ro);
 
     planned.begin = plan.times.size();
-    planned.duration = *ro.tau;
     planned.goal = target.goal;
     appendRollout(traj, s == 0, t_offset, orientation, gripper, &plan);
     planned.end = plan.times.size();
+    planned.duration = plan.times.back() - t_offset;  // as sampled: the durations sum to the plan's
     t_offset = plan.times.back();
     position = plan.poses.back().position;
     orientation = plan.poses.back().orientation;

@@ -127,6 +127,7 @@ class Executor {
     clock_timeout_ = param(pnh, "clock_timeout", clock_timeout_);
     motion_lead_ = param(pnh, "motion_lead", motion_lead_);
     connect_timeout_ = param(pnh, "connect_timeout", connect_timeout_);
+    tf_timeout_ = param(pnh, "tf_timeout", tf_timeout_);
     trajectory_period_ = param(pnh, "trajectory_period", trajectory_period_);
     feedback_period_ = param(pnh, "feedback_period", feedback_period_);
     paths_.allowed_roots = param(pnh, "allowed_roots", paths_.allowed_roots);
@@ -189,13 +190,13 @@ class Executor {
     return out;
   }
 
-  // The pose of `source` in `target` from tf, waited for at most ~connect_timeout of WALL time
-  // (tf's own timeouts run on sim time, which a paused simulation never advances).
+  // The pose of `source` in `target` from tf, waited for at most ~tf_timeout of WALL time (tf's
+  // own timeouts run on sim time, which a paused simulation never advances).
   Eigen::Isometry3d transform(const std::string& target, const std::string& source) {
     std::string why;
     const auto t0 = Clock::now();
     while (!tf_buffer_.canTransform(target, source, ros::Time(0), &why)) {
-      if (wallSince(t0) > connect_timeout_ || !ros::ok())
+      if (wallSince(t0) > tf_timeout_ || !ros::ok())
         throw std::invalid_argument("no transform from '" + source + "' to '" + target +
                                     "' on tf: " + why);
       ros::WallDuration(0.01).sleep();
@@ -488,6 +489,7 @@ class Executor {
   lfd_dmp::ExecutorOptions options_;
   lfd_dmp::RequestLimits limits_;
   double settle_time_ = 0.5, clock_timeout_ = 5.0, motion_lead_ = 0.1, connect_timeout_ = 5.0;
+  double tf_timeout_ = 1.0;
   double trajectory_period_ = 0.01, feedback_period_ = 0.05;
   std::unique_ptr<lfd_dmp::TaskPlanner> planner_;
   tf2_ros::Buffer tf_buffer_;

@@ -7,7 +7,6 @@ executor knows no simulator (it follows sim time); this client does.
 No rospy timeout is used while paused: rospy's run on sim time, which stands still until this
 client steps. Every wait here is bounded in wall time.
 """
-import gc
 import time
 
 STEP_CHUNK = 50  # physics steps (1 ms) per /bridge/step call while a goal moves
@@ -56,10 +55,16 @@ class Cell(object):
         self.srv = master.service_proxies(node_name, {
             "/bridge/reset": ResetSim, "/bridge/set_scene": SetScene, "/bridge/pause": SetBool,
             "/bridge/step": StepSim})
-        self.action = actionlib.SimpleActionClient("/executor/execute", ExecuteTaskAction)
-        if not self.action.wait_for_server(rospy.Duration(120)):
-            raise RuntimeError("the executor's action /executor/execute did not come up in 120 s")
-        self.poses, self.feedback = {}, []
+        # The plain client: SimpleActionClient drops a result that arrives before send_goal has
+        # returned (a refusal answered within the caller's time slice), and its timeouts run on
+        # sim time, which stands still while paused.
+        self.action = actionlib.ActionClient("/executor/execute", ExecuteTaskAction)
+        deadline = time.time() + 120
+        while self.action.last_status_msg is None:
+            if time.time() > deadline:
+                raise RuntimeError("the executor's action /executor/execute did not come up in 120 s")
+            time.sleep(0.01)
+        self.goal_handle, self.poses, self.feedback = None, {}, []
         self.subs = [rospy.Subscriber("/objects/%s/pose" % o, PoseStamped, self._on_pose, o,
                                       queue_size=5) for o in objects]
         self.srv["/bridge/pause"](data=lockstep)
@@ -118,7 +123,11 @@ class Cell(object):
     def send(self, goal):
         """Sends a goal; its feedback is collected in self.feedback."""
         self.feedback = []
-        self.action.send_goal(goal, feedback_cb=self.feedback.append)
+        self.goal_handle = self.action.send_goal(
+            goal, feedback_cb=lambda gh, fb: self.feedback.append(fb))
+
+    def cancel(self):
+        self.goal_handle.cancel()
 
     def moving(self):
         """The feedback says the motion was sent (it starts at feedback.motion_start)."""
@@ -126,8 +135,8 @@ class Cell(object):
         return any(f.state != ExecuteTaskFeedback.PLANNING for f in self.feedback)
 
     def done(self):
-        from actionlib import SimpleGoalState
-        return self.action.simple_state == SimpleGoalState.DONE
+        from actionlib import CommState
+        return self.goal_handle.get_comm_state() == CommState.DONE
 
     def drive(self, until=None, timeout=GOAL_TIMEOUT_S):
         """Steps the simulation while the goal moves, until it is done (or `until()` is true):
@@ -144,18 +153,16 @@ class Cell(object):
         return True
 
     def result(self):
-        """The finished goal's result and state; the goal is forgotten (the server keeps
-        announcing its status a while, which a lingering handle would log as errors)."""
-        result, state = self.action.get_result(), self.action.get_state()
-        self.action.stop_tracking_goal()
-        gc.collect()
-        return result, state
+        """The finished goal's result and final status (actionlib_msgs/GoalStatus); the goal
+        handle is released."""
+        gh, self.goal_handle = self.goal_handle, None
+        return gh.get_result(), gh.get_goal_status()
 
     def execute(self, goal, timeout=GOAL_TIMEOUT_S):
         """Sends the goal and drives it to its end: (result, wall s); cancelled after `timeout`."""
         started = time.time()
         self.send(goal)
         if not self.drive(timeout=timeout):
-            self.action.cancel_goal()
+            self.cancel()
             raise RuntimeError("the goal took over %.0f s of wall time; cancelled" % (time.time() - started))
         return self.result()[0], time.time() - started

@@ -1,0 +1,297 @@
+#!/usr/bin/python3
+"""rostest (executor_action.test): the executor's action on a library learned from a freshly
+recorded tiny grasp dataset, the simulation driven in lockstep (lfd_tools.lockstep). Covers an
+unseen goal reproduced with its feedback, preemption while moving and while planning, an
+out-of-range and an unreachable goal, sim time stopping during the final settle (issue 12), bad
+requests and a seeded fuzz of random and extreme goals; after each the node still answers."""
+import copy
+import glob
+import math
+import os
+import random
+import time
+import unittest
+
+import rospy
+import rostest
+from actionlib_msgs.msg import GoalStatus
+from lfd_msgs.msg import DemoSegmentation, ExecuteTaskFeedback
+from lfd_msgs.srv import LearnSkills
+from lfd_tools import bags as lfd_bags
+from lfd_tools import judge, lockstep, tasks
+
+TASK = "grasp"
+FUZZ_GOALS = 150      # seeded random goals of test_7 (~10 s on the 2-core machine)
+FUZZ_SECONDS = 120.0  # its wall-time budget
+ANSWER_S = 15.0       # wall s any single refused or dry-run goal may take
+
+
+def moved(pose, dx=0.0, dy=0.0, dz=0.0):
+    p = copy.deepcopy(pose)
+    p["position"] = [p["position"][0] + dx, p["position"][1] + dy, p["position"][2] + dz]
+    return p
+
+
+class ExecutorAction(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.scene = tasks.unseen_scenes(TASK, "sim")[4]  # id 104, never demonstrated
+        cls.parked = tasks.parked(TASK)
+        out = rospy.get_param("/executor_test/output_dir")
+        summary = os.path.join(out, "demonstrator_summary_%s_sim.yaml" % TASK)
+        deadline = time.time() + 300
+        while not os.path.exists(summary):
+            assert time.time() < deadline, "the demonstrator did not finish the dataset"
+            time.sleep(1)
+        time.sleep(1)
+        bags = sorted(glob.glob(os.path.join(out, "*.bag")))
+        assert len(bags) == 4, bags
+        # The lockstep client (it pauses the simulation) once the demonstrator is done with it.
+        cls.cell = lockstep.Cell(list(cls.scene["objects"]) + list(cls.parked), node_name="executor_test")
+        cls.library = os.path.join(out, "%s.json" % TASK)
+        rospy.wait_for_service("/learner/learn", timeout=120)
+        segs = [DemoSegmentation(source=b, changepoint_times=lfd_bags.ground_truth_changepoints(
+            b, tasks.expected_transitions(TASK))) for b in bags]
+        res = rospy.ServiceProxy("/learner/learn", LearnSkills)(
+            task=TASK, output_path=cls.library, segmentations=segs,
+            segment_names=tasks.segment_names(TASK))
+        assert res.success, res.error
+        cls.out = out
+
+    # ---- helpers --------------------------------------------------------------------------------
+    def place(self, scene=None):
+        self.cell.set_scene(dict(self.parked, **(scene or self.scene)["objects"]), 0.3)
+
+    def goal(self, scene=None, **kw):
+        return lockstep.execute_goal(self.library, scene or self.scene, **kw)
+
+    def answer(self, goal, timeout=ANSWER_S):
+        """Sends a goal and drives it: (result, state); fails the test if it does not end."""
+        self.cell.send(goal)
+        ended = self.cell.drive(timeout=timeout)
+        if not ended:
+            self.cell.cancel()
+        self.assertTrue(ended, "the goal did not end in %.0f s (feedback %s): %s"
+                        % (timeout, self.latest(), goal))
+        return self.cell.result()
+
+    def refused(self, goal, *fragments):
+        result, state = self.answer(goal)
+        self.assertEqual(state, GoalStatus.ABORTED, result.error)
+        self.assertFalse(result.success)
+        for f in fragments:
+            self.assertIn(f, result.error)
+        return result
+
+    def assert_alive(self):
+        """A valid dry run still succeeds (the node is up and not stuck)."""
+        result, state = self.answer(self.goal(dry_run=True))
+        self.assertEqual(state, GoalStatus.SUCCEEDED, result.error)
+        self.assertTrue(result.success)
+
+    def latest(self):
+        return self.cell.feedback[-1] if self.cell.feedback else None
+
+    def in_settle(self):
+        """Sim time is 0.1 s past the trajectory's end: the executor settles (0.5 s) from there.
+        Decided on the stepped clock, not on feedback that might arrive late."""
+        f = self.latest()
+        return bool(f and f.state != ExecuteTaskFeedback.PLANNING and
+                    self.cell.now() >= f.motion_start.to_sec() + f.planned_duration + 0.1)
+
+    # ---- tests ----------------------------------------------------------------------------------
+    def test_1_reproduces_an_unseen_goal_with_feedback(self):
+        self.place()
+        result, wall = self.cell.execute(self.goal())
+        self.assertTrue(result.success, result.error)
+        self.assertEqual(list(result.segment_names), tasks.segment_names(TASK))
+        self.assertEqual(len(result.segment_frames), 2)
+        # Learned, not written: the approach ends at the stick (its frame or its heading frame,
+        # which these 4 demos tell apart by millimetres), the move at the goal.
+        self.assertIn(result.segment_frames[0].split(" / ")[0], ("object:stick", "heading:stick"))
+        self.assertTrue(result.segment_frames[1].startswith("goal"), result.segment_frames)
+        self.assertGreater(result.motion_start.to_sec(), 0.0)
+        self.assertAlmostEqual(sum(result.segment_durations), result.planned_duration, places=6)
+        self.assertGreater(result.execution_time, result.planned_duration)  # it reached the end
+        self.assertLess(result.execution_time, 1.05 * result.planned_duration + 0.1)
+        self.assertLess(result.final_position_error, 0.005)
+        self.assertLess(result.extrapolation_distance, 0.05)
+        fb = self.cell.feedback
+        states = [f.state for f in fb]
+        for s in (ExecuteTaskFeedback.PLANNING, ExecuteTaskFeedback.MOVING, ExecuteTaskFeedback.SETTLING):
+            self.assertIn(s, states)
+        self.assertEqual(sorted({f.segment for f in fb if f.state != ExecuteTaskFeedback.PLANNING}),
+                         sorted(tasks.segment_names(TASK)))
+        progress = [f.progress for f in fb if f.state == ExecuteTaskFeedback.MOVING]
+        self.assertEqual(progress, sorted(progress))
+        self.assertGreater(fb[-1].progress, 0.99)
+        self.assertLess(max(f.tcp_position_error for f in fb), 0.01)  # tracked the plan
+        self.assertEqual(fb[-1].motion_start, result.motion_start)
+        self.cell.advance(1.0)
+        final = self.cell.object_pose(tasks.success_criterion(TASK)["object"])
+        outcome = judge.physical_outcome(tasks.success_criterion(TASK), final["position"],
+                                         self.scene["goal"]["position"], tasks.table_top())
+        self.assertTrue(outcome["success"], outcome["reason"])
+
+    def test_2_preempted_while_moving_then_answers(self):
+        self.place()
+        self.cell.send(self.goal(duration_scale=2.0))
+        self.assertTrue(self.cell.drive(until=lambda: self.latest() and self.latest().progress > 0.3))
+        self.assertFalse(self.cell.done())
+        self.cell.cancel()
+        cancelled = time.time()
+        while not self.cell.done() and time.time() - cancelled < 10.0:
+            time.sleep(0.005)  # not stepping: the cancel is served without sim time moving
+        result, state = self.cell.result()
+        self.assertEqual(state, GoalStatus.PREEMPTED, result.error)
+        self.assertIn("preempted", result.error)
+        self.assertIn("the arm holds there", result.error)
+        self.assertLess(time.time() - cancelled, 1.5)
+        self.assert_alive()
+
+    def test_3_preempted_while_planning(self):
+        self.place()
+        self.cell.send(self.goal(duration_scale=10.0))  # the longest plan the limits allow
+        self.assertTrue(self.cell.drive(until=lambda: self.cell.feedback, timeout=10.0))
+        self.cell.cancel()  # active and planning (~0.15 s of IK for 87 s of motion)
+        started = time.time()
+        self.assertTrue(self.cell.drive(timeout=10.0))
+        result, state = self.cell.result()
+        self.assertEqual(state, GoalStatus.PREEMPTED, result.error)
+        self.assertIn("cancelled while planning", result.error)
+        self.assertEqual(result.motion_start.to_sec(), 0.0)  # nothing was sent
+        self.assertLess(time.time() - started, 5.0)
+        self.assert_alive()
+
+    def test_4_out_of_range_and_unreachable_goals(self):
+        far = {"objects": {"stick": moved(self.scene["objects"]["stick"], 0.3, 0.25)},
+               "goal": moved(self.scene["goal"], 0.3, 0.25)}
+        result = self.refused(self.goal(far), "outside the demonstrated range", "allow_extrapolation")
+        self.assertTrue(result.outside_demo_range)
+        self.assertGreater(result.extrapolation_distance, 0.1)  # reported with the refusal
+        self.assertEqual(result.motion_start.to_sec(), 0.0)  # nothing moved
+        result, state = self.answer(self.goal(far, allow_extrapolation=True, dry_run=True))
+        self.assertEqual(state, GoalStatus.SUCCEEDED, result.error)
+        self.assertTrue(result.outside_demo_range)
+        self.assertGreater(result.extrapolation_distance, 0.1)
+        self.assertTrue(any("kernel average" in w for w in result.warnings), result.warnings)
+        unreachable = {"objects": {"stick": moved(self.scene["objects"]["stick"], 0.9)},
+                       "goal": moved(self.scene["goal"], 0.9)}  # 1.3 m in front of the pelvis
+        self.refused(self.goal(unreachable, allow_extrapolation=True), "unreachable")
+        self.assert_alive()
+
+    def test_5_sim_time_stopping_during_the_settle_fails_the_goal(self):
+        # Issue 12: the call never returned, cancel did nothing, later requests were refused
+        # "busy", and when time resumed it reported success.
+        self.place()
+        self.cell.send(self.goal())
+        self.assertTrue(self.cell.drive(until=self.in_settle))
+        stopped = time.time()
+        while not self.cell.done() and time.time() - stopped < 10.0:
+            time.sleep(0.01)  # no stepping: sim time stands still
+        result, state = self.cell.result()
+        self.assertEqual(state, GoalStatus.ABORTED)
+        self.assertFalse(result.success)
+        self.assertIn("sim time stopped", result.error)
+        self.assertLess(time.time() - stopped, 4.0)  # ~clock_timeout (2 s in the test launch)
+        # A cancel during a stopped settle is served at once.
+        self.place()
+        self.cell.send(self.goal())
+        self.assertTrue(self.cell.drive(until=self.in_settle))
+        cancelled = time.time()
+        self.cell.cancel()
+        while not self.cell.done() and time.time() - cancelled < 10.0:
+            time.sleep(0.01)
+        result, state = self.cell.result()
+        self.assertEqual(state, GoalStatus.PREEMPTED, result.error)
+        self.assertLess(time.time() - cancelled, 1.5)
+        self.assert_alive()  # and nothing is "busy"
+
+    def test_6_bad_requests_are_clear_errors(self):
+        g = self.goal(dry_run=True)
+        cases = []
+
+        def case(fragment, edit):
+            goal = copy.deepcopy(g)
+            edit(goal)
+            cases.append((fragment, goal))
+
+        def quaternion(goal, w, x, y, z):
+            goal.goal.pose.orientation.w, goal.goal.pose.orientation.x = w, x
+            goal.goal.pose.orientation.y, goal.goal.pose.orientation.z = y, z
+
+        case("zero quaternion", lambda x: quaternion(x, 0, 0, 0, 0))
+        case("norm 2", lambda x: quaternion(x, 2 * math.cos(0.15), 0, 0, 2 * math.sin(0.15)))
+        case("NaN", lambda x: setattr(x.goal.pose.position, "x", float("nan")))
+        case("workspace", lambda x: setattr(x.goal.pose.position, "x", 1e11))
+        for scale in (1e-9, 1000.0, -1.0, float("inf")):
+            case("~limits/min_duration_scale", lambda x, s=scale: setattr(x, "duration_scale", s))
+        case("named twice", lambda x: (x.object_names.append("stick"),
+                                       x.object_poses.append(x.object_poses[0])))
+        case("empty", lambda x: setattr(x, "object_names", [""]))
+        case("object names but", lambda x: x.object_poses.append(x.object_poses[0]))
+        case("no transform", lambda x: setattr(x.goal.header, "frame_id", "nowhere"))
+        case("frame_id", lambda x: setattr(x.goal.header, "frame_id", ""))
+        case("no object 'stick'", lambda x: (setattr(x, "object_names", []), setattr(x, "object_poses", [])))
+        case("library is empty", lambda x: setattr(x, "library", ""))
+        case("missing.json", lambda x: setattr(x, "library", os.path.join(self.out, "missing.json")))
+        case("~limits/max_name_length", lambda x: setattr(x, "library", "x" * 5000))
+        old = os.path.join(self.out, "version1.json")
+        with open(old, "w") as f:
+            f.write('{"format": "lfd_skill_library", "version": 1, "segments": []}')
+        case("relearn", lambda x: setattr(x, "library", old))
+        for fragment, goal in cases:
+            with self.subTest(fragment=fragment):
+                self.refused(goal, fragment)
+        self.assert_alive()
+
+    def test_7_fuzz_random_and_extreme_goals(self):
+        """Seeded random goals: each ends within ANSWER_S with a sane success or a clear error,
+        and the whole run stays within FUZZ_SECONDS; the node answers at the end."""
+        rng = random.Random(12)
+        extremes = [0.0, -0.0, 1e-300, 1e300, -1e300, float("nan"), float("inf"), -float("inf"), 1e-9, 7.0]
+        started = time.time()
+        succeeded = 0
+        for i in range(FUZZ_GOALS):
+            goal = self.goal(dry_run=rng.random() < 0.95)
+            for p in [goal.goal] + list(goal.object_poses):
+                if rng.random() < 0.3:
+                    setattr(p.pose.position, rng.choice("xyz"),
+                            rng.choice(extremes + [rng.uniform(-3, 3)]))
+                if rng.random() < 0.2:
+                    setattr(p.pose.orientation, rng.choice("wxyz"), rng.choice(extremes + [rng.uniform(-2, 2)]))
+                if rng.random() < 0.02:  # an unknown frame costs ~tf_timeout
+                    p.header.frame_id = rng.choice(["", "base_link", "nowhere", "w" * 300])
+            if rng.random() < 0.2:
+                goal.duration_scale = rng.choice(extremes + [rng.uniform(0.05, 12)])
+            if rng.random() < 0.1:
+                goal.object_names = rng.choice([[], ["stick", "stick"], ["box"], ["s" * 1000], [""]])
+                goal.object_poses = goal.object_poses[:1] * len(goal.object_names)
+            if rng.random() < 0.05:
+                goal.library = rng.choice(["", "/", "../x", "/dev/zero", "grasp", "\0"])
+            goal.allow_extrapolation = rng.random() < 0.3
+            if not goal.dry_run:
+                self.place()
+            t_goal = time.time()
+            result, state = self.answer(goal, timeout=ANSWER_S if goal.dry_run else 60.0)
+            rospy.loginfo("fuzz goal %d: state %d in %.2f s: %s", i, state, time.time() - t_goal,
+                          result.error if result else None)
+            self.assertIn(state, (GoalStatus.SUCCEEDED, GoalStatus.ABORTED), "goal %d" % i)
+            if state == GoalStatus.SUCCEEDED:
+                succeeded += 1
+                self.assertTrue(result.success)
+                self.assertTrue(all(math.isfinite(v) for v in
+                                    [result.planned_duration, result.extrapolation_distance]))
+                self.assertGreater(result.planned_duration, 0.0)
+            else:
+                self.assertFalse(result.success)
+                self.assertTrue(result.error, "goal %d failed without an error" % i)
+        elapsed = time.time() - started
+        rospy.loginfo("fuzz: %d goals, %d succeeded, %.1f s", FUZZ_GOALS, succeeded, elapsed)
+        self.assertLess(elapsed, FUZZ_SECONDS)
+        self.assertGreater(succeeded, 0)  # the fuzz also reached planning, not only refusals
+        self.assert_alive()
+
+
+if __name__ == "__main__":
+    rostest.rosrun("lfd_test", "executor_action", ExecutorAction)
