@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <sstream>
+#include <tuple>
 
 namespace lfd_dmp {
 namespace {
@@ -66,20 +67,71 @@ HeadingFrame headingFrame(const SkillLibrary& lib, const SegmentSkills& seg,
   return h;
 }
 
-// Distance of a goal from the convex hull of the demos' goal positions, and the allowed margin.
-void demoRange(const SegmentSkills& seg, const ExecutorOptions& options, SegmentTarget* t) {
-  Eigen::MatrixXd points(3, static_cast<Eigen::Index>(seg.demos.size()));
+// The convex hull distance of `q` from the columns of `points` and the margin allowed: a fraction
+// of their spread, at least `floor`.
+std::pair<double, double> hullRange(const Eigen::MatrixXd& points, const Eigen::VectorXd& q,
+                                    double fraction, double floor) {
   double diameter = 0.0;
-  for (size_t j = 0; j < seg.demos.size(); ++j) {
+  for (Eigen::Index i = 0; i < points.cols(); ++i)
+    for (Eigen::Index j = 0; j < i; ++j)
+      diameter = std::max(diameter, (points.col(i) - points.col(j)).norm());
+  return {lfd::convexHullDistance(points, q), std::max(fraction * diameter, floor)};
+}
+
+// Where the motion's shape would be extrapolated: the goal from the hull of the demos' goals.
+void shapeRange(const SegmentSkills& seg, const ExecutorOptions& options, SegmentTarget* t) {
+  Eigen::MatrixXd points(3, static_cast<Eigen::Index>(seg.demos.size()));
+  for (size_t j = 0; j < seg.demos.size(); ++j)
     points.col(static_cast<Eigen::Index>(j)) = seg.demos[j].dmp.position->goal();
-    for (size_t i = 0; i < j; ++i)
-      diameter = std::max(diameter, (points.col(static_cast<Eigen::Index>(i)) -
-                                     points.col(static_cast<Eigen::Index>(j)))
-                                        .norm());
+  std::tie(t->shape_distance, t->shape_margin) = hullRange(
+      points, t->goal.position, options.generalization.range_margin, options.min_range_margin);
+}
+
+// How far the new pose of `frame` lies from its poses in the demos' scenes (the base frame has none).
+// `with_origin` false: only its rotation counts (an orientation is learned relative to it).
+DemoRange frameRange(const SkillLibrary& lib, const lfd::SceneFrame& frame, const lfd::Pose& now,
+                     bool with_origin, const ExecutorOptions& options) {
+  DemoRange r;
+  r.frame = frame.name();
+  std::vector<lfd::Pose> demo;
+  for (const auto& [id, d] : lib.demo_scenes) {
+    try {
+      demo.push_back(lfd::framePose(frame, d.scene, d.start, options.frames));
+    } catch (const std::invalid_argument&) {  // undefined in that demo: not a demonstrated pose
+    }
   }
-  t->range_distance = lfd::convexHullDistance(points, t->goal.position);
-  t->range_margin =
-      std::max(options.generalization.range_margin * diameter, options.min_range_margin);
+  if (frame.kind == lfd::SceneFrame::Kind::kBase || demo.empty()) return r;
+  Eigen::MatrixXd origins(3, static_cast<Eigen::Index>(demo.size())), rotations = origins;
+  std::vector<Eigen::Quaterniond> qs;
+  for (const lfd::Pose& p : demo) qs.push_back(p.orientation);
+  const Eigen::Quaterniond mean = lfd::meanQuaternion(qs);
+  // Rotation vectors about the mean: a hull in 3-D, sign-safe for spreads below half a turn.
+  auto vec = [&](const Eigen::Quaterniond& q) {
+    Eigen::Quaterniond d = mean.conjugate() * q;
+    if (d.w() < 0.0) d.coeffs() = -d.coeffs();
+    const Eigen::AngleAxisd aa(d);
+    return Eigen::Vector3d(aa.angle() * aa.axis());
+  };
+  for (size_t j = 0; j < demo.size(); ++j) {
+    origins.col(static_cast<Eigen::Index>(j)) = demo[j].position;
+    rotations.col(static_cast<Eigen::Index>(j)) = vec(demo[j].orientation);
+  }
+  const auto& g = options.generalization;
+  if (with_origin)
+    std::tie(r.distance, r.distance_margin) =
+        hullRange(origins, now.position, g.range_margin, options.min_range_margin);
+  std::tie(r.angle, r.angle_margin) =
+      hullRange(rotations, vec(now.orientation), g.range_margin, options.min_range_angle);
+  return r;
+}
+
+// The frame (of the two) farther outside its demonstrated range, relative to its margins.
+DemoRange worse(const DemoRange& a, const DemoRange& b) {
+  auto ratio = [](const DemoRange& r) {
+    return std::max(r.distance / std::max(r.distance_margin, 1e-12),
+                    r.angle / std::max(r.angle_margin, 1e-12));
+  };
+  return ratio(b) > ratio(a) ? b : a;
 }
 
 void checkLibrary(const SkillLibrary& library) {
@@ -105,24 +157,24 @@ void checkLibrary(const SkillLibrary& library) {
 void checkRange(const std::vector<SegmentTarget>& targets, bool allow, ExecutionPlan* plan) {
   const SegmentTarget* worst = nullptr;
   for (const SegmentTarget& t : targets) {
-    plan->extrapolation_distance = std::max(plan->extrapolation_distance, t.range_distance);
-    if (t.range_distance > t.range_margin &&
-        (!worst || t.range_distance - t.range_margin > worst->range_distance - worst->range_margin))
-      worst = &t;
+    plan->extrapolation_distance = std::max(plan->extrapolation_distance, t.range.distance);
+    plan->extrapolation_angle = std::max(plan->extrapolation_angle, t.range.angle);
+    if (t.range.outside() && !worst) worst = &t;
   }
   if (!worst) return;
   plan->outside_demo_range = true;
+  const DemoRange& r = worst->range;
   std::ostringstream m;
   m.precision(3);
-  m << "segment '" << worst->name << "' goal " << vec(worst->goal.position) << " lies "
-    << worst->range_distance << " m from the demonstrated goals (allowed " << worst->range_margin
-    << " m: ~generalization/range_margin x their spread, at least ~min_range_margin)";
+  m << "segment '" << worst->name << "': its frame " << r.frame << " lies " << r.distance
+    << " m and " << r.angle << " rad from where the demonstrations had it (allowed " << r.distance_margin
+    << " m, " << r.angle_margin << " rad: ~generalization/range_margin x their spread, at least "
+    << "~min_range_margin, ~min_range_angle)";
   if (!allow)
     throw OutsideDemoRange(m.str() + "; outside the demonstrated range (set allow_extrapolation "
                                      "to run it anyway)",
-                           plan->extrapolation_distance);
-  plan->warnings.push_back(m.str() + "; run anyway (allow_extrapolation), generalized by the "
-                                     "kernel average there");
+                           plan->extrapolation_distance, plan->extrapolation_angle);
+  plan->warnings.push_back(m.str() + "; run anyway (allow_extrapolation)");
 }
 
 // Samples of one generalized segment appended to the plan (each later segment starts where the
@@ -189,7 +241,13 @@ std::vector<SegmentTarget> segmentTargets(const SkillLibrary& library, const lfd
       throw std::invalid_argument("segment '" + seg.name + "' (goal frames " + t.frames +
                                   "): " + e.what());
     }
-    demoRange(seg, options, &t);
+    t.range = worse(frameRange(library, g.position_frame,
+                               lfd::framePose(g.position_frame, scene, start, options.frames), true,
+                               options),
+                    frameRange(library, g.orientation_frame,
+                               lfd::framePose(g.orientation_frame, scene, start, options.frames),
+                               false, options));
+    shapeRange(seg, options, &t);
     targets.push_back(t);
   }
   return targets;
@@ -265,11 +323,15 @@ ExecutionPlan TaskPlanner::plan(const SkillLibrary& library,
     if (dmps.empty())
       throw std::invalid_argument("segment '" + seg.name + "' has no usable demonstration");
     const Eigen::VectorXd query = use_all ? all_query : Eigen::VectorXd(target.goal.position);
-    // Outside the demonstrated range the local linear fit would extrapolate the motion's shape
-    // (a teleop approach from an undemonstrated side swept through the box); the kernel average
-    // is a convex mix of demonstrated shapes, only its end moves to the new goal.
+    // Beyond the demos' goals the local linear fit would extrapolate the motion's shape (a teleop
+    // approach to a side demonstrated once swept through the box); the kernel average is a convex
+    // mix of demonstrated shapes, only its end moves to the new goal.
     lfd::GeneralizationOptions gen_options = options.generalization;
-    if (target.range_distance > target.range_margin) gen_options.local_linear = false;
+    if (target.shape_distance > target.shape_margin) {
+      gen_options.local_linear = false;
+      plan.warnings.push_back("segment '" + seg.name + "': its goal lies beyond the demos' goals: "
+                              "generalized by the kernel average");
+    }
     lfd::GeneralizationResult gen = lfd::generalizeSegment(dmps, params, query, gen_options);
     if (heading) gen.dmp = gen.dmp.rotated(yawMatrix(heading->yaw));
 

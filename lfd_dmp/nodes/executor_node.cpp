@@ -123,6 +123,8 @@ class Executor {
     gen.range_margin = param(pnh, "generalization/range_margin", gen.range_margin);
     options_.min_range_margin =
         param(pnh, "generalization/min_range_margin", options_.min_range_margin);
+    options_.min_range_angle =
+        param(pnh, "generalization/min_range_angle", options_.min_range_angle);
     settle_time_ = param(pnh, "settle_time", settle_time_);
     clock_timeout_ = param(pnh, "clock_timeout", clock_timeout_);
     motion_lead_ = param(pnh, "motion_lead", motion_lead_);
@@ -268,8 +270,10 @@ class Executor {
       const Eigen::VectorXd q = currentJoints(&gripper);
       std::vector<std::string> warnings;
       const auto targets = lfd_dmp::segmentTargets(library, s, planner().forward(q), opt, &warnings);
-      for (const auto& t : targets)
-        result.extrapolation_distance = std::max(result.extrapolation_distance, t.range_distance);
+      for (const auto& t : targets) {
+        result.extrapolation_distance = std::max(result.extrapolation_distance, t.range.distance);
+        result.extrapolation_angle = std::max(result.extrapolation_angle, t.range.angle);
+      }
       lfd_dmp::ExecutionPlan plan = planner().plan(library, targets, q, gripper, opt, [this] {
         return server_->isPreemptRequested() || !ros::ok();
       });
@@ -287,6 +291,7 @@ class Executor {
       finish(&result, e.what(), true);
     } catch (const lfd_dmp::OutsideDemoRange& e) {
       result.extrapolation_distance = e.distance;
+      result.extrapolation_angle = e.angle;
       result.outside_demo_range = true;
       finish(&result, e.what(), false);
     } catch (const std::exception& e) {
@@ -312,6 +317,7 @@ class Executor {
     result->planned_duration = plan.duration();
     result->warnings = plan.warnings;
     result->extrapolation_distance = plan.extrapolation_distance;
+    result->extrapolation_angle = plan.extrapolation_angle;
     result->outside_demo_range = plan.outside_demo_range;
     for (const auto& w : plan.warnings) ROS_WARN("executor: %s", w.c_str());
     for (const auto& s : plan.segments) {

@@ -294,13 +294,13 @@ TEST_F(PlannerTest, GoalsOutsideTheDemonstratedRangeAreRefusedUnlessAllowed) {
   opt.dt = 0.01;
   const Eigen::Vector3d grasp = home_.position + Eigen::Vector3d(0.02, 0.0, -0.045);
   auto t = targets(grasp, grasp + Eigen::Vector3d(0.0, 0.05, 0.12));
-  t[1].range_distance = 0.2;
-  t[1].range_margin = 0.03;
+  t[1].range = {"goal", 0.2, 0.05, 0.03, 0.1};
   try {
     planner_.plan(lib_, t, q0_, 0.04, opt);
     FAIL() << "a goal outside the demonstrated range was planned";
   } catch (const lfd_dmp::OutsideDemoRange& e) {
     EXPECT_DOUBLE_EQ(e.distance, 0.2);
+    EXPECT_DOUBLE_EQ(e.angle, 0.05);
     const std::string msg = e.what();
     EXPECT_NE(msg.find("segment 'move'"), std::string::npos) << msg;
     EXPECT_NE(msg.find("allow_extrapolation"), std::string::npos) << msg;
@@ -310,11 +310,17 @@ TEST_F(PlannerTest, GoalsOutsideTheDemonstratedRangeAreRefusedUnlessAllowed) {
   EXPECT_TRUE(plan.outside_demo_range);
   EXPECT_DOUBLE_EQ(plan.extrapolation_distance, 0.2);
   ASSERT_FALSE(plan.warnings.empty());
-  EXPECT_NE(plan.warnings.back().find("kernel average"), std::string::npos);
-  t[1].range_distance = 0.01;  // inside the margin: no flag, the distance still reported
+  EXPECT_NE(plan.warnings.back().find("allow_extrapolation"), std::string::npos);
+  t[1].range.distance = 0.01;  // inside the margins: no flag, the distance still reported
   const lfd_dmp::ExecutionPlan inside = planner_.plan(lib_, t, q0_, 0.04, opt);
   EXPECT_FALSE(inside.outside_demo_range);
   EXPECT_DOUBLE_EQ(inside.extrapolation_distance, 0.01);
+  // A goal beyond the demos' goals: the motion's shape comes from the kernel average there.
+  t[1].shape_distance = 0.1;
+  t[1].shape_margin = 0.02;
+  const lfd_dmp::ExecutionPlan convex = planner_.plan(lib_, t, q0_, 0.04, opt);
+  ASSERT_FALSE(convex.warnings.empty());
+  EXPECT_NE(convex.warnings.back().find("kernel average"), std::string::npos);
 }
 
 // Issue 12: duration_scale 1000 took 1.36 GB. The plan is refused before anything is allocated,
@@ -406,7 +412,8 @@ TEST_F(PlannerTest, SegmentGoalsFollowTheFramesLearnedFromTheDemos) {
   ASSERT_TRUE(t[1].heading.has_value());
   EXPECT_NEAR(t[1].heading->yaw, -0.3, 1e-9);
   EXPECT_EQ(t[1].heading->demo_yaw.size(), 4u);
-  EXPECT_LT(t[0].range_distance, t[0].range_margin);  // inside the demonstrated range
+  EXPECT_FALSE(t[0].range.outside());  // a heading and a box position like the demos'
+  EXPECT_FALSE(t[1].range.outside());
   const lfd_dmp::ExecutionPlan plan = planner_.plan(lib, t, q0_, std::nullopt, opt);
   EXPECT_LT((plan.poses[plan.segments[1].end - 1].position - t[1].goal.position).norm(), 0.004);
   EXPECT_LT(strokeDeviation(plan, t[0].goal.position, t[1].goal.position), 0.002);
@@ -428,7 +435,9 @@ TEST_F(PlannerTest, SegmentGoalsFollowTheFramesLearnedFromTheDemos) {
   far.objects["box"].position += Eigen::Vector3d(0.5, 0.0, 0.0);
   far.goal.position += Eigen::Vector3d(0.5, 0.0, 0.0);
   const auto tf = lfd_dmp::segmentTargets(lib, far, home_, opt, &warnings);
-  EXPECT_GT(tf[0].range_distance, 0.4);
+  EXPECT_GT(tf[0].range.distance, 0.4);
+  EXPECT_TRUE(tf[0].range.outside());
+  EXPECT_GT(tf[0].shape_distance, tf[0].shape_margin);
   EXPECT_THROW(planner_.plan(lib, tf, q0_, std::nullopt, opt), lfd_dmp::OutsideDemoRange);
   // A library learned without scenes cannot be executed: relearn.
   lfd_dmp::SkillLibrary no_goals = lib;

@@ -217,7 +217,7 @@ class Response(object):
         self.final_position_error, self.final_orientation_error = 0.004, 0.02
         self.segment_durations = [4.0, 6.0]
         self.segment_frames = ["object:stick / object:stick", "goal / goal"]
-        self.extrapolation_distance, self.outside_demo_range = 0.0, False
+        self.extrapolation_distance, self.extrapolation_angle, self.outside_demo_range = 0.0, 0.0, False
 
 
 class Records(unittest.TestCase):

@@ -60,7 +60,7 @@ class Cell(object):
         # sim time, which stands still while paused.
         self.action = actionlib.ActionClient("/executor/execute", ExecuteTaskAction)
         deadline = time.time() + 120
-        while self.action.last_status_msg is None:
+        while not self._server_ready():
             if time.time() > deadline:
                 raise RuntimeError("the executor's action /executor/execute did not come up in 120 s")
             time.sleep(0.01)
@@ -71,6 +71,17 @@ class Cell(object):
         self.sim_time = self.step(1) if lockstep else None
         while rospy.Time.now().is_zero():
             time.sleep(0.01)
+
+    def _server_ready(self):
+        """ActionClient.wait_for_server's test, without its sim-time timeout: the server's status
+        arrived and every topic to and from it is connected (a goal sent earlier is lost)."""
+        a = self.action
+        if not a.last_status_msg:
+            return False
+        server = a.last_status_msg._connection_header["callerid"]
+        return (a.pub_goal.impl.has_connection(server) and a.pub_cancel.impl.has_connection(server)
+                and any(c.callerid_pub == server for c in a.result_sub.impl.connections)
+                and any(c.callerid_pub == server for c in a.feedback_sub.impl.connections))
 
     def _on_pose(self, msg, name):
         self.poses[name] = msg

@@ -38,13 +38,29 @@ struct HeadingFrame {
   std::map<std::string, double> demo_yaw;  ///< each demo's heading, by demo id
 };
 
+/// How far a segment's new goal frames lie from the demonstrated ones: the position frame's origin
+/// from the convex hull of the demos' origins, the rotation of both frames (as a rotation vector
+/// about the demos' mean) from the hull of theirs. What the goal is learned relative to decides what "demonstrated"
+/// means: a push along a demonstrated heading, starting where boxes started, is inside even if the
+/// fist ends somewhere no demo's did.
+struct DemoRange {
+  std::string frame;              ///< the frame (of the segment's two) farthest outside
+  double distance = 0.0;          ///< m
+  double angle = 0.0;             ///< rad
+  double distance_margin = 0.0;   ///< m allowed
+  double angle_margin = 0.0;      ///< rad allowed
+  bool outside() const { return distance > distance_margin || angle > angle_margin; }
+};
+
 struct SegmentTarget {
   std::string name;
   TcpPose goal;
   std::string frames;  ///< "<position frame> / <orientation frame>", for reports
   std::optional<HeadingFrame> heading;
-  double range_distance = 0.0;  ///< m from the convex hull of the demos' goal positions
-  double range_margin = 0.0;    ///< m allowed before the goal counts as outside the demos' range
+  DemoRange range;
+  /// m from the convex hull of the demos' goal positions, and the margin beyond which the local
+  /// linear fit would extrapolate the motion's shape (the kernel average is used there instead).
+  double shape_distance = 0.0, shape_margin = 0.0;
 };
 
 /// A change of the thresholded gripper state at `sample` (close = true).
@@ -63,8 +79,9 @@ struct ExecutorOptions {
   double dt = 0.002;              ///< s between planned samples (500 Hz)
   double duration_scale = 1.0;    ///< multiplies every generalized segment duration
   bool all_segment_goals = true;  ///< generalize over all segment goals (task via-points) of a demo
-  lfd::GeneralizationOptions generalization;  ///< range_margin: fraction of the demos' goal spread
-  double min_range_margin = 0.02;  ///< m: the smallest margin (demos that all end in one place)
+  lfd::GeneralizationOptions generalization;  ///< range_margin: fraction of the demos' spread
+  double min_range_margin = 0.02;  ///< m: the smallest distance margin (demos in one place)
+  double min_range_angle = 0.1;    ///< rad: the smallest angle margin
   bool allow_extrapolation = false;  ///< plan goals outside the demonstrated range anyway
   lfd::FrameOptions frames;
   bool heading_frames = true;  ///< generalize segments that follow a heading in its frame
@@ -77,9 +94,10 @@ struct ExecutorOptions {
 /// A goal outside the demonstrated range when extrapolation is not allowed.
 class OutsideDemoRange : public std::invalid_argument {
  public:
-  OutsideDemoRange(const std::string& what, double distance)
-      : std::invalid_argument(what), distance(distance) {}
-  double distance;  ///< m, the largest distance of a segment goal from its demos' goals
+  OutsideDemoRange(const std::string& what, double distance, double angle)
+      : std::invalid_argument(what), distance(distance), angle(angle) {}
+  double distance;  ///< m, the largest DemoRange::distance of the segments
+  double angle;     ///< rad, the largest DemoRange::angle
 };
 
 /// Planning stopped because the caller cancelled it.
@@ -107,7 +125,8 @@ struct ExecutionPlan {
   std::vector<GripperEvent> gripper_events;
   std::vector<PlannedSegment> segments;
   std::vector<std::string> warnings;
-  double extrapolation_distance = 0.0;  ///< m, largest SegmentTarget::range_distance
+  double extrapolation_distance = 0.0;  ///< m, largest DemoRange::distance of the segments
+  double extrapolation_angle = 0.0;     ///< rad, largest DemoRange::angle
   bool outside_demo_range = false;
   double max_ik_position_error = 0.0;
   double max_ik_orientation_error = 0.0;
@@ -116,8 +135,8 @@ struct ExecutionPlan {
 };
 
 /// The goal of every segment of `library` in `scene` for a task starting with the TCP at `start`:
-/// its learned frames and offsets, the heading frame it is generalized in, and its distance from
-/// the demonstrated goals. Throws std::invalid_argument when the library has no learned goals
+/// its learned frames and offsets, the heading frame it is generalized in, and how far it lies
+/// from what was demonstrated (DemoRange; the shape distance). Throws std::invalid_argument when the library has no learned goals
 /// (relearn it) or the scene lacks what a frame needs (an object, a defined heading).
 std::vector<SegmentTarget> segmentTargets(const SkillLibrary& library, const lfd::Scene& scene,
                                           const TcpPose& start, const ExecutorOptions& options,
