@@ -450,6 +450,62 @@ TEST_F(PlannerTest, SegmentGoalsFollowTheFramesLearnedFromTheDemos) {
   }
 }
 
+// Nothing is task-specific: a task no code knows (four segments, objects named "cup" and "tray")
+// learns where each segment ends from its scenes, and a new scene gives the goals.
+TEST_F(PlannerTest, AnyTaskLearnsItsSegmentGoalsFromItsScenes) {
+  std::vector<lfd_dmp::DemoRecording> demos;
+  std::vector<std::vector<double>> cps;
+  const Eigen::Vector3d up(0.0, 0.0, 0.06);
+  for (int j = 0; j < 5; ++j) {
+    lfd::Scene scene;
+    scene.objects["cup"].position = home_.position + Eigen::Vector3d(0.05 - 0.02 * j, 0.03 * j - 0.06, -0.06);
+    scene.objects["tray"].position = home_.position + Eigen::Vector3d(0.02 * j, -0.05, -0.07);
+    scene.goal.position = home_.position + Eigen::Vector3d(-0.03 * j, 0.04 + 0.01 * j, -0.04);
+    const Eigen::Vector3d via[5] = {home_.position, scene.objects["cup"].position,
+                                    scene.goal.position, scene.goal.position + up, home_.position};
+    lfd_dmp::DemoRecording rec;
+    rec.id = "demo_" + std::to_string(j);
+    rec.frame = "base_link";
+    rec.scene = scene;
+    const int m = 801;
+    rec.times = Eigen::VectorXd::LinSpaced(m, 0.0, 8.0);
+    rec.positions.resize(m, 3);
+    rec.quaternions.resize(m, 4);
+    for (int k = 0; k < m; ++k) {
+      const int s = std::min(3, static_cast<int>(rec.times[k] / 2.0));
+      const double u = minJerk(std::clamp((rec.times[k] - 2.0 * s) / 2.0, 0.0, 1.0));
+      rec.positions.row(k) = (via[s] + u * (via[s + 1] - via[s])).transpose();
+      rec.quaternions.row(k) << home_.orientation.w(), home_.orientation.x(), home_.orientation.y(),
+          home_.orientation.z();
+    }
+    demos.push_back(rec);
+    cps.push_back({2.0, 4.0, 6.0});
+  }
+  lfd_dmp::LearnOptions learn;
+  learn.task = "stack";
+  learn.segment_names = {"reach", "carry", "lift", "home"};
+  learn.params.num_basis = 20;
+  const lfd_dmp::SkillLibrary lib = lfd_dmp::learnSkillLibrary(demos, cps, learn).library;
+  const char* expected[4] = {"object:cup", "goal", "goal", "start"};
+  for (int s = 0; s < 4; ++s) EXPECT_EQ(lib.segments[s].goal->position_frame.name(), expected[s]);
+  lfd::Scene scene;
+  scene.objects["cup"].position = home_.position + Eigen::Vector3d(0.0, 0.0, -0.06);
+  scene.objects["tray"].position = home_.position + Eigen::Vector3d(0.04, -0.05, -0.07);
+  scene.goal.position = home_.position + Eigen::Vector3d(-0.05, 0.06, -0.04);
+  lfd_dmp::ExecutorOptions opt;
+  opt.dt = 0.004;
+  std::vector<std::string> warnings;
+  const auto t = lfd_dmp::segmentTargets(lib, scene, home_, opt, &warnings);
+  EXPECT_LT((t[0].goal.position - scene.objects["cup"].position).norm(), 1e-6);
+  EXPECT_LT((t[1].goal.position - scene.goal.position).norm(), 1e-6);
+  EXPECT_LT((t[2].goal.position - (scene.goal.position + up)).norm(), 1e-6);
+  EXPECT_LT((t[3].goal.position - home_.position).norm(), 1e-6);
+  const lfd_dmp::ExecutionPlan plan = planner_.plan(lib, t, q0_, std::nullopt, opt);
+  ASSERT_EQ(plan.segments.size(), 4u);
+  for (int s = 0; s < 4; ++s)
+    EXPECT_LT((plan.poses[plan.segments[s].end - 1].position - t[s].goal.position).norm(), 0.004);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
