@@ -88,15 +88,16 @@ DemoRecording readDemoBag(const std::string& path, const DemoBagTopics& topics,
       }
     } else if (m.getTopic() == topics.pose) {
       const auto msg = m.instantiate<geometry_msgs::PoseStamped>();
-      if (!msg) throw std::runtime_error(path + ": " + topics.pose + " is not geometry_msgs/PoseStamped");
+      if (!msg)
+        throw std::runtime_error(path + ": " + topics.pose + " is not geometry_msgs/PoseStamped");
       const double stamp = msg->header.stamp.toSec();
       const auto& p = msg->pose.position;
       const auto& q = msg->pose.orientation;
       const std::array<double, 7> row = {p.x, p.y, p.z, q.w, q.x, q.y, q.z};
       for (double v : row) {
         if (!std::isfinite(v)) {
-          throw std::runtime_error(path + ": non-finite pose on " + topics.pose + " at t = " +
-                                   std::to_string(stamp));
+          throw std::runtime_error(path + ": non-finite pose on " + topics.pose +
+                                   " at t = " + std::to_string(stamp));
         }
       }
       if (!t.empty() && stamp <= t.back()) continue;  // duplicate / out-of-order stamp

@@ -79,9 +79,7 @@ std::optional<SceneRecord> sceneFromMetadata(const std::string& extra_json) {
 }
 
 lfd::Scene transformScene(const lfd::Scene& scene, const Eigen::Isometry3d& frame_in_target) {
-  auto move = [&](const lfd::Pose& p) {
-    return lfd::toPose(frame_in_target * lfd::toIsometry(p));
-  };
+  auto move = [&](const lfd::Pose& p) { return lfd::toPose(frame_in_target * lfd::toIsometry(p)); };
   lfd::Scene out;
   for (const auto& [name, p] : scene.objects) out.objects[name] = move(p);
   out.goal = move(scene.goal);

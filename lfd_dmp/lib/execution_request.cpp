@@ -39,8 +39,7 @@ double checkedDurationScale(double scale, const RequestLimits& l) {
   if (scale == 0.0) return 1.0;
   if (!std::isfinite(scale) || scale < l.min_duration_scale || scale > l.max_duration_scale)
     throw std::invalid_argument("duration_scale " + number(scale) + " is outside [" +
-                                number(l.min_duration_scale) + ", " +
-                                number(l.max_duration_scale) +
+                                number(l.min_duration_scale) + ", " + number(l.max_duration_scale) +
                                 "] (~limits/min_duration_scale, ~limits/max_duration_scale)");
   return scale;
 }
@@ -51,8 +50,9 @@ lfd::Pose checkedPose(const Eigen::Vector3d& position, const Eigen::Vector4d& wx
     throw std::invalid_argument(what + " has a NaN or infinite value");
   const double norm = wxyz.norm();
   if (norm < 1e-9)
-    throw std::invalid_argument(what + " has a zero quaternion (no orientation; identity is "
-                                       "w = 1)");
+    throw std::invalid_argument(what +
+                                " has a zero quaternion (no orientation; identity is "
+                                "w = 1)");
   if (std::abs(norm - 1.0) > l.quaternion_tolerance)
     throw std::invalid_argument(what + " has a quaternion of norm " + number(norm) +
                                 ", not a rotation (|norm - 1| over ~limits/quaternion_tolerance " +
@@ -74,8 +74,7 @@ void checkInWorkspace(const lfd::Pose& pose, const std::string& what, const Requ
   }
 }
 
-void checkObjectNames(const std::vector<std::string>& names, size_t poses,
-                      const RequestLimits& l) {
+void checkObjectNames(const std::vector<std::string>& names, size_t poses, const RequestLimits& l) {
   if (names.size() != poses)
     throw std::invalid_argument(std::to_string(names.size()) + " object names but " +
                                 std::to_string(poses) + " object poses");

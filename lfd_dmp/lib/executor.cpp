@@ -87,8 +87,8 @@ void shapeRange(const SegmentSkills& seg, const ExecutorOptions& options, Segmen
       points, t->goal.position, options.generalization.range_margin, options.min_range_margin);
 }
 
-// How far the new pose of `frame` lies from its poses in the demos' scenes (the base frame has none).
-// `with_origin` false: only its rotation counts (an orientation is learned relative to it).
+// How far the new pose of `frame` lies from its poses in the demos' scenes (the base frame has
+// none). `with_origin` false: only its rotation counts (an orientation is learned relative to it).
 DemoRange frameRange(const SkillLibrary& lib, const lfd::SceneFrame& frame, const lfd::Pose& now,
                      bool with_origin, const ExecutorOptions& options) {
   DemoRange r;
@@ -167,12 +167,14 @@ void checkRange(const std::vector<SegmentTarget>& targets, bool allow, Execution
   std::ostringstream m;
   m.precision(3);
   m << "segment '" << worst->name << "': its frame " << r.frame << " lies " << r.distance
-    << " m and " << r.angle << " rad from where the demonstrations had it (allowed " << r.distance_margin
-    << " m, " << r.angle_margin << " rad: ~generalization/range_margin x their spread, at least "
+    << " m and " << r.angle << " rad from where the demonstrations had it (allowed "
+    << r.distance_margin << " m, " << r.angle_margin
+    << " rad: ~generalization/range_margin x their spread, at least "
     << "~min_range_margin, ~min_range_angle)";
   if (!allow)
-    throw OutsideDemoRange(m.str() + "; outside the demonstrated range (set allow_extrapolation "
-                                     "to run it anyway)",
+    throw OutsideDemoRange(m.str() +
+                               "; outside the demonstrated range (set allow_extrapolation "
+                               "to run it anyway)",
                            plan->extrapolation_distance, plan->extrapolation_angle);
   plan->warnings.push_back(m.str() + "; run anyway (allow_extrapolation)");
 }
@@ -241,12 +243,12 @@ std::vector<SegmentTarget> segmentTargets(const SkillLibrary& library, const lfd
       throw std::invalid_argument("segment '" + seg.name + "' (goal frames " + t.frames +
                                   "): " + e.what());
     }
-    t.range = worse(frameRange(library, g.position_frame,
-                               lfd::framePose(g.position_frame, scene, start, options.frames), true,
-                               options),
-                    frameRange(library, g.orientation_frame,
-                               lfd::framePose(g.orientation_frame, scene, start, options.frames),
-                               false, options));
+    t.range = worse(
+        frameRange(library, g.position_frame,
+                   lfd::framePose(g.position_frame, scene, start, options.frames), true, options),
+        frameRange(library, g.orientation_frame,
+                   lfd::framePose(g.orientation_frame, scene, start, options.frames), false,
+                   options));
     shapeRange(seg, options, &t);
     targets.push_back(t);
   }
@@ -261,7 +263,8 @@ ExecutionPlan TaskPlanner::plan(const SkillLibrary& library,
                                 const ExecutorOptions& options,
                                 const std::function<bool()>& cancelled) {
   auto poll = [&](const std::string& where) {
-    if (cancelled && cancelled()) throw PlanningCancelled("cancelled while planning (" + where + ")");
+    if (cancelled && cancelled())
+      throw PlanningCancelled("cancelled while planning (" + where + ")");
   };
   if (library.segments.empty()) throw std::invalid_argument("the skill library has no segments");
   if (targets.size() != library.segments.size()) {
@@ -329,7 +332,8 @@ ExecutionPlan TaskPlanner::plan(const SkillLibrary& library,
     lfd::GeneralizationOptions gen_options = options.generalization;
     if (target.shape_distance > target.shape_margin) {
       gen_options.local_linear = false;
-      plan.warnings.push_back("segment '" + seg.name + "': its goal lies beyond the demos' goals: "
+      plan.warnings.push_back("segment '" + seg.name +
+                              "': its goal lies beyond the demos' goals: "
                               "generalized by the kernel average");
     }
     lfd::GeneralizationResult gen = lfd::generalizeSegment(dmps, params, query, gen_options);
@@ -342,8 +346,8 @@ ExecutionPlan TaskPlanner::plan(const SkillLibrary& library,
     samples += *ro.tau / options.dt;
     if (!(samples <= static_cast<double>(options.max_samples))) {
       std::ostringstream m;
-      m << "the plan would have over " << options.max_samples << " samples ("
-        << t_offset + *ro.tau << " s at dt " << options.dt
+      m << "the plan would have over " << options.max_samples << " samples (" << t_offset + *ro.tau
+        << " s at dt " << options.dt
         << " s): over the limit (~limits/max_plan_seconds; duration_scale "
         << options.duration_scale << ")";
       throw std::invalid_argument(m.str());

@@ -17,8 +17,8 @@ geometry_msgs::Pose toPoseMsg(const lfd::Pose& p) {
   return m;
 }
 
-trajectory_msgs::JointTrajectory toJointTrajectory(const ExecutionPlan& plan, const ros::Time& start,
-                                                   double period) {
+trajectory_msgs::JointTrajectory toJointTrajectory(const ExecutionPlan& plan,
+                                                   const ros::Time& start, double period) {
   trajectory_msgs::JointTrajectory msg;
   msg.header.stamp = start;
   msg.joint_names = plan.joint_names;

@@ -76,8 +76,9 @@ bool checkScenes(const std::vector<DemoRecording>& demos, std::string* frame) {
                                   demos.front().id + " in '" + demos.front().frame + "'");
   }
   if (with > 0 && with < demos.size())
-    throw std::invalid_argument("demos without a scene (objects and goal in their metadata): " +
-                                without + "; the segment goals are learned from every demo's scene");
+    throw std::invalid_argument(
+        "demos without a scene (objects and goal in their metadata): " + without +
+        "; the segment goals are learned from every demo's scene");
   *frame = demos.front().frame.empty() ? "base_link" : demos.front().frame;
   return with > 0;
 }

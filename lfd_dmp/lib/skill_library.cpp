@@ -140,25 +140,28 @@ json goalJson(const lfd::SegmentGoalModel& g) {
     candidates.push_back(json{{"frame", c.frame.name()},
                               {"position_spread_m", spreadJson(c.position_m)},
                               {"orientation_spread_rad", spreadJson(c.orientation_rad)}});
-  return json{{"position",
-               {{"frame", g.position_frame.name()},
-                {"offset", vectorJson(g.position_offset)},
-                {"spread_m", spreadJson(g.position_spread)}}},
-              {"orientation",
-               {{"frame", g.orientation_frame.name()},
-                {"offset", quaternionJson(g.orientation_offset)},
-                {"spread_rad", spreadJson(g.orientation_spread)}}},
-              {"heading", {{"object", g.heading_object}, {"spread_rad", spreadJson(g.heading_spread)}}},
-              {"candidates", candidates}};
+  return json{
+      {"position",
+       {{"frame", g.position_frame.name()},
+        {"offset", vectorJson(g.position_offset)},
+        {"spread_m", spreadJson(g.position_spread)}}},
+      {"orientation",
+       {{"frame", g.orientation_frame.name()},
+        {"offset", quaternionJson(g.orientation_offset)},
+        {"spread_rad", spreadJson(g.orientation_spread)}}},
+      {"heading", {{"object", g.heading_object}, {"spread_rad", spreadJson(g.heading_spread)}}},
+      {"candidates", candidates}};
 }
 
 lfd::SegmentGoalModel goalFromJson(const json& j, const std::string& w) {
   lfd::SegmentGoalModel g;
   const json& p = member(j, "position", w);
   g.position_frame = frameFromJson(member(p, "frame", w + ".position"), w + ".position.frame");
-  g.position_offset = bounded(vector(member(p, "offset", w + ".position"), w + ".position.offset", 3),
-                              kMaxPositionMagnitude, w + ".position.offset", "position");
-  g.position_spread = spreadFromJson(member(p, "spread_m", w + ".position"), w + ".position.spread_m");
+  g.position_offset =
+      bounded(vector(member(p, "offset", w + ".position"), w + ".position.offset", 3),
+              kMaxPositionMagnitude, w + ".position.offset", "position");
+  g.position_spread =
+      spreadFromJson(member(p, "spread_m", w + ".position"), w + ".position.spread_m");
   const json& o = member(j, "orientation", w);
   g.orientation_frame =
       frameFromJson(member(o, "frame", w + ".orientation"), w + ".orientation.frame");
@@ -168,7 +171,8 @@ lfd::SegmentGoalModel goalFromJson(const json& j, const std::string& w) {
       spreadFromJson(member(o, "spread_rad", w + ".orientation"), w + ".orientation.spread_rad");
   const json& h = member(j, "heading", w);
   g.heading_object = text(member(h, "object", w + ".heading"), w + ".heading.object");
-  g.heading_spread = spreadFromJson(member(h, "spread_rad", w + ".heading"), w + ".heading.spread_rad");
+  g.heading_spread =
+      spreadFromJson(member(h, "spread_rad", w + ".heading"), w + ".heading.spread_rad");
   if (j.contains("candidates")) {
     const json& c = j["candidates"];
     if (!c.is_array()) fail(w + ".candidates", "expected an array");
@@ -313,8 +317,7 @@ lfd::SegmentDmp segmentDmpFromJson(const json& j, const lfd::DmpParameters& para
       dmp.position.emplace(params, dmp.tau, weights(member(p, "weights", w), w + ".weights", d, n),
                            bounded(vector(member(p, "start", w), w + ".start", d),
                                    kMaxPositionMagnitude, w + ".start", "position"),
-                           goal,
-                           vector(member(p, "start_velocity", w), w + ".start_velocity", d));
+                           goal, vector(member(p, "start_velocity", w), w + ".start_velocity", d));
     }
     if (j.contains("orientation")) {
       const std::string w = where + ".orientation";
@@ -356,9 +359,10 @@ SkillLibrary skillLibraryFromJson(const json& j) {
   }
   const double version = number(member(j, "version", root), "version");
   if (version == 1) {
-    fail("version", "version 1 has no learned segment goals (they were rules in the executor's "
-                    "config): relearn the library with this build (learn_skills.py or "
-                    "/learner/learn)");
+    fail("version",
+         "version 1 has no learned segment goals (they were rules in the executor's "
+         "config): relearn the library with this build (learn_skills.py or "
+         "/learner/learn)");
   }
   if (version != kSkillLibraryVersion) {
     fail("version", "unsupported version " + std::to_string(static_cast<int>(version)) +

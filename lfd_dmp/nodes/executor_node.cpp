@@ -15,9 +15,9 @@
 #include "lfd_dmp/executor.hpp"
 #include "lfd_dmp/plan_messages.hpp"
 
+#include <lfd_msgs/ExecuteTaskAction.h>
 #include <lfd_core/robot_setup.hpp>
 #include <lfd_core/safe_paths.hpp>
-#include <lfd_msgs/ExecuteTaskAction.h>
 
 #include <actionlib/server/simple_action_server.h>
 #include <ros/ros.h>
@@ -133,8 +133,10 @@ class Executor {
     trajectory_period_ = param(pnh, "trajectory_period", trajectory_period_);
     feedback_period_ = param(pnh, "feedback_period", feedback_period_);
     paths_.allowed_roots = param(pnh, "allowed_roots", paths_.allowed_roots);
-    limits_.min_duration_scale = param(pnh, "limits/min_duration_scale", limits_.min_duration_scale);
-    limits_.max_duration_scale = param(pnh, "limits/max_duration_scale", limits_.max_duration_scale);
+    limits_.min_duration_scale =
+        param(pnh, "limits/min_duration_scale", limits_.min_duration_scale);
+    limits_.max_duration_scale =
+        param(pnh, "limits/max_duration_scale", limits_.max_duration_scale);
     limits_.max_plan_seconds = param(pnh, "limits/max_plan_seconds", limits_.max_plan_seconds);
     limits_.quaternion_tolerance =
         param(pnh, "limits/quaternion_tolerance", limits_.quaternion_tolerance);
@@ -146,8 +148,9 @@ class Executor {
     lfd_dmp::checkLimits(limits_);
     if (!(options_.dt > 0.0) || !(settle_time_ >= 0.0) || !(clock_timeout_ > 0.0) ||
         !(motion_lead_ >= 0.0) || !(trajectory_period_ > 0.0))
-      throw std::runtime_error("executor: dt, clock_timeout, trajectory_period must be > 0 and "
-                               "settle_time, motion_lead >= 0");
+      throw std::runtime_error(
+          "executor: dt, clock_timeout, trajectory_period must be > 0 and "
+          "settle_time, motion_lead >= 0");
     options_.max_samples = static_cast<size_t>(limits_.max_plan_seconds / options_.dt);
   }
 
@@ -186,8 +189,8 @@ class Executor {
     lfd_dmp::checkNameLength(ps.header.frame_id, what + " frame", limits_);
     if (ps.header.frame_id.empty())
       throw std::invalid_argument(what + " has no header.frame_id (e.g. world)");
-    const lfd::Pose out = lfd::toPose(transform(cartesianFrame(), ps.header.frame_id) *
-                                      lfd::toIsometry(raw));
+    const lfd::Pose out =
+        lfd::toPose(transform(cartesianFrame(), ps.header.frame_id) * lfd::toIsometry(raw));
     lfd_dmp::checkInWorkspace(out, what, limits_);
     return out;
   }
@@ -269,7 +272,8 @@ class Executor {
       std::optional<double> gripper;
       const Eigen::VectorXd q = currentJoints(&gripper);
       std::vector<std::string> warnings;
-      const auto targets = lfd_dmp::segmentTargets(library, s, planner().forward(q), opt, &warnings);
+      const auto targets =
+          lfd_dmp::segmentTargets(library, s, planner().forward(q), opt, &warnings);
       for (const auto& t : targets) {
         result.extrapolation_distance = std::max(result.extrapolation_distance, t.range.distance);
         result.extrapolation_angle = std::max(result.extrapolation_angle, t.range.angle);
@@ -349,8 +353,8 @@ class Executor {
     const ros::Time t0 = ros::Time::now() + ros::Duration(motion_lead_);
     trajectory_pub_.publish(lfd_dmp::toJointTrajectory(plan, t0, trajectory_period_));
     for (const lfd_dmp::GripperEvent& e : plan.gripper_events)
-      gripper_pub_.publish(
-          lfd_dmp::gripperCommand(e.close, robot_.gripper, t0 + ros::Duration(plan.times[e.sample])));
+      gripper_pub_.publish(lfd_dmp::gripperCommand(e.close, robot_.gripper,
+                                                   t0 + ros::Duration(plan.times[e.sample])));
     result->motion_start = t0;
     executed_ = nav_msgs::Path();
     feedback_.motion_start = t0;
@@ -377,8 +381,9 @@ class Executor {
     }
     if (reached.isZero()) {
       reached = ros::Time::now();
-      result->warnings.push_back("the TCP did not come within the IK tolerance of its final pose "
-                                 "in ~settle_time");
+      result->warnings.push_back(
+          "the TCP did not come within the IK tolerance of its final pose "
+          "in ~settle_time");
     }
     result->execution_time = (reached - t0).toSec();
     result->final_position_error = feedback_.tcp_position_error;
@@ -435,8 +440,8 @@ class Executor {
       const lfd::Pose tcp = planner().forward(q);
       feedback_.tcp_position_error = (tcp.position - plan.poses[k].position).norm();
       feedback_.tcp_orientation_error = tcp.orientation.angularDistance(plan.poses[k].orientation);
-      feedback_.progress = plan.duration() > 0 ? std::min(1.0, (stamp - t0).toSec() / plan.duration())
-                                               : 1.0;
+      feedback_.progress =
+          plan.duration() > 0 ? std::min(1.0, (stamp - t0).toSec() / plan.duration()) : 1.0;
       feedback_.progress = std::max(0.0, feedback_.progress);
       const auto& seg = segmentAt(plan, k);
       feedback_.segment_index = static_cast<uint32_t>(&seg - plan.segments.data());

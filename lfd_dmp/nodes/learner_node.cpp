@@ -127,8 +127,8 @@ class Learner {
     const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(tf_timeout_);
     while (!tf_buffer_.canTransform(target, source, ros::Time(0), &why)) {
       if (ros::WallTime::now() > deadline || !ros::ok())
-        throw std::runtime_error("no transform from '" + source + "' to '" + target + "' (" +
-                                 why + ")");
+        throw std::runtime_error("no transform from '" + source + "' to '" + target + "' (" + why +
+                                 ")");
       ros::WallDuration(0.01).sleep();
     }
     const auto t = tf_buffer_.lookupTransform(target, source, ros::Time(0)).transform;

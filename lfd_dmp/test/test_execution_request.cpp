@@ -39,7 +39,8 @@ TEST(ExecutionRequest, QuaternionsAreNormalizedWithinTheToleranceAndRefusedBeyon
   EXPECT_NEAR(ok.orientation.norm(), 1.0, 1e-12);
   EXPECT_NEAR(ok.orientation.angularDistance(Eigen::Quaterniond(c, 0, 0, s)), 0.0, 1e-12);
   // Issue 12: 2 x a yaw of 0.3 was planned at 0.96 rad; a zero quaternion was read as yaw 0.
-  std::string m = refusal([&] { lfd_dmp::checkedPose(p, Eigen::Vector4d(2 * c, 0, 0, 2 * s), "goal", l); });
+  std::string m =
+      refusal([&] { lfd_dmp::checkedPose(p, Eigen::Vector4d(2 * c, 0, 0, 2 * s), "goal", l); });
   EXPECT_NE(m.find("norm 2"), std::string::npos) << m;
   EXPECT_NE(m.find("~limits/quaternion_tolerance"), std::string::npos) << m;
   m = refusal([&] { lfd_dmp::checkedPose(p, Eigen::Vector4d::Zero(), "goal", l); });
@@ -65,7 +66,9 @@ TEST(ExecutionRequest, PosesOutsideTheWorkspaceAndBadNamesAreRefused) {
   lfd::Pose near;
   near.position = Eigen::Vector3d(0.5, -0.3, 0.0);
   EXPECT_NO_THROW(lfd_dmp::checkInWorkspace(near, "goal", l));
-  EXPECT_NE(refusal([&] { lfd_dmp::checkObjectNames({"box", "box"}, 2, l); }).find("twice"),
+  EXPECT_NE(refusal([&] {
+              lfd_dmp::checkObjectNames({"box", "box"}, 2, l);
+            }).find("twice"),
             std::string::npos);
   EXPECT_NE(refusal([&] { lfd_dmp::checkObjectNames({""}, 1, l); }).find("empty"),
             std::string::npos);

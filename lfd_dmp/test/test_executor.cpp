@@ -130,8 +130,7 @@ lfd::CartesianToJoints converter(const lfd::KinematicChain& chain, const Eigen::
 
 class PlannerTest : public ::testing::Test {
  protected:
-  PlannerTest()
-      : chain_(chain()), q0_(homePosture(chain_)), planner_(converter(chain_, q0_)) {
+  PlannerTest() : chain_(chain()), q0_(homePosture(chain_)), planner_(converter(chain_, q0_)) {
     home_ = planner_.forward(q0_);
     lib_ = library(home_);
   }
@@ -213,9 +212,10 @@ TEST_F(PlannerTest, OverflowingSkillWeightsAreAClearError) {
   lfd_dmp::SkillLibrary lib = lib_;
   for (lfd_dmp::DemoSkill& demo : lib.segments[0].demos) {
     const lfd::PositionDmp p = *demo.dmp.position;  // a copy: emplace destroys the original
-    demo.dmp.position.emplace(p.parameters(), p.tau(),
-                              Eigen::MatrixXd::Constant(p.weights().rows(), p.weights().cols(), 1e300),
-                              p.start(), p.goal(), p.startVelocity());
+    demo.dmp.position.emplace(
+        p.parameters(), p.tau(),
+        Eigen::MatrixXd::Constant(p.weights().rows(), p.weights().cols(), 1e300), p.start(),
+        p.goal(), p.startVelocity());
   }
   lfd_dmp::ExecutorOptions opt;
   opt.dt = 0.01;
@@ -458,7 +458,8 @@ TEST_F(PlannerTest, AnyTaskLearnsItsSegmentGoalsFromItsScenes) {
   const Eigen::Vector3d up(0.0, 0.0, 0.06);
   for (int j = 0; j < 5; ++j) {
     lfd::Scene scene;
-    scene.objects["cup"].position = home_.position + Eigen::Vector3d(0.05 - 0.02 * j, 0.03 * j - 0.06, -0.06);
+    scene.objects["cup"].position =
+        home_.position + Eigen::Vector3d(0.05 - 0.02 * j, 0.03 * j - 0.06, -0.06);
     scene.objects["tray"].position = home_.position + Eigen::Vector3d(0.02 * j, -0.05, -0.07);
     scene.goal.position = home_.position + Eigen::Vector3d(-0.03 * j, 0.04 + 0.01 * j, -0.04);
     const Eigen::Vector3d via[5] = {home_.position, scene.objects["cup"].position,

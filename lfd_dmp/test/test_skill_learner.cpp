@@ -5,9 +5,9 @@
 
 #include <geometry_msgs/PoseStamped.h>
 #include <lfd_msgs/DemoMetadata.h>
-#include <tf2_msgs/TFMessage.h>
 #include <rosbag/bag.h>
 #include <sensor_msgs/JointState.h>
+#include <tf2_msgs/TFMessage.h>
 
 #include <gtest/gtest.h>
 
@@ -132,7 +132,8 @@ TEST(SkillLearner, NamesSegmentsOnlyWhenTheVoteGivesTheTasksCount) {
   opt.segment_names = {"approach", "move"};
   const auto out = lfd_dmp::learnSkillLibrary(demos, cps, opt);
   ASSERT_EQ(out.library.segments.size(), 3u);
-  for (size_t s = 0; s < 3; ++s) EXPECT_EQ(out.library.segments[s].name, "segment_" + std::to_string(s));
+  for (size_t s = 0; s < 3; ++s)
+    EXPECT_EQ(out.library.segments[s].name, "segment_" + std::to_string(s));
   ASSERT_EQ(out.warnings.size(), 2u);
   EXPECT_NE(out.warnings[0].find("left unnamed"), std::string::npos) << out.warnings[0];
 }
@@ -325,7 +326,8 @@ TEST(DemoScene, StaticTransformsChainAndRefuseWhatDoesNotConnect) {
   tf.add("world", "base_link", up);
   tf.add("base_link", "chest", turned);
   const Eigen::Isometry3d world_in_chest = tf.lookup("chest", "world");
-  EXPECT_NEAR((world_in_chest * Eigen::Vector3d(0.1, 1.0, 0.85) - Eigen::Vector3d(1, 0, 0)).norm(), 0.0, 1e-12);
+  EXPECT_NEAR((world_in_chest * Eigen::Vector3d(0.1, 1.0, 0.85) - Eigen::Vector3d(1, 0, 0)).norm(),
+              0.0, 1e-12);
   EXPECT_TRUE(tf.lookup("world", "world").isApprox(Eigen::Isometry3d::Identity()));
   EXPECT_THROW(tf.lookup("world", "camera"), std::runtime_error);
   EXPECT_THROW(tf.add("a", "a", up), std::runtime_error);

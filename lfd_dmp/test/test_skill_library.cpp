@@ -58,9 +58,9 @@ SkillLibrary makeLibrary() {
     goal.orientation_spread = 0.05;
     goal.heading_object = s == 1 ? "stick" : "";
     goal.heading_spread = 0.1;
-    goal.candidates = {{lfd::SceneFrame::parse("base"), 0.2, 0.3},
-                       {lfd::SceneFrame::parse("heading:stick"),
-                        std::numeric_limits<double>::infinity(), 0.05}};
+    goal.candidates = {
+        {lfd::SceneFrame::parse("base"), 0.2, 0.3},
+        {lfd::SceneFrame::parse("heading:stick"), std::numeric_limits<double>::infinity(), 0.05}};
     seg.goal = goal;
     lib.segments.push_back(seg);
   }
@@ -183,8 +183,7 @@ TEST(SkillLibrary, ValidationNamesTheProblem) {
   EXPECT_NE(loadError(j).find("gripper.weights: weight -1e+12"), std::string::npos) << loadError(j);
   j = good;
   j["segments"][0]["demos"][0]["dmp"]["position"]["goal"][0] = 1e300;
-  EXPECT_NE(loadError(j).find("position.goal: position 1e+300"), std::string::npos)
-      << loadError(j);
+  EXPECT_NE(loadError(j).find("position.goal: position 1e+300"), std::string::npos) << loadError(j);
 
   j = good;
   j["segments"][0]["demos"][0]["dmp"].erase("tau");

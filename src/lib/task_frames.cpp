@@ -31,8 +31,8 @@ const Pose& objectPose(const Scene& scene, const std::string& name) {
   if (it == scene.objects.end()) {
     std::string known;
     for (const auto& [n, p] : scene.objects) known += (known.empty() ? "" : ", ") + n;
-    throw std::invalid_argument("the scene has no object '" + name + "' (it has: " +
-                                (known.empty() ? "none" : known) + ")");
+    throw std::invalid_argument("the scene has no object '" + name +
+                                "' (it has: " + (known.empty() ? "none" : known) + ")");
   }
   return it->second;
 }
@@ -124,8 +124,8 @@ double headingSpread(const std::string& object, const std::vector<SegmentDemoEnd
   double sum = 0.0;
   for (const SegmentDemoEnds& d : demos) {
     try {
-      const double motion = headingYaw(d.segment_start.position, d.segment_end.position,
-                                       options.min_motion_length);
+      const double motion =
+          headingYaw(d.segment_start.position, d.segment_end.position, options.min_motion_length);
       const double a = wrapAngle(motion - sceneHeading(d.scene, object, options.frames));
       sum += a * a;
     } catch (const std::invalid_argument&) {
@@ -151,7 +151,8 @@ SceneFrame SceneFrame::parse(const std::string& name) {
     f.kind = k;
     if (namesObject(k)) {
       if (colon == std::string::npos || colon + 1 == name.size())
-        throw std::invalid_argument("frame '" + name + "' needs an object name: " + kind + ":<name>");
+        throw std::invalid_argument("frame '" + name + "' needs an object name: " + kind +
+                                    ":<name>");
       f.object = name.substr(colon + 1);
     } else if (colon != std::string::npos) {
       throw std::invalid_argument("frame '" + name + "': " + kind + " takes no object name");
@@ -175,8 +176,8 @@ double headingYaw(const Eigen::Vector3d& from, const Eigen::Vector3d& to, double
   const Eigen::Vector2d d = (to - from).head<2>();
   if (!d.allFinite() || !(d.norm() >= min_length)) {
     std::ostringstream m;
-    m << "its start and end are " << d.norm() << " m apart horizontally (a heading needs >= "
-      << min_length << " m)";
+    m << "its start and end are " << d.norm()
+      << " m apart horizontally (a heading needs >= " << min_length << " m)";
     throw std::invalid_argument(m.str());
   }
   return std::atan2(d.y(), d.x());
@@ -207,8 +208,8 @@ Pose framePose(const SceneFrame& frame, const Scene& scene, const Pose& start,
     case K::kGoalHeading: {
       Pose p;
       p.orientation = yawQuaternion(sceneHeading(scene, frame.object, options));
-      p.position =
-          frame.kind == K::kHeading ? objectPose(scene, frame.object).position : scene.goal.position;
+      p.position = frame.kind == K::kHeading ? objectPose(scene, frame.object).position
+                                             : scene.goal.position;
       return p;
     }
   }
@@ -224,7 +225,7 @@ Eigen::Quaterniond meanQuaternion(const std::vector<Eigen::Quaterniond>& qs) {
   }
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix4d> solver(m);
   Eigen::Vector4d c = solver.eigenvectors().col(3);  // largest eigenvalue last
-  if (c.dot(qs.front().coeffs()) < 0.0) c = -c;       // the inputs' hemisphere, for readability
+  if (c.dot(qs.front().coeffs()) < 0.0) c = -c;      // the inputs' hemisphere, for readability
   return Eigen::Quaterniond(c[3], c[0], c[1], c[2]).normalized();
 }
 

@@ -46,8 +46,8 @@ PushDemo pushDemo(std::mt19937& rng) {
   d.scene.goal = pose(box + len(rng) * u);
   const double fist = std::remainder(a, M_PI / 2);
   d.approach = pose(box - 0.072 * u + Eigen::Vector3d(noise(rng), noise(rng), noise(rng)), fist);
-  d.push = pose(d.scene.goal.position - 0.052 * u + Eigen::Vector3d(noise(rng), noise(rng), 0),
-                fist);
+  d.push =
+      pose(d.scene.goal.position - 0.052 * u + Eigen::Vector3d(noise(rng), noise(rng), 0), fist);
   return d;
 }
 

@@ -14,11 +14,11 @@
 namespace lfd_dmp {
 
 struct DemoBagTopics {
-  std::string pose = "/ee_pose";               ///< geometry_msgs/PoseStamped (base_link)
-  std::string gripper = "/gripper/state";      ///< sensor_msgs/JointState
-  std::string gripper_joint = "R_GRIPPER";     ///< joint whose position is the opening
-  std::string metadata = "/lfd/metadata";      ///< lfd_msgs/DemoMetadata (extra_json: the scene)
-  std::string tf_static = "/tf_static";        ///< tf2_msgs/TFMessage
+  std::string pose = "/ee_pose";            ///< geometry_msgs/PoseStamped (base_link)
+  std::string gripper = "/gripper/state";   ///< sensor_msgs/JointState
+  std::string gripper_joint = "R_GRIPPER";  ///< joint whose position is the opening
+  std::string metadata = "/lfd/metadata";   ///< lfd_msgs/DemoMetadata (extra_json: the scene)
+  std::string tf_static = "/tf_static";     ///< tf2_msgs/TFMessage
 };
 
 /// The pose of frame `source` in frame `target` from elsewhere than the bag (the live tf tree);

@@ -42,7 +42,6 @@ void checkObjectNames(const std::vector<std::string>& names, size_t poses,
                       const RequestLimits& limits);
 
 /// A name or path from a request within ~limits/max_name_length (clipped in the message).
-void checkNameLength(const std::string& text, const std::string& what,
-                     const RequestLimits& limits);
+void checkNameLength(const std::string& text, const std::string& what, const RequestLimits& limits);
 
 }  // namespace lfd_dmp

@@ -40,15 +40,15 @@ struct HeadingFrame {
 
 /// How far a segment's new goal frames lie from the demonstrated ones: the position frame's origin
 /// from the convex hull of the demos' origins, the rotation of both frames (as a rotation vector
-/// about the demos' mean) from the hull of theirs. What the goal is learned relative to decides what "demonstrated"
-/// means: a push along a demonstrated heading, starting where boxes started, is inside even if the
-/// fist ends somewhere no demo's did.
+/// about the demos' mean) from the hull of theirs. What the goal is learned relative to decides
+/// what "demonstrated" means: a push along a demonstrated heading, starting where boxes started, is
+/// inside even if the fist ends somewhere no demo's did.
 struct DemoRange {
-  std::string frame;              ///< the frame (of the segment's two) farthest outside
-  double distance = 0.0;          ///< m
-  double angle = 0.0;             ///< rad
-  double distance_margin = 0.0;   ///< m allowed
-  double angle_margin = 0.0;      ///< rad allowed
+  std::string frame;             ///< the frame (of the segment's two) farthest outside
+  double distance = 0.0;         ///< m
+  double angle = 0.0;            ///< rad
+  double distance_margin = 0.0;  ///< m allowed
+  double angle_margin = 0.0;     ///< rad allowed
   bool outside() const { return distance > distance_margin || angle > angle_margin; }
 };
 
@@ -80,11 +80,11 @@ struct ExecutorOptions {
   double duration_scale = 1.0;    ///< multiplies every generalized segment duration
   bool all_segment_goals = true;  ///< generalize over all segment goals (task via-points) of a demo
   lfd::GeneralizationOptions generalization;  ///< range_margin: fraction of the demos' spread
-  double min_range_margin = 0.02;  ///< m: the smallest distance margin (demos in one place)
-  double min_range_angle = 0.1;    ///< rad: the smallest angle margin
+  double min_range_margin = 0.02;    ///< m: the smallest distance margin (demos in one place)
+  double min_range_angle = 0.1;      ///< rad: the smallest angle margin
   bool allow_extrapolation = false;  ///< plan goals outside the demonstrated range anyway
   lfd::FrameOptions frames;
-  bool heading_frames = true;  ///< generalize segments that follow a heading in its frame
+  bool heading_frames = true;   ///< generalize segments that follow a heading in its frame
   size_t max_samples = 100000;  ///< planned samples (memory and time bound of one plan)
   double gripper_threshold_fraction = 0.5;
   double gripper_hysteresis = 0.05;
@@ -136,8 +136,9 @@ struct ExecutionPlan {
 
 /// The goal of every segment of `library` in `scene` for a task starting with the TCP at `start`:
 /// its learned frames and offsets, the heading frame it is generalized in, and how far it lies
-/// from what was demonstrated (DemoRange; the shape distance). Throws std::invalid_argument when the library has no learned goals
-/// (relearn it) or the scene lacks what a frame needs (an object, a defined heading).
+/// from what was demonstrated (DemoRange; the shape distance). Throws std::invalid_argument when
+/// the library has no learned goals (relearn it) or the scene lacks what a frame needs (an object,
+/// a defined heading).
 std::vector<SegmentTarget> segmentTargets(const SkillLibrary& library, const lfd::Scene& scene,
                                           const TcpPose& start, const ExecutorOptions& options,
                                           std::vector<std::string>* warnings);

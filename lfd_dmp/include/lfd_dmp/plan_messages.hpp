@@ -5,8 +5,8 @@
 
 #include "lfd_dmp/executor.hpp"
 
-#include <lfd_core/robot_setup.hpp>
 #include <lfd_msgs/GripperCommand.h>
+#include <lfd_core/robot_setup.hpp>
 
 #include <geometry_msgs/Pose.h>
 #include <nav_msgs/Path.h>
@@ -22,8 +22,8 @@ geometry_msgs::Pose toPoseMsg(const lfd::Pose& p);
 
 /// The planned joints every `period` s (and the last sample), velocities by central differences,
 /// header.stamp = `start`: the driver interpolates them on its clock from then on.
-trajectory_msgs::JointTrajectory toJointTrajectory(const ExecutionPlan& plan, const ros::Time& start,
-                                                   double period);
+trajectory_msgs::JointTrajectory toJointTrajectory(const ExecutionPlan& plan,
+                                                   const ros::Time& start, double period);
 
 /// A trajectory of one point that holds `q` from `stamp` on (a stop).
 trajectory_msgs::JointTrajectory holdTrajectory(const std::vector<std::string>& joints,

@@ -82,7 +82,7 @@ struct SkillLibrary {
   /// s; the Gaussian low-pass applied to the demos before learning (LearnOptions; 0 = none).
   /// Optional in the file (absent = 0, as written before it was recorded).
   double smoothing_sigma = 0.0;
-  std::string cartesian_frame = "base_link";  ///< frame of the poses (DMPs, scenes, goals)
+  std::string cartesian_frame = "base_link";     ///< frame of the poses (DMPs, scenes, goals)
   std::map<std::string, DemoScene> demo_scenes;  ///< by demo_id
   std::vector<SegmentSkills> segments;
 };

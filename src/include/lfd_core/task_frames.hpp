@@ -97,7 +97,7 @@ struct SegmentGoalModel {
   double orientation_spread = 0.0;  ///< rad, RMS across the demos in that frame
   /// The object whose heading the segment's motion follows ("" = none): generalize there.
   std::string heading_object;
-  double heading_spread = 0.0;  ///< rad, RMS angle between the motion and that heading
+  double heading_spread = 0.0;          ///< rad, RMS angle between the motion and that heading
   std::vector<FrameSpread> candidates;  ///< every frame tried, for reports
 };
 
