@@ -54,6 +54,19 @@ bool is_constant(const FeatureMatrix& demo, int col) {
   return !(hi - lo > 1e-12 * (1.0 + std::max(std::abs(hi), std::abs(lo))));
 }
 
+// The channels of one sensor share their name up to the last '/' (a topic's array or vector:
+// /touch/values/0 and /touch/values/1); names without '/' (CSV columns) are one sensor.
+std::vector<std::size_t> sensor_groups(const std::vector<std::string>& names) {
+  std::map<std::string, std::size_t> ids;
+  std::vector<std::size_t> groups;
+  for (const std::string& name : names) {
+    const std::size_t slash = name.rfind('/');
+    const std::string sensor = slash == std::string::npos ? "" : name.substr(0, slash);
+    groups.push_back(ids.emplace(sensor, ids.size()).first->second);
+  }
+  return groups;
+}
+
 // Runs job(d) for every demonstration on up to `threads` threads; rethrows the first failure (by
 // demonstration index) with the demonstration named.
 template <typename Job>
@@ -103,57 +116,127 @@ DemoSettings settings_for(const FeatureMatrix& demo, const SegmentationPipelineC
   return {in_samples(config, rate), rate};
 }
 
-// SegmentationPipelineConfig::consensus_count. Significance of a changepoint: the log10 p-value
-// of the ClaSP candidate that placed it.
-void prune_to_consensus(const std::vector<FeatureMatrix>& demos, bool validated,
-                        SegmentationPipelineResult* result) {
-  // With sensor validation only demos with evidence vote: a demo without any sensory event had no
-  // zone, so its count of 0 says nothing about the task (a dead sensor, a missed contact).
+// The changepoint count the voting demos agree on: the most common count, held by at least 3 demos
+// and by more demos than any other count; 0 = no agreement. With sensor validation only demos
+// with evidence vote: a demo without any sensory event had no zone, so its count of 0 says
+// nothing about the task (a dead sensor, a missed contact).
+struct Agreement {
+  std::size_t count = 0, votes = 0, voters = 0;
+};
+
+Agreement agreed_count(const SegmentationPipelineResult& result, bool validated) {
   std::map<std::size_t, std::size_t> votes;  // changepoint count -> demos
-  std::size_t n = 0;
-  for (const DemoSegmentationResult& d : result->demos) {
+  Agreement a;
+  for (const DemoSegmentationResult& d : result.demos) {
     if (validated && d.events.empty()) continue;
     ++votes[d.changepoints.size()];
-    ++n;
+    ++a.voters;
   }
-  if (votes.empty()) return;
-  const auto top = std::max_element(
-      votes.begin(), votes.end(), [](const auto& a, const auto& b) { return a.second < b.second; });
-  if (n < 3 || 2 * top->second <= n) return;  // no clear majority: nothing to agree on
-  const std::size_t k = top->first;
-  // A majority that found nothing says nothing about where the boundaries are: the changepoints
-  // of the other demos each stand on a sensory event of their own.
-  if (k == 0) return;
+  std::size_t runner_up = 0;
+  for (const auto& [count, n] : votes) {
+    if (n > a.votes) {
+      runner_up = a.votes;
+      a = {count, n, a.voters};
+    } else {
+      runner_up = std::max(runner_up, n);
+    }
+  }
+  // A count that most demos found 0 of says nothing about where the boundaries are: the
+  // changepoints of the other demos each stand on a sensory event of their own.
+  if (a.votes < 3 || a.votes == runner_up || a.count == 0) a.count = 0;
+  return a;
+}
+
+double log10_p_of(const DemoSegmentationResult& d, std::size_t cp) {
+  for (const SplitCandidate& c : d.clasp.candidates)
+    if (c.accepted && c.index == cp) return c.log10_p_value;
+  return 0.0;
+}
+
+// A demo with more changepoints than agreed keeps its `k` most significant.
+void prune_to(std::size_t k, const FeatureMatrix& demo, DemoSegmentationResult* out,
+              std::ostringstream* msg) {
+  std::vector<std::pair<double, std::size_t>> by_p;  // (log10 p, changepoint)
+  for (std::size_t cp : out->changepoints) by_p.emplace_back(log10_p_of(*out, cp), cp);
+  std::stable_sort(by_p.begin(), by_p.end());
+  *msg << "; dropped the least significant:";
+  out->changepoints.clear();
+  for (std::size_t i = 0; i < by_p.size(); ++i) {
+    if (i < k) {
+      out->changepoints.push_back(by_p[i].second);
+      continue;
+    }
+    out->pruned.push_back(by_p[i].second);
+    *msg << " t=" << demo.time_at(by_p[i].second) << " (p=1e" << std::lround(by_p[i].first) << ")";
+  }
+}
+
+// A demo with fewer changepoints than agreed takes, from the zones that hold none, ClaSP's
+// best in-zone candidates that were not significant on their own but reach `log10_p` (the
+// other demos' agreement is evidence too), most significant first. Only candidates of ranges
+// that are still whole (no changepoint inside) count: the others were found before a split.
+void fill_to(std::size_t k, double log10_p, const FeatureMatrix& demo, DemoSegmentationResult* out,
+             std::ostringstream* msg) {
+  std::vector<const SplitCandidate*> pool;
+  for (const SplitCandidate& c : out->clasp.candidates) {
+    if (c.accepted || c.log10_p_value > log10_p) continue;
+    const bool whole =
+        std::none_of(out->changepoints.begin(), out->changepoints.end(),
+                     [&](std::size_t cp) { return c.range_begin < cp && cp < c.range_end; });
+    if (whole) pool.push_back(&c);
+  }
+  std::stable_sort(pool.begin(), pool.end(), [](const SplitCandidate* a, const SplitCandidate* b) {
+    return a->log10_p_value < b->log10_p_value;
+  });
+  const auto zone_of = [&](std::size_t t) -> int {
+    for (std::size_t z = 0; z < out->zones.size(); ++z)
+      if (out->zones[z].contains(t)) return static_cast<int>(z);
+    return -1;
+  };
+  *msg << "; added the best in-zone candidates:";
+  for (const SplitCandidate* c : pool) {
+    if (out->changepoints.size() >= k) break;
+    const int zone = zone_of(c->index);
+    const bool taken = std::any_of(out->changepoints.begin(), out->changepoints.end(),
+                                   [&](std::size_t cp) { return zone_of(cp) == zone; });
+    const bool too_close =
+        std::any_of(out->changepoints.begin(), out->changepoints.end(), [&](std::size_t cp) {
+          return (cp > c->index ? cp - c->index : c->index - cp) < out->min_segment_length;
+        });
+    if (zone < 0 || taken || too_close) continue;
+    out->changepoints.push_back(c->index);
+    out->added.push_back(c->index);
+    *msg << " t=" << demo.time_at(c->index) << " (p=1e" << std::lround(c->log10_p_value) << ")";
+  }
+  std::sort(out->changepoints.begin(), out->changepoints.end());
+  std::sort(out->added.begin(), out->added.end());
+}
+
+// SegmentationPipelineConfig::consensus_count: demos of one task hold the same skills.
+void agree_on_count(const std::vector<FeatureMatrix>& demos, bool validated, double fill_p,
+                    SegmentationPipelineResult* result) {
+  const Agreement a = agreed_count(*result, validated);
+  if (a.count == 0) return;
   for (std::size_t d = 0; d < result->demos.size(); ++d) {
     DemoSegmentationResult& out = result->demos[d];
-    if (out.changepoints.size() <= k) continue;
-    std::vector<std::pair<double, std::size_t>> by_p;  // (log10 p, changepoint)
-    for (std::size_t cp : out.changepoints) {
-      double log_p = 0.0;
-      for (const SplitCandidate& c : out.clasp.candidates)
-        if (c.accepted && c.index == cp) log_p = c.log10_p_value;
-      by_p.emplace_back(log_p, cp);
-    }
-    std::stable_sort(by_p.begin(), by_p.end());
+    const std::size_t had = out.changepoints.size();
+    if (had == a.count || (had < a.count && !(fill_p > 0.0 && validated))) continue;
     std::ostringstream msg;
-    msg << demo_context(d) << ": " << out.changepoints.size() << " changepoints where "
-        << top->second << " of the " << n << " voting demonstrations have " << k
-        << "; dropped the least significant:";
-    out.changepoints.clear();
-    out.changepoint_times.clear();
-    for (std::size_t i = 0; i < by_p.size(); ++i) {
-      const std::size_t cp = by_p[i].second;
-      if (i < k) {
-        out.changepoints.push_back(cp);
-        continue;
-      }
-      out.pruned.push_back(cp);
-      msg << " t=" << demos[d].time_at(cp) << " (p=1e" << std::lround(by_p[i].first) << ")";
-    }
+    msg << demo_context(d) << ": " << had << " changepoints where " << a.votes << " of the "
+        << a.voters << " voting demonstrations have " << a.count;
+    if (had > a.count)
+      prune_to(a.count, demos[d], &out, &msg);
+    else
+      fill_to(a.count, std::log10(fill_p), demos[d], &out, &msg);
+    if (out.changepoints.size() == had && out.pruned.empty()) continue;  // nothing to add
     std::sort(out.changepoints.begin(), out.changepoints.end());
     std::sort(out.pruned.begin(), out.pruned.end());
+    out.changepoint_times.clear();
+    out.pruned_times.clear();
+    out.added_times.clear();
     for (std::size_t cp : out.changepoints) out.changepoint_times.push_back(demos[d].time_at(cp));
     for (std::size_t cp : out.pruned) out.pruned_times.push_back(demos[d].time_at(cp));
+    for (std::size_t cp : out.added) out.added_times.push_back(demos[d].time_at(cp));
     result->warnings.push_back(msg.str());
   }
 }
@@ -313,6 +396,7 @@ SegmentationPipelineResult run_segmentation_pipeline(
                                   ? "no sensor features: ClaSP changepoints are not validated"
                                   : "sensor validation disabled: ClaSP changepoints are accepted");
   }
+  const std::vector<std::size_t> groups = sensor_groups(sensor_features);
   result.demos.resize(demos.size());
   for_each_demo(demos.size(), config.threads, [&](std::size_t d) {
     const FeatureMatrix& demo = demos[d];
@@ -326,14 +410,19 @@ SegmentationPipelineResult run_segmentation_pipeline(
       demo_config.window_sizes.assign(result.selected_features.size(), own.window_size);
     // Events do not depend on min_s: detected once, for the zone-guided search and validation.
     const SensorEvents events =
-        validate ? detect_sensor_events(demo.select(sensor_features).data, own.events)
+        validate ? detect_sensor_events(demo.select(sensor_features).data, own.events, groups)
                  : SensorEvents{};
     const auto zones = [&](std::size_t min_s) {
       return confidence_zones(events.all, min_s, static_cast<std::size_t>(demo.rows()));
     };
     if (validate && config.search_in_zones) {
       demo_config.candidate_zones_for = zones;
-      if (config.anchor_to_events) demo_config.zone_anchors = events.all;
+      if (config.anchor_to_events) {
+        for (const SensoryEvent& e : events.details) {
+          demo_config.zone_anchors.push_back(e.index);
+          demo_config.preferred_anchors.push_back(e.rest_edge);
+        }
+      }
     }
     out.clasp = segment_multivariate(state, result.feature_weights, demo_config);
     out.min_segment_length = out.clasp.min_segment_length;
@@ -344,13 +433,15 @@ SegmentationPipelineResult run_segmentation_pipeline(
       out.rejected = v.rejected;
       out.zones = v.zones;
       out.events = events.all;
+      out.event_details = events.details;
     } else {
       out.changepoints = out.clasp.changepoints;
     }
     for (std::size_t cp : out.changepoints) out.changepoint_times.push_back(demo.time_at(cp));
     for (std::size_t cp : out.rejected) out.rejected_times.push_back(demo.time_at(cp));
   });
-  if (config.consensus_count) prune_to_consensus(demos, validate, &result);
+  if (config.consensus_count)
+    agree_on_count(demos, validate, config.consensus_fill_p_value, &result);
   result.segmentation_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - segmentation_start).count();
   for (std::size_t d = 0; d < demos.size() && validate; ++d) {

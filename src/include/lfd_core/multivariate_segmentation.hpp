@@ -84,6 +84,8 @@ struct MultivariateSegmentationConfig {
   /// threshold). The sensory event is independent evidence of a change there, so ClaSP's own
   /// evidence may be weaker than for a candidate anywhere.
   double zone_p_value_threshold = 0.0;
+  /// The same for a zone that holds a preferred anchor (0 = as zone_p_value_threshold).
+  double rest_edge_p_value_threshold = 0.0;
   /// Sensory events that anchor the zones (zone-guided search only; empty = off). ClaSP still
   /// decides whether a zone holds a changepoint (its in-zone argmax and that argmax's
   /// significance), but the changepoint is placed at the zone's event nearest to the argmax. The
@@ -91,6 +93,10 @@ struct MultivariateSegmentationConfig {
   /// peaks up to a window away from the interaction, often on the zone's edge and at a different
   /// point of the skill in every demo; the sensors time an interaction to a few samples.
   std::vector<std::size_t> zone_anchors;
+  /// Per zone_anchors entry (empty = none): a zone's preferred anchors are taken before its
+  /// others (the sensory events where a signal leaves or regains its rest level: contact made or
+  /// lost, rather than a force ramp reaching its plateau).
+  std::vector<bool> preferred_anchors;
   int num_changepoints = -1;          ///< < 0: stop with the significance test; >= 0: exact count
   std::size_t max_changepoints = 16;  ///< safety cap when the test decides
 };

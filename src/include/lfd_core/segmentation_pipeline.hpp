@@ -60,11 +60,16 @@ struct SegmentationPipelineConfig {
   /// With search_in_zones: each changepoint sits on the sensory event of its zone nearest to
   /// ClaSP's in-zone argmax (MultivariateSegmentationConfig::zone_anchors).
   bool anchor_to_events = true;
-  /// Demonstrations of one task hold the same skills: when more than half of the demos (at least
-  /// 3) agree on K validated changepoints, a demo with more keeps its K most significant ones and
-  /// reports the others as `pruned` (a hesitation mid-skill is then not a skill boundary). Demos
-  /// with fewer changepoints are left as they are.
+  /// Demonstrations of one task hold the same skills: when the most common count K of validated
+  /// changepoints is held by at least 3 voting demos and by more than any other count, a demo
+  /// with more keeps its K most significant ones and reports the others as `pruned` (a hesitation
+  /// mid-skill is then not a skill boundary). With sensor validation only demos with a sensory
+  /// event vote.
   bool consensus_count = true;
+  /// With consensus_count and sensor validation: a demo with fewer than K changepoints takes its
+  /// best in-zone candidates down to this p-value (0 = never), one per free zone: the agreement
+  /// of the other demos is evidence that a skill boundary is there.
+  double consensus_fill_p_value = 0.0;
   /// Worker threads for DTW and the per-demonstration segmentations (<= 0 = all cores).
   int threads = 0;
 };
@@ -84,9 +89,14 @@ struct DemoSegmentationResult {
   std::vector<double> rejected_times;
   std::vector<std::size_t> pruned;  ///< validated, dropped to the consensus count (consensus_count)
   std::vector<double> pruned_times;
-  std::vector<Interval> zones;         ///< confidence zones (row indices, closed)
-  std::vector<std::size_t> events;     ///< sensory events (row indices)
-  std::size_t min_segment_length = 0;  ///< the min_s used for ClaSP and the zones
+  /// In-zone candidates accepted because the other demos agree on more changepoints
+  /// (consensus_fill_p_value); also in `changepoints`.
+  std::vector<std::size_t> added;
+  std::vector<double> added_times;
+  std::vector<Interval> zones;              ///< confidence zones (row indices, closed)
+  std::vector<std::size_t> events;          ///< sensory events (row indices)
+  std::vector<SensoryEvent> event_details;  ///< the same with rest edges and strengths
+  std::size_t min_segment_length = 0;       ///< the min_s used for ClaSP and the zones
   std::size_t num_samples = 0;
   double sample_rate = 0.0;        ///< Hz of the demonstration's clock (0 = index-only series)
   MultivariateSegmentation clasp;  ///< candidates, windows, profiles (paper Fig. 5, 8)
