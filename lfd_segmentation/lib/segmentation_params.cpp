@@ -124,7 +124,18 @@ SegmentationParams params_from_yaml(const YAML::Node& root) {
       "rest_edge_p_value_threshold");
   p.pipeline.validate_with_sensors =
       get<bool>(root, "validate_with_sensors", p.pipeline.validate_with_sensors);
-  p.pipeline.search_in_zones = get<bool>(root, "search_in_zones", p.pipeline.search_in_zones);
+  p.pipeline.procedure = lfd::parse_segmentation_procedure(
+      get<std::string>(root, "procedure", lfd::to_string(p.pipeline.procedure)));
+  if (root["search_in_zones"])
+    throw std::invalid_argument(
+        "segmentation parameter 'search_in_zones' is now 'procedure' (zone_search or paper)");
+  p.pipeline.paper_candidates =
+      get<std::size_t>(root, "paper_candidates", p.pipeline.paper_candidates);
+  if (p.pipeline.paper_candidates < 1 ||
+      p.pipeline.paper_candidates > p.pipeline.segmentation.max_changepoints)
+    throw std::invalid_argument("segmentation parameter 'paper_candidates' must be in [1, " +
+                                std::to_string(p.pipeline.segmentation.max_changepoints) +
+                                "] (max_changepoints)");
   p.pipeline.anchor_to_events = get<bool>(root, "anchor_to_events", p.pipeline.anchor_to_events);
   p.pipeline.consensus_count = get<bool>(root, "consensus_count", p.pipeline.consensus_count);
   p.pipeline.consensus_fill_p_value =

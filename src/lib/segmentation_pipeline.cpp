@@ -1,5 +1,7 @@
 #include "lfd_core/segmentation_pipeline.hpp"
 
+#include "lfd_core/segmentation_consensus.hpp"
+
 #include <algorithm>
 #include <atomic>
 #include <chrono>
@@ -116,129 +118,72 @@ DemoSettings settings_for(const FeatureMatrix& demo, const SegmentationPipelineC
   return {in_samples(config, rate), rate};
 }
 
-// The changepoint count the voting demos agree on: the most common count, held by at least 3 demos
-// and by more demos than any other count; 0 = no agreement. With sensor validation only demos
-// with evidence vote: a demo without any sensory event had no zone, so its count of 0 says
-// nothing about the task (a dead sensor, a missed contact).
-struct Agreement {
-  std::size_t count = 0, votes = 0, voters = 0;
-};
-
-Agreement agreed_count(const SegmentationPipelineResult& result, bool validated) {
-  std::map<std::size_t, std::size_t> votes;  // changepoint count -> demos
-  Agreement a;
-  for (const DemoSegmentationResult& d : result.demos) {
-    if (validated && d.events.empty()) continue;
-    ++votes[d.changepoints.size()];
-    ++a.voters;
-  }
-  std::size_t runner_up = 0;
-  for (const auto& [count, n] : votes) {
-    if (n > a.votes) {
-      runner_up = a.votes;
-      a = {count, n, a.voters};
-    } else {
-      runner_up = std::max(runner_up, n);
+// Every demo's sample-count settings; checks its clock and that it holds 2 min_s.
+std::vector<DemoSettings> demo_settings(const std::vector<FeatureMatrix>& demos,
+                                        const SegmentationPipelineConfig& config) {
+  std::vector<DemoSettings> settings;
+  for (std::size_t d = 0; d < demos.size(); ++d) {
+    try {
+      settings.push_back(settings_for(demos[d], config));
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument(demo_context(d) + ": " + e.what());
+    }
+    const std::size_t min_s = settings.back().config.segmentation.min_segment_length;
+    if (min_s > 0 && static_cast<std::size_t>(demos[d].rows()) < 2 * min_s) {
+      throw std::invalid_argument(demo_context(d) + " has " + std::to_string(demos[d].rows()) +
+                                  " samples, fewer than 2 * min_s = " + std::to_string(2 * min_s));
     }
   }
-  // A count that most demos found 0 of says nothing about where the boundaries are: the
-  // changepoints of the other demos each stand on a sensory event of their own.
-  if (a.votes < 3 || a.votes == runner_up || a.count == 0) a.count = 0;
-  return a;
+  return settings;
 }
 
-double log10_p_of(const DemoSegmentationResult& d, std::size_t cp) {
-  for (const SplitCandidate& c : d.clasp.candidates)
-    if (c.accepted && c.index == cp) return c.log10_p_value;
-  return 0.0;
-}
-
-// A demo with more changepoints than agreed keeps its `k` most significant.
-void prune_to(std::size_t k, const FeatureMatrix& demo, DemoSegmentationResult* out,
-              std::ostringstream* msg) {
-  std::vector<std::pair<double, std::size_t>> by_p;  // (log10 p, changepoint)
-  for (std::size_t cp : out->changepoints) by_p.emplace_back(log10_p_of(*out, cp), cp);
-  std::stable_sort(by_p.begin(), by_p.end());
-  *msg << "; dropped the least significant:";
-  out->changepoints.clear();
-  for (std::size_t i = 0; i < by_p.size(); ++i) {
-    if (i < k) {
-      out->changepoints.push_back(by_p[i].second);
-      continue;
-    }
-    out->pruned.push_back(by_p[i].second);
-    *msg << " t=" << demo.time_at(by_p[i].second) << " (p=1e" << std::lround(by_p[i].first) << ")";
-  }
-}
-
-// A demo with fewer changepoints than agreed takes, from the zones that hold none, ClaSP's
-// best in-zone candidates that were not significant on their own but reach `log10_p` (the
-// other demos' agreement is evidence too), most significant first. Only candidates of ranges
-// that are still whole (no changepoint inside) count: the others were found before a split.
-void fill_to(std::size_t k, double log10_p, const FeatureMatrix& demo, DemoSegmentationResult* out,
-             std::ostringstream* msg) {
-  std::vector<const SplitCandidate*> pool;
-  for (const SplitCandidate& c : out->clasp.candidates) {
-    if (c.accepted || c.log10_p_value > log10_p) continue;
-    const bool whole =
-        std::none_of(out->changepoints.begin(), out->changepoints.end(),
-                     [&](std::size_t cp) { return c.range_begin < cp && cp < c.range_end; });
-    if (whole) pool.push_back(&c);
-  }
-  std::stable_sort(pool.begin(), pool.end(), [](const SplitCandidate* a, const SplitCandidate* b) {
-    return a->log10_p_value < b->log10_p_value;
-  });
-  const auto zone_of = [&](std::size_t t) -> int {
-    for (std::size_t z = 0; z < out->zones.size(); ++z)
-      if (out->zones[z].contains(t)) return static_cast<int>(z);
-    return -1;
+// II-C for one demonstration: ClaSP on the selected features and the sensory zones, met as the
+// procedure says.
+DemoSegmentationResult segment_demo(const FeatureMatrix& demo, const DemoSettings& settings,
+                                    const SegmentationPipelineResult& prepared, bool validate,
+                                    const std::vector<std::size_t>& groups) {
+  const SegmentationPipelineConfig& own = settings.config;
+  DemoSegmentationResult out;
+  out.num_samples = static_cast<std::size_t>(demo.rows());
+  out.sample_rate = settings.rate;
+  MultivariateSegmentationConfig seg = own.segmentation;
+  if (own.window_size > 0)
+    seg.window_sizes.assign(prepared.selected_features.size(), own.window_size);
+  // Events do not depend on min_s: detected once, for the zone-guided search and validation.
+  const SensorEvents events =
+      validate
+          ? detect_sensor_events(demo.select(prepared.sensor_features).data, own.events, groups)
+          : SensorEvents{};
+  const auto zones = [&](std::size_t min_s) {
+    return confidence_zones(events.all, min_s, static_cast<std::size_t>(demo.rows()));
   };
-  *msg << "; added the best in-zone candidates:";
-  for (const SplitCandidate* c : pool) {
-    if (out->changepoints.size() >= k) break;
-    const int zone = zone_of(c->index);
-    const bool taken = std::any_of(out->changepoints.begin(), out->changepoints.end(),
-                                   [&](std::size_t cp) { return zone_of(cp) == zone; });
-    const bool too_close =
-        std::any_of(out->changepoints.begin(), out->changepoints.end(), [&](std::size_t cp) {
-          return (cp > c->index ? cp - c->index : c->index - cp) < out->min_segment_length;
-        });
-    if (zone < 0 || taken || too_close) continue;
-    out->changepoints.push_back(c->index);
-    out->added.push_back(c->index);
-    *msg << " t=" << demo.time_at(c->index) << " (p=1e" << std::lround(c->log10_p_value) << ")";
+  if (validate && own.procedure == SegmentationProcedure::kZoneSearch) {
+    seg.candidate_zones_for = zones;
+    for (const SensoryEvent& e :
+         own.anchor_to_events ? events.details : std::vector<SensoryEvent>{}) {
+      seg.zone_anchors.push_back(e.index);
+      seg.preferred_anchors.push_back(e.rest_edge);
+    }
+  } else if (validate) {
+    seg.num_changepoints = static_cast<int>(own.paper_candidates);
   }
-  std::sort(out->changepoints.begin(), out->changepoints.end());
-  std::sort(out->added.begin(), out->added.end());
-}
-
-// SegmentationPipelineConfig::consensus_count: demos of one task hold the same skills.
-void agree_on_count(const std::vector<FeatureMatrix>& demos, bool validated, double fill_p,
-                    SegmentationPipelineResult* result) {
-  const Agreement a = agreed_count(*result, validated);
-  if (a.count == 0) return;
-  for (std::size_t d = 0; d < result->demos.size(); ++d) {
-    DemoSegmentationResult& out = result->demos[d];
-    const std::size_t had = out.changepoints.size();
-    if (had == a.count || (had < a.count && !(fill_p > 0.0 && validated))) continue;
-    std::ostringstream msg;
-    msg << demo_context(d) << ": " << had << " changepoints where " << a.votes << " of the "
-        << a.voters << " voting demonstrations have " << a.count;
-    if (had > a.count)
-      prune_to(a.count, demos[d], &out, &msg);
-    else
-      fill_to(a.count, std::log10(fill_p), demos[d], &out, &msg);
-    if (out.changepoints.size() == had && out.pruned.empty()) continue;  // nothing to add
-    std::sort(out.changepoints.begin(), out.changepoints.end());
-    std::sort(out.pruned.begin(), out.pruned.end());
-    out.changepoint_times.clear();
-    out.pruned_times.clear();
-    out.added_times.clear();
-    for (std::size_t cp : out.changepoints) out.changepoint_times.push_back(demos[d].time_at(cp));
-    for (std::size_t cp : out.pruned) out.pruned_times.push_back(demos[d].time_at(cp));
-    for (std::size_t cp : out.added) out.added_times.push_back(demos[d].time_at(cp));
-    result->warnings.push_back(msg.str());
+  out.clasp = segment_multivariate(demo.select(prepared.selected_features).data,
+                                   prepared.feature_weights, seg);
+  out.min_segment_length = out.clasp.min_segment_length;
+  if (validate) {
+    const ChangepointValidation v =
+        validate_with_zones(out.clasp.changepoints, zones(out.min_segment_length));
+    out.changepoints = v.accepted;
+    out.rejected = v.rejected;
+    out.zones = v.zones;
+    out.events = events.all;
+    out.event_details = events.details;
+  } else {
+    out.changepoints = out.clasp.changepoints;
   }
+  for (std::size_t cp : out.changepoints) out.changepoint_times.push_back(demo.time_at(cp));
+  for (std::size_t cp : out.rejected) out.rejected_times.push_back(demo.time_at(cp));
+  return out;
 }
 
 }  // namespace
@@ -248,6 +193,16 @@ std::size_t samples(double seconds, double rate, std::size_t at_least) {
   return std::max<std::size_t>(at_least, static_cast<std::size_t>(std::lround(seconds * rate)));
 }
 }  // namespace
+
+SegmentationProcedure parse_segmentation_procedure(const std::string& name) {
+  if (name == "zone_search") return SegmentationProcedure::kZoneSearch;
+  if (name == "paper") return SegmentationProcedure::kPaper;
+  throw std::invalid_argument("unknown segmentation procedure '" + name + "' (zone_search, paper)");
+}
+
+std::string to_string(SegmentationProcedure procedure) {
+  return procedure == SegmentationProcedure::kPaper ? "paper" : "zone_search";
+}
 
 SegmentationPipelineConfig in_samples(const SegmentationPipelineConfig& config, double rate) {
   SegmentationPipelineConfig s = config;
@@ -282,11 +237,13 @@ double sample_rate_of(const FeatureMatrix& demo) {
   return 1.0 / step;
 }
 
-SegmentationPipelineResult run_segmentation_pipeline(
-    const std::vector<FeatureMatrix>& demos, const std::vector<std::string>& sensor_features,
-    const SegmentationPipelineConfig& config, const std::vector<std::string>& state_features) {
+PreparedSegmentation prepare_segmentation(const std::vector<FeatureMatrix>& demos,
+                                          const std::vector<std::string>& sensor_features,
+                                          const SegmentationPipelineConfig& config,
+                                          const std::vector<std::string>& state_features) {
   if (demos.empty()) throw std::invalid_argument("no demonstrations to segment");
-  SegmentationPipelineResult result;
+  PreparedSegmentation prepared;
+  SegmentationPipelineResult& result = prepared.base;
 
   // ---- input checks: shape, same features, roles, finite samples, lengths
   for (std::size_t d = 0; d < demos.size(); ++d) {
@@ -329,19 +286,7 @@ SegmentationPipelineResult run_segmentation_pipeline(
   for (std::size_t d = 0; d < demos.size(); ++d)
     check_finite(demos[d].select(used), demo_context(d));
 
-  std::vector<DemoSettings> settings;
-  for (std::size_t d = 0; d < demos.size(); ++d) {
-    try {
-      settings.push_back(settings_for(demos[d], config));
-    } catch (const std::invalid_argument& e) {
-      throw std::invalid_argument(demo_context(d) + ": " + e.what());
-    }
-    const std::size_t min_s = settings.back().config.segmentation.min_segment_length;
-    if (min_s > 0 && static_cast<std::size_t>(demos[d].rows()) < 2 * min_s) {
-      throw std::invalid_argument(demo_context(d) + " has " + std::to_string(demos[d].rows()) +
-                                  " samples, fewer than 2 * min_s = " + std::to_string(2 * min_s));
-    }
-  }
+  demo_settings(demos, config);  // checks every demo's clock and length
 
   // ---- constant state features carry no information
   std::vector<std::string> informative;
@@ -385,11 +330,18 @@ SegmentationPipelineResult run_segmentation_pipeline(
     result.feature_weights.assign(informative.size(), 1.0);
   }
 
-  const auto segmentation_start = std::chrono::steady_clock::now();
   result.relevance_seconds =
-      std::chrono::duration<double>(segmentation_start - relevance_start).count();
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - relevance_start).count();
+  return prepared;
+}
 
-  // ---- II-C multivariate ClaSP + sensory validation, one demonstration per worker
+SegmentationPipelineResult segment_prepared(const PreparedSegmentation& prepared,
+                                            const std::vector<FeatureMatrix>& demos,
+                                            const SegmentationPipelineConfig& config) {
+  const auto segmentation_start = std::chrono::steady_clock::now();
+  SegmentationPipelineResult result = prepared.base;
+  const std::vector<std::string>& sensor_features = result.sensor_features;
+  const std::vector<DemoSettings> settings = demo_settings(demos, config);
   const bool validate = config.validate_with_sensors && !sensor_features.empty();
   if (!validate) {
     result.warnings.push_back(sensor_features.empty()
@@ -399,49 +351,10 @@ SegmentationPipelineResult run_segmentation_pipeline(
   const std::vector<std::size_t> groups = sensor_groups(sensor_features);
   result.demos.resize(demos.size());
   for_each_demo(demos.size(), config.threads, [&](std::size_t d) {
-    const FeatureMatrix& demo = demos[d];
-    DemoSegmentationResult& out = result.demos[d];
-    out.num_samples = static_cast<std::size_t>(demo.rows());
-    out.sample_rate = settings[d].rate;
-    const Eigen::MatrixXd state = demo.select(result.selected_features).data;
-    const SegmentationPipelineConfig& own = settings[d].config;
-    MultivariateSegmentationConfig demo_config = own.segmentation;
-    if (own.window_size > 0)
-      demo_config.window_sizes.assign(result.selected_features.size(), own.window_size);
-    // Events do not depend on min_s: detected once, for the zone-guided search and validation.
-    const SensorEvents events =
-        validate ? detect_sensor_events(demo.select(sensor_features).data, own.events, groups)
-                 : SensorEvents{};
-    const auto zones = [&](std::size_t min_s) {
-      return confidence_zones(events.all, min_s, static_cast<std::size_t>(demo.rows()));
-    };
-    if (validate && config.search_in_zones) {
-      demo_config.candidate_zones_for = zones;
-      if (config.anchor_to_events) {
-        for (const SensoryEvent& e : events.details) {
-          demo_config.zone_anchors.push_back(e.index);
-          demo_config.preferred_anchors.push_back(e.rest_edge);
-        }
-      }
-    }
-    out.clasp = segment_multivariate(state, result.feature_weights, demo_config);
-    out.min_segment_length = out.clasp.min_segment_length;
-    if (validate) {
-      const ChangepointValidation v =
-          validate_with_zones(out.clasp.changepoints, zones(out.min_segment_length));
-      out.changepoints = v.accepted;
-      out.rejected = v.rejected;
-      out.zones = v.zones;
-      out.events = events.all;
-      out.event_details = events.details;
-    } else {
-      out.changepoints = out.clasp.changepoints;
-    }
-    for (std::size_t cp : out.changepoints) out.changepoint_times.push_back(demo.time_at(cp));
-    for (std::size_t cp : out.rejected) out.rejected_times.push_back(demo.time_at(cp));
+    result.demos[d] = segment_demo(demos[d], settings[d], result, validate, groups);
   });
-  if (config.consensus_count)
-    agree_on_count(demos, validate, config.consensus_fill_p_value, &result);
+  if (config.consensus_count && config.procedure == SegmentationProcedure::kZoneSearch)
+    agree_on_changepoint_count(demos, validate, config.consensus_fill_p_value, &result);
   result.segmentation_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - segmentation_start).count();
   for (std::size_t d = 0; d < demos.size() && validate; ++d) {
@@ -450,14 +363,18 @@ SegmentationPipelineResult run_segmentation_pipeline(
         result.warnings.push_back(demo_context(d) + ": sensor '" + sensor +
                                   "' is constant (dead or disconnected?): no zone from it");
     }
-  }
-  for (std::size_t d = 0; d < demos.size(); ++d) {
-    if (validate && result.demos[d].events.empty()) {
+    if (result.demos[d].events.empty())
       result.warnings.push_back(demo_context(d) +
                                 ": no sensory event detected, so no changepoint can be validated");
-    }
   }
   return result;
+}
+
+SegmentationPipelineResult run_segmentation_pipeline(
+    const std::vector<FeatureMatrix>& demos, const std::vector<std::string>& sensor_features,
+    const SegmentationPipelineConfig& config, const std::vector<std::string>& state_features) {
+  return segment_prepared(prepare_segmentation(demos, sensor_features, config, state_features),
+                          demos, config);
 }
 
 }  // namespace lfd

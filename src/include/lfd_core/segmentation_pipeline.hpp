@@ -37,6 +37,22 @@ struct TimeParameters {
   double event_noise_block = 1.0;     ///< block length of the local noise estimate (s)
 };
 
+/// How ClaSP's candidates meet the sensory zones.
+enum class SegmentationProcedure {
+  /// Ours: the zones first, each recursion step takes its argmax inside them, the changepoint
+  /// sits on a sensory event of its zone (anchor_to_events), the demos agree on their count
+  /// (consensus_count).
+  kZoneSearch,
+  /// The paper's (II-C, Fig. 8): `paper_candidates` candidates anywhere from the recursive,
+  /// Kaiser-penalized combined profile, then the zone filter (eq. 1): those inside a zone are
+  /// the changepoints.
+  kPaper,
+};
+
+/// "zone_search" or "paper" (throws std::invalid_argument otherwise).
+SegmentationProcedure parse_segmentation_procedure(const std::string& name);
+std::string to_string(SegmentationProcedure procedure);
+
 struct SegmentationPipelineConfig {
   /// Time parameters in seconds (see TimeParameters); when unset, the sample counts of
   /// `segmentation`, `window_size` and `events` are used as they are (index-only series).
@@ -52,13 +68,14 @@ struct SegmentationPipelineConfig {
   SensoryEventConfig events;
   /// false: every ClaSP changepoint is accepted (no sensor validation).
   bool validate_with_sensors = true;
-  /// true: the zones are computed first and ClaSP searches its candidates only inside them, one
-  /// changepoint per zone (MultivariateSegmentationConfig::candidate_zones). false: the paper's
-  /// order, candidates anywhere and then validated, where a strong out-of-zone peak can hide the
-  /// in-zone change of its range. Needs validate_with_sensors.
-  bool search_in_zones = true;
-  /// With search_in_zones: each changepoint sits on the sensory event of its zone nearest to
-  /// ClaSP's in-zone argmax (MultivariateSegmentationConfig::zone_anchors).
+  /// How candidates meet zones (needs validate_with_sensors; without sensors ClaSP's
+  /// changepoints are taken as they are).
+  SegmentationProcedure procedure = SegmentationProcedure::kZoneSearch;
+  /// kPaper: the number of candidates the recursion proposes (no significance test; fewer when
+  /// the ranges are too short for min_s). The paper's Fig. 8 shows five.
+  std::size_t paper_candidates = 5;
+  /// kZoneSearch: each changepoint sits on the sensory event of its zone nearest to ClaSP's
+  /// in-zone argmax, rest edges first (MultivariateSegmentationConfig::zone_anchors).
   bool anchor_to_events = true;
   /// Demonstrations of one task hold the same skills: when the most common count K of validated
   /// changepoints is held by at least 3 voting demos and by more than any other count, a demo
@@ -115,9 +132,29 @@ struct SegmentationPipelineResult {
   double segmentation_seconds = 0;  ///< wall time of II-C (ClaSP + validation, all demos)
 };
 
-/// Runs the pipeline. `sensor_features` name the sensor columns; `state_features` name the
-/// candidates for segmentation (empty = every column that is not a sensor). Every demonstration
-/// must have the same set of features (any column order).
+/// The part of the pipeline that does not depend on the combination method nor on any II-C
+/// setting: input checks, constant features, II-B feature relevance. `base` holds everything of
+/// the result but the demos.
+struct PreparedSegmentation {
+  SegmentationPipelineResult base;
+};
+
+/// Checks and II-B of run_segmentation_pipeline (same arguments, same errors).
+PreparedSegmentation prepare_segmentation(const std::vector<FeatureMatrix>& demos,
+                                          const std::vector<std::string>& sensor_features,
+                                          const SegmentationPipelineConfig& config = {},
+                                          const std::vector<std::string>& state_features = {});
+
+/// II-C on prepared demos: `config` may differ from the one prepared with in its II-C settings
+/// only (combination, ClaSP, events, procedure), e.g. to compare the combinations on one feature
+/// selection. `demos` must be the prepared ones.
+SegmentationPipelineResult segment_prepared(const PreparedSegmentation& prepared,
+                                            const std::vector<FeatureMatrix>& demos,
+                                            const SegmentationPipelineConfig& config = {});
+
+/// Runs the pipeline (prepare_segmentation, then segment_prepared). `sensor_features` name the
+/// sensor columns; `state_features` name the candidates for segmentation (empty = every column that
+/// is not a sensor). Every demonstration must have the same set of features (any column order).
 /// Throws std::invalid_argument (with the demonstration and feature named) for: no
 /// demonstrations, features that differ between demonstrations, unknown feature names, NaN/Inf
 /// samples, empty demonstrations, demonstrations shorter than 2 * min_s, no state feature, or
