@@ -75,8 +75,8 @@ class CliSegmenter(object):
         tmp.close()
         return tmp.name
 
-    def __call__(self, bags, method):
-        cmd = [self.cli, "--config", self._config(), "--no-profiles", "--combination", method]
+    def _run(self, bags, methods):
+        cmd = [self.cli, "--config", self._config(), "--no-profiles", "--combination", ",".join(methods)]
         if self.topics and not self.no_sensors:
             cmd += ["--topics", self.topics]
         cmd += bags
@@ -86,6 +86,18 @@ class CliSegmenter(object):
         out = json.loads(proc.stdout)
         if not out.get("success"):
             raise RuntimeError("segmentation failed: %s" % out.get("error"))
+        return out
+
+    def __call__(self, bags, method):
+        return self._answer(self._run(bags, [method]))
+
+    def methods(self, bags, methods):
+        """Every method from one CLI run: the features are selected once."""
+        out = self._run(bags, methods)
+        return {m: self._answer(out["methods"][m]) for m in methods}
+
+    @staticmethod
+    def _answer(out):
         demos = []
         for d in out["demos"]:
             demos.append({"changepoint_times": d["changepoint_times"], "rejected_times": d.get("rejected_times", []),
@@ -131,11 +143,11 @@ def datasets_to_run(args, config):
         # a labels.json is named by its folder (pr2_ikea), a truth file by itself
         name = (os.path.basename(os.path.dirname(os.path.abspath(args.labels))) if args.labels
                 else os.path.splitext(os.path.basename(args.truth))[0])
-        return [(name, lambda seg, m, tol: segmentation_scoring.evaluate_truth_file(seg, demos, m, tol))]
+        return [(name, lambda seg, ms, tol: segmentation_scoring.evaluate_truth_file_methods(seg, demos, ms, tol))]
     if not args.datasets:
         raise RuntimeError("give --datasets, --truth or --labels")
-    return [(n, lambda seg, m, tol, n=n: segmentation_scoring.evaluate_dataset(seg, os.path.join(args.datasets, n), m, config, tol))
-            for n in args.names.split(",") if n]
+    return [(n, lambda seg, ms, tol, n=n: segmentation_scoring.evaluate_dataset_methods(
+        seg, os.path.join(args.datasets, n), ms, config, tol)) for n in args.names.split(",") if n]
 
 
 def main():
@@ -174,17 +186,17 @@ def main():
         "dataset", "method", "correct", "rate", "cover", "f1", "err_med", "err_p95", "time_s", "features"))
     for name, evaluate in rows:
         results[name] = {}
+        try:
+            answers = evaluate(segment, methods, tol)
+        except (RuntimeError, rospy.ServiceException, rosbag.ROSBagException, OSError, ValueError) as exc:
+            print("%-14s %-18s error: %s" % (name, ",".join(methods), exc))
+            # also where a caller (the pipeline) looks for a tool's last words
+            print("error: %s %s: %s" % (name, ",".join(methods), exc), file=sys.stderr)
+            results[name] = {m: {"error": str(exc)} for m in methods}
+            failures += 1
+            continue
         for method in methods:
-            try:
-                r = evaluate(segment, method, tol)
-            except (RuntimeError, rospy.ServiceException, rosbag.ROSBagException, OSError, ValueError) as exc:
-                print("%-14s %-18s error: %s" % (name, method, exc))
-                # also where a caller (the pipeline) looks for a tool's last words
-                print("error: %s %s: %s" % (name, method, exc), file=sys.stderr)
-                results[name][method] = {"error": str(exc)}
-                failures += 1
-                continue
-            results[name][method] = r
+            r = results[name][method] = answers[method]
             print("%-14s %-18s %4d/%-3d %5.0f%% %6.3f %6.3f %7.3f %7.3f %8.2f  %s" % (
                 name, method, r["correct"], r["demos"], 100 * r["success_rate"], r["covering"], r["f1"],
                 r["time_error_median_s"], r["time_error_p95_s"], r["service_time_s"],
