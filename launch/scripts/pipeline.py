@@ -56,7 +56,6 @@ Reduced runs (CI): `--demos N` records N configurations per dataset (spread over
 later stages use the bags present), `--goals N` reproduces N unseen goals per task (spread).
 """
 import argparse
-import collections
 import contextlib
 import json
 import os
@@ -68,7 +67,8 @@ import time
 import yaml
 from lfd_tools import config as lfd_config
 from lfd_tools import judge, report as records
-from lfd_tools.master import background_launch, private_master, stop_group
+from lfd_tools.jobs import run_parallel, run_tool, split, workers
+from lfd_tools.master import background_launch, private_master
 from lfd_tools.processes import TAG_VAR, kill_tagged
 
 HERE = os.path.dirname(os.path.abspath(__file__))
@@ -77,28 +77,10 @@ DATASETS = ("sim_grasp", "sim_push", "teleop_grasp", "teleop_push")
 TASKS_FILE = os.path.join(ROOT, "config", "tasks.yaml")
 LEARN_SKILLS = os.path.join(ROOT, "lfd_dmp", "scripts", "learn_skills.py")
 REPRODUCE_GOALS = os.path.join(ROOT, "lfd_dmp", "scripts", "reproduce_goals.py")
-STDERR_TAIL_LINES = 3  # of a failed tool's stderr, quoted in the stage's error
 
 
 def say(msg):
     print("[pipeline] %s" % msg, flush=True)
-
-
-def run(cmd, env=None):
-    """Runs a stage's tool; returns (exit status, its last stderr lines). Its stderr still shows."""
-    say("$ " + " ".join(cmd))
-    proc = subprocess.Popen(cmd, env=env, start_new_session=True, stderr=subprocess.PIPE,
-                            universal_newlines=True, errors="replace")
-    tail = collections.deque(maxlen=STDERR_TAIL_LINES)
-    try:
-        for line in proc.stderr:
-            sys.stderr.write(line)
-            if line.strip() and not line[0].isspace():  # a traceback's code lines are indented
-                tail.append(line.rstrip())
-        return proc.wait(), "\n".join(tail)
-    except KeyboardInterrupt:
-        stop_group(proc, 30)
-        raise
 
 
 def failed(what, rc, tail):
@@ -139,16 +121,23 @@ def reduced_tasks_file(out, demos):
 
 
 def stage_datasets(out, args, report):
+    """The datasets dealt over the workers, each worker a simulation on a master of its own."""
     data = os.path.join(out, "datasets")
-    cmd = ["/usr/bin/python3", os.path.join(ROOT, "lfd_sim_bridge", "scripts", "generate_datasets.py"),
-           "--out", data, "--datasets", ",".join(args.datasets),
-           "--tasks-file", reduced_tasks_file(out, args.demos)]
-    with private_master() as env:
-        rc, tail = run(cmd, env)
+    tasks_file = reduced_tasks_file(out, args.demos)
+    groups = split(args.datasets, workers(args.jobs))
+
+    def generate(names):
+        cmd = ["/usr/bin/python3", os.path.join(ROOT, "lfd_sim_bridge", "scripts", "generate_datasets.py"),
+               "--out", data, "--datasets", ",".join(names), "--tasks-file", tasks_file]
+        with private_master() as env:
+            return run_tool(cmd, env, label="+".join(names) if len(groups) > 1 else None)
+
+    results = run_parallel([lambda g=g: generate(g) for g in groups], args.jobs)
     report["datasets"] = {n: {"demos": count_bags(os.path.join(data, n)), "path": os.path.join(data, n)}
                           for n in args.datasets}
-    if rc != 0:
-        raise failed("dataset generation failed; see the table above", rc, tail)
+    bad = [(rc, tail) for rc, tail in results if rc != 0]
+    if bad:
+        raise failed("dataset generation failed; see the table above", *bad[0])
 
 
 def require_bags(data, names):
@@ -166,7 +155,7 @@ def stage_segment(out, args, report):
     result = os.path.join(out, "segmentation.json")
     with private_master() as env:
         with background_launch(["roslaunch", "lfd_launch", "segment.launch"], env):
-            rc, tail = run(["/usr/bin/python3", os.path.join(ROOT, "lfd_segmentation", "scripts",
+            rc, tail = run_tool(["/usr/bin/python3", os.path.join(ROOT, "lfd_segmentation", "scripts",
                                                               "evaluate_segmentation.py"),
                             "--datasets", data, "--names", ",".join(args.datasets), "--out", result], env)
     if not os.path.exists(result):
@@ -220,7 +209,7 @@ def stage_learn(out, args, report):
                 result = os.path.join(skills, "learning_%s.json" % mode)
                 with contextlib.suppress(FileNotFoundError):
                     os.remove(result)
-                rc, tail = run(["/usr/bin/python3", LEARN_SKILLS, "--attach", "--dataset", data, "--mode", mode,
+                rc, tail = run_tool(["/usr/bin/python3", LEARN_SKILLS, "--attach", "--dataset", data, "--mode", mode,
                                 "--tasks", ",".join(tasks), "--library-dir", skills, "--out", result], env)
                 res = load_json(result)
                 if res is None:
@@ -275,24 +264,30 @@ def stage_reproduce(out, args, report):
             todo.setdefault(mode, []).append((task, ids))
     if not todo:
         return "skipped"
-    with private_master() as env:
-        with background_launch(["roslaunch", "lfd_launch", "reproduce.launch", "library_dir:=" + skills], env):
-            for mode, items in todo.items():
-                for task, ids in items:
-                    reproduce_one(results, skills, mode, task, ids, report, env)
+    items = [(mode, task, ids) for mode, tasks in todo.items() for task, ids in tasks]
+    groups = split(items, workers(args.jobs))
+
+    def reproduce(group):  # one simulation and executor for the worker's libraries
+        with private_master() as env:
+            with background_launch(["roslaunch", "lfd_launch", "reproduce.launch", "library_dir:=" + skills], env):
+                for mode, task, ids in group:
+                    reproduce_one(results, skills, mode, task, ids, report, env,
+                                  "%s_%s" % (mode, task) if len(groups) > 1 else None)
+
+    run_parallel([lambda g=g: reproduce(g) for g in groups], args.jobs)
     return None
 
 
-def reproduce_one(results, skills, mode, task, ids, report, env):
+def reproduce_one(results, skills, mode, task, ids, report, env, label):
     path = os.path.join(results, "%s_%s.json" % (task, mode))
     with contextlib.suppress(FileNotFoundError):
         os.remove(path)
     say("reproduce %s_%s: %d unseen goals %s" % (mode, task, len(ids), ids))
     section = report[records.reproduction_key(mode)]
     try:
-        rc, tail = run(["/usr/bin/python3", REPRODUCE_GOALS, "--attach", "--library-dir", skills, "--mode", mode,
+        rc, tail = run_tool(["/usr/bin/python3", REPRODUCE_GOALS, "--attach", "--library-dir", skills, "--mode", mode,
                         "--tasks", task, "--goals", ",".join(map(str, ids)), "--record-dir", results,
-                        "--out", path], env)
+                        "--out", path], env, label)
     except KeyboardInterrupt:  # report the goals done; a rerun redoes the task
         entry = task_record(path, mode, task)
         if entry:
@@ -339,14 +334,17 @@ def stage_figures(out, args, report):
     report["figure_problems"] = []  # this run's
     os.makedirs(figs, exist_ok=True)
     plot = os.path.join(ROOT, "lfd_segmentation", "scripts", "plot_segmentation.py")
-    made = {}
-    for name in args.datasets:
+
+    def dataset_figures(name):
         say("figures %s ..." % name)
-        made[name] = run_quiet(["/usr/bin/python3", plot, "--dataset", os.path.join(data, name),
-                                "--config", os.path.join(ROOT, "config", "segmentation.yaml"),
-                                "--out", figs, "--prefix", name + "_", "--demo", "0"])
+        paths = run_quiet(["/usr/bin/python3", plot, "--dataset", os.path.join(data, name),
+                           "--config", os.path.join(ROOT, "config", "segmentation.yaml"),
+                           "--out", figs, "--prefix", name + "_", "--demo", "0"])
         bags = sorted(b for b in os.listdir(os.path.join(data, name)) if b.endswith(".bag"))
-        made[name] += snapshots(report, name, os.path.join(data, name, bags[0]), figs)
+        return paths + snapshots(report, name, os.path.join(data, name, bags[0]), figs)
+
+    made = dict(zip(args.datasets, run_parallel(
+        [lambda n=n: dataset_figures(n) for n in args.datasets], args.jobs)))
     # The first reproduction of each task was recorded: snapshots at the end of each segment.
     for mode in ("sim", "teleop"):
         for task, entry in sorted(report.get(records.reproduction_key(mode), {}).items()):
@@ -476,6 +474,8 @@ def main():
                          "reproduces the simulated tasks; teleop adds ~3.5 min")
     ap.add_argument("--force", action="store_true",
                     help="learn and reproduce again even where results exist")
+    ap.add_argument("--jobs", type=int, default=0,
+                    help="independent simulations / figure jobs at once (0 = one per core)")
     # roslaunch (launch/pipeline.launch) appends __name:= / __log:= remappings: not ours.
     args = ap.parse_args([a for a in sys.argv[1:] if not a.startswith("__")])
     # SIGTERM (kill, CI timeouts) and a SIGINT ignored by a non-interactive parent shell stop the

@@ -200,12 +200,7 @@ std::vector<GripperEvent> gripperEvents(const std::vector<double>& values, doubl
   return events;
 }
 
-TaskPlanner::TaskPlanner(const lfd::KinematicChain& chain, const lfd::IkOptions& ik_options,
-                         const Eigen::VectorXd& preferred_posture,
-                         const lfd_sim_bridge::demo::IkTolerance& tolerance)
-    : ik_(chain, Eigen::Isometry3d::Identity(), ik_options, tolerance) {
-  if (preferred_posture.size() == chain.dof()) ik_.setPreferredPosture(preferred_posture);
-}
+TaskPlanner::TaskPlanner(const lfd::CartesianToJoints& ik) : ik_(ik) {}
 
 ExecutionPlan TaskPlanner::plan(const SkillLibrary& library,
                                 const std::vector<SegmentTarget>& targets,
@@ -327,9 +322,9 @@ ExecutionPlan TaskPlanner::plan(const SkillLibrary& library,
   }
 
   // Reachability of the WHOLE path before anything moves.
-  std::vector<lfd_sim_bridge::demo::TimedPose> samples(plan.poses.size());
+  std::vector<lfd::TimedPose> samples(plan.poses.size());
   for (size_t k = 0; k < samples.size(); ++k) samples[k] = {plan.times[k], plan.poses[k]};
-  lfd_sim_bridge::demo::JointPath path;
+  lfd::JointPath path;
   try {
     path = ik_.convert(samples, q_start);
   } catch (const std::runtime_error& e) {

@@ -9,6 +9,7 @@
 // The logic is lfd_dmp::TaskPlanner (lib/executor.cpp); this file is ROS I/O and sim-time pacing.
 // Parameters: config/executor.yaml (loaded by launch/reproduce.launch).
 #include "lfd_dmp/executor.hpp"
+#include "lfd_core/robot_setup.hpp"
 #include "lfd_sim_bridge/pose_msg.hpp"
 
 #include <lfd_msgs/ExecuteTask.h>
@@ -61,6 +62,9 @@ class Executor {
   Executor(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh) {
     pnh.param<std::string>("tasks_file", tasks_file_, "");
     pnh.param<std::string>("library_dir", library_dir_, "");
+    std::string robot_file;
+    pnh.param<std::string>("robot_file", robot_file, "");
+    robot_ = lfd::loadRobotSetup(robot_file);
     pnh.param("dt", options_.dt, options_.dt);
     pnh.param("all_segment_goals", options_.all_segment_goals, options_.all_segment_goals);
     pnh.param("gripper/threshold_fraction", options_.gripper_threshold_fraction,
@@ -76,8 +80,6 @@ class Executor {
               options_.generalization.local_linear);
     pnh.param("generalization/range_margin", options_.generalization.range_margin,
               options_.generalization.range_margin);
-    pnh.param("ik_tolerance/position", tolerance_.position, tolerance_.position);
-    pnh.param("ik_tolerance/orientation", tolerance_.orientation, tolerance_.orientation);
     pnh.param("settle_time", settle_time_, settle_time_);
     pnh.param("clock_timeout", clock_timeout_, clock_timeout_);
     std::vector<double> b;
@@ -153,19 +155,8 @@ class Executor {
       throw std::runtime_error("/robot_description is not set (launch sim.launch)");
     const lfd_sim_bridge::demo::TaskSetup setup =
         lfd_sim_bridge::demo::loadTaskSetup(tasks_file_, task, "sim");
-    if (setup.ik_base != "base_link")
-      throw std::runtime_error("the executor expects an IK chain starting at base_link");
-    const lfd::KinematicChain chain =
-        lfd::KinematicChain::fromUrdfString(urdf, setup.ik_base, setup.ik_tip);
-    lfd::IkOptions ik;
-    ik.joint_costs = Eigen::VectorXd::Ones(chain.dof());
-    Eigen::VectorXd preferred = Eigen::VectorXd::Zero(chain.dof());
-    for (int i = 0; i < chain.dof(); ++i) {
-      const std::string& j = chain.jointNames()[i];
-      if (setup.joint_costs.count(j)) ik.joint_costs[i] = setup.joint_costs.at(j);
-      if (setup.preferred_posture.count(j)) preferred[i] = setup.preferred_posture.at(j);
-    }
-    planners_[task] = std::make_unique<lfd_dmp::TaskPlanner>(chain, ik, preferred, tolerance_);
+    planners_[task] =
+        std::make_unique<lfd_dmp::TaskPlanner>(lfd::makeCartesianToJoints(urdf, robot_));
     gripper_orientation_[task] = task == "push" ? setup.push_orientation : setup.grasp_orientation;
   }
 
@@ -435,7 +426,7 @@ class Executor {
   ros::NodeHandle nh_;
   std::string tasks_file_, library_dir_, gripper_joint_ = "R_GRIPPER";
   lfd_dmp::ExecutorOptions options_;
-  lfd_sim_bridge::demo::IkTolerance tolerance_;
+  lfd::RobotSetup robot_;
   double open_opening_ = 0.08, close_opening_ = 0.0, close_effort_ = 20.0;
   double settle_time_ = 0.5, clock_timeout_ = 5.0;
   Eigen::Vector3d base_in_world_{0.0, 0.0, 0.85};

@@ -181,10 +181,17 @@ TEST(SegmentTargets, GraspAndPushRulesFollowTheSituation) {
   EXPECT_THROW(lfd_dmp::parseOrientationRule("sideways"), std::invalid_argument);
 }
 
+// The planner's IK: the chain with default options, pulled toward the home posture.
+lfd::CartesianToJoints converter(const lfd::KinematicChain& chain, const Eigen::VectorXd& home) {
+  lfd::CartesianToJoints ik(chain);
+  ik.setPreferredPosture(home);
+  return ik;
+}
+
 class PlannerTest : public ::testing::Test {
  protected:
   PlannerTest()
-      : chain_(chain()), q0_(homePosture(chain_)), planner_(chain_, lfd::IkOptions(), q0_) {
+      : chain_(chain()), q0_(homePosture(chain_)), planner_(converter(chain_, q0_)) {
     home_ = planner_.forward(q0_);
     lib_ = library(home_);
   }

@@ -74,14 +74,6 @@ TaskSetup loadTaskSetup(const std::string& path, const std::string& task, const 
   setup.object = task == "grasp" ? "stick" : "box";
   try {
     if (root["table_top"]) setup.table_top = root["table_top"].as<double>();
-    if (const YAML::Node ik = root["ik"]) {
-      if (ik["base_link"]) setup.ik_base = ik["base_link"].as<std::string>();
-      if (ik["tip_link"]) setup.ik_tip = ik["tip_link"].as<std::string>();
-      if (ik["preferred_posture"])
-        setup.preferred_posture = ik["preferred_posture"].as<std::map<std::string, double>>();
-      if (ik["joint_costs"])
-        setup.joint_costs = ik["joint_costs"].as<std::map<std::string, double>>();
-    }
     if (const YAML::Node g = root["gripper_orientation"]) {
       if (g["grasp"])
         setup.grasp_orientation = parseQuaternion(g["grasp"], path, "gripper_orientation.grasp");

@@ -10,7 +10,7 @@
 // dropped however loaded the machine is; the sim then runs exactly as fast as the nodes keep up.
 //
 // Private parameters (config/demonstrator.yaml): task, mode, configurations, output_dir, seed,
-// tasks_file, speed_min/max, sample_period, contact_threshold, lead_in, tail, phase_rate,
+// tasks_file, robot_file, speed_min/max, sample_period, contact_threshold, lead_in, tail, phase_rate,
 // skip_existing, lockstep, lockstep_chunk, geometry/*, timing/*, teleop/*.
 #include <atomic>
 #include <cmath>
@@ -40,7 +40,7 @@
 #include <tf2_ros/transform_listener.h>
 #include <trajectory_msgs/JointTrajectory.h>
 
-#include "lfd_sim_bridge/demo_ik.hpp"
+#include "lfd_core/robot_setup.hpp"
 #include "lfd_sim_bridge/demo_plan.hpp"
 #include "lfd_sim_bridge/demo_tasks.hpp"
 #include "lfd_sim_bridge/pose_msg.hpp"
@@ -134,6 +134,7 @@ class Demonstrator {
     if (output_dir_.empty()) throw std::invalid_argument("~output_dir is required");
     seed_ = param(pnh, "seed", 1);
     setup_ = demo::loadTaskSetup(param<std::string>(pnh, "tasks_file", ""), task_, mode_);
+    robot_ = lfd::loadRobotSetup(param<std::string>(pnh, "robot_file", ""));
     std::vector<int> wanted = param(pnh, "configurations", std::vector<int>());
     for (const demo::TaskConfiguration& c : setup_.configurations)
       if (wanted.empty() || std::find(wanted.begin(), wanted.end(), c.index) != wanted.end())
@@ -257,26 +258,9 @@ class Demonstrator {
     std::string urdf;
     if (!nh_.getParam("/robot_description", urdf))
       throw std::runtime_error("/robot_description is not set (launch sim.launch)");
-    const lfd::KinematicChain chain =
-        lfd::KinematicChain::fromUrdfString(urdf, setup_.ik_base, setup_.ik_tip);
-    // Pose of the IK base in base_link and of base_link in the world, from /tf_static and the
-    // URDF (the chain base is base_link itself unless tasks.yaml says otherwise).
-    Eigen::Isometry3d chain_base = Eigen::Isometry3d::Identity();
-    if (setup_.ik_base != "base_link") {
-      const lfd::KinematicChain to_base =
-          lfd::KinematicChain::fromUrdfString(urdf, "base_link", setup_.ik_base);
-      chain_base = to_base.forward(Eigen::VectorXd::Zero(to_base.dof()));  // joints at zero
-    }
-    lfd::IkOptions options;
-    options.joint_costs = Eigen::VectorXd::Ones(chain.dof());
-    preferred_ = Eigen::VectorXd::Zero(chain.dof());
-    for (int i = 0; i < chain.dof(); ++i) {
-      const std::string& joint = chain.jointNames()[i];
-      if (setup_.joint_costs.count(joint)) options.joint_costs[i] = setup_.joint_costs.at(joint);
-      if (setup_.preferred_posture.count(joint)) preferred_[i] = setup_.preferred_posture.at(joint);
-    }
-    converter_ = std::make_unique<demo::CartesianToJoints>(chain, chain_base, options);
-    converter_->setPreferredPosture(preferred_);
+    // The IK of config/robot.yaml (chain, costs, posture) for poses in base_link; base_link's
+    // pose in the world comes from /tf_static.
+    converter_ = std::make_unique<lfd::CartesianToJoints>(lfd::makeCartesianToJoints(urdf, robot_));
     const geometry_msgs::TransformStamped w =
         tf_buffer_.lookupTransform("world", "base_link", ros::Time(0), ros::Duration(30.0));
     world_from_base_ = Eigen::Isometry3d::Identity();
@@ -370,7 +354,7 @@ class Demonstrator {
         teleop_.enabled
             ? demo::Tremor(teleop_.tremor_rms, teleop_.tremor_low_hz, teleop_.tremor_high_hz, rng())
             : demo::Tremor();
-    std::vector<demo::JointPath> paths;
+    std::vector<lfd::JointPath> paths;
     demo::Pose from = start;
     Eigen::VectorXd seed = q0;
     double t0 = 0.0;
@@ -438,7 +422,7 @@ class Demonstrator {
              static_cast<unsigned long>(stop.response.messages_written));
   }
 
-  void runPhase(const demo::Phase& phase, const demo::JointPath& path) {
+  void runPhase(const demo::Phase& phase, const lfd::JointPath& path) {
     const ros::Time phase_start = now();
     setPhase(phase, phase_start);
     sendTrajectory(path);
@@ -469,7 +453,7 @@ class Demonstrator {
     advanceTo(phase_start + ros::Duration(t));
   }
 
-  void sendTrajectory(const demo::JointPath& path) {
+  void sendTrajectory(const lfd::JointPath& path) {
     trajectory_msgs::JointTrajectory msg;
     msg.header.stamp = lockstep_ ? now() : ros::Time(0);  // lockstep: exactly now; else on receipt
     msg.joint_names = path.joint_names;
@@ -663,8 +647,8 @@ class Demonstrator {
   demo::Geometry geometry_;
   demo::Timing timing_;
   demo::TeleopStyle teleop_;
-  std::unique_ptr<demo::CartesianToJoints> converter_;
-  Eigen::VectorXd preferred_;
+  lfd::RobotSetup robot_;
+  std::unique_ptr<lfd::CartesianToJoints> converter_;
   Eigen::Isometry3d world_from_base_ = Eigen::Isometry3d::Identity();
 
   ros::Publisher trajectory_pub_, gripper_pub_, phase_pub_;

@@ -64,7 +64,6 @@ TEST(TaskSetup, RepositoryConfigurationsCoverThePaperDatasets) {
 TEST(TaskSetup, ParsesPoseFormsAndReportsErrors) {
   const std::string good = writeTemp(
       "table_top: 0.7\n"
-      "ik: {base_link: chest_link, tip_link: r_gripper_tcp, joint_costs: {WAIST_Y: 3}}\n"
       "gripper_orientation: {grasp: [0, 0, 0, 1]}\n"
       "grasp:\n"
       "  sim:\n"
@@ -72,8 +71,6 @@ TEST(TaskSetup, ParsesPoseFormsAndReportsErrors) {
       "0.9], yaw: 0}}\n");
   const demo::TaskSetup s = demo::loadTaskSetup(good, "grasp", "sim");
   EXPECT_DOUBLE_EQ(s.table_top, 0.7);
-  EXPECT_EQ(s.ik_base, "chest_link");
-  EXPECT_DOUBLE_EQ(s.joint_costs.at("WAIST_Y"), 3.0);
   EXPECT_NEAR(std::abs(s.grasp_orientation.z()), 1.0, 1e-12);
   ASSERT_EQ(s.configurations.size(), 1u);
   EXPECT_EQ(s.configurations[0].index, 4);

@@ -19,6 +19,7 @@ namespace {
 
 const std::string kModelDir = LFD_SIM_MODEL_DIR;
 const std::string kTasksPath = kModelDir + "/../../config/tasks.yaml";
+const std::string kRobotPath = kModelDir + "/../../config/robot.yaml";
 
 constexpr double kGraspAboveCenter = 0.005, kPregrasp = 0.10, kLift = 0.15;
 constexpr double kPushFace = 0.04 + 0.012, kPushClearance = 0.02, kPushPrelift = 0.08;
@@ -54,12 +55,10 @@ class Tasks : public ::testing::Test {
     root_ = YAML::LoadFile(kTasksPath);
     table_ = root_["table_top"].as<double>();
     base_z_ = root_["base_link_in_world"][2].as<double>();
-    const YAML::Node ik = root_["ik"];
+    const YAML::Node ik = YAML::LoadFile(kRobotPath)["ik"];
     chain_ = std::make_unique<lfd::KinematicChain>(lfd::KinematicChain::fromUrdfFile(
         kModelDir + "/jvrc1_like.urdf", ik["base_link"].as<std::string>(),
         ik["tip_link"].as<std::string>()));
-    EXPECT_EQ(root_["ik_base_link"].as<std::string>(), chain_->baseLink());
-    EXPECT_EQ(root_["ik_tip_link"].as<std::string>(), chain_->tipLink());
     lfd::IkOptions options;
     options.joint_costs = Eigen::VectorXd::Ones(chain_->dof());
     for (const auto& kv : ik["joint_costs"]) {

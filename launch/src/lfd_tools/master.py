@@ -7,6 +7,7 @@ import subprocess
 import time
 
 START_TIMEOUT_S = 30.0
+START_ATTEMPTS = 5
 PARAM_SERVER_GRACE_S = 1.0  # the parameter server answers a little after the port opens
 
 
@@ -44,22 +45,32 @@ def master_online(env=None):
     return bool(uri) and rosgraph.is_master_online(uri)
 
 
+def start_roscore():
+    """(process, env) of a roscore on a free port. The port is free when chosen, but another
+    process (a second master's servers, starting at the same time) may take it before roscore
+    binds it: then roscore exits at once, and another port is tried."""
+    for _ in range(START_ATTEMPTS):
+        port = free_port()
+        env = dict(os.environ, ROS_MASTER_URI=master_uri(port))
+        core = subprocess.Popen(["roscore", "-p", str(port)], env=env, stdout=subprocess.DEVNULL,
+                                stderr=subprocess.DEVNULL, start_new_session=True)
+        deadline = time.time() + START_TIMEOUT_S
+        while not port_open(port) and core.poll() is None:
+            if time.time() > deadline:
+                stop_group(core, 15)
+                raise RuntimeError("roscore did not come up on port %d" % port)
+            time.sleep(0.2)
+        if core.poll() is None:
+            return core, env
+    raise RuntimeError("roscore exited at start %d times (last port %d)" % (START_ATTEMPTS, port))
+
+
 @contextlib.contextmanager
 def private_master():
     """A roscore on a free port; yields a copy of os.environ whose ROS_MASTER_URI points to it.
     The master (and whatever it started) is stopped on exit."""
-    port = free_port()
-    env = dict(os.environ, ROS_MASTER_URI=master_uri(port))
-    core = subprocess.Popen(["roscore", "-p", str(port)], env=env, stdout=subprocess.DEVNULL,
-                            stderr=subprocess.DEVNULL, start_new_session=True)
+    core, env = start_roscore()
     try:
-        deadline = time.time() + START_TIMEOUT_S
-        while not port_open(port):
-            if core.poll() is not None:
-                raise RuntimeError("roscore exited at start (port %d)" % port)
-            if time.time() > deadline:
-                raise RuntimeError("roscore did not come up on port %d" % port)
-            time.sleep(0.2)
         time.sleep(PARAM_SERVER_GRACE_S)
         yield env
     finally:

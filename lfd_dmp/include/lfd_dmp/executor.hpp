@@ -2,7 +2,7 @@
 // trajectory. Paper II-D / III: every segment's DMP is generalized from the demonstrations to the
 // segment's new goal, rolled out in sequence from the robot's current TCP pose (each segment starts
 // where the previous one ended), converted to joint targets by the core IK (warm-started, joint
-// limits, null-space posture; lfd_sim_bridge's CartesianToJoints, shared with the demonstrator),
+// limits, null-space posture; lfd_core's CartesianToJoints, shared with the demonstrator),
 // and the gripper DMP is thresholded into open/close commands. The whole path is checked by IK
 // BEFORE anything moves, so an unreachable goal is refused with the failing pose in the message.
 // executor_node.cpp only adds ROS I/O and sim-time streaming.
@@ -10,10 +10,8 @@
 
 #include "lfd_dmp/skill_library.hpp"
 
+#include <lfd_core/cartesian_path.hpp>
 #include <lfd_core/dmp_generalization.hpp>
-#include <lfd_core/inverse_kinematics.hpp>
-#include <lfd_core/kinematic_chain.hpp>
-#include <lfd_sim_bridge/demo_ik.hpp>
 
 #include <Eigen/Geometry>
 
@@ -23,7 +21,7 @@
 
 namespace lfd_dmp {
 
-using TcpPose = lfd_sim_bridge::demo::Pose;  // position + unit quaternion, base_link
+using TcpPose = lfd::Pose;  // position + unit quaternion, base_link
 
 /// Which pose of the task situation a segment's goal is attached to.
 enum class GoalReference { kObject, kGoal, kStart };
@@ -134,9 +132,8 @@ struct ExecutionPlan {
 
 class TaskPlanner {
  public:
-  TaskPlanner(const lfd::KinematicChain& chain, const lfd::IkOptions& ik_options,
-              const Eigen::VectorXd& preferred_posture,
-              const lfd_sim_bridge::demo::IkTolerance& tolerance = {});
+  /// `ik`: the robot's Cartesian->joint conversion (lfd::makeCartesianToJoints of robot.yaml).
+  explicit TaskPlanner(const lfd::CartesianToJoints& ik);
 
   const lfd::KinematicChain& chain() const { return ik_.chain(); }
   TcpPose forward(const Eigen::VectorXd& q) const { return ik_.forward(q); }
@@ -149,7 +146,7 @@ class TaskPlanner {
                      const ExecutorOptions& options);
 
  private:
-  lfd_sim_bridge::demo::CartesianToJoints ik_;
+  lfd::CartesianToJoints ik_;
 };
 
 }  // namespace lfd_dmp

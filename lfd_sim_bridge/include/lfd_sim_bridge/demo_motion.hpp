@@ -7,13 +7,12 @@
 
 #include <Eigen/Geometry>
 
+#include "lfd_core/pose.hpp"
+
 namespace lfd_sim_bridge {
 namespace demo {
 
-struct Pose {
-  Eigen::Vector3d position = Eigen::Vector3d::Zero();
-  Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();
-};
+using Pose = lfd::Pose;
 
 // Minimum-jerk progress s(u) = 10u^3 - 15u^4 + 6u^5 for u in [0, 1] (clamped outside): zero
 // velocity and acceleration at both ends, like a human reaching movement.

@@ -112,10 +112,7 @@ DemoPlan planDemo(const TaskInstance& instance, const Pose& start, const Geometr
 // Yaw (rad) of a pose about the base z axis (the stick's axis direction on the table).
 double yawOf(const Eigen::Quaterniond& q);
 
-struct TimedPose {
-  double t = 0.0;  // s from the start of the sampled span
-  Pose pose;
-};
+using TimedPose = lfd::TimedPose;
 
 // Samples the segments of one phase every `dt` from `start` (the phase's start pose) at times
 // t0 + k*dt; the last sample lands exactly at the phase end. Moves follow the minimum-jerk law;

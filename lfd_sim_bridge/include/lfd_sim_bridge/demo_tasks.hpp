@@ -24,9 +24,6 @@ struct TaskSetup {
   std::string object;  // "stick" or "box"
   std::vector<TaskConfiguration> configurations;
   std::map<std::string, Pose> park;  // where the objects not used by the task wait (world)
-  std::string ik_base = "base_link", ik_tip = "r_gripper_tcp";
-  // IK null-space posture and per-joint motion costs by joint name (unlisted: 0 rad / cost 1).
-  std::map<std::string, double> preferred_posture, joint_costs;
   // TCP orientation (base_link) grasping a stick lying along x / pushing along +x.
   Eigen::Quaterniond grasp_orientation = Eigen::Quaterniond::Identity();
   Eigen::Quaterniond push_orientation = Eigen::Quaterniond::Identity();
