@@ -156,6 +156,9 @@ SegmentationParams params_from_yaml(const YAML::Node& root) {
       lfd::parse_clasp_distance(get<std::string>(clasp, "distance", lfd::to_string(cc.distance)));
   cc.score = lfd::parse_clasp_score(get<std::string>(clasp, "score", lfd::to_string(cc.score)));
   cc.p_value_threshold = get<double>(clasp, "p_value_threshold", cc.p_value_threshold);
+  seg.significance_per_sample =
+      non_negative(get<double>(clasp, "significance_per_sample", seg.significance_per_sample),
+                   "clasp/significance_per_sample");
   cc.tie_jitter = non_negative(get<double>(clasp, "tie_jitter", cc.tie_jitter), "clasp/tie_jitter");
 
   const YAML::Node events = root["events"];
@@ -168,6 +171,7 @@ SegmentationParams params_from_yaml(const YAML::Node& root) {
   ev.noise_floor_excursions =
       get<double>(events, "noise_floor_excursions", ev.noise_floor_excursions);
   ev.hysteresis = get<double>(events, "hysteresis", ev.hysteresis);
+  ev.zones_from_rest_edges = get<bool>(events, "zones_from_rest_edges", ev.zones_from_rest_edges);
   ev.placement = lfd::parse_event_placement(
       get<std::string>(events, "placement", lfd::to_string(ev.placement)));
   if (events && events["place_on_change"])

@@ -382,8 +382,13 @@ MultivariateSegmentation segment_multivariate(const Eigen::MatrixXd& features,
       const double needed = restricted
                                 ? zone_needed[static_cast<std::size_t>(zone_of(c.profile_argmax))]
                                 : needed_log10_p;
-      if (learn && c.log10_p_value > needed) {  // not significant
-        if (!restricted) return;                // plain ClaSP: the range stays whole
+      // Outside zones a long demo needs more evidence (significance_per_sample): the rank-sum
+      // test's log p grows with the number of subsequences for the same split quality.
+      const double needed_here =
+          restricted ? needed
+                     : std::min(needed, -config.significance_per_sample * static_cast<double>(n));
+      if (learn && c.log10_p_value > needed_here) {  // not significant
+        if (!restricted) return;                     // plain ClaSP: the range stays whole
         tested[static_cast<std::size_t>(zone_of(c.profile_argmax))] = true;
         continue;
       }

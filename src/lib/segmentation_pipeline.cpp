@@ -154,8 +154,10 @@ DemoSegmentationResult segment_demo(const FeatureMatrix& demo, const DemoSetting
       validate
           ? detect_sensor_events(demo.select(prepared.sensor_features).data, own.events, groups)
           : SensorEvents{};
+  const std::vector<std::size_t>& zone_events =
+      own.events.zones_from_rest_edges ? events.zone_events : events.all;
   const auto zones = [&](std::size_t min_s) {
-    return confidence_zones(events.all, min_s, static_cast<std::size_t>(demo.rows()));
+    return confidence_zones(zone_events, min_s, static_cast<std::size_t>(demo.rows()));
   };
   if (validate && own.procedure == SegmentationProcedure::kZoneSearch) {
     seg.candidate_zones_for = zones;

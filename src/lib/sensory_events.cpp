@@ -291,17 +291,55 @@ bool at_rest(const Channel& c, std::size_t from, std::size_t to) {
   return median_of(d) < c.on;
 }
 
+// For every sample, the length of the run of samples around it where the whole group sits at
+// rest (0 where it does not).
+std::vector<std::size_t> rest_run_lengths(const std::vector<Channel>& channels,
+                                          const std::vector<std::size_t>& group) {
+  const std::size_t n = channels[group.front()].y.size();
+  std::vector<std::size_t> run(n, 0);
+  std::size_t t = 0;
+  while (t < n) {
+    const auto quiet = [&](std::size_t i) {
+      for (std::size_t c : group)
+        if (!channels[c].events.empty() &&
+            !(std::abs(channels[c].y[i] - channels[c].rest) < channels[c].on))
+          return false;
+      return true;
+    };
+    if (!quiet(t)) {
+      ++t;
+      continue;
+    }
+    std::size_t end = t;
+    while (end < n && quiet(end)) ++end;
+    std::fill(run.begin() + static_cast<std::ptrdiff_t>(t),
+              run.begin() + static_cast<std::ptrdiff_t>(end), end - t);
+    t = end;
+  }
+  return run;
+}
+
 // A sensor of several channels (a touch pad per finger, a force vector) is at rest only when
-// all of them are: one pad letting go while the other takes over is not the contact's end.
+// all of them are: one pad letting go while the other takes over is not the contact's end. And
+// a rest shorter than `min_rest` samples (the merge gap: activity separated by less is one
+// activity) is a pause within the interaction, not its end: a teleoperator's hesitation, an arm
+// slowing between two strokes.
 void flag_rest_edges_of_group(std::vector<Channel>* channels, const std::vector<std::size_t>& group,
-                              std::size_t lag) {
+                              std::size_t lag, std::size_t min_rest) {
+  const std::vector<std::size_t> run = rest_run_lengths(*channels, group);
+  const auto longest = [&](std::size_t from, std::size_t to) {
+    std::size_t best = 0;
+    for (std::size_t t = from; t < std::min(to, run.size()); ++t) best = std::max(best, run[t]);
+    return best;
+  };
   for (std::size_t c : group) {
     for (PlacedEvent& p : (*channels)[c].events) {
-      const std::size_t e = p.event.index;
-      bool before = p.from_rest, after = p.to_rest;
+      const std::size_t e = p.event.index, lo = e > lag ? e - lag : 0;
+      bool before = p.from_rest && longest(lo, e) >= min_rest;
+      bool after = p.to_rest && longest(e, e + lag) >= min_rest;
       for (std::size_t o : group) {
         if (o == c) continue;
-        before = before && at_rest((*channels)[o], e > lag ? e - lag : 0, e);
+        before = before && at_rest((*channels)[o], lo, e);
         after = after && at_rest((*channels)[o], e, e + lag);
       }
       p.event.rest_edge = before || after;
@@ -411,9 +449,21 @@ SensorEvents detect_sensor_events(const Eigen::MatrixXd& sensors, const SensoryE
   }
   std::map<std::size_t, std::vector<std::size_t>> members;  // group id -> its columns
   for (std::size_t c = 0; c < cols; ++c) members[groups.empty() ? c : groups[c]].push_back(c);
-  for (const auto& [id, group] : members)
-    flag_rest_edges_of_group(&channels, group, config.difference_lag);
   SensorEvents out;
+  for (const auto& [id, group] : members) {
+    flag_rest_edges_of_group(&channels, group, config.difference_lag, config.merge_gap);
+    // zone_events: a sensor's rest edges, or all its events when it never leaves rest cleanly.
+    bool any_rest_edge = false;
+    for (std::size_t c : group)
+      for (const PlacedEvent& p : channels[c].events)
+        any_rest_edge = any_rest_edge || p.event.rest_edge;
+    for (std::size_t c : group)
+      for (const PlacedEvent& p : channels[c].events)
+        if (p.event.rest_edge || !any_rest_edge) out.zone_events.push_back(p.event.index);
+  }
+  std::sort(out.zone_events.begin(), out.zone_events.end());
+  out.zone_events.erase(std::unique(out.zone_events.begin(), out.zone_events.end()),
+                        out.zone_events.end());
   for (const Channel& c : channels) {
     out.per_sensor.emplace_back();
     for (const PlacedEvent& p : c.events) {

@@ -97,6 +97,11 @@ struct MultivariateSegmentationConfig {
   /// others (the sensory events where a signal leaves or regains its rest level: contact made or
   /// lost, rather than a force ramp reaching its plateau).
   std::vector<bool> preferred_anchors;
+  /// Candidates outside zones (no sensors) need log10 p <= -significance_per_sample x the
+  /// demo's length (samples) when that is stricter than clasp.p_value_threshold; 0 = off. The
+  /// log p of ClaSP's rank-sum test grows with the number of subsequences for the same split
+  /// quality, so a fixed threshold over-segments long or densely sampled demos.
+  double significance_per_sample = 0.0;
   int num_changepoints = -1;          ///< < 0: stop with the significance test; >= 0: exact count
   std::size_t max_changepoints = 16;  ///< safety cap when the test decides
 };

@@ -87,6 +87,9 @@ struct SensoryEventConfig {
   /// ones. 0 = one robust sigma over the whole demo.
   std::size_t noise_block = 0;
   EventPlacement placement = EventPlacement::kShift;
+  /// Confidence zones only around SensorEvents::zone_events (rest edges): a force that varies
+  /// while in contact, or a ramp reaching its plateau, is no new phase. false = every event.
+  bool zones_from_rest_edges = false;
 };
 
 /// One sensory event, with what a zone needs to weigh it.
@@ -136,6 +139,9 @@ struct SensorEvents {
   std::vector<std::size_t> all;                      ///< every sensor's events (sorted, unique)
   std::vector<std::vector<std::size_t>> per_sensor;  ///< per column of `sensors`
   std::vector<SensoryEvent> details;  ///< every sensor's events (sorted by index, unique)
+  /// The events that mark a sensory interaction (sorted, unique): each sensor's rest edges, or
+  /// all its events when it has none (a sensor that never rests, or kThreshold/kShift placement).
+  std::vector<std::size_t> zone_events;
 };
 
 /// Events of every sensor column (rows = samples); they do not depend on min_s. `groups` gives
