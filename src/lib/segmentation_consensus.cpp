@@ -118,7 +118,8 @@ void agree_on_changepoint_count(const std::vector<FeatureMatrix>& demos, bool va
   for (std::size_t d = 0; d < result->demos.size(); ++d) {
     DemoSegmentationResult& out = result->demos[d];
     const std::size_t had = out.changepoints.size();
-    if (had == a.count || (had < a.count && !(fill_p > 0.0 && validated))) continue;
+    const bool can_fill = fill_p > 0.0 && validated && !out.events.empty();
+    if (had == a.count || (had < a.count && !can_fill)) continue;
     std::ostringstream msg;
     msg << demo_context(d) << ": " << had << " changepoints where " << a.votes << " of the "
         << a.voters << " voting demonstrations have " << a.count;

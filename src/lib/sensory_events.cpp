@@ -54,11 +54,12 @@ double noise_sigma(const std::vector<double>& d, std::size_t block) {
 }
 
 // SensoryEventConfig::noise_floor_excursions: how far the detector's own statistic (the lagged
-// difference `mag`) goes when nothing happens. Each block of `block` samples whose raw signal
-// moves at all gives its largest |lagged difference|; the 10th percentile of those is the quiet
-// excursion. Unlike a sigma of the raw differences it needs no noise model: clipped (a touch
-// pad's force cannot go below 0), quantized or correlated noise is measured as the detector sees
-// it.
+// difference `mag`) goes when nothing happens. Each block of `block` samples gives its largest
+// |lagged difference|, 0 for a block whose raw signal does not move at all; the 10th percentile
+// of those is the quiet excursion. Unlike a sigma of the raw differences it needs no noise model:
+// drift, clipped (a touch pad's force cannot go below 0), quantized or correlated noise is
+// measured as the detector sees it. A noise-free signal (constant between its changes) has a
+// quiet excursion of 0.
 double quiet_excursion(const Eigen::Ref<const Eigen::VectorXd>& signal,
                        const std::vector<double>& mag, std::size_t block) {
   const std::size_t n = mag.size();
@@ -67,10 +68,9 @@ double quiet_excursion(const Eigen::Ref<const Eigen::VectorXd>& signal,
   for (std::size_t b = 0; b + block <= n; b += block) {
     const auto part =
         signal.segment(static_cast<Eigen::Index>(b), static_cast<Eigen::Index>(block));
-    if (!(part.maxCoeff() > part.minCoeff())) continue;  // stale or dead: not the noise
-    maxima.push_back(*std::max_element(mag.begin() + b, mag.begin() + b + block));
+    const bool still = !(part.maxCoeff() > part.minCoeff());
+    maxima.push_back(still ? 0.0 : *std::max_element(mag.begin() + b, mag.begin() + b + block));
   }
-  if (maxima.empty()) return 0.0;
   const std::size_t k = maxima.size() / 10;
   std::nth_element(maxima.begin(), maxima.begin() + static_cast<std::ptrdiff_t>(k), maxima.end());
   return maxima[k];
