@@ -39,6 +39,8 @@ const char* kUsage = R"(usage: segment [options] FILE...
                             distance_average | weighted_distance_average, or 'all'. Several: the
                             features are selected once and the JSON holds one result per name
                             under "methods" (the selection does not depend on the combination)
+  --procedure NAME          zone_search (default: zones first, changepoints on their events) |
+                            paper (the paper's: paper_candidates anywhere, then the zone filter)
   --threshold T             relevance threshold in (0,1]
   --min-segment-seconds S   min segment length min_s (s)
   --window-seconds S        fixed ClaSP window (s)
@@ -92,7 +94,7 @@ struct Options {
   std::string topics;  ///< --topics: a YAML file with the topics list
   bool list_fields = false;
   std::vector<std::string> files, sensors, states;
-  std::string time_column, combination, output;
+  std::string time_column, combination, output, procedure;
   double rate = 0, threshold = 0, min_seconds = 0, window_seconds = 0;
   long num_changepoints = 0, threads = -1;
   bool timing = false, feature_profiles = false, profiles = true;
@@ -136,6 +138,8 @@ Options parse_args(int argc, char** argv) {
       o.rate = number();
     } else if (arg == "--combination") {
       o.combination = value();
+    } else if (arg == "--procedure") {
+      o.procedure = value();
     } else if (arg == "--threshold") {
       o.threshold = number();
     } else if (arg == "--min-segment-seconds") {
@@ -178,6 +182,8 @@ nlohmann::json run(const Options& o) {
   if (o.rate > 0) params.rate = o.rate;
   const std::vector<lfd::ProfileCombination> combinations = parse_combinations(o.combination);
   if (combinations.size() == 1) params.pipeline.segmentation.combination = combinations[0];
+  if (!o.procedure.empty())
+    params.pipeline.procedure = lfd::parse_segmentation_procedure(o.procedure);
   if (o.threshold != 0) {
     if (!(o.threshold > 0 && o.threshold <= 1))
       throw std::invalid_argument("--threshold must be in (0,1]");

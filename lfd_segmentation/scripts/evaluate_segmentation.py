@@ -7,7 +7,8 @@ validated changepoints with the ground-truth phase transitions recorded on /lfd/
 segmenter never reads). The protocol and its tolerance come from config/evaluation.yaml.
 
   evaluate_segmentation.py --datasets DIR [--names sim_grasp,sim_push] [--methods ...] --out result.json
-                           [--cli PATH/TO/segment [--seg-config YAML] [--topics YAML] [--no-sensors]]
+                           [--cli PATH/TO/segment [--seg-config YAML] [--topics YAML] [--no-sensors]
+                            [--procedure paper]]
   evaluate_segmentation.py --truth truth.yaml ...        (demos whose truth is not on /lfd/phase)
   evaluate_segmentation.py --labels pr2_ikea/labels.json [--runs pos_1,neg_1] [--write-truth t.yaml] ...
 
@@ -56,8 +57,9 @@ from lfd_tools import report, segmentation_scoring
 class CliSegmenter(object):
     """Runs the `segment` CLI on the bags of one dataset; returns a service-like result."""
 
-    def __init__(self, cli, config, no_sensors, topics=""):
+    def __init__(self, cli, config, no_sensors, topics="", procedure=""):
         self.cli, self.config, self.no_sensors, self.topics = cli, config, no_sensors, topics
+        self.procedure = procedure
 
     def _config(self):
         if not self.no_sensors:
@@ -79,6 +81,8 @@ class CliSegmenter(object):
         cmd = [self.cli, "--config", self._config(), "--no-profiles", "--combination", ",".join(methods)]
         if self.topics and not self.no_sensors:
             cmd += ["--topics", self.topics]
+        if self.procedure:
+            cmd += ["--procedure", self.procedure]
         cmd += bags
         proc = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, universal_newlines=True)
         if not proc.stdout.strip():
@@ -120,7 +124,7 @@ def call_service(segment, bags, method):
 
 def make_segmenter(args):
     if args.cli:
-        return CliSegmenter(args.cli, args.seg_config, args.no_sensors, args.topics)
+        return CliSegmenter(args.cli, args.seg_config, args.no_sensors, args.topics, args.procedure)
     try:
         rospy.wait_for_service(args.service, timeout=30.0)
     except rospy.ROSException:
@@ -168,6 +172,7 @@ def main():
                     help="segmentation parameters for --cli (default: config/segmentation.yaml)")
     ap.add_argument("--topics", default="", help="with --cli: topics file passed to `segment --topics`")
     ap.add_argument("--no-sensors", action="store_true", help="with --cli: drop the sensor topics")
+    ap.add_argument("--procedure", default="", help="with --cli: zone_search or paper (segment --procedure)")
     args = ap.parse_args(rospy.myargv()[1:])
 
     try:
