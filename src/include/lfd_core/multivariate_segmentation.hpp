@@ -74,8 +74,9 @@ struct MultivariateSegmentationConfig {
   /// Optional extension (empty = the paper: candidates anywhere, validated afterwards). When
   /// given, e.g. the confidence zones of sensory_events.hpp, each recursion step takes the argmax
   /// of its penalized profile only inside these intervals, so a strong peak outside every zone
-  /// cannot hide a weaker in-zone changepoint of the same range. Each zone then holds at most one
-  /// changepoint (a zone marks one sensory interaction).
+  /// cannot hide a weaker in-zone changepoint of the same range. Without zone_anchors each zone
+  /// holds at most one changepoint (a zone marks one sensory interaction); with them, one per
+  /// anchor (zones closer than min_s merge and may hold several interactions).
   std::vector<Interval> candidate_zones;
   /// Alternative to candidate_zones for zones that depend on min_s (eq. 1): called once min_s is
   /// known, its result replaces candidate_zones. Empty result = no zone, hence no changepoint.

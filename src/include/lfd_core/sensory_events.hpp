@@ -10,14 +10,18 @@
 //   and the ending of each sensory event); an activity still on at the end yields no off-event.
 // Robustness (real sensors are noisy; the paper's real-data failure mode is too many events):
 //   - median_window: running median before differencing; removes spikes but keeps step edges;
-//   - noise_floor_sigmas: thr is raised to at least that many robust noise sigmas (1.4826 * MAD)
-//     of the raw first difference, so a sensor carrying only noise produces no event at all;
+//   - noise floors: thr is raised to at least noise_floor_excursions quiet excursions (the largest
+//     lagged difference within a quiet block) and/or noise_floor_sigmas robust sigmas of the raw
+//     first difference, so a sensor carrying only noise or drift produces no event at all;
 //   - hysteresis: activity switches off below hysteresis * thr (1 = the paper's single threshold);
 //   - min_active_samples / merge_gap: drop one-sample blips, merge bursts closer than merge_gap;
-//   - difference_lag: level change over a lag instead of the sample-to-sample difference. With a
-//     lag L > 1 a step at t0 keeps the lagged difference high from t0 - L/2 to t0 + L/2, so the
-//     events are moved back onto the change: the on-event by +L/2, the off-event by -L/2 (a step
-//     gives one event at t0, a ramp one at its start and one at its end).
+//   - difference_lag: level change over a lag instead of the sample-to-sample difference. A step
+//     at t0 keeps the lagged difference high from t0 - L/2 to t0 + L/2; `placement` says where in
+//     the burst the events go (where the thresholds are crossed, shifted back by L/2, or fitted
+//     where the level starts to change and where it settles);
+//   - rest edges: the events where a sensor (all channels of it) leaves its rest level or settles
+//     back at it for at least merge_gap (contact made or lost) can be the only ones that make
+//     zones (zones_from_rest_edges);
 //   - threshold kNoise + noise_block: the threshold is a statistic of the noise measured where the
 //     sensor is quiet (see EventThreshold).
 #pragma once
@@ -67,9 +71,10 @@ struct SensoryEventConfig {
   std::size_t median_window = 5;    ///< odd; 0 or 1 = no smoothing (paper-literal)
   double noise_floor_sigmas = 6.0;  ///< 0 = paper-literal (no noise floor)
   /// The threshold is also at least this many quiet excursions (0 = off; needs noise_block): the
-  /// largest lagged difference within a block where nothing happens (10th percentile over the
-  /// blocks that move). Measured on the detector's own statistic, so clipped, quantized or
-  /// correlated noise needs no model (a touch pad's force clipped at 0 fooled the sigma).
+  /// largest lagged difference within a block, 0 for a block whose raw signal does not move at
+  /// all, 10th percentile over the blocks. Measured on the detector's own statistic, so drift,
+  /// clipped, quantized or correlated noise needs no model (a sigma of the raw differences does
+  /// not see a drift).
   double noise_floor_excursions = 0.0;
   double hysteresis = 0.5;             ///< in (0, 1]; 1 = paper-literal single threshold
   std::size_t min_active_samples = 1;  ///< bursts shorter than this are ignored
@@ -80,11 +85,11 @@ struct SensoryEventConfig {
   /// zero-mean vibration (a swinging load, chattering contact) is not an event, while contact
   /// made or lost is. The noise floor then comes from these lagged differences themselves.
   std::size_t difference_lag = 1;
-  /// Local noise estimate: the differences are cut into blocks of this many samples, each block's
-  /// robust sigma (1.4826 x MAD about its median) is taken, blocks that do not move at all (a
-  /// sensor holding a stale value, a quantized sensor at rest) are left out, and the noise sigma
-  /// is the 10th percentile of the others: the quiet stretches set it, however long the busy
-  /// ones. 0 = one robust sigma over the whole demo.
+  /// Local noise estimates, in blocks of this many samples: the quiet excursion above, and the
+  /// sigma of noise_floor_sigmas (each block's robust sigma, 1.4826 x MAD about its median, of
+  /// the raw differences, blocks that do not move at all left out, the 10th percentile of the
+  /// others). Either way the quiet stretches set it, however long the busy ones. 0 = one robust
+  /// sigma over the whole demo, no excursion floor.
   std::size_t noise_block = 0;
   EventPlacement placement = EventPlacement::kShift;
   /// Confidence zones only around SensorEvents::zone_events (rest edges): a force that varies
