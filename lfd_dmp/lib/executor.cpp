@@ -88,9 +88,10 @@ void shapeRange(const SegmentSkills& seg, const ExecutorOptions& options, Segmen
 }
 
 // How far the new pose of `frame` lies from its poses in the demos' scenes (the base frame has
-// none). `with_origin` false: only its rotation counts (an orientation is learned relative to it).
+// none). A position is learned as an offset in the frame: its origin counts, and its rotation as
+// far as it moves that offset (angle x offset length, m). An orientation: only the rotation (rad).
 DemoRange frameRange(const SkillLibrary& lib, const lfd::SceneFrame& frame, const lfd::Pose& now,
-                     bool with_origin, const ExecutorOptions& options) {
+                     std::optional<double> position_offset, const ExecutorOptions& options) {
   DemoRange r;
   r.frame = frame.name();
   std::vector<lfd::Pose> demo;
@@ -117,11 +118,13 @@ DemoRange frameRange(const SkillLibrary& lib, const lfd::SceneFrame& frame, cons
     rotations.col(static_cast<Eigen::Index>(j)) = vec(demo[j].orientation);
   }
   const auto& g = options.generalization;
-  if (with_origin)
-    std::tie(r.distance, r.distance_margin) =
-        hullRange(origins, now.position, g.range_margin, options.min_range_margin);
   std::tie(r.angle, r.angle_margin) =
       hullRange(rotations, vec(now.orientation), g.range_margin, options.min_range_angle);
+  if (!position_offset) return r;
+  std::tie(r.distance, r.distance_margin) =
+      hullRange(origins, now.position, g.range_margin, options.min_range_margin);
+  r.distance = std::max(r.distance, r.angle * *position_offset);
+  r.angle = 0.0;  // counted through the offset it moves
   return r;
 }
 
@@ -243,12 +246,12 @@ std::vector<SegmentTarget> segmentTargets(const SkillLibrary& library, const lfd
       throw std::invalid_argument("segment '" + seg.name + "' (goal frames " + t.frames +
                                   "): " + e.what());
     }
-    t.range = worse(
-        frameRange(library, g.position_frame,
-                   lfd::framePose(g.position_frame, scene, start, options.frames), true, options),
-        frameRange(library, g.orientation_frame,
-                   lfd::framePose(g.orientation_frame, scene, start, options.frames), false,
-                   options));
+    t.range = worse(frameRange(library, g.position_frame,
+                               lfd::framePose(g.position_frame, scene, start, options.frames),
+                               g.position_offset.norm(), options),
+                    frameRange(library, g.orientation_frame,
+                               lfd::framePose(g.orientation_frame, scene, start, options.frames),
+                               std::nullopt, options));
     shapeRange(seg, options, &t);
     targets.push_back(t);
   }

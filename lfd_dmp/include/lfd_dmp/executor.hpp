@@ -39,9 +39,10 @@ struct HeadingFrame {
 };
 
 /// How far a segment's new goal frames lie from the demonstrated ones: the position frame's origin
-/// from the convex hull of the demos' origins, the rotation of both frames (as a rotation vector
-/// about the demos' mean) from the hull of theirs. What the goal is learned relative to decides
-/// what "demonstrated" means: a push along a demonstrated heading, starting where boxes started, is
+/// from the convex hull of the demos' origins (and its rotation as far as it moves the learned
+/// offset: angle x offset length), the orientation frame's rotation (as a rotation vector about
+/// the demos' mean) from the hull of theirs. What the goal is learned relative to decides what
+/// "demonstrated" means: a push along a demonstrated heading, starting where boxes started, is
 /// inside even if the fist ends somewhere no demo's did.
 struct DemoRange {
   std::string frame;             ///< the frame (of the segment's two) farthest outside
