@@ -107,14 +107,18 @@ OffsetStats statistics(const std::vector<Pose>& offsets) {
 }
 
 // The smaller spread wins. Frames that explain the demos equally (e.g. the goal's and the object's
-// orientation when every demo carried the object at its own yaw) are told apart by where the end
-// is: the frame whose origin it lies nearest to.
+// orientation when every demo carried the object at its own yaw; the base and the start when
+// every demo started at home) are told apart by where the end is: the frame whose origin it lies
+// nearest to (by over a micrometre: else the first in candidate order stays). Equal spreads: within
+// kTieSpread (10 um or urad, far below any sensor's resolution) plus 0.1%.
+constexpr double kTieSpread = 1e-5;
+
 bool better(double spread, double distance, double best_spread, double best_distance) {
   if (!std::isfinite(spread)) return false;
   if (!std::isfinite(best_spread)) return true;
-  const double tie = 1e-9 + 1e-6 * best_spread;
+  const double tie = kTieSpread + 1e-3 * best_spread;
   if (spread < best_spread - tie) return true;
-  return spread <= best_spread + tie && distance < best_distance;
+  return spread <= best_spread + tie && distance < best_distance - 1e-6;
 }
 
 // RMS angle between each demo's horizontal motion and the object's heading (infinite when either

@@ -111,8 +111,9 @@ struct FrameSelectionOptions {
 };
 
 /// Learns a segment's goal from its demos (at least one; the frames are those of the objects
-/// every demo's scene names). Frames whose spreads are equal (to 1e-6, relative) are told apart by
-/// the end's mean distance from their origin: the nearer one is kept (what the skill ends at).
+/// every demo's scene names). Frames whose spreads are equal (within 10 um or urad + 0.1%) are
+/// told apart by the end's mean distance from their origin: the nearer one is kept (what the
+/// skill ends at).
 /// Throws std::invalid_argument on no demos or non-finite poses.
 SegmentGoalModel learnSegmentGoal(const std::vector<SegmentDemoEnds>& demos,
                                   const FrameSelectionOptions& options);
