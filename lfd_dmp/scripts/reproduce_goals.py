@@ -141,8 +141,12 @@ def main():
     out = args.out or os.path.join(lib_dir, "reproduction_%s.json" % args.mode)
     names = [t for t in args.tasks.split(",") if t] if args.tasks else tasks.names()
     wanted = {int(g) for g in args.goals.split(",") if g}
-    scenes = {t: [s for s in tasks.unseen_scenes(t, args.mode) if not wanted or s["id"] in wanted]
-              for t in names}
+    scenes = {}
+    for t in names:
+        try:
+            scenes[t] = [s for s in tasks.unseen_scenes(t, args.mode) if not wanted or s["id"] in wanted]
+        except (KeyError, TypeError) as exc:
+            raise RuntimeError("task %s has no unseen %s scenes (%s: %s)" % (t, args.mode, type(exc).__name__, exc))
     objects = sorted({o for t in names for s in scenes[t] for o in s["objects"]} |
                      {o for t in names for o in tasks.parked(t)})
     key = report.reproduction_key(args.mode)
