@@ -6,8 +6,7 @@ import os
 import time
 
 from lfd_tools import bags as lfd_bags
-from lfd_tools import config as lfd_config
-from lfd_tools import judge
+from lfd_tools import judge, tasks
 
 
 def run_and_score(segment, method, inputs, truths, spans, tolerance):
@@ -35,11 +34,12 @@ def run_and_score(segment, method, inputs, truths, spans, tolerance):
 
 
 def evaluate_dataset(segment, folder, method, config, tolerance):
-    """A dataset folder whose bags carry /lfd/phase ground truth."""
+    """A dataset folder whose bags carry /lfd/phase ground truth; the transitions to find are the
+    task file's (`config`, the evaluation protocol, is not needed for them)."""
     bags = lfd_bags.list_bags(folder)
     truth = [lfd_bags.phase_transitions(b) for b in bags]
     task = truth[0][0]
-    expected = lfd_config.expected_transitions(config, task)
+    expected = tasks.expected_transitions(task)
     windows = [judge.expected_windows(phases, expected, 0.0) for _, phases in truth]
     spans = [lfd_bags.bag_span(b) for b in bags]
     out = run_and_score(segment, method, bags, windows, spans, tolerance)
