@@ -91,15 +91,6 @@ def count_bags(folder):
     return len([f for f in os.listdir(folder) if f.endswith(".bag")])
 
 
-def spread(items, n):
-    """n items evenly spread over the list (all of them when n <= 0 or n >= len)."""
-    if n <= 0 or n >= len(items):
-        return list(items)
-    if n == 1:
-        return [items[len(items) // 2]]
-    return [items[round(i * (len(items) - 1) / (n - 1))] for i in range(n)]
-
-
 def stage_datasets(out, args, report):
     """The datasets dealt over the workers, each worker a simulation on a master of its own."""
     data = os.path.join(out, "datasets")
@@ -204,7 +195,7 @@ def stage_learn(out, args, report):
 
 
 def goal_ids(task, mode, n):
-    return [e["id"] for e in spread(tasks.unseen_scenes(task, mode), n)]
+    return [e["id"] for e in tasks.spread(tasks.unseen_scenes(task, mode), n)]
 
 
 def task_record(result_path, mode, task):

@@ -60,6 +60,18 @@ Frame compose(const Frame& f, const Pose& local) {
   return out;
 }
 
+// `f` moved by a uniform draw within the object's +- ranges (none listed: unchanged).
+Frame jittered(const Frame& f, const std::map<std::string, task::Jitter>& ranges,
+               const std::string& object, std::mt19937& rng) {
+  const auto j = ranges.find(object);
+  if (j == ranges.end()) return f;
+  std::uniform_real_distribution<double> sym(-1.0, 1.0);
+  Pose local;
+  for (int i = 0; i < 3; ++i) local.position[i] = j->second.position[i] * sym(rng);
+  local.orientation = yawRotation(j->second.yaw * sym(rng));
+  return compose(f, local);
+}
+
 }  // namespace
 
 double Phase::duration() const {
@@ -132,7 +144,6 @@ DemoState TaskInterpreter::begin(const task::Configuration& c,
   if (!(speed > 0.0) || !std::isfinite(speed))
     throw std::invalid_argument("demo speed factor must be > 0, got " + std::to_string(speed));
   const Eigen::Isometry3d base_from_world = world_from_base.inverse();
-  std::uniform_real_distribution<double> sym(-1.0, 1.0);
   DemoState s;
   s.start = start;
   s.grasp_tcp = start;
@@ -144,19 +155,9 @@ DemoState TaskInterpreter::begin(const task::Configuration& c,
   s.frames["tcp"] = tcp_start;
   for (const std::string& name : task_.objects) {
     const Frame truth = fromWorld(base_from_world, c.objects.at(name));
-    Frame aim = truth;  // where the hand takes it: the task's variation, the operator's error
-    const auto v = task_.variation.find(name);
-    if (v != task_.variation.end()) {
-      Pose local;
-      for (int i = 0; i < 3; ++i) local.position[i] = v->second.position[i] * sym(rng);
-      local.orientation = yawRotation(v->second.yaw * sym(rng));
-      aim = compose(truth, local);
-    }
-    if (teleop_.enabled && std::count(task_.teleop_placement.begin(),
-                                      task_.teleop_placement.end(), name)) {
-      aim.position.x() += teleop_.placement_error * sym(rng);
-      aim.position.y() += teleop_.placement_error * sym(rng);
-    }
+    // Where the hand takes it: the task's variation and, in teleop mode, the operator's error.
+    Frame aim = jittered(truth, task_.variation, name, rng);
+    if (teleop_.enabled) aim = jittered(aim, task_.teleop_placement, name, rng);
     s.frames[name] = aim;
     s.true_starts[name] = truth;
     // The object's own frames (a drawer's handle), moved by their joint's start value.

@@ -221,9 +221,12 @@ class TaskReader {
                        "defined under frames: before it)");
   }
 
-  void readVariation(const YAML::Node& variation, const YAML::Node& placement) {
-    for (const auto& kv : variation) {
-      const std::string name = kv.first.Scalar(), key = "variation." + name;
+  // {object: {x, y, z, yaw}}: uniform +- ranges in the object's axes (m, rad).
+  std::map<std::string, Jitter> readJitters(const YAML::Node& n, const std::string& section) const {
+    std::map<std::string, Jitter> out;
+    if (n && !n.IsMap()) r_.fail(section, "expected {object: {x, y, z, yaw}}");
+    for (const auto& kv : n) {
+      const std::string name = kv.first.Scalar(), key = section + "." + name;
       if (!isObject(name)) r_.fail(key, "'" + name + "' is not an object of the task");
       r_.onlyKeys(kv.second, key, {"x", "y", "z", "yaw"});
       Jitter j;
@@ -231,14 +234,14 @@ class TaskReader {
       for (int i = 0; i < 3; ++i)
         if (kv.second[axes[i]]) j.position[i] = r_.number(kv.second[axes[i]], key + "." + axes[i]);
       if (kv.second["yaw"]) j.yaw = r_.number(kv.second["yaw"], key + ".yaw");
-      t_.variation[name] = j;
+      out[name] = j;
     }
-    for (size_t i = 0; placement && i < placement.size(); ++i) {
-      const std::string key = "teleop_placement[" + std::to_string(i) + "]";
-      const std::string name = r_.text(placement[i], key);
-      if (!isObject(name)) r_.fail(key, "'" + name + "' is not an object of the task");
-      t_.teleop_placement.push_back(name);
-    }
+    return out;
+  }
+
+  void readVariation(const YAML::Node& variation, const YAML::Node& placement) {
+    t_.variation = readJitters(variation, "variation");
+    t_.teleop_placement = readJitters(placement, "teleop_placement");
   }
 
   PoseSpec poseSpec(const YAML::Node& n, const std::string& key) const {

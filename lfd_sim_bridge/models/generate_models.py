@@ -49,10 +49,12 @@ FREE_OBJECTS = {
     'block': (0.10, '0.8 0.2 0.25 1', 4, '1.2 0.02 0.001'),
 }
 # The drawer: the tray and the handle fin (half sizes, m), the drawer's mass (kg) and its slide's
-# damping (N s/m) and dry friction (N): a light pull opens it and it stops when let go.
+# damping (N s/m) and dry friction (N): a light pull opens it and it stops when let go. The fin is
+# 3 cm thick like the stick: the gripper's position servo closing on it then reaches the effort
+# limit (robot.yaml close_effort), where a 1.5 cm fin got half the squeeze.
 DRAWER_TRAY_HALF = (0.085, 0.10, 0.035)
 DRAWER_FRONT_HALF = (0.005, 0.105, 0.045)
-DRAWER_FIN_HALF = (0.035, 0.0075, 0.01)
+DRAWER_FIN_HALF = (0.035, 0.015, 0.01)
 DRAWER_MASS, DRAWER_DAMPING, DRAWER_FRICTION = 0.4, 8.0, 1.5
 # The finger tips on the table (wiping): a soft, slippery contact, like a cloth on a wet table
 # (MuJoCo impedance 0.5-0.9 over 5 mm: a 6 mm press of the stiff arm gives ~8 N; friction 0.05).

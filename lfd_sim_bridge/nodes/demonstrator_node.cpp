@@ -83,8 +83,7 @@ demo::TeleopStyle teleopStyle(const ros::NodeHandle& pnh, bool enabled) {
            {"timed_close", &t.timed_close},
            {"tremor_rms", &t.tremor_rms},
            {"tremor_low_hz", &t.tremor_low_hz},
-           {"tremor_high_hz", &t.tremor_high_hz},
-           {"placement_error", &t.placement_error}})
+           {"tremor_high_hz", &t.tremor_high_hz}})
     pnh.getParam("teleop/" + name, *value);
   return t;
 }

@@ -32,17 +32,8 @@ from lfd_tools import tasks
 from lfd_tools.master import master_for_this_process
 
 
-def spread(items, n):
-    """n items evenly spread over the list (all of them when n <= 0 or n >= len)."""
-    if n <= 0 or n >= len(items):
-        return list(items)
-    if n == 1:
-        return [items[len(items) // 2]]
-    return [items[round(i * (len(items) - 1) / (n - 1))] for i in range(n)]
-
-
 def configurations(task, mode, demos=0):
-    return [s["id"] for s in spread(tasks.scenes(task, mode), demos)]
+    return [s["id"] for s in tasks.spread(tasks.scenes(task, mode), demos)]
 
 
 def bag_name(out, task, mode, config):

@@ -231,14 +231,17 @@ TEST(TaskInterpreter, GuardedStepsAndReplanningFromAContact) {
   // Stopped 12 mm above its target: the next phase starts there; its targets are the goal's.
   demo::Pose stopped = approach.segments.back().target;
   stopped.position.z() += 0.012;
-  const demo::Phase wipe = in.planPhase(s, 1, stopped);
-  EXPECT_NEAR(wipe.segments.front().target.position.z(), 0.80 + 0.006 - 0.85, 1e-12);
-  // Relative to the TCP, the retreat follows where the wipe ended.
-  demo::Pose wiped = wipe.segments.back().target;
+  const demo::Phase press = in.planPhase(s, 1, stopped);
+  EXPECT_EQ(press.name, "press");
+  EXPECT_TRUE(press.window);
+  EXPECT_NEAR(press.segments.front().target.position.z(), 0.80 + 0.006 - 0.85, 1e-12);
+  // Relative to the TCP, the lift-off follows where the wipe ended.
+  demo::Pose wiped = in.planPhase(s, 2, press.segments.back().target).segments.back().target;
   wiped.position.y() += 0.01;
-  const demo::Phase retreat = in.planPhase(s, 2, wiped);
-  EXPECT_LT((retreat.segments.front().target.position - wiped.position -
-             Eigen::Vector3d(0, 0, 0.08)).norm(), 1e-12);
+  const demo::Phase lift = in.planPhase(s, 3, wiped);
+  EXPECT_LT((lift.segments.front().target.position - wiped.position - Eigen::Vector3d(0, 0, 0.02))
+                .norm(),
+            1e-12);
 }
 
 TEST(TaskInterpreter, SpeedScalesEveryDuration) {

@@ -287,8 +287,9 @@ def wrap(angle, period):
 
 
 def physical_outcome(criteria, object_position, goal_position, table_top, object_yaw=None, goal_yaw=None):
-    """Judges an object's final pose against its goal with a task's criteria (evaluation.yaml
-    `reproduction.<task>`). Returns success, distance_m, height_m (above the table top),
+    """Judges an object's final pose against its goal: the object_at_goal rule (and, with
+    min_lift_m, a height rule) of a task's criterion, as tasks.success_criterion also gives them:
+    {object, distance, tolerance_m, min_lift_m, yaw_symmetry}. Returns success, distance_m, height_m (above the table top),
     yaw_error_rad (None without both yaws; modulo the object's symmetry) and a reason."""
     d = [a - b for a, b in zip(object_position[:3], goal_position[:3])]
     horizontal = criteria["distance"] == "xy"

@@ -101,6 +101,16 @@ def names():
     return sorted(found)
 
 
+def spread(items, n):
+    """n items evenly spread over the list (all of them when n <= 0 or n >= len): a reduced run's
+    configurations or goals."""
+    if n <= 0 or n >= len(items):
+        return list(items)
+    if n == 1:
+        return [items[len(items) // 2]]
+    return [items[round(i * (len(items) - 1) / (n - 1))] for i in range(n)]
+
+
 def datasets(tasks=None):
     """Dataset names <mode>_<task> of the tasks (default all), sim first."""
     return ["%s_%s" % (m, t) for m in MODES for t in (tasks or names())]

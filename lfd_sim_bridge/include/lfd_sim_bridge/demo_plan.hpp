@@ -4,8 +4,8 @@
 // file's primitives (move to a pose relative to a named frame, carry, push, open or close the
 // gripper, close until contact, move until contact, hold, release, retreat).
 // Teleop-like mode adds what a human operator does: hesitations (a move split into two
-// sub-movements with a pause), uneven segment durations, a misjudged object position, hand tremor
-// and a timed gripper close without force feedback.
+// sub-movements with a pause), uneven segment durations, a misjudged object position (the task
+// file's teleop_placement), hand tremor and a timed gripper close without force feedback.
 #pragma once
 
 #include <cstdint>
@@ -68,8 +68,6 @@ struct TeleopStyle {
   double timed_close = 0.9;      // s the operator waits after commanding the close
   double tremor_rms = 0.002;     // m per axis
   double tremor_low_hz = 8.0, tremor_high_hz = 12.0;
-  double placement_error = 0.01;  // m, uniform +- in world x and y: where the operator believes
-                                  // the objects of the task's teleop_placement are
 };
 
 // The closed fingers form a square block: TCP to any of its faces (m), for touch frames.

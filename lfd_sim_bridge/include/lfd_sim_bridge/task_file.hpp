@@ -122,7 +122,7 @@ struct TaskDefinition {
   std::vector<std::string> objects;  // the scene objects the task uses
   std::vector<std::pair<std::string, FrameSpec>> frames;  // in definition order
   std::map<std::string, Jitter> variation;
-  std::vector<std::string> teleop_placement;  // objects the operator misjudges (teleop mode)
+  std::map<std::string, Jitter> teleop_placement;  // the teleop operator's misjudgement, per object
   bool gripper_closed_at_start = false;       // the robot starts with the gripper closed
   std::vector<PhaseSpec> phases;
   std::map<std::string, std::vector<Configuration>> configurations;  // "sim", "teleop"
