@@ -41,7 +41,8 @@ phases:
       - {hold: 1.0}
   - name: leave
     steps:
-      - {retreat: [0, 0, 0.1], duration: 1.0, label: up}
+      - {retreat: [0, 0, 0.02], duration: 0.3, label: lift_off}
+      - {retreat: [0, 0, 0.08], duration: 0.8, label: up}
       - {move: {frame: start}, duration: 1.5, label: home}
 success:
   - {rule: object_at_goal, object: box, distance: xy, tolerance_m: 0.01}
