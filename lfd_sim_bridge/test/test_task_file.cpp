@@ -112,65 +112,25 @@ TEST(TaskFile, MalformedFilesAreRefusedNamingTheKey) {
   expectRefused("objects: [mug]\n", "objects[0]: 'mug' is not an object of the scene file");
   const std::string missing_success = validTask();
   expectRefused(missing_success.substr(0, missing_success.find("success:")), "success: missing");
-  expectRefused(validTask(R"(
-phases:
-  - name: approach
-    steps:
-      - {teleport: {frame: goal}, duration: 1}
-)"),
-                "phases[0].steps[0]: expected exactly one primitive");
-  expectRefused(validTask(R"(
-phases:
-  - name: approach
-    steps:
-      - {move: {frame: goal}, hold: 1, duration: 1}
-)"),
-                "phases[0].steps[0]: expected exactly one primitive");
-  expectRefused(validTask(R"(
-phases:
-  - name: approach
-    steps:
-      - {move: {frame: teapot}, duration: 1}
-)"),
-                "phases[0].steps[0].move.frame: unknown frame 'teapot'");
-  expectRefused(validTask(R"(
-phases:
-  - name: approach
-    steps:
-      - {move: {frame: goal}, duration: -1}
-)"),
-                "phases[0].steps[0].duration: must be > 0");
-  expectRefused(validTask(R"(
-phases:
-  - name: approach
-    steps:
-      - {move: {frame: goal}, duration: 1, until_contact: any}
-      - {hold: 1}
-)"),
-                "phases[0].steps[0].until_contact: a step that waits for contact ends its phase");
-  expectRefused(validTask(R"(
-phases:
-  - name: approach
-    steps:
-      - {carry: stick, to: {frame: goal}, duration: 1}
-)"),
-                "phases[0].steps[0]: carry before any gripper close");
-  expectRefused(validTask(R"(
-phases:
-  - name: approach
-    window: true
-    steps:
-      - {hold: 1}
-)"),
+  // One phase with the given steps.
+  const std::pair<const char*, const char*> bad_steps[] = {
+      {"{teleport: {frame: goal}, duration: 1}", "phases[0].steps[0]: expected exactly one primitive"},
+      {"{move: {frame: goal}, hold: 1, duration: 1}", "phases[0].steps[0]: expected exactly one primitive"},
+      {"{move: {frame: teapot}, duration: 1}", "phases[0].steps[0].move.frame: unknown frame 'teapot'"},
+      {"{move: {frame: goal}, duration: -1}", "phases[0].steps[0].duration: must be > 0"},
+      {"{move: {frame: goal}, duration: 1, until_contact: any}, {hold: 1}",
+       "phases[0].steps[0].until_contact: a step that waits for contact ends its phase"},
+      {"{carry: stick, to: {frame: goal}, duration: 1}", "phases[0].steps[0]: carry before any gripper close"},
+      {"{gripper: open, until_contact: both, duration: 1}", "only a close waits for contact"},
+  };
+  for (const auto& [steps, says] : bad_steps)
+    expectRefused(validTask(std::string("phases:\n  - name: approach\n    steps: [") + steps + "]\n"), says);
+  expectRefused(validTask("phases:\n  - name: approach\n    window: true\n    steps: [{hold: 1}]\n"),
                 "the first and the last phase are skills");
-  expectRefused(validTask(R"(
-phases:
-  - name: approach
-    steps: [{hold: 1}]
-  - name: approach
-    steps: [{hold: 1}]
-)"),
+  expectRefused(validTask("phases:\n  - name: approach\n    steps: [{hold: 1}]\n"
+                          "  - name: approach\n    steps: [{hold: 1}]\n"),
                 "phases[1].name: 'approach' repeats");
+  expectRefused(validTask("", "frames:\n  here: {frame: tcp}\n"), "frames.here.frame: a frame is fixed");
 }
 
 TEST(TaskFile, BadConfigurationsAreRefusedNamingTheEntry) {
