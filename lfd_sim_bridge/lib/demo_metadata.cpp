@@ -43,12 +43,14 @@ std::string metadataJson(const DemoMetadata& m) {
   s << "{\"task\": " << jsonString(t.name) << ", \"frame\": \"world\", \"scene\": {\"frame\": "
     << "\"world\", \"objects\": {";
   for (size_t i = 0; i < t.objects.size(); ++i)
-    s << (i ? ", " : "") << jsonString(t.objects[i]) << ": " << poseJson(c.objects.at(t.objects[i]));
+    s << (i ? ", " : "") << jsonString(t.objects[i]) << ": "
+      << poseJson(c.objects.at(t.objects[i]));
   s << "}, \"goal\": " << poseJson(c.goal) << ", \"joints\": {";
   const std::vector<std::string> joints = t.joints(*m.scene);
   for (size_t i = 0; i < joints.size(); ++i) {
     const auto q = c.joints.find(joints[i]);
-    s << (i ? ", " : "") << jsonString(joints[i]) << ": " << (q == c.joints.end() ? 0.0 : q->second);
+    s << (i ? ", " : "") << jsonString(joints[i]) << ": "
+      << (q == c.joints.end() ? 0.0 : q->second);
   }
   s << "}}, \"phases\": [";
   for (size_t i = 0; i < t.phases.size(); ++i) s << (i ? ", " : "") << jsonString(t.phases[i].name);

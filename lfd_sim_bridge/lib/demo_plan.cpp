@@ -175,7 +175,8 @@ DemoState TaskInterpreter::begin(const task::Configuration& c,
   for (const auto& [name, spec] : task_.frames) s.frames[name] = resolveFrame(s, spec);
   for (const task::PhaseSpec& phase : task_.phases) {
     s.timings.emplace_back();
-    for (const task::Step& step : phase.steps) s.timings.back().push_back(drawTiming(step, speed, rng));
+    for (const task::Step& step : phase.steps)
+      s.timings.back().push_back(drawTiming(step, speed, rng));
   }
   return s;
 }
@@ -244,7 +245,8 @@ void TaskInterpreter::addStep(DemoState& s, const task::Step& step, const StepTi
       if (step.until_contact != Contact::kNone && teleop_.enabled) {
         // No force feedback: the operator closes after a reaction delay and waits a fixed time.
         out->push_back(hold("react", *tcp, teleop_.reaction_delay));
-        Segment close = hold(step.label, *tcp, teleop_.timed_close * timing.duration / step.duration);
+        Segment close =
+            hold(step.label, *tcp, teleop_.timed_close * timing.duration / step.duration);
         close.gripper = action;
         out->push_back(close);
         return;
@@ -268,7 +270,8 @@ void TaskInterpreter::addStep(DemoState& s, const task::Step& step, const StepTi
       break;
     }
     case StepKind::kPush: {  // the hand moves the object along the table by its displacement
-      Eigen::Vector3d travel = targetFrame(s, step.target).position - s.true_starts.at(step.held).position;
+      Eigen::Vector3d travel =
+          targetFrame(s, step.target).position - s.true_starts.at(step.held).position;
       travel.z() = 0.0;
       to = poseAt(tcp->position + travel, tcp->orientation);
       break;
@@ -296,7 +299,8 @@ Phase TaskInterpreter::planPhase(DemoState& s, size_t i, const Pose& tcp) const 
   phase.index = static_cast<int>(i);
   phase.window = spec.window;
   Pose at = tcp;
-  for (size_t k = 0; k < spec.steps.size(); ++k) addStep(s, spec.steps[k], s.timings[i][k], &at, &phase.segments);
+  for (size_t k = 0; k < spec.steps.size(); ++k)
+    addStep(s, spec.steps[k], s.timings[i][k], &at, &phase.segments);
   return phase;
 }
 

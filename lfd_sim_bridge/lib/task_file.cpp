@@ -127,7 +127,8 @@ SceneObject readSceneObject(const Reader& r, const std::string& name, const YAML
     if (joint.axis.norm() < 1e-9) r.fail(jkey + ".axis", "is zero");
     joint.axis.normalize();
     const YAML::Node range = j.second["range"];
-    if (!range.IsSequence() || range.size() != 2) r.fail(jkey + ".range", "expected [lower, upper]");
+    if (!range.IsSequence() || range.size() != 2)
+      r.fail(jkey + ".range", "expected [lower, upper]");
     joint.lower = r.number(range[0], jkey + ".range");
     joint.upper = r.number(range[1], jkey + ".range");
     o.joints[j.first.Scalar()] = joint;
@@ -290,7 +291,8 @@ class TaskReader {
         r_.onlyKeys(v, key, {"touch", "along"});
         f.kind = FrameSpec::Kind::kTouch;
         f.object = r_.text(v["touch"], key + ".touch");
-        if (!isObject(f.object)) r_.fail(key + ".touch", "'" + f.object + "' is not an object of the task");
+        if (!isObject(f.object))
+          r_.fail(key + ".touch", "'" + f.object + "' is not an object of the task");
         f.along = r_.text(v["along"], key + ".along");
         needFixedFrame(f.along, key + ".along");
       } else {
@@ -311,14 +313,15 @@ class TaskReader {
 
   Step readStep(const YAML::Node& n, const std::string& key) const {
     if (!n.IsMap()) r_.fail(key, "expected a mapping with one primitive");
-    static const std::set<std::string> primitives = {"move", "carry", "push", "gripper",
-                                                     "release", "hold", "retreat"};
+    static const std::set<std::string> primitives = {"move",    "carry", "push",   "gripper",
+                                                     "release", "hold",  "retreat"};
     std::vector<std::string> found;
     for (const auto& kv : n)
       if (primitives.count(kv.first.Scalar())) found.push_back(kv.first.Scalar());
     if (found.size() != 1)
-      r_.fail(key, "expected exactly one primitive of move, carry, push, gripper, release, hold, "
-                   "retreat");
+      r_.fail(key,
+              "expected exactly one primitive of move, carry, push, gripper, release, hold, "
+              "retreat");
     const std::string p = found.front();
     Step s;
     s.where = key;
@@ -337,7 +340,8 @@ class TaskReader {
       if (what != "open" && what != "close") r_.fail(key + ".gripper", "expected open or close");
       s.kind = StepKind::kGripper;
       s.open = what == "open";
-      if (n["until_contact"]) s.until_contact = contact(n["until_contact"], key + ".until_contact", Contact::kBoth);
+      if (n["until_contact"])
+        s.until_contact = contact(n["until_contact"], key + ".until_contact", Contact::kBoth);
       if (s.open && s.until_contact != Contact::kNone)
         r_.fail(key + ".until_contact", "only a close waits for contact");
     } else if (p == "retreat") {
@@ -353,7 +357,8 @@ class TaskReader {
       r_.onlyKeys(n, key, {"move", "duration", "label", "until_contact", "settle"});
       s.kind = StepKind::kMove;
       s.target = poseSpec(n["move"], key + ".move");
-      if (n["until_contact"]) s.until_contact = contact(n["until_contact"], key + ".until_contact", Contact::kAny);
+      if (n["until_contact"])
+        s.until_contact = contact(n["until_contact"], key + ".until_contact", Contact::kAny);
     } else {  // carry, push
       r_.onlyKeys(n, key, {p, "to", "duration", "label"});
       s.kind = p == "carry" ? StepKind::kCarry : StepKind::kPush;
@@ -423,7 +428,8 @@ class TaskReader {
       for (const auto& kv : e) {
         const std::string k = kv.first.Scalar();
         if (k != "id" && k != "goal" && k != "joints" && !isObject(k))
-          r_.fail(ckey, "unknown key '" + k + "' (expected id, goal, joints and the task's objects)");
+          r_.fail(ckey,
+                  "unknown key '" + k + "' (expected id, goal, joints and the task's objects)");
       }
       for (const auto& kv : e["joints"]) {
         const std::string j = kv.first.Scalar();
@@ -468,10 +474,9 @@ Scene loadScene(const std::string& path) {
   s.base_in_world = r.vec3(root["base_link_in_world"], "base_link_in_world");
   const YAML::Node q = root["tool_orientation"];
   if (!q || !q.IsSequence() || q.size() != 4) r.fail("tool_orientation", "expected [w, x, y, z]");
-  s.tool_orientation = Eigen::Quaterniond(r.number(q[0], "tool_orientation"),
-                                          r.number(q[1], "tool_orientation"),
-                                          r.number(q[2], "tool_orientation"),
-                                          r.number(q[3], "tool_orientation"));
+  s.tool_orientation =
+      Eigen::Quaterniond(r.number(q[0], "tool_orientation"), r.number(q[1], "tool_orientation"),
+                         r.number(q[2], "tool_orientation"), r.number(q[3], "tool_orientation"));
   if (s.tool_orientation.norm() < 1e-9) r.fail("tool_orientation", "is a zero quaternion");
   s.tool_orientation.normalize();
   const YAML::Node objects = root["objects"];

@@ -108,10 +108,10 @@ struct DemoResult {
 
 // How a phase ended: at its planned end, or where a guarded step felt contact.
 struct PhaseEnd {
-  double elapsed = 0.0;            // s of sim time the phase took
-  bool contact = false;            // a guarded step ended it early
-  double contact_time = 0.0;       // s from the phase start
-  Eigen::VectorXd joints;          // the chain's commanded joints where it ended
+  double elapsed = 0.0;       // s of sim time the phase took
+  bool contact = false;       // a guarded step ended it early
+  double contact_time = 0.0;  // s from the phase start
+  Eigen::VectorXd joints;     // the chain's commanded joints where it ended
 };
 
 class Demonstrator {
@@ -136,8 +136,8 @@ class Demonstrator {
     demo::ToolGeometry tool;
     pnh.getParam("tool/fist_half_width", tool.fist_half_width);
     teleop_ = teleopStyle(pnh, mode_ == "teleop");
-    interpreter_ = std::make_unique<demo::TaskInterpreter>(definition, scene, robot_.gripper, tool,
-                                                           teleop_);
+    interpreter_ =
+        std::make_unique<demo::TaskInterpreter>(definition, scene, robot_.gripper, tool, teleop_);
 
     speed_min_ = param(pnh, "speed_min", 0.7);
     speed_max_ = param(pnh, "speed_max", 1.3);
@@ -190,9 +190,10 @@ class Demonstrator {
     writeSummary(results);
     int recorded = 0;
     for (const DemoResult& r : results) recorded += r.recorded ? 1 : 0;
-    ROS_INFO("demonstrator: %s/%s done, %d of %zu demos recorded (judge them from the bags: "
-             "check_demo_bag.py)",
-             task_name_.c_str(), mode_.c_str(), recorded, results.size());
+    ROS_INFO(
+        "demonstrator: %s/%s done, %d of %zu demos recorded (judge them from the bags: "
+        "check_demo_bag.py)",
+        task_name_.c_str(), mode_.c_str(), recorded, results.size());
     return recorded;
   }
 
@@ -621,7 +622,8 @@ class Demonstrator {
     if (touch_.values.empty()) return false;
     const auto [lo, hi] = std::minmax_element(touch_.values.begin(), touch_.values.end());
     const double value = mode == demo::Contact::kAny ? *hi : *lo;
-    return value >= contact_threshold_ && (mode != demo::Contact::kBoth || touch_.values.size() >= 2);
+    return value >= contact_threshold_ &&
+           (mode != demo::Contact::kBoth || touch_.values.size() >= 2);
   }
 
   // Where the task's objects and articulated joints are now (logged; the judge reads the bags).

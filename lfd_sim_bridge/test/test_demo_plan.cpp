@@ -137,8 +137,9 @@ TEST(TaskInterpreter, GraspGeometryLiftsAndCarriesTheStickToItsGoal) {
   EXPECT_NEAR(demo::yawOf(grasp.orientation), 0.3, 1e-9);
   const demo::Pose pre = segment(p, "pregrasp").target;
   EXPECT_LT((pre.position - grasp.position - Eigen::Vector3d(0, 0, 0.10)).norm(), 1e-9);
-  EXPECT_LT((segment(p, "lift").target.position - grasp.position - Eigen::Vector3d(0, 0, 0.15)).norm(),
-            1e-9);
+  EXPECT_LT(
+      (segment(p, "lift").target.position - grasp.position - Eigen::Vector3d(0, 0, 0.15)).norm(),
+      1e-9);
   // The stick keeps its place in the hand: it ends at its goal, turned by the goal's yaw.
   const demo::Pose end = phaseEnd(p, 2);
   EXPECT_LT((end.position - Eigen::Vector3d(0.35, -0.35, 0.95 + 0.005 - 0.85)).norm(), 1e-9);
@@ -147,9 +148,9 @@ TEST(TaskInterpreter, GraspGeometryLiftsAndCarriesTheStickToItsGoal) {
 
 TEST(TaskInterpreter, SymmetricToolTakesTheNearestTurn) {
   // A stick at yaw 2.8 rad is grasped at 2.8 - pi (the gripper is symmetric by a half turn).
-  const demo::DemoPlan p = plan(interpreter(fromText(kGrasp)),
-                                configuration({{"stick", pose(0.4, -0.2, 0.815, 2.8)}},
-                                              pose(0.35, -0.35, 0.95, 2.8)));
+  const demo::DemoPlan p =
+      plan(interpreter(fromText(kGrasp)),
+           configuration({{"stick", pose(0.4, -0.2, 0.815, 2.8)}}, pose(0.35, -0.35, 0.95, 2.8)));
   EXPECT_NEAR(demo::yawOf(phaseEnd(p, 0).orientation), 2.8 - M_PI, 1e-9);
 }
 
@@ -173,7 +174,8 @@ TEST(TaskInterpreter, DiagonalPushTouchesTheBoxCorner) {
   // Pushed along its diagonal, the cube meets the fist with a corner, half * sqrt(2) from its
   // centre: the approach must end there, not at the face distance (which is inside the box).
   const demo::DemoPlan p = plan(interpreter(shipped("push")), pushScene(pose(0.50, 0.0, 0.84)));
-  const Eigen::Vector3d offset = Eigen::Vector3d(0.40, -0.10, 0.84 - 0.85) - phaseEnd(p, 0).position;
+  const Eigen::Vector3d offset =
+      Eigen::Vector3d(0.40, -0.10, 0.84 - 0.85) - phaseEnd(p, 0).position;
   EXPECT_NEAR(offset.head<2>().norm(), 0.04 * std::sqrt(2.0) + 0.012, 1e-9);
   EXPECT_NEAR(offset.x(), offset.y(), 1e-12);  // straight behind, along the push
 }
@@ -182,9 +184,9 @@ TEST(TaskInterpreter, SlightlyOffAxisPushMeetsTheFaceNotTheCorner) {
   // 16 degrees off the box's axis, the corner lies beside the push line, out of the fist's
   // reach: the fist's trailing edge touches the face first.
   const double angle = 16.0 * M_PI / 180.0, half = 0.04, fist = 0.012;
-  const demo::DemoPlan p = plan(interpreter(shipped("push")),
-                                pushScene(pose(0.40 + 0.1 * std::cos(angle),
-                                               -0.10 + 0.1 * std::sin(angle), 0.84)));
+  const demo::DemoPlan p =
+      plan(interpreter(shipped("push")),
+           pushScene(pose(0.40 + 0.1 * std::cos(angle), -0.10 + 0.1 * std::sin(angle), 0.84)));
   const Eigen::Vector3d offset = Eigen::Vector3d(0.40, -0.10, -0.01) - phaseEnd(p, 0).position;
   const double face_depth = (half + fist * std::sin(angle)) / std::cos(angle);
   ASSERT_LT(face_depth, half * (std::cos(angle) + std::sin(angle)));  // not the corner
@@ -223,8 +225,8 @@ TEST(TaskInterpreter, ObjectFramesFollowTheirJoint) {
 TEST(TaskInterpreter, GuardedStepsAndReplanningFromAContact) {
   const demo::TaskInterpreter in = interpreter(shipped("wipe"));
   std::mt19937 rng(1);
-  demo::DemoState s = in.begin(configuration({}, pose(0.5, -0.3, 0.80)), worldFromBase(), kStart,
-                               1.0, rng);
+  demo::DemoState s =
+      in.begin(configuration({}, pose(0.5, -0.3, 0.80)), worldFromBase(), kStart, 1.0, rng);
   const demo::Phase approach = in.planPhase(s, 0, kStart);
   EXPECT_EQ(approach.segments.back().until_contact, demo::Contact::kAny);
   EXPECT_EQ(approach.segments.front().until_contact, demo::Contact::kNone);
@@ -239,9 +241,9 @@ TEST(TaskInterpreter, GuardedStepsAndReplanningFromAContact) {
   demo::Pose wiped = in.planPhase(s, 2, press.segments.back().target).segments.back().target;
   wiped.position.y() += 0.01;
   const demo::Phase lift = in.planPhase(s, 3, wiped);
-  EXPECT_LT((lift.segments.front().target.position - wiped.position - Eigen::Vector3d(0, 0, 0.02))
-                .norm(),
-            1e-12);
+  EXPECT_LT(
+      (lift.segments.front().target.position - wiped.position - Eigen::Vector3d(0, 0, 0.02)).norm(),
+      1e-12);
 }
 
 TEST(TaskInterpreter, SpeedScalesEveryDuration) {
@@ -260,7 +262,8 @@ TEST(TaskInterpreter, VariationMovesWhereTheHandTakesTheObject) {
   for (uint32_t seed = 1; seed < 20; ++seed) {
     const demo::Pose g = phaseEnd(plan(in, graspScene(), 1.0, seed), 0);
     const Eigen::Vector3d d = g.position - Eigen::Vector3d(0.40, -0.20, -0.03);
-    EXPECT_LE(std::abs(d.dot(Eigen::Vector3d(-std::sin(0.3), std::cos(0.3), 0))), 1e-9);  // along it
+    EXPECT_LE(std::abs(d.dot(Eigen::Vector3d(-std::sin(0.3), std::cos(0.3), 0))),
+              1e-9);  // along it
     EXPECT_LE(d.head<2>().norm(), 0.015 + 1e-9);
     EXPECT_LE(std::abs(demo::yawOf(g.orientation) - 0.3), 0.08 + 1e-9);
     spread = std::max(spread, d.head<2>().norm());
@@ -275,8 +278,10 @@ TEST(TaskInterpreter, TeleopHesitatesAndClosesByTime) {
   for (uint32_t seed = 1; seed <= 20; ++seed) {
     const demo::DemoPlan p = plan(teleop, graspScene(), 1.0, seed);
     for (const auto& phase : p.phases)
-      for (const auto& s : phase.segments) hesitations += s.label.find("_hesitate") != std::string::npos;
-    durations_differ += std::abs(p.duration() - plan(sim, graspScene(), 1.0, seed).duration()) > 1e-6;
+      for (const auto& s : phase.segments)
+        hesitations += s.label.find("_hesitate") != std::string::npos;
+    durations_differ +=
+        std::abs(p.duration() - plan(sim, graspScene(), 1.0, seed).duration()) > 1e-6;
     // No force feedback: a reaction delay, then a timed close without waiting for contact.
     const demo::Phase& grasp = p.phases[1];
     ASSERT_EQ(grasp.segments.size(), 2u);
@@ -284,7 +289,8 @@ TEST(TaskInterpreter, TeleopHesitatesAndClosesByTime) {
     EXPECT_EQ(grasp.segments[1].until_contact, demo::Contact::kNone);
     EXPECT_NEAR(grasp.segments[1].duration, 0.9, 1e-12);
     // A hesitation splits a move but it still ends at the same pose.
-    EXPECT_LT((phaseEnd(p, 2).position - phaseEnd(plan(sim, graspScene()), 2).position).norm(), 1e-9);
+    EXPECT_LT((phaseEnd(p, 2).position - phaseEnd(plan(sim, graspScene()), 2).position).norm(),
+              1e-9);
   }
   EXPECT_GT(hesitations, 5);
   EXPECT_GT(durations_differ, 15);

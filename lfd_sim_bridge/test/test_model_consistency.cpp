@@ -127,7 +127,8 @@ TEST(ModelConsistency, SameJointsAxesAndLimits) {
     const int body = mj_name2id(m.get(), mjOBJ_BODY, o.name.c_str());
     ASSERT_GE(body, 0) << o.name;
     EXPECT_EQ(m->body_mocapid[body] >= 0, o.fixed) << o.name;
-    if (!o.fixed) EXPECT_GE(mj_name2id(m.get(), mjOBJ_JOINT, (o.name + "_free").c_str()), 0) << o.name;
+    if (!o.fixed)
+      EXPECT_GE(mj_name2id(m.get(), mjOBJ_JOINT, (o.name + "_free").c_str()), 0) << o.name;
     for (const auto& [name, frame] : o.frames)
       if (!frame.body.empty()) EXPECT_GE(mj_name2id(m.get(), mjOBJ_BODY, frame.body.c_str()), 0);
   }
@@ -145,7 +146,8 @@ std::string readFile(const std::string& path) {
 TEST(ModelConsistency, GeneratedFilesAreUpToDate) {
   const std::string out = testing::TempDir() + "lfd_models";
   ASSERT_EQ(std::system(("mkdir -p " + out + " && /usr/bin/python3 " + kModelDir +
-                         "/generate_models.py " + out + " > /dev/null").c_str()),
+                         "/generate_models.py " + out + " > /dev/null")
+                            .c_str()),
             0);
   for (const char* file : {"workcell.xml", "jvrc1_like.xml", "jvrc1_like.urdf"})
     EXPECT_EQ(readFile(out + "/" + file), readFile(kModelDir + "/" + file))

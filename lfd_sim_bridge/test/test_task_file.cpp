@@ -114,28 +114,36 @@ TEST(TaskFile, MalformedFilesAreRefusedNamingTheKey) {
   expectRefused(missing_success.substr(0, missing_success.find("success:")), "success: missing");
   // One phase with the given steps.
   const std::pair<const char*, const char*> bad_steps[] = {
-      {"{teleport: {frame: goal}, duration: 1}", "phases[0].steps[0]: expected exactly one primitive"},
-      {"{move: {frame: goal}, hold: 1, duration: 1}", "phases[0].steps[0]: expected exactly one primitive"},
-      {"{move: {frame: teapot}, duration: 1}", "phases[0].steps[0].move.frame: unknown frame 'teapot'"},
+      {"{teleport: {frame: goal}, duration: 1}",
+       "phases[0].steps[0]: expected exactly one primitive"},
+      {"{move: {frame: goal}, hold: 1, duration: 1}",
+       "phases[0].steps[0]: expected exactly one primitive"},
+      {"{move: {frame: teapot}, duration: 1}",
+       "phases[0].steps[0].move.frame: unknown frame 'teapot'"},
       {"{move: {frame: goal}, duration: -1}", "phases[0].steps[0].duration: must be > 0"},
       {"{move: {frame: goal}, duration: 1, until_contact: any}, {hold: 1}",
        "phases[0].steps[0].until_contact: a step that waits for contact ends its phase"},
-      {"{carry: stick, to: {frame: goal}, duration: 1}", "phases[0].steps[0]: carry before any gripper close"},
+      {"{carry: stick, to: {frame: goal}, duration: 1}",
+       "phases[0].steps[0]: carry before any gripper close"},
       {"{gripper: open, until_contact: both, duration: 1}", "only a close waits for contact"},
   };
   for (const auto& [steps, says] : bad_steps)
-    expectRefused(validTask(std::string("phases:\n  - name: approach\n    steps: [") + steps + "]\n"), says);
-  expectRefused(validTask("phases:\n  - name: approach\n    window: true\n    steps: [{hold: 1}]\n"),
-                "the first and the last phase are skills");
+    expectRefused(
+        validTask(std::string("phases:\n  - name: approach\n    steps: [") + steps + "]\n"), says);
+  expectRefused(
+      validTask("phases:\n  - name: approach\n    window: true\n    steps: [{hold: 1}]\n"),
+      "the first and the last phase are skills");
   expectRefused(validTask("phases:\n  - name: approach\n    steps: [{hold: 1}]\n"
                           "  - name: approach\n    steps: [{hold: 1}]\n"),
                 "phases[1].name: 'approach' repeats");
-  expectRefused(validTask("", "frames:\n  here: {frame: tcp}\n"), "frames.here.frame: a frame is fixed");
+  expectRefused(validTask("", "frames:\n  here: {frame: tcp}\n"),
+                "frames.here.frame: a frame is fixed");
 }
 
 TEST(TaskFile, BadConfigurationsAreRefusedNamingTheEntry) {
   std::string t = validTask();
-  const std::string sim_entry = "    - {id: 0, stick: [0.5, -0.3, 0.815, 0.1], goal: [0.5, -0.2, 0.95, 0.1]}\n  teleop:";
+  const std::string sim_entry =
+      "    - {id: 0, stick: [0.5, -0.3, 0.815, 0.1], goal: [0.5, -0.2, 0.95, 0.1]}\n  teleop:";
   const auto with_sim = [&](const std::string& entries) {
     std::string out = t;
     out.replace(out.find(sim_entry), sim_entry.size(), entries + "\n  teleop:");
@@ -146,10 +154,12 @@ TEST(TaskFile, BadConfigurationsAreRefusedNamingTheEntry) {
                 "configurations.sim[0].stick");
   expectRefused(with_sim("    - {id: 0, stick: [0.5, -0.3, x], goal: [0.5, -0.2, 0.95]}"),
                 "'x' is not a number");
-  expectRefused(with_sim("    - {id: 0, stick: [0.5, -0.3, 0.8], goal: [0.5, -0.2, 0.95], box: [0, 0, 0]}"),
-                "unknown key 'box'");
-  expectRefused(with_sim("    - {id: 0, stick: [0.5, -0.3, 0.8], goal: [0.5, -0.2, 0.95], joints: {lid: 1}}"),
-                "configurations.sim[0].joints.lid: not a joint");
+  expectRefused(
+      with_sim("    - {id: 0, stick: [0.5, -0.3, 0.8], goal: [0.5, -0.2, 0.95], box: [0, 0, 0]}"),
+      "unknown key 'box'");
+  expectRefused(
+      with_sim("    - {id: 0, stick: [0.5, -0.3, 0.8], goal: [0.5, -0.2, 0.95], joints: {lid: 1}}"),
+      "configurations.sim[0].joints.lid: not a joint");
   expectRefused(with_sim("    - {id: 3, stick: [0.5, -0.3, 0.8], goal: [0.5, -0.2, 0.9]}\n"
                          "    - {id: 3, stick: [0.5, -0.3, 0.8], goal: [0.5, -0.2, 0.9]}"),
                 "id 3 repeats");

@@ -33,7 +33,8 @@ std::vector<std::string> taskNames() {
   if (DIR* d = opendir((kConfig + "tasks").c_str())) {
     while (dirent* e = readdir(d)) {
       const std::string f = e->d_name;
-      if (f.size() > 5 && f.substr(f.size() - 5) == ".yaml") names.push_back(f.substr(0, f.size() - 5));
+      if (f.size() > 5 && f.substr(f.size() - 5) == ".yaml")
+        names.push_back(f.substr(0, f.size() - 5));
     }
     closedir(d);
   }
@@ -130,7 +131,8 @@ TEST_F(TaskFiles, TheShippedTasksAreThere) {
 
 TEST_F(TaskFiles, CountsAndUnseenGoalsFollowTheProtocol) {
   for (const std::string& name : taskNames()) {
-    const task::TaskDefinition t = task::loadTask(task::taskFilePath(kConfig + "tasks", name), scene_);
+    const task::TaskDefinition t =
+        task::loadTask(task::taskFilePath(kConfig + "tasks", name), scene_);
     for (const std::string mode : {"sim", "teleop"}) {
       const auto& demos = t.configurations.at(mode);
       const auto& unseen = t.unseen.at(mode);
@@ -165,7 +167,8 @@ TEST_F(TaskFiles, CountsAndUnseenGoalsFollowTheProtocol) {
 
 TEST_F(TaskFiles, EveryPlannedPathIsReachableWithMargin) {
   for (const std::string& name : taskNames()) {
-    const task::TaskDefinition t = task::loadTask(task::taskFilePath(kConfig + "tasks", name), scene_);
+    const task::TaskDefinition t =
+        task::loadTask(task::taskFilePath(kConfig + "tasks", name), scene_);
     for (const std::string mode : {"sim", "teleop"}) {
       for (const auto* list : {&t.configurations.at(mode), &t.unseen.at(mode)}) {
         for (const task::Configuration& c : *list) {

@@ -435,8 +435,9 @@ TEST(WorkcellSim, DrawerIsPlacedReportedAndResetLikeTheOtherObjects) {
   EXPECT_NEAR(open.object_poses[2].position[0], 0.70 - 0.245, 1e-3);
   EXPECT_NEAR(open.object_poses[1].position[0], 0.70, 1e-9);
   const auto names = open.joint_names;
-  EXPECT_NE(std::find(names.begin(), names.end(), "drawer_slide"), names.end());  // on /joint_states
-  sim.reset();  // closed again, the cabinet where the scene put it
+  EXPECT_NE(std::find(names.begin(), names.end(), "drawer_slide"),
+            names.end());  // on /joint_states
+  sim.reset();             // closed again, the cabinet where the scene put it
   EXPECT_NEAR(sim.jointPosition("drawer_slide"), 0.0, 1e-9);
   EXPECT_NEAR(sim.readState().object_poses[1].position[0], 0.70, 1e-9);
   sim.injectNaNForTest();

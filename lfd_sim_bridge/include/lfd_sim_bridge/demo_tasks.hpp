@@ -1,6 +1,7 @@
 // The tool orientation of a task, for lfd_dmp's executor until it stops depending on this package
 // (issue 15 frees it from the simulator): read from the task files (config/tasks/<task>.yaml and
-// the scene file beside their folder). The demonstrator itself uses task_file.hpp and demo_plan.hpp.
+// the scene file beside their folder). The demonstrator itself uses task_file.hpp and
+// demo_plan.hpp.
 #pragma once
 
 #include <string>

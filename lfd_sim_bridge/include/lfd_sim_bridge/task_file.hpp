@@ -42,11 +42,11 @@ struct SceneObject {
 
 struct Scene {
   std::string path;
-  double table_top = 0.0;                       // world z of the table surface
+  double table_top = 0.0;                                   // world z of the table surface
   Eigen::Vector3d base_in_world = Eigen::Vector3d::Zero();  // base_link (no rotation)
   Eigen::Quaterniond tool_orientation = Eigen::Quaterniond::Identity();  // TCP at yaw 0
-  std::vector<SceneObject> objects;             // file order
-  const SceneObject* find(const std::string& name) const;  // nullptr when unknown
+  std::vector<SceneObject> objects;                                      // file order
+  const SceneObject* find(const std::string& name) const;                // nullptr when unknown
 };
 
 // Throws std::runtime_error naming the file and the key.
@@ -76,8 +76,8 @@ struct Step {
   std::string where;  // "phases[1].steps[0]", for messages
   std::string label;  // names the motion in logs and plans
   double duration = 0.0;
-  PoseSpec target;   // move, carry, push
-  std::string held;  // carry, push: the object (or object frame) the hand moves
+  PoseSpec target;    // move, carry, push
+  std::string held;   // carry, push: the object (or object frame) the hand moves
   bool open = false;  // gripper: open (release) or close
   // move: stop once the pads touch (a guarded move); gripper close: close until both pads touch
   // (sim mode; the teleop operator closes for a fixed time). Ends its phase.
@@ -98,8 +98,8 @@ struct FrameSpec {
   enum class Kind { kRelative, kHeading, kTouch };
   Kind kind = Kind::kRelative;
   std::string where;
-  PoseSpec relative;         // kRelative: `position`/`yaw` relative to `frame` (axes: `axes`)
-  std::string from, to;      // kHeading: at `from`, x pointing (horizontally) toward `to`
+  PoseSpec relative;          // kRelative: `position`/`yaw` relative to `frame` (axes: `axes`)
+  std::string from, to;       // kHeading: at `from`, x pointing (horizontally) toward `to`
   std::string object, along;  // kTouch: where the closed fist first touches `object` moving
                               // along the x axis of `along` (its yaw)
 };
@@ -119,11 +119,11 @@ struct Configuration {
 
 struct TaskDefinition {
   std::string name, path;
-  std::vector<std::string> objects;  // the scene objects the task uses
+  std::vector<std::string> objects;                       // the scene objects the task uses
   std::vector<std::pair<std::string, FrameSpec>> frames;  // in definition order
   std::map<std::string, Jitter> variation;
   std::map<std::string, Jitter> teleop_placement;  // the teleop operator's misjudgement, per object
-  bool gripper_closed_at_start = false;       // the robot starts with the gripper closed
+  bool gripper_closed_at_start = false;            // the robot starts with the gripper closed
   std::vector<PhaseSpec> phases;
   std::map<std::string, std::vector<Configuration>> configurations;  // "sim", "teleop"
   std::map<std::string, std::vector<Configuration>> unseen;          // reproduction goals

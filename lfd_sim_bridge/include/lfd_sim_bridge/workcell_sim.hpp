@@ -212,7 +212,7 @@ class WorkcellSim {
   void updateTouch();
   std::vector<std::pair<std::string, int>> objects_;  // name, body id
   std::vector<double> initial_qpos_;                  // model qpos0: initial object poses
-  std::vector<double> scene_qpos_;  // object poses last set (divergence recovery restores them)
+  std::vector<double> scene_qpos_;   // object poses last set (divergence recovery restores them)
   std::vector<double> scene_mocap_;  // fixed objects' poses last set, 7 per mocap body
   int freeJointOf(int body) const;   // the body's free joint, or -1
   void restoreMocap();
