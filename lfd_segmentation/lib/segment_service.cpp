@@ -1,7 +1,10 @@
 #include "lfd_segmentation/segment_service.hpp"
 
+#include <sys/stat.h>
+
 #include <chrono>
 #include <cmath>
+#include <sstream>
 #include <stdexcept>
 
 #include "lfd_core/safe_paths.hpp"
@@ -41,6 +44,23 @@ SegmentationParams apply_overrides(const SegmentationParams& params,
 
 namespace {
 
+// PreparedCache's key: what the bags' features and their selection depend on.
+std::string cache_key(const std::vector<std::string>& paths, const SegmentationParams& p) {
+  std::ostringstream key;
+  key.precision(17);
+  key << "T=" << p.pipeline.relevance.threshold;
+  for (const std::string& path : paths) {
+    for (const std::string& part : demo_parts(path)) {
+      struct stat st {};
+      if (::stat(part.c_str(), &st) != 0) return "";  // not cacheable: read (and fail) afresh
+      key << "|" << part << ":" << st.st_size << ":" << st.st_mtim.tv_sec << "."
+          << st.st_mtim.tv_nsec;
+    }
+    key << ";";
+  }
+  return key.str();
+}
+
 lfd_msgs::DemoSegmentation demo_message(const DemoFeatures& demo,
                                         const lfd::DemoSegmentationResult& r, double rate) {
   lfd_msgs::DemoSegmentation m;
@@ -77,7 +97,7 @@ lfd_msgs::DemoSegmentation demo_message(const DemoFeatures& demo,
 
 void handle_segment_request(const SegmentationParams& params,
                             const lfd_msgs::Segment::Request& request,
-                            lfd_msgs::Segment::Response& response) {
+                            lfd_msgs::Segment::Response& response, PreparedCache* cache) {
   const auto start = std::chrono::steady_clock::now();
   response = lfd_msgs::Segment::Response();
   try {
@@ -99,21 +119,30 @@ void handle_segment_request(const SegmentationParams& params,
         }
       }
     }
-    std::vector<DemoFeatures> demos;
-    std::vector<lfd::FeatureMatrix> matrices;
-    for (const std::string& path : request.bag_paths) {
-      demos.push_back(read_bag_features(path, p.topics, p.rate, p.limits));
-      matrices.push_back(demos.back().matrix);
+    const std::string key = cache_key(request.bag_paths, p);
+    PreparedCache local;  // a request that cannot be cached (no cache, a file not stat-able)
+    PreparedCache& used = cache && !key.empty() ? *cache : local;
+    const lfd::SegmentationPipelineConfig config = p.pipeline_config();
+    if (used.key.empty() || used.key != key) {
+      used = PreparedCache{};  // the stale entry goes before anything is read
+      for (const std::string& path : request.bag_paths) {
+        used.demos.push_back(read_bag_features(path, p.topics, p.rate, p.limits));
+        used.matrices.push_back(used.demos.back().matrix);
+      }
+      check_demos_fit(p, used.matrices, request.bag_paths);
+      used.prepared = lfd::prepare_segmentation(used.matrices, used.demos[0].sensor_features,
+                                                config, used.demos[0].state_features);
+      used.key = key;
     }
-    check_demos_fit(p, matrices, request.bag_paths);
-    const lfd::SegmentationPipelineResult result = lfd::run_segmentation_pipeline(
-        matrices, demos[0].sensor_features, p.pipeline_config(), demos[0].state_features);
+    check_demos_fit(p, used.matrices, request.bag_paths);  // this request's window_seconds
+    const lfd::SegmentationPipelineResult result =
+        lfd::segment_prepared(used.prepared, used.matrices, config);
     response.warnings = result.warnings;
     response.selected_features = result.selected_features;
     response.selected_weights = result.feature_weights;
     response.sensor_features = result.sensor_features;
-    for (std::size_t d = 0; d < demos.size(); ++d) {
-      response.demos.push_back(demo_message(demos[d], result.demos[d], p.rate));
+    for (std::size_t d = 0; d < used.demos.size(); ++d) {
+      response.demos.push_back(demo_message(used.demos[d], result.demos[d], p.rate));
     }
     if (result.relevance_computed) {
       for (const lfd::FeatureRelevance& f : result.relevance.features) {

@@ -117,8 +117,14 @@ json to_json(const lfd::SegmentationPipelineResult& r, const std::vector<lfd::Fe
     demo["rejected_times"] = s.rejected_times;
     demo["pruned"] = s.pruned;
     demo["pruned_times"] = s.pruned_times;
+    demo["added"] = s.added;
+    demo["added_times"] = s.added_times;
     demo["events"] = s.events;
     demo["event_times"] = times_json(s.events, demos[d]);
+    std::vector<std::size_t> rest_edges;
+    for (const lfd::SensoryEvent& e : s.event_details)
+      if (e.rest_edge) rest_edges.push_back(e.index);
+    demo["rest_edge_event_times"] = times_json(rest_edges, demos[d]);
     demo["sample_rate"] = s.sample_rate;
     demo["zones"] = zones;
     demo_list.push_back(demo);

@@ -119,11 +119,30 @@ SegmentationParams params_from_yaml(const YAML::Node& root) {
   seg.zone_p_value_threshold =
       non_negative(get<double>(root, "zone_p_value_threshold", seg.zone_p_value_threshold),
                    "zone_p_value_threshold");
+  seg.rest_edge_p_value_threshold = non_negative(
+      get<double>(root, "rest_edge_p_value_threshold", seg.rest_edge_p_value_threshold),
+      "rest_edge_p_value_threshold");
   p.pipeline.validate_with_sensors =
       get<bool>(root, "validate_with_sensors", p.pipeline.validate_with_sensors);
-  p.pipeline.search_in_zones = get<bool>(root, "search_in_zones", p.pipeline.search_in_zones);
+  p.pipeline.procedure = lfd::parse_segmentation_procedure(
+      get<std::string>(root, "procedure", lfd::to_string(p.pipeline.procedure)));
+  if (root["search_in_zones"])
+    throw std::invalid_argument(
+        "segmentation parameter 'search_in_zones' is now 'procedure' (zone_search or paper)");
+  p.pipeline.paper_candidates =
+      get<std::size_t>(root, "paper_candidates", p.pipeline.paper_candidates);
+  if (p.pipeline.paper_candidates < 1 ||
+      p.pipeline.paper_candidates > p.pipeline.segmentation.max_changepoints)
+    throw std::invalid_argument("segmentation parameter 'paper_candidates' must be in [1, " +
+                                std::to_string(p.pipeline.segmentation.max_changepoints) +
+                                "] (max_changepoints)");
   p.pipeline.anchor_to_events = get<bool>(root, "anchor_to_events", p.pipeline.anchor_to_events);
   p.pipeline.consensus_count = get<bool>(root, "consensus_count", p.pipeline.consensus_count);
+  p.pipeline.consensus_fill_p_value =
+      get<double>(root, "consensus_fill_p_value", p.pipeline.consensus_fill_p_value);
+  if (!(p.pipeline.consensus_fill_p_value >= 0.0 && p.pipeline.consensus_fill_p_value < 1.0))
+    throw std::invalid_argument(
+        "segmentation parameter 'consensus_fill_p_value' must be in [0, 1)");
   p.pipeline.threads = get<int>(root, "threads", p.pipeline.threads);
 
   const YAML::Node clasp = root["clasp"];
@@ -137,6 +156,9 @@ SegmentationParams params_from_yaml(const YAML::Node& root) {
       lfd::parse_clasp_distance(get<std::string>(clasp, "distance", lfd::to_string(cc.distance)));
   cc.score = lfd::parse_clasp_score(get<std::string>(clasp, "score", lfd::to_string(cc.score)));
   cc.p_value_threshold = get<double>(clasp, "p_value_threshold", cc.p_value_threshold);
+  seg.significance_per_sample =
+      non_negative(get<double>(clasp, "significance_per_sample", seg.significance_per_sample),
+                   "clasp/significance_per_sample");
   cc.tie_jitter = non_negative(get<double>(clasp, "tie_jitter", cc.tie_jitter), "clasp/tie_jitter");
 
   const YAML::Node events = root["events"];
@@ -146,8 +168,16 @@ SegmentationParams params_from_yaml(const YAML::Node& root) {
   ev.threshold_ratio = get<double>(events, "threshold_ratio", ev.threshold_ratio);
   ev.relative_floor = get<double>(events, "relative_floor", ev.relative_floor);
   ev.noise_floor_sigmas = get<double>(events, "noise_floor_sigmas", ev.noise_floor_sigmas);
+  ev.noise_floor_excursions =
+      get<double>(events, "noise_floor_excursions", ev.noise_floor_excursions);
   ev.hysteresis = get<double>(events, "hysteresis", ev.hysteresis);
-  ev.place_on_change = get<bool>(events, "place_on_change", ev.place_on_change);
+  ev.zones_from_rest_edges = get<bool>(events, "zones_from_rest_edges", ev.zones_from_rest_edges);
+  ev.placement = lfd::parse_event_placement(
+      get<std::string>(events, "placement", lfd::to_string(ev.placement)));
+  if (events && events["place_on_change"])
+    throw std::invalid_argument(
+        "segmentation parameter 'events/place_on_change' is now 'events/placement' (threshold, "
+        "shift or fit)");
   auto& t = p.time;
   t.event_median =
       non_negative(get<double>(events, "median_seconds", t.event_median), "events/median_seconds");

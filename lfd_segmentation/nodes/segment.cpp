@@ -4,6 +4,7 @@
 // Otherwise the full pipeline across the files (feature relevance, weighted ClaSP, sensor
 // validation). Bags use the topics/roles of --config; CSV columns are state features except the
 // --sensor-columns.
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <fstream>
@@ -34,8 +35,12 @@ const char* kUsage = R"(usage: segment [options] FILE...
   --state-columns a,b,c     CSV columns considered for segmentation (default: all other columns)
   --time-column NAME        CSV time column (default: time, t, timestamp or stamp if present)
   --rate HZ                 bag resampling rate / CSV sample rate (overrides a CSV time column)
-  --combination NAME        average | product | weighted_average | weighted_product |
-                            distance_average | weighted_distance_average
+  --combination NAME[,NAME] average | product | weighted_average | weighted_product |
+                            distance_average | weighted_distance_average, or 'all'. Several: the
+                            features are selected once and the JSON holds one result per name
+                            under "methods" (the selection does not depend on the combination)
+  --procedure NAME          zone_search (default: zones first, changepoints on their events) |
+                            paper (the paper's: paper_candidates anywhere, then the zone filter)
   --threshold T             relevance threshold in (0,1]
   --min-segment-seconds S   min segment length min_s (s)
   --window-seconds S        fixed ClaSP window (s)
@@ -62,6 +67,24 @@ bool ends_with(const std::string& s, const std::string& suffix) {
          s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
 }
 
+// --combination: empty = the config's, "all" = every method, else a comma list.
+std::vector<lfd::ProfileCombination> parse_combinations(const std::string& list) {
+  std::vector<lfd::ProfileCombination> out;
+  if (list == "all") {
+    for (const char* name : {"average", "product", "weighted_average", "weighted_product",
+                             "distance_average", "weighted_distance_average"})
+      out.push_back(lfd::parse_profile_combination(name));
+    return out;
+  }
+  for (const std::string& name : split_list(list)) {
+    const lfd::ProfileCombination c = lfd::parse_profile_combination(name);
+    if (std::find(out.begin(), out.end(), c) != out.end())
+      throw std::invalid_argument("--combination names '" + name + "' twice");
+    out.push_back(c);
+  }
+  return out;
+}
+
 double seconds_since(std::chrono::steady_clock::time_point t) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
 }
@@ -71,7 +94,7 @@ struct Options {
   std::string topics;  ///< --topics: a YAML file with the topics list
   bool list_fields = false;
   std::vector<std::string> files, sensors, states;
-  std::string time_column, combination, output;
+  std::string time_column, combination, output, procedure;
   double rate = 0, threshold = 0, min_seconds = 0, window_seconds = 0;
   long num_changepoints = 0, threads = -1;
   bool timing = false, feature_profiles = false, profiles = true;
@@ -115,6 +138,8 @@ Options parse_args(int argc, char** argv) {
       o.rate = number();
     } else if (arg == "--combination") {
       o.combination = value();
+    } else if (arg == "--procedure") {
+      o.procedure = value();
     } else if (arg == "--threshold") {
       o.threshold = number();
     } else if (arg == "--min-segment-seconds") {
@@ -155,9 +180,10 @@ nlohmann::json run(const Options& o) {
     if (params.topics.empty()) throw std::invalid_argument(o.topics + " has no 'topics:' list");
   }
   if (o.rate > 0) params.rate = o.rate;
-  if (!o.combination.empty()) {
-    params.pipeline.segmentation.combination = lfd::parse_profile_combination(o.combination);
-  }
+  const std::vector<lfd::ProfileCombination> combinations = parse_combinations(o.combination);
+  if (combinations.size() == 1) params.pipeline.segmentation.combination = combinations[0];
+  if (!o.procedure.empty())
+    params.pipeline.procedure = lfd::parse_segmentation_procedure(o.procedure);
   if (o.threshold != 0) {
     if (!(o.threshold > 0 && o.threshold <= 1))
       throw std::invalid_argument("--threshold must be in (0,1]");
@@ -208,6 +234,9 @@ nlohmann::json run(const Options& o) {
   nlohmann::json out;
   const auto compute_start = std::chrono::steady_clock::now();
   if (!bags && demos.size() == 1 && o.sensors.empty()) {
+    if (combinations.size() > 1)
+      throw std::invalid_argument(
+          "several combinations need the pipeline (bags, several CSV files or --sensor-columns)");
     // Plain parameter-free multivariate ClaSP over the chosen columns, equal weights.
     lfd::FeatureMatrix demo = states.empty() ? demos[0] : demos[0].select(states);
     lfd::check_finite(demo, o.files[0]);
@@ -217,10 +246,21 @@ nlohmann::json run(const Options& o) {
     const lfd::MultivariateSegmentation s = lfd::segment_multivariate(demo.data, {}, seg);
     out = lfd_segmentation::to_json(s, demo, o.files[0], json_options);
     out["mode"] = "clasp";
-  } else {
+  } else if (combinations.size() <= 1) {
     const lfd::SegmentationPipelineResult r =
         lfd::run_segmentation_pipeline(demos, sensors, config, states);
     out = lfd_segmentation::to_json(r, demos, o.files, json_options);
+    out["mode"] = "pipeline";
+  } else {
+    const lfd::PreparedSegmentation prepared =
+        lfd::prepare_segmentation(demos, sensors, config, states);
+    out["methods"] = nlohmann::json::object();
+    for (lfd::ProfileCombination c : combinations) {
+      lfd::SegmentationPipelineConfig own = config;
+      own.segmentation.combination = c;
+      out["methods"][lfd::to_string(c)] = lfd_segmentation::to_json(
+          lfd::segment_prepared(prepared, demos, own), demos, o.files, json_options);
+    }
     out["mode"] = "pipeline";
   }
   const double compute_time = seconds_since(compute_start);

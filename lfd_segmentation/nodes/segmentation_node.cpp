@@ -57,9 +57,11 @@ int main(int argc, char** argv) {
         "segmentation: no ~topics configured; every request will fail (load "
         "config/segmentation.yaml)");
   }
-  auto callback = [&params](lfd_msgs::Segment::Request& req, lfd_msgs::Segment::Response& res) {
+  lfd_segmentation::PreparedCache cache;  // requests are served one at a time
+  auto callback = [&params, &cache](lfd_msgs::Segment::Request& req,
+                                    lfd_msgs::Segment::Response& res) {
     ROS_INFO("segmentation: request with %zu bag(s)", req.bag_paths.size());
-    lfd_segmentation::handle_segment_request(params, req, res);
+    lfd_segmentation::handle_segment_request(params, req, res, &cache);
     for (const std::string& w : res.warnings) ROS_WARN("segmentation: %s", w.c_str());
     if (res.success) {
       std::string summary;

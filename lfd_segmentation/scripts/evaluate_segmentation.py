@@ -7,7 +7,8 @@ validated changepoints with the ground-truth phase transitions recorded on /lfd/
 segmenter never reads). The protocol and its tolerance come from config/evaluation.yaml.
 
   evaluate_segmentation.py --datasets DIR [--names sim_grasp,sim_push] [--methods ...] --out result.json
-                           [--cli PATH/TO/segment [--seg-config YAML] [--topics YAML] [--no-sensors]]
+                           [--cli PATH/TO/segment [--seg-config YAML] [--topics YAML] [--no-sensors]
+                            [--procedure paper]]
   evaluate_segmentation.py --truth truth.yaml ...        (demos whose truth is not on /lfd/phase)
   evaluate_segmentation.py --labels pr2_ikea/labels.json [--runs pos_1,neg_1] [--write-truth t.yaml] ...
 
@@ -56,8 +57,9 @@ from lfd_tools import report, segmentation_scoring, tasks
 class CliSegmenter(object):
     """Runs the `segment` CLI on the bags of one dataset; returns a service-like result."""
 
-    def __init__(self, cli, config, no_sensors, topics=""):
+    def __init__(self, cli, config, no_sensors, topics="", procedure=""):
         self.cli, self.config, self.no_sensors, self.topics = cli, config, no_sensors, topics
+        self.procedure = procedure
 
     def _config(self):
         if not self.no_sensors:
@@ -75,10 +77,12 @@ class CliSegmenter(object):
         tmp.close()
         return tmp.name
 
-    def __call__(self, bags, method):
-        cmd = [self.cli, "--config", self._config(), "--no-profiles", "--combination", method]
+    def _run(self, bags, methods):
+        cmd = [self.cli, "--config", self._config(), "--no-profiles", "--combination", ",".join(methods)]
         if self.topics and not self.no_sensors:
             cmd += ["--topics", self.topics]
+        if self.procedure:
+            cmd += ["--procedure", self.procedure]
         cmd += bags
         proc = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, universal_newlines=True)
         if not proc.stdout.strip():
@@ -86,6 +90,18 @@ class CliSegmenter(object):
         out = json.loads(proc.stdout)
         if not out.get("success"):
             raise RuntimeError("segmentation failed: %s" % out.get("error"))
+        return out
+
+    def __call__(self, bags, method):
+        return self._answer(self._run(bags, [method]))
+
+    def methods(self, bags, methods):
+        """Every method from one CLI run: the features are selected once."""
+        out = self._run(bags, methods)
+        return {m: self._answer(out["methods"][m]) for m in methods}
+
+    @staticmethod
+    def _answer(out):
         demos = []
         for d in out["demos"]:
             demos.append({"changepoint_times": d["changepoint_times"], "rejected_times": d.get("rejected_times", []),
@@ -108,7 +124,7 @@ def call_service(segment, bags, method):
 
 def make_segmenter(args):
     if args.cli:
-        return CliSegmenter(args.cli, args.seg_config, args.no_sensors, args.topics)
+        return CliSegmenter(args.cli, args.seg_config, args.no_sensors, args.topics, args.procedure)
     try:
         rospy.wait_for_service(args.service, timeout=30.0)
     except rospy.ROSException:
@@ -131,10 +147,11 @@ def datasets_to_run(args, config):
         # a labels.json is named by its folder (pr2_ikea), a truth file by itself
         name = (os.path.basename(os.path.dirname(os.path.abspath(args.labels))) if args.labels
                 else os.path.splitext(os.path.basename(args.truth))[0])
-        return [(name, lambda seg, m, tol: segmentation_scoring.evaluate_truth_file(seg, demos, m, tol))]
+        return [(name, lambda seg, ms, tol: segmentation_scoring.evaluate_truth_file_methods(seg, demos, ms, tol))]
     if not args.datasets:
         raise RuntimeError("give --datasets, --truth or --labels")
-    return [(n, lambda seg, m, tol, n=n: segmentation_scoring.evaluate_dataset(seg, os.path.join(args.datasets, n), m, config, tol))
+    return [(n, lambda seg, ms, tol, n=n: segmentation_scoring.evaluate_dataset_methods(
+        seg, os.path.join(args.datasets, n), ms, config, tol))
             for n in (args.names.split(",") if args.names else tasks.datasets()) if n]
 
 
@@ -156,6 +173,7 @@ def main():
                     help="segmentation parameters for --cli (default: config/segmentation.yaml)")
     ap.add_argument("--topics", default="", help="with --cli: topics file passed to `segment --topics`")
     ap.add_argument("--no-sensors", action="store_true", help="with --cli: drop the sensor topics")
+    ap.add_argument("--procedure", default="", help="with --cli: zone_search or paper (segment --procedure)")
     args = ap.parse_args(rospy.myargv()[1:])
 
     try:
@@ -174,17 +192,17 @@ def main():
         "dataset", "method", "correct", "rate", "cover", "f1", "err_med", "err_p95", "time_s", "features"))
     for name, evaluate in rows:
         results[name] = {}
+        try:
+            answers = evaluate(segment, methods, tol)
+        except (RuntimeError, rospy.ServiceException, rosbag.ROSBagException, OSError, ValueError) as exc:
+            print("%-14s %-18s error: %s" % (name, ",".join(methods), exc))
+            # also where a caller (the pipeline) looks for a tool's last words
+            print("error: %s %s: %s" % (name, ",".join(methods), exc), file=sys.stderr)
+            results[name] = {m: {"error": str(exc)} for m in methods}
+            failures += 1
+            continue
         for method in methods:
-            try:
-                r = evaluate(segment, method, tol)
-            except (RuntimeError, rospy.ServiceException, rosbag.ROSBagException, OSError, ValueError) as exc:
-                print("%-14s %-18s error: %s" % (name, method, exc))
-                # also where a caller (the pipeline) looks for a tool's last words
-                print("error: %s %s: %s" % (name, method, exc), file=sys.stderr)
-                results[name][method] = {"error": str(exc)}
-                failures += 1
-                continue
-            results[name][method] = r
+            r = results[name][method] = answers[method]
             print("%-14s %-18s %4d/%-3d %5.0f%% %6.3f %6.3f %7.3f %7.3f %8.2f  %s" % (
                 name, method, r["correct"], r["demos"], 100 * r["success_rate"], r["covering"], r["f1"],
                 r["time_error_median_s"], r["time_error_p95_s"], r["service_time_s"],

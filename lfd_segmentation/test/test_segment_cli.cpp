@@ -101,6 +101,44 @@ TEST(SegmentCli, SeveralCsvRunThePipelineWithSensorValidation) {
   EXPECT_TRUE(j.contains("timing"));
 }
 
+// Several combinations: one feature selection, one result per method under "methods", each the
+// same as a run with that method alone; a name given twice or one CSV alone is an error.
+TEST(SegmentCli, SeveralCombinationsShareOneSelection) {
+  std::string files;
+  for (int d = 0; d < 3; ++d) {
+    const std::string csv = (temp_dir() / ("multi" + std::to_string(d) + ".csv")).string();
+    write_demo_csv(csv, 450 + 30 * d, 20 + d);
+    files += " " + csv;
+  }
+  int status = -1;
+  const auto all =
+      run_cli("--sensor-columns touch --no-profiles --combination all" + files, &status);
+  ASSERT_EQ(status, 0) << all.dump();
+  ASSERT_EQ(all["methods"].size(), 6u);
+  const auto two =
+      run_cli("--sensor-columns touch --no-profiles --combination product,weighted_average" + files,
+              &status);
+  ASSERT_EQ(status, 0) << two.dump();
+  ASSERT_EQ(two["methods"].size(), 2u);
+  const auto alone =
+      run_cli("--sensor-columns touch --no-profiles --combination product" + files, &status);
+  ASSERT_EQ(status, 0);
+  EXPECT_FALSE(alone.contains("methods"));
+  for (int d = 0; d < 3; ++d) {
+    EXPECT_EQ(two["methods"]["product"]["demos"][d]["changepoints"],
+              alone["demos"][d]["changepoints"]);
+    EXPECT_EQ(all["methods"]["product"]["demos"][d]["changepoints"],
+              alone["demos"][d]["changepoints"]);
+  }
+  EXPECT_EQ(two["methods"]["product"]["selected_features"], alone["selected_features"]);
+  auto bad = run_cli("--sensor-columns touch --combination product,product" + files, &status);
+  EXPECT_EQ(status, 1);
+  EXPECT_NE(bad["error"].get<std::string>().find("twice"), std::string::npos) << bad.dump();
+  bad = run_cli("--combination product,average " + (temp_dir() / "multi0.csv").string(), &status);
+  EXPECT_EQ(status, 1);
+  EXPECT_NE(bad["error"].get<std::string>().find("several combinations"), std::string::npos);
+}
+
 TEST(SegmentCli, BadInputFailsWithAnErrorInTheJson) {
   const std::string csv = (temp_dir() / "bad.csv").string();
   std::ofstream(csv) << "time,a,b\n0,1,2\n0.1,nan,3\n0.2,1,4\n";

@@ -65,6 +65,42 @@ class SegmentService : public ::testing::Test {
 fs::path SegmentService::dir_;
 lfd_segmentation::SegmentationParams SegmentService::params_;
 
+// The cache of the last request's bags and selection: a second request on the same bags with
+// another method gives what an uncached request gives, and a bag that changed on disk is read
+// again (a new file at the same path, another size and time).
+TEST_F(SegmentService, ACachedSelectionGivesTheUncachedAnswer) {
+  std::vector<std::string> bags = good_bags(3);
+  lfd_segmentation::PreparedCache cache;
+  lfd_msgs::Segment::Request request;
+  request.bag_paths = bags;
+  lfd_msgs::Segment::Response first, cached;
+  lfd_segmentation::handle_segment_request(params_, request, first, &cache);
+  ASSERT_TRUE(first.success) << first.error;
+  EXPECT_FALSE(cache.key.empty());
+  EXPECT_EQ(cache.demos.size(), 3u);
+  request.combination = "average";
+  lfd_segmentation::handle_segment_request(params_, request, cached, &cache);
+  const auto plain = call(bags, request);
+  ASSERT_TRUE(cached.success && plain.success);
+  EXPECT_EQ(cached.selected_features, plain.selected_features);
+  for (std::size_t d = 0; d < bags.size(); ++d)
+    EXPECT_EQ(cached.demos[d].changepoints, plain.demos[d].changepoints);
+  // Replace the second bag by a longer demo: the cache must not answer for the old file.
+  const std::string key = cache.key;
+  const std::string replaced = (dir_ / "replaced.bag").string();
+  DemoBagOptions o;
+  o.seed = 7;
+  o.duration = 9.5;
+  lfd_segmentation_test::write_demo_bag(replaced, o);
+  fs::copy_file(replaced, bags[1], fs::copy_options::overwrite_existing);
+  lfd_msgs::Segment::Response again;
+  lfd_segmentation::handle_segment_request(params_, request, again, &cache);
+  ASSERT_TRUE(again.success) << again.error;
+  EXPECT_NE(cache.key, key);
+  EXPECT_NEAR(again.demos[1].num_samples, 9.5 * params_.rate, 2.0);
+  fs::remove(bags[1]);  // good1 is written afresh by the next test that needs it
+}
+
 TEST_F(SegmentService, GoodRequestValidatesTheGraspChangepoint) {
   const auto bags = good_bags(3);
   const auto r = call(bags);

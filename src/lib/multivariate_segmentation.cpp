@@ -213,11 +213,15 @@ MultivariateSegmentation segment_multivariate(const Eigen::MatrixXd& features,
   };
   std::priority_queue<Queued> queue;
 
-  // Zone-guided search: a zone marks one sensory interaction, hence at most one changepoint; once
-  // a zone holds a changepoint it is closed to later candidates.
+  // Zone-guided search: without anchors a zone marks one sensory interaction, hence at most one
+  // changepoint; once a zone holds a changepoint it is closed to later candidates. With anchors
+  // each changepoint sits on its own event, and zones closer than min_s merged into one can hold
+  // several interactions (a short push: contact and release 2 s apart); the recursion's min_s
+  // margins keep their changepoints apart.
   const std::vector<Interval> zones =
       config.candidate_zones_for ? config.candidate_zones_for(min_s) : config.candidate_zones;
   const bool restricted = config.candidate_zones_for || !zones.empty();  // no zone: no candidate
+  const bool one_per_zone = config.zone_anchors.empty();
   std::vector<bool> zone_used(zones.size(), false);
   const auto zone_of = [&](std::size_t t) -> int {
     for (std::size_t z = 0; z < zones.size(); ++z)
@@ -227,7 +231,7 @@ MultivariateSegmentation segment_multivariate(const Eigen::MatrixXd& features,
   const auto in_candidate_zone = [&](std::size_t t) {
     if (!restricted) return true;
     const int z = zone_of(t);
-    return z >= 0 && !zone_used[static_cast<std::size_t>(z)];
+    return z >= 0 && !(one_per_zone && zone_used[static_cast<std::size_t>(z)]);
   };
   // The anchor (sensory event) of t's zone nearest to t, relative to `begin`; -1 = none.
   const auto anchor_for = [&](const Eigen::VectorXd& profile, std::size_t begin,
@@ -235,17 +239,35 @@ MultivariateSegmentation segment_multivariate(const Eigen::MatrixXd& features,
     if (!restricted) return -1;
     const int zone = zone_of(begin + static_cast<std::size_t>(t));
     Eigen::Index nearest = -1;
-    for (std::size_t a : config.zone_anchors) {
+    bool nearest_preferred = false;
+    for (std::size_t i = 0; i < config.zone_anchors.size(); ++i) {
+      const std::size_t a = config.zone_anchors[i];
       if (a < begin || a >= begin + static_cast<std::size_t>(profile.size())) continue;
       const Eigen::Index rel = static_cast<Eigen::Index>(a - begin);
       if (zone_of(a) != zone || std::isnan(profile[rel])) continue;
-      if (nearest < 0 || std::abs(rel - t) < std::abs(nearest - t)) nearest = rel;
+      const bool preferred = i < config.preferred_anchors.size() && config.preferred_anchors[i];
+      if (nearest >= 0 && nearest_preferred && !preferred) continue;
+      if (nearest < 0 || (preferred && !nearest_preferred) ||
+          std::abs(rel - t) < std::abs(nearest - t)) {
+        nearest = rel;
+        nearest_preferred = preferred;
+      }
     }
     return nearest;
   };
   const double needed_log10_p = restricted && config.zone_p_value_threshold > 0.0
                                     ? std::log10(config.zone_p_value_threshold)
                                     : log10_threshold;
+  // A zone around a preferred anchor (a rest edge) carries more evidence (rest_edge_p_value).
+  std::vector<double> zone_needed(zones.size(), needed_log10_p);
+  if (config.rest_edge_p_value_threshold > 0.0) {
+    for (std::size_t i = 0; i < config.zone_anchors.size(); ++i) {
+      const int z = zone_of(config.zone_anchors[i]);
+      if (z >= 0 && i < config.preferred_anchors.size() && config.preferred_anchors[i])
+        zone_needed[static_cast<std::size_t>(z)] =
+            std::max(needed_log10_p, std::log10(config.rest_edge_p_value_threshold));
+    }
+  }
   const auto evaluate = [&](std::size_t begin, std::size_t end, bool first) {
     const std::size_t len = end - begin;
     if (len < 2 * min_s + 1) return;
@@ -317,6 +339,18 @@ MultivariateSegmentation segment_multivariate(const Eigen::MatrixXd& features,
     // Each zone is its own hypothesis: when the best in-zone split of this range is not
     // significant, the range's other zones are still tested (next best first).
     std::vector<bool> tested(zones.size(), false);
+    // With anchors a zone is searched only while it holds an event ClaSP may split at (inside
+    // this range and its min_s margins): its others sit on changepoints already.
+    if (restricted && !one_per_zone) {
+      std::vector<bool> anchored(zones.size(), false);
+      for (std::size_t a : config.zone_anchors) {
+        const int z = zone_of(a);
+        if (z >= 0 && a >= begin && a < end &&
+            !std::isnan(penalized[static_cast<Eigen::Index>(a - begin)]))
+          anchored[static_cast<std::size_t>(z)] = true;
+      }
+      for (std::size_t z = 0; z < zones.size(); ++z) tested[z] = !anchored[z];
+    }
     for (;;) {
       Eigen::Index best = -1;
       for (Eigen::Index t = 0; t < penalized.size(); ++t) {
@@ -345,8 +379,16 @@ MultivariateSegmentation segment_multivariate(const Eigen::MatrixXd& features,
       c.score = penalized[best];
       c.log10_p_value = weighted_log_p / weight_sum;
       out.candidates.push_back(c);
-      if (learn && c.log10_p_value > needed_log10_p) {  // not significant
-        if (!restricted) return;                        // plain ClaSP: the range stays whole
+      const double needed = restricted
+                                ? zone_needed[static_cast<std::size_t>(zone_of(c.profile_argmax))]
+                                : needed_log10_p;
+      // Outside zones a long demo needs more evidence (significance_per_sample): the rank-sum
+      // test's log p grows with the number of subsequences for the same split quality.
+      const double needed_here =
+          restricted ? needed
+                     : std::min(needed, -config.significance_per_sample * static_cast<double>(n));
+      if (learn && c.log10_p_value > needed_here) {  // not significant
+        if (!restricted) return;                     // plain ClaSP: the range stays whole
         tested[static_cast<std::size_t>(zone_of(c.profile_argmax))] = true;
         continue;
       }
@@ -359,7 +401,7 @@ MultivariateSegmentation segment_multivariate(const Eigen::MatrixXd& features,
   while (!queue.empty() && out.changepoints.size() < max_cps) {
     SplitCandidate& c = out.candidates[queue.top().candidate_index];
     queue.pop();
-    if (restricted) {
+    if (restricted && one_per_zone) {
       const int z = zone_of(c.index);
       if (zone_used[static_cast<std::size_t>(z)]) {
         evaluate(c.range_begin, c.range_end, false);  // its zone was taken meanwhile: search again

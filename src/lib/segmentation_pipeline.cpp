@@ -1,5 +1,7 @@
 #include "lfd_core/segmentation_pipeline.hpp"
 
+#include "lfd_core/segmentation_consensus.hpp"
+
 #include <algorithm>
 #include <atomic>
 #include <chrono>
@@ -54,6 +56,19 @@ bool is_constant(const FeatureMatrix& demo, int col) {
   return !(hi - lo > 1e-12 * (1.0 + std::max(std::abs(hi), std::abs(lo))));
 }
 
+// The channels of one sensor share their name up to the last '/' (a topic's array or vector:
+// /touch/values/0 and /touch/values/1); names without '/' (CSV columns) are one sensor.
+std::vector<std::size_t> sensor_groups(const std::vector<std::string>& names) {
+  std::map<std::string, std::size_t> ids;
+  std::vector<std::size_t> groups;
+  for (const std::string& name : names) {
+    const std::size_t slash = name.rfind('/');
+    const std::string sensor = slash == std::string::npos ? "" : name.substr(0, slash);
+    groups.push_back(ids.emplace(sensor, ids.size()).first->second);
+  }
+  return groups;
+}
+
 // Runs job(d) for every demonstration on up to `threads` threads; rethrows the first failure (by
 // demonstration index) with the demonstration named.
 template <typename Job>
@@ -103,59 +118,74 @@ DemoSettings settings_for(const FeatureMatrix& demo, const SegmentationPipelineC
   return {in_samples(config, rate), rate};
 }
 
-// SegmentationPipelineConfig::consensus_count. Significance of a changepoint: the log10 p-value
-// of the ClaSP candidate that placed it.
-void prune_to_consensus(const std::vector<FeatureMatrix>& demos, bool validated,
-                        SegmentationPipelineResult* result) {
-  // With sensor validation only demos with evidence vote: a demo without any sensory event had no
-  // zone, so its count of 0 says nothing about the task (a dead sensor, a missed contact).
-  std::map<std::size_t, std::size_t> votes;  // changepoint count -> demos
-  std::size_t n = 0;
-  for (const DemoSegmentationResult& d : result->demos) {
-    if (validated && d.events.empty()) continue;
-    ++votes[d.changepoints.size()];
-    ++n;
-  }
-  if (votes.empty()) return;
-  const auto top = std::max_element(
-      votes.begin(), votes.end(), [](const auto& a, const auto& b) { return a.second < b.second; });
-  if (n < 3 || 2 * top->second <= n) return;  // no clear majority: nothing to agree on
-  const std::size_t k = top->first;
-  // A majority that found nothing says nothing about where the boundaries are: the changepoints
-  // of the other demos each stand on a sensory event of their own.
-  if (k == 0) return;
-  for (std::size_t d = 0; d < result->demos.size(); ++d) {
-    DemoSegmentationResult& out = result->demos[d];
-    if (out.changepoints.size() <= k) continue;
-    std::vector<std::pair<double, std::size_t>> by_p;  // (log10 p, changepoint)
-    for (std::size_t cp : out.changepoints) {
-      double log_p = 0.0;
-      for (const SplitCandidate& c : out.clasp.candidates)
-        if (c.accepted && c.index == cp) log_p = c.log10_p_value;
-      by_p.emplace_back(log_p, cp);
+// Every demo's sample-count settings; checks its clock and that it holds 2 min_s.
+std::vector<DemoSettings> demo_settings(const std::vector<FeatureMatrix>& demos,
+                                        const SegmentationPipelineConfig& config) {
+  std::vector<DemoSettings> settings;
+  for (std::size_t d = 0; d < demos.size(); ++d) {
+    try {
+      settings.push_back(settings_for(demos[d], config));
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument(demo_context(d) + ": " + e.what());
     }
-    std::stable_sort(by_p.begin(), by_p.end());
-    std::ostringstream msg;
-    msg << demo_context(d) << ": " << out.changepoints.size() << " changepoints where "
-        << top->second << " of the " << n << " voting demonstrations have " << k
-        << "; dropped the least significant:";
-    out.changepoints.clear();
-    out.changepoint_times.clear();
-    for (std::size_t i = 0; i < by_p.size(); ++i) {
-      const std::size_t cp = by_p[i].second;
-      if (i < k) {
-        out.changepoints.push_back(cp);
-        continue;
-      }
-      out.pruned.push_back(cp);
-      msg << " t=" << demos[d].time_at(cp) << " (p=1e" << std::lround(by_p[i].first) << ")";
+    const std::size_t min_s = settings.back().config.segmentation.min_segment_length;
+    if (min_s > 0 && static_cast<std::size_t>(demos[d].rows()) < 2 * min_s) {
+      throw std::invalid_argument(demo_context(d) + " has " + std::to_string(demos[d].rows()) +
+                                  " samples, fewer than 2 * min_s = " + std::to_string(2 * min_s));
     }
-    std::sort(out.changepoints.begin(), out.changepoints.end());
-    std::sort(out.pruned.begin(), out.pruned.end());
-    for (std::size_t cp : out.changepoints) out.changepoint_times.push_back(demos[d].time_at(cp));
-    for (std::size_t cp : out.pruned) out.pruned_times.push_back(demos[d].time_at(cp));
-    result->warnings.push_back(msg.str());
   }
+  return settings;
+}
+
+// II-C for one demonstration: ClaSP on the selected features and the sensory zones, met as the
+// procedure says.
+DemoSegmentationResult segment_demo(const FeatureMatrix& demo, const DemoSettings& settings,
+                                    const SegmentationPipelineResult& prepared, bool validate,
+                                    const std::vector<std::size_t>& groups) {
+  const SegmentationPipelineConfig& own = settings.config;
+  DemoSegmentationResult out;
+  out.num_samples = static_cast<std::size_t>(demo.rows());
+  out.sample_rate = settings.rate;
+  MultivariateSegmentationConfig seg = own.segmentation;
+  if (own.window_size > 0)
+    seg.window_sizes.assign(prepared.selected_features.size(), own.window_size);
+  // Events do not depend on min_s: detected once, for the zone-guided search and validation.
+  const SensorEvents events =
+      validate
+          ? detect_sensor_events(demo.select(prepared.sensor_features).data, own.events, groups)
+          : SensorEvents{};
+  const std::vector<std::size_t>& zone_events =
+      own.events.zones_from_rest_edges ? events.zone_events : events.all;
+  const auto zones = [&](std::size_t min_s) {
+    return confidence_zones(zone_events, min_s, static_cast<std::size_t>(demo.rows()));
+  };
+  if (validate && own.procedure == SegmentationProcedure::kZoneSearch) {
+    seg.candidate_zones_for = zones;
+    for (const SensoryEvent& e :
+         own.anchor_to_events ? events.details : std::vector<SensoryEvent>{}) {
+      seg.zone_anchors.push_back(e.index);
+      seg.preferred_anchors.push_back(e.rest_edge);
+    }
+  } else if (validate) {
+    seg.num_changepoints = static_cast<int>(own.paper_candidates);
+  }
+  out.clasp = segment_multivariate(demo.select(prepared.selected_features).data,
+                                   prepared.feature_weights, seg);
+  out.min_segment_length = out.clasp.min_segment_length;
+  if (validate) {
+    const ChangepointValidation v =
+        validate_with_zones(out.clasp.changepoints, zones(out.min_segment_length));
+    out.changepoints = v.accepted;
+    out.rejected = v.rejected;
+    out.zones = v.zones;
+    out.events = events.all;
+    out.event_details = events.details;
+  } else {
+    out.changepoints = out.clasp.changepoints;
+  }
+  for (std::size_t cp : out.changepoints) out.changepoint_times.push_back(demo.time_at(cp));
+  for (std::size_t cp : out.rejected) out.rejected_times.push_back(demo.time_at(cp));
+  return out;
 }
 
 }  // namespace
@@ -165,6 +195,16 @@ std::size_t samples(double seconds, double rate, std::size_t at_least) {
   return std::max<std::size_t>(at_least, static_cast<std::size_t>(std::lround(seconds * rate)));
 }
 }  // namespace
+
+SegmentationProcedure parse_segmentation_procedure(const std::string& name) {
+  if (name == "zone_search") return SegmentationProcedure::kZoneSearch;
+  if (name == "paper") return SegmentationProcedure::kPaper;
+  throw std::invalid_argument("unknown segmentation procedure '" + name + "' (zone_search, paper)");
+}
+
+std::string to_string(SegmentationProcedure procedure) {
+  return procedure == SegmentationProcedure::kPaper ? "paper" : "zone_search";
+}
 
 SegmentationPipelineConfig in_samples(const SegmentationPipelineConfig& config, double rate) {
   SegmentationPipelineConfig s = config;
@@ -199,11 +239,13 @@ double sample_rate_of(const FeatureMatrix& demo) {
   return 1.0 / step;
 }
 
-SegmentationPipelineResult run_segmentation_pipeline(
-    const std::vector<FeatureMatrix>& demos, const std::vector<std::string>& sensor_features,
-    const SegmentationPipelineConfig& config, const std::vector<std::string>& state_features) {
+PreparedSegmentation prepare_segmentation(const std::vector<FeatureMatrix>& demos,
+                                          const std::vector<std::string>& sensor_features,
+                                          const SegmentationPipelineConfig& config,
+                                          const std::vector<std::string>& state_features) {
   if (demos.empty()) throw std::invalid_argument("no demonstrations to segment");
-  SegmentationPipelineResult result;
+  PreparedSegmentation prepared;
+  SegmentationPipelineResult& result = prepared.base;
 
   // ---- input checks: shape, same features, roles, finite samples, lengths
   for (std::size_t d = 0; d < demos.size(); ++d) {
@@ -246,19 +288,7 @@ SegmentationPipelineResult run_segmentation_pipeline(
   for (std::size_t d = 0; d < demos.size(); ++d)
     check_finite(demos[d].select(used), demo_context(d));
 
-  std::vector<DemoSettings> settings;
-  for (std::size_t d = 0; d < demos.size(); ++d) {
-    try {
-      settings.push_back(settings_for(demos[d], config));
-    } catch (const std::invalid_argument& e) {
-      throw std::invalid_argument(demo_context(d) + ": " + e.what());
-    }
-    const std::size_t min_s = settings.back().config.segmentation.min_segment_length;
-    if (min_s > 0 && static_cast<std::size_t>(demos[d].rows()) < 2 * min_s) {
-      throw std::invalid_argument(demo_context(d) + " has " + std::to_string(demos[d].rows()) +
-                                  " samples, fewer than 2 * min_s = " + std::to_string(2 * min_s));
-    }
-  }
+  demo_settings(demos, config);  // checks every demo's clock and length
 
   // ---- constant state features carry no information
   std::vector<std::string> informative;
@@ -302,55 +332,31 @@ SegmentationPipelineResult run_segmentation_pipeline(
     result.feature_weights.assign(informative.size(), 1.0);
   }
 
-  const auto segmentation_start = std::chrono::steady_clock::now();
   result.relevance_seconds =
-      std::chrono::duration<double>(segmentation_start - relevance_start).count();
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - relevance_start).count();
+  return prepared;
+}
 
-  // ---- II-C multivariate ClaSP + sensory validation, one demonstration per worker
+SegmentationPipelineResult segment_prepared(const PreparedSegmentation& prepared,
+                                            const std::vector<FeatureMatrix>& demos,
+                                            const SegmentationPipelineConfig& config) {
+  const auto segmentation_start = std::chrono::steady_clock::now();
+  SegmentationPipelineResult result = prepared.base;
+  const std::vector<std::string>& sensor_features = result.sensor_features;
+  const std::vector<DemoSettings> settings = demo_settings(demos, config);
   const bool validate = config.validate_with_sensors && !sensor_features.empty();
   if (!validate) {
     result.warnings.push_back(sensor_features.empty()
                                   ? "no sensor features: ClaSP changepoints are not validated"
                                   : "sensor validation disabled: ClaSP changepoints are accepted");
   }
+  const std::vector<std::size_t> groups = sensor_groups(sensor_features);
   result.demos.resize(demos.size());
   for_each_demo(demos.size(), config.threads, [&](std::size_t d) {
-    const FeatureMatrix& demo = demos[d];
-    DemoSegmentationResult& out = result.demos[d];
-    out.num_samples = static_cast<std::size_t>(demo.rows());
-    out.sample_rate = settings[d].rate;
-    const Eigen::MatrixXd state = demo.select(result.selected_features).data;
-    const SegmentationPipelineConfig& own = settings[d].config;
-    MultivariateSegmentationConfig demo_config = own.segmentation;
-    if (own.window_size > 0)
-      demo_config.window_sizes.assign(result.selected_features.size(), own.window_size);
-    // Events do not depend on min_s: detected once, for the zone-guided search and validation.
-    const SensorEvents events =
-        validate ? detect_sensor_events(demo.select(sensor_features).data, own.events)
-                 : SensorEvents{};
-    const auto zones = [&](std::size_t min_s) {
-      return confidence_zones(events.all, min_s, static_cast<std::size_t>(demo.rows()));
-    };
-    if (validate && config.search_in_zones) {
-      demo_config.candidate_zones_for = zones;
-      if (config.anchor_to_events) demo_config.zone_anchors = events.all;
-    }
-    out.clasp = segment_multivariate(state, result.feature_weights, demo_config);
-    out.min_segment_length = out.clasp.min_segment_length;
-    if (validate) {
-      const ChangepointValidation v =
-          validate_with_zones(out.clasp.changepoints, zones(out.min_segment_length));
-      out.changepoints = v.accepted;
-      out.rejected = v.rejected;
-      out.zones = v.zones;
-      out.events = events.all;
-    } else {
-      out.changepoints = out.clasp.changepoints;
-    }
-    for (std::size_t cp : out.changepoints) out.changepoint_times.push_back(demo.time_at(cp));
-    for (std::size_t cp : out.rejected) out.rejected_times.push_back(demo.time_at(cp));
+    result.demos[d] = segment_demo(demos[d], settings[d], result, validate, groups);
   });
-  if (config.consensus_count) prune_to_consensus(demos, validate, &result);
+  if (config.consensus_count && config.procedure == SegmentationProcedure::kZoneSearch)
+    agree_on_changepoint_count(demos, validate, config.consensus_fill_p_value, &result);
   result.segmentation_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - segmentation_start).count();
   for (std::size_t d = 0; d < demos.size() && validate; ++d) {
@@ -359,14 +365,18 @@ SegmentationPipelineResult run_segmentation_pipeline(
         result.warnings.push_back(demo_context(d) + ": sensor '" + sensor +
                                   "' is constant (dead or disconnected?): no zone from it");
     }
-  }
-  for (std::size_t d = 0; d < demos.size(); ++d) {
-    if (validate && result.demos[d].events.empty()) {
+    if (result.demos[d].events.empty())
       result.warnings.push_back(demo_context(d) +
                                 ": no sensory event detected, so no changepoint can be validated");
-    }
   }
   return result;
+}
+
+SegmentationPipelineResult run_segmentation_pipeline(
+    const std::vector<FeatureMatrix>& demos, const std::vector<std::string>& sensor_features,
+    const SegmentationPipelineConfig& config, const std::vector<std::string>& state_features) {
+  return segment_prepared(prepare_segmentation(demos, sensor_features, config, state_features),
+                          demos, config);
 }
 
 }  // namespace lfd

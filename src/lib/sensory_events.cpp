@@ -4,8 +4,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <stdexcept>
 #include <string>
+
+#include "lfd_core/ramp_fit.hpp"
 
 namespace lfd {
 namespace {
@@ -19,8 +22,9 @@ void check_config(const SensoryEventConfig& c) {
   if (!(c.hysteresis > 0.0 && c.hysteresis <= 1.0))
     throw std::invalid_argument("sensory events: hysteresis must be in (0, 1], got " +
                                 std::to_string(c.hysteresis));
-  if (!(c.noise_floor_sigmas >= 0.0))
-    throw std::invalid_argument("sensory events: noise_floor_sigmas must be >= 0");
+  if (!(c.noise_floor_sigmas >= 0.0) || !(c.noise_floor_excursions >= 0.0))
+    throw std::invalid_argument(
+        "sensory events: noise_floor_sigmas and noise_floor_excursions must be >= 0");
   if (c.difference_lag < 1)
     throw std::invalid_argument("sensory events: difference_lag must be >= 1");
 }
@@ -47,6 +51,29 @@ double noise_sigma(const std::vector<double>& d, std::size_t block) {
   const std::size_t k = sigmas.size() / 10;
   std::nth_element(sigmas.begin(), sigmas.begin() + static_cast<std::ptrdiff_t>(k), sigmas.end());
   return sigmas[k];
+}
+
+// SensoryEventConfig::noise_floor_excursions: how far the detector's own statistic (the lagged
+// difference `mag`) goes when nothing happens. Each block of `block` samples gives its largest
+// |lagged difference|, 0 for a block whose raw signal does not move at all; the 10th percentile
+// of those is the quiet excursion. Unlike a sigma of the raw differences it needs no noise model:
+// drift, clipped (a touch pad's force cannot go below 0), quantized or correlated noise is
+// measured as the detector sees it. A noise-free signal (constant between its changes) has a
+// quiet excursion of 0.
+double quiet_excursion(const Eigen::Ref<const Eigen::VectorXd>& signal,
+                       const std::vector<double>& mag, std::size_t block) {
+  const std::size_t n = mag.size();
+  if (block == 0 || n < 2 * block) return 0.0;
+  std::vector<double> maxima;
+  for (std::size_t b = 0; b + block <= n; b += block) {
+    const auto part =
+        signal.segment(static_cast<Eigen::Index>(b), static_cast<Eigen::Index>(block));
+    const bool still = !(part.maxCoeff() > part.minCoeff());
+    maxima.push_back(still ? 0.0 : *std::max_element(mag.begin() + b, mag.begin() + b + block));
+  }
+  const std::size_t k = maxima.size() / 10;
+  std::nth_element(maxima.begin(), maxima.begin() + static_cast<std::ptrdiff_t>(k), maxima.end());
+  return maxima[k];
 }
 
 double median_of(std::vector<double> v) {
@@ -89,47 +116,65 @@ std::string to_string(EventThreshold threshold) {
   return threshold == EventThreshold::kNoise ? "noise" : "ratio_of_max";
 }
 
-std::vector<std::size_t> detect_sensory_events(const Eigen::Ref<const Eigen::VectorXd>& signal,
-                                               const SensoryEventConfig& config) {
-  check_config(config);
-  if (!signal.allFinite()) throw std::invalid_argument("sensory events: signal has NaN/Inf values");
-  const std::size_t n = static_cast<std::size_t>(signal.size());
-  if (n < 2) return {};
-  const std::vector<double> y = running_median(signal, config.median_window);
-  const std::size_t lag = config.difference_lag, ahead = lag / 2, behind = lag - ahead;
-  // Only differences of fully smoothed samples: the median's window shrinks at the ends, where a
-  // single noisy sample would otherwise look like a level change.
-  const std::size_t edge = config.median_window > 1 ? config.median_window / 2 : 0;
+namespace {
+
+struct Burst {
+  std::size_t begin, end;  // end = first quiet sample, or n if still active at the end
+  double peak;             // largest lagged difference inside
+};
+
+// An event and on which side its channel is at rest (kFit).
+struct PlacedEvent {
+  SensoryEvent event;
+  bool from_rest = false, to_rest = false;
+};
+
+struct Channel {
+  std::vector<double> y;  // median-smoothed signal
+  double rest = 0.0;      // rest level
+  double on = 0.0;        // activity threshold
+  std::vector<PlacedEvent> events;
+};
+
+// The detector's statistic: |y[t + ahead] - y[t - behind]| of the smoothed y, 0 where it would
+// use the median's shrunk edges (a single noisy sample there would look like a level change).
+std::vector<double> lagged_differences(const std::vector<double>& y, std::size_t lag,
+                                       std::size_t edge) {
+  const std::size_t n = y.size(), ahead = lag / 2, behind = lag - ahead;
   std::vector<double> mag(n, 0.0);
   for (std::size_t t = behind + edge; t + ahead + edge < n; ++t)
     mag[t] = std::abs(y[t + ahead] - y[t - behind]);
-  const double peak = *std::max_element(mag.begin(), mag.end());
-  if (!(peak > 0.0)) return {};
-  // The noise is measured on the RAW first differences (nearly independent samples, so a block of
-  // a second gives a fair estimate; a running median leaves plateaus whose differences are mostly
-  // 0, and lagged differences of a smoothed signal are so correlated that a block holds only a few
-  // independent values). For white noise of sigma s the raw differences have sigma sqrt(2) s and
-  // the lagged differences of a median of w samples sqrt(2) * 1.2533 s / sqrt(w): the floor is
-  // scaled by 1.2533 / sqrt(w). Correlated noise is underestimated by the raw differences, which
-  // is why the floor is a generous number of sigmas.
-  std::vector<double> diffs;
-  for (std::size_t t = 1; t < n; ++t)
-    diffs.push_back(signal[static_cast<Eigen::Index>(t)] -
-                    signal[static_cast<Eigen::Index>(t - 1)]);
-  const double smoothing = lag > 1 && config.median_window > 1
-                               ? 1.2533 / std::sqrt(static_cast<double>(config.median_window))
-                               : 1.0;
-  const double sigma =
-      config.noise_floor_sigmas > 0.0 ? smoothing * noise_sigma(diffs, config.noise_block) : 0.0;
-  const double noise_floor = config.noise_floor_sigmas * sigma;
-  const double on = config.threshold == EventThreshold::kNoise
-                        ? std::max(noise_floor, config.relative_floor * peak)
-                        : std::max(noise_floor, config.threshold_ratio * peak);
-  const double off = config.hysteresis * on;
+  return mag;
+}
 
-  struct Burst {
-    std::size_t begin, end;  // end = first quiet sample, or n if still active at the end
-  };
+// On-threshold of the activity: the paper's ratio of the largest difference (or the noise rule),
+// never below the noise floors.
+double activity_threshold(const Eigen::Ref<const Eigen::VectorXd>& signal,
+                          const std::vector<double>& mag, double peak,
+                          const SensoryEventConfig& config) {
+  // The sigma floor is measured on the RAW first differences (nearly independent samples) and
+  // scaled to the lagged differences of a median of w samples (white noise: x 1.2533 / sqrt(w)).
+  double sigma = 0.0;
+  if (config.noise_floor_sigmas > 0.0) {
+    std::vector<double> diffs;
+    for (Eigen::Index t = 1; t < signal.size(); ++t) diffs.push_back(signal[t] - signal[t - 1]);
+    const double smoothing = config.difference_lag > 1 && config.median_window > 1
+                                 ? 1.2533 / std::sqrt(static_cast<double>(config.median_window))
+                                 : 1.0;
+    sigma = smoothing * noise_sigma(diffs, config.noise_block);
+  }
+  const double excursion =
+      config.noise_floor_excursions > 0.0 ? quiet_excursion(signal, mag, config.noise_block) : 0.0;
+  const double floor =
+      std::max(config.noise_floor_sigmas * sigma, config.noise_floor_excursions * excursion);
+  const double ratio =
+      config.threshold == EventThreshold::kNoise ? config.relative_floor : config.threshold_ratio;
+  return std::max(floor, ratio * peak);
+}
+
+std::vector<Burst> find_bursts(const std::vector<double>& mag, double on, double off,
+                               bool walk_back) {
+  const std::size_t n = mag.size();
   std::vector<Burst> bursts;
   bool active = false;
   for (std::size_t t = 1; t < n; ++t) {
@@ -138,39 +183,219 @@ std::vector<std::size_t> detect_sensory_events(const Eigen::Ref<const Eigen::Vec
       // force that builds up slowly crosses `on` late (symmetric to the off-event below).
       std::size_t begin = t;
       const std::size_t floor_at = bursts.empty() ? 1 : bursts.back().end + 1;
-      while (config.place_on_change && begin > floor_at && mag[begin - 1] > off) --begin;
-      bursts.push_back({begin, n});
+      while (walk_back && begin > floor_at && mag[begin - 1] > off) --begin;
+      bursts.push_back({begin, n, 0.0});
       active = true;
     } else if (active && mag[t] <= off) {
       bursts.back().end = t;
       active = false;
     }
+    if (active) bursts.back().peak = std::max(bursts.back().peak, mag[t]);
   }
+  return bursts;
+}
+
+std::vector<Burst> merge_bursts(const std::vector<Burst>& bursts, std::size_t gap, std::size_t n) {
   std::vector<Burst> merged;
   for (const Burst& b : bursts) {
-    if (!merged.empty() && merged.back().end != n &&
-        b.begin - merged.back().end <= config.merge_gap)
+    if (!merged.empty() && merged.back().end != n && b.begin - merged.back().end <= gap) {
       merged.back().end = b.end;
-    else
+      merged.back().peak = std::max(merged.back().peak, b.peak);
+    } else {
       merged.push_back(b);
+    }
   }
-  // With a lag the activity starts L/2 before the change and ends L/2 after it: move the events
-  // back onto the change (see the header).
-  const bool shift = config.place_on_change && lag > 1;
-  const std::size_t on_shift = shift ? ahead : 0, off_shift = shift ? behind : 0;
-  std::vector<std::size_t> events;
-  for (const Burst& b : merged) {
+  return merged;
+}
+
+// EventPlacement::kFit: the burst's start where the level starts to change and its end where it
+// settles (fit_ramp around each end); the ends of a short ramp or step are one event. An event
+// whose outer level is the rest level (the level at the demo's start, within the activity
+// threshold) leaves or regains rest on this channel.
+void place_by_fit(const Burst& b, const Channel& c, const SensoryEventConfig& config,
+                  std::vector<PlacedEvent>* events) {
+  const std::size_t n = c.y.size(), lag = config.difference_lag;
+  const double strength = b.peak / c.on;
+  const std::size_t lo = b.begin > lag ? b.begin - lag : 0;
+  const RampFit first = fit_ramp(c.y, lo, std::min(n, b.begin + 2 * lag + 1));
+  const bool from_rest = std::abs(first.before - c.rest) < c.on;
+  if (b.end == n) {
+    events->push_back({{first.start, from_rest, strength}, from_rest, false});
+    return;
+  }
+  const std::size_t hi = std::min(n, b.end + lag + 1);
+  const RampFit last = fit_ramp(c.y, b.end > 2 * lag + lo ? b.end - 2 * lag : lo, hi);
+  const bool to_rest = std::abs(last.after - c.rest) < c.on;
+  if (last.end <= first.start + lag / 2) {  // one step: the rest side says where
+    const std::size_t at = !from_rest && to_rest ? last.end : first.start;
+    events->push_back({{at, from_rest || to_rest, strength}, from_rest, to_rest});
+    return;
+  }
+  events->push_back({{first.start, from_rest, strength}, from_rest, false});
+  events->push_back({{last.end, to_rest, strength}, false, to_rest});
+}
+
+// EventPlacement::kThreshold and kShift: at the burst's ends, shifted back onto the change by
+// half a lag (kShift; a burst that spans less than half a lag after the shifts is one step).
+void place_at_burst_ends(const Burst& b, std::size_t n, const SensoryEventConfig& config,
+                         double strength, std::vector<PlacedEvent>* events) {
+  const std::size_t lag = config.difference_lag, ahead = lag / 2, behind = lag - ahead;
+  const bool shift = config.placement == EventPlacement::kShift && lag > 1;
+  const std::size_t begin = std::min(b.begin + (shift ? ahead : 0), n - 1);
+  events->push_back({{begin, false, strength}, false, false});
+  if (b.end != n && b.end - (shift ? behind : 0) >= begin + (shift ? ahead : 1))
+    events->push_back({{b.end - (shift ? behind : 0), false, strength}, false, false});
+}
+
+// One channel: smoothed signal, rest level, activity threshold and its events.
+Channel analyse_channel(const Eigen::Ref<const Eigen::VectorXd>& signal,
+                        const SensoryEventConfig& config) {
+  if (!signal.allFinite()) throw std::invalid_argument("sensory events: signal has NaN/Inf values");
+  Channel c;
+  const std::size_t n = static_cast<std::size_t>(signal.size());
+  if (n < 2) return c;
+  c.y = running_median(signal, config.median_window);
+  const std::size_t edge = config.median_window > 1 ? config.median_window / 2 : 0;
+  const std::vector<double> mag = lagged_differences(c.y, config.difference_lag, edge);
+  const double peak = *std::max_element(mag.begin(), mag.end());
+  if (!(peak > 0.0)) return c;
+  c.on = activity_threshold(signal, mag, peak, config);
+  const bool walk_back = config.placement != EventPlacement::kThreshold;
+  const std::vector<Burst> bursts = merge_bursts(
+      find_bursts(mag, c.on, config.hysteresis * c.on, walk_back), config.merge_gap, n);
+  // The rest level: where the sensor starts, before the robot interacts with anything.
+  const std::size_t head =
+      std::min(n, std::max<std::size_t>(config.noise_block, config.difference_lag));
+  c.rest = median_of(std::vector<double>(c.y.begin(), c.y.begin() + head));
+  const bool fit = config.placement == EventPlacement::kFit && config.difference_lag > 1;
+  for (const Burst& b : bursts) {
     if (b.end != n && b.end - b.begin < config.min_active_samples) continue;
-    const std::size_t begin = std::min(b.begin + on_shift, n - 1);
-    events.push_back(begin);
-    // A burst that spans less than half a lag after the shifts is a single edge (a step): one
-    // event.
-    if (b.end != n && b.end - off_shift >= begin + (shift ? ahead : 1))
-      events.push_back(b.end - off_shift);
+    if (fit)
+      place_by_fit(b, c, config, &c.events);
+    else
+      place_at_burst_ends(b, n, config, b.peak / c.on, &c.events);
   }
-  std::sort(events.begin(), events.end());
-  events.erase(std::unique(events.begin(), events.end()), events.end());
-  return events;
+  std::sort(c.events.begin(), c.events.end(), [](const PlacedEvent& a, const PlacedEvent& b) {
+    return a.event.index < b.event.index;
+  });
+  return c;
+}
+
+// Whether channel c sits at its rest level over [from, to) (median distance within its threshold).
+bool at_rest(const Channel& c, std::size_t from, std::size_t to) {
+  if (c.events.empty()) return true;  // never active
+  to = std::min(to, c.y.size());
+  if (from >= to) return true;
+  std::vector<double> d;
+  for (std::size_t t = from; t < to; ++t) d.push_back(std::abs(c.y[t] - c.rest));
+  return median_of(d) < c.on;
+}
+
+// For every sample, the length of the run of samples around it where the whole group sits at
+// rest (0 where it does not).
+std::vector<std::size_t> rest_run_lengths(const std::vector<Channel>& channels,
+                                          const std::vector<std::size_t>& group) {
+  const std::size_t n = channels[group.front()].y.size();
+  std::vector<std::size_t> run(n, 0);
+  std::size_t t = 0;
+  while (t < n) {
+    const auto quiet = [&](std::size_t i) {
+      for (std::size_t c : group)
+        if (!channels[c].events.empty() &&
+            !(std::abs(channels[c].y[i] - channels[c].rest) < channels[c].on))
+          return false;
+      return true;
+    };
+    if (!quiet(t)) {
+      ++t;
+      continue;
+    }
+    std::size_t end = t;
+    while (end < n && quiet(end)) ++end;
+    std::fill(run.begin() + static_cast<std::ptrdiff_t>(t),
+              run.begin() + static_cast<std::ptrdiff_t>(end), end - t);
+    t = end;
+  }
+  return run;
+}
+
+// A sensor of several channels (a touch pad per finger, a force vector) is at rest only when
+// all of them are: one pad letting go while the other takes over is not the contact's end. And
+// a rest shorter than `min_rest` samples (the merge gap: activity separated by less is one
+// activity) is a pause within the interaction, not its end: a teleoperator's hesitation, an arm
+// slowing between two strokes.
+void flag_rest_edges_of_group(std::vector<Channel>* channels, const std::vector<std::size_t>& group,
+                              std::size_t lag, std::size_t min_rest) {
+  const std::vector<std::size_t> run = rest_run_lengths(*channels, group);
+  const auto longest = [&](std::size_t from, std::size_t to) {
+    std::size_t best = 0;
+    for (std::size_t t = from; t < std::min(to, run.size()); ++t) best = std::max(best, run[t]);
+    return best;
+  };
+  for (std::size_t c : group) {
+    for (PlacedEvent& p : (*channels)[c].events) {
+      const std::size_t e = p.event.index, lo = e > lag ? e - lag : 0;
+      bool before = p.from_rest && longest(lo, e) >= min_rest;
+      bool after = p.to_rest && longest(e, e + lag) >= min_rest;
+      for (std::size_t o : group) {
+        if (o == c) continue;
+        before = before && at_rest((*channels)[o], lo, e);
+        after = after && at_rest((*channels)[o], e, e + lag);
+      }
+      p.event.rest_edge = before || after;
+    }
+  }
+}
+
+std::vector<SensoryEvent> unique_by_index(std::vector<SensoryEvent> events) {
+  std::stable_sort(events.begin(), events.end(),
+                   [](const SensoryEvent& a, const SensoryEvent& b) { return a.index < b.index; });
+  std::vector<SensoryEvent> unique;
+  for (const SensoryEvent& e : events) {
+    if (!unique.empty() && unique.back().index == e.index) {
+      unique.back().rest_edge = unique.back().rest_edge || e.rest_edge;
+      unique.back().strength = std::max(unique.back().strength, e.strength);
+    } else {
+      unique.push_back(e);
+    }
+  }
+  return unique;
+}
+
+}  // namespace
+
+EventPlacement parse_event_placement(const std::string& name) {
+  if (name == "threshold") return EventPlacement::kThreshold;
+  if (name == "shift") return EventPlacement::kShift;
+  if (name == "fit") return EventPlacement::kFit;
+  throw std::invalid_argument("unknown event placement '" + name + "' (threshold, shift, fit)");
+}
+
+std::string to_string(EventPlacement placement) {
+  switch (placement) {
+    case EventPlacement::kThreshold:
+      return "threshold";
+    case EventPlacement::kShift:
+      return "shift";
+    case EventPlacement::kFit:
+      return "fit";
+  }
+  return "?";
+}
+
+std::vector<SensoryEvent> detect_sensory_event_details(
+    const Eigen::Ref<const Eigen::VectorXd>& signal, const SensoryEventConfig& config) {
+  check_config(config);
+  std::vector<SensoryEvent> events;
+  for (const PlacedEvent& p : analyse_channel(signal, config).events) events.push_back(p.event);
+  return unique_by_index(events);
+}
+
+std::vector<std::size_t> detect_sensory_events(const Eigen::Ref<const Eigen::VectorXd>& signal,
+                                               const SensoryEventConfig& config) {
+  std::vector<std::size_t> out;
+  for (const SensoryEvent& e : detect_sensory_event_details(signal, config)) out.push_back(e.index);
+  return out;
 }
 
 std::vector<Interval> confidence_zones(const std::vector<std::size_t>& events, std::size_t min_s,
@@ -206,19 +431,50 @@ ChangepointValidation validate_with_zones(const std::vector<std::size_t>& candid
   return out;
 }
 
-SensorEvents detect_sensor_events(const Eigen::MatrixXd& sensors,
-                                  const SensoryEventConfig& config) {
+SensorEvents detect_sensor_events(const Eigen::MatrixXd& sensors, const SensoryEventConfig& config,
+                                  const std::vector<std::size_t>& groups) {
   check_config(config);
-  SensorEvents out;
-  for (Eigen::Index c = 0; c < sensors.cols(); ++c) {
-    if (!sensors.col(c).allFinite())
+  const std::size_t cols = static_cast<std::size_t>(sensors.cols());
+  if (!groups.empty() && groups.size() != cols)
+    throw std::invalid_argument("sensory events: " + std::to_string(groups.size()) +
+                                " group ids for " + std::to_string(cols) + " sensor columns");
+  std::vector<Channel> channels;
+  for (std::size_t c = 0; c < cols; ++c) {
+    try {
+      channels.push_back(analyse_channel(sensors.col(static_cast<Eigen::Index>(c)), config));
+    } catch (const std::invalid_argument&) {
       throw std::invalid_argument("sensory events: sensor column " + std::to_string(c) +
                                   " has NaN/Inf values");
-    out.per_sensor.push_back(detect_sensory_events(sensors.col(c), config));
+    }
+  }
+  std::map<std::size_t, std::vector<std::size_t>> members;  // group id -> its columns
+  for (std::size_t c = 0; c < cols; ++c) members[groups.empty() ? c : groups[c]].push_back(c);
+  SensorEvents out;
+  for (const auto& [id, group] : members) {
+    flag_rest_edges_of_group(&channels, group, config.difference_lag, config.merge_gap);
+    // zone_events: a sensor's rest edges, or all its events when it never leaves rest cleanly.
+    bool any_rest_edge = false;
+    for (std::size_t c : group)
+      for (const PlacedEvent& p : channels[c].events)
+        any_rest_edge = any_rest_edge || p.event.rest_edge;
+    for (std::size_t c : group)
+      for (const PlacedEvent& p : channels[c].events)
+        if (p.event.rest_edge || !any_rest_edge) out.zone_events.push_back(p.event.index);
+  }
+  std::sort(out.zone_events.begin(), out.zone_events.end());
+  out.zone_events.erase(std::unique(out.zone_events.begin(), out.zone_events.end()),
+                        out.zone_events.end());
+  for (const Channel& c : channels) {
+    out.per_sensor.emplace_back();
+    for (const PlacedEvent& p : c.events) {
+      out.per_sensor.back().push_back(p.event.index);
+      out.details.push_back(p.event);
+    }
     out.all.insert(out.all.end(), out.per_sensor.back().begin(), out.per_sensor.back().end());
   }
   std::sort(out.all.begin(), out.all.end());
   out.all.erase(std::unique(out.all.begin(), out.all.end()), out.all.end());
+  out.details = unique_by_index(out.details);
   return out;
 }
 

@@ -334,6 +334,85 @@ TEST(MultivariateSegmentation, AnchorsPlaceChangepointsOnTheZoneEvents) {
   }
 }
 
+// A zone's preferred anchors (rest edges: contact made or lost) are taken before a nearer
+// event of the same zone (a force ramp reaching its plateau).
+TEST(MultivariateSegmentation, PreferredAnchorsComeFirstInTheirZone) {
+  const Eigen::MatrixXd f = changes_at_600_and_1300();
+  lfd::MultivariateSegmentationConfig config;
+  config.min_segment_length = 100;
+  config.candidate_zones = {{450, 760}, {1150, 1450}};
+  config.zone_anchors = {680, 740, 1380};
+  const auto nearest = lfd::segment_multivariate(f, {1.0, 1.0}, config);
+  ASSERT_EQ(nearest.changepoints.size(), 2u);
+  EXPECT_EQ(nearest.changepoints[0], 680u);
+  config.preferred_anchors = {false, true, false};
+  const auto preferred = lfd::segment_multivariate(f, {1.0, 1.0}, config);
+  ASSERT_EQ(preferred.changepoints.size(), 2u);
+  EXPECT_EQ(preferred.changepoints[0], 740u);
+  EXPECT_EQ(preferred.changepoints[1], 1380u);
+}
+
+// Events closer than min_s make one merged zone, which may hold several interactions (a short
+// push: contact and release). With anchors each changepoint sits on its own event of that zone;
+// without anchors the zone holds one.
+TEST(MultivariateSegmentation, AMergedZoneHoldsOneAnchoredChangepointPerEvent) {
+  const Eigen::MatrixXd f = changes_at_600_and_1300();
+  lfd::MultivariateSegmentationConfig config;
+  config.min_segment_length = 100;
+  config.candidate_zones = {{450, 1450}};
+  const auto one = lfd::segment_multivariate(f, {1.0, 1.0}, config);
+  EXPECT_EQ(one.changepoints.size(), 1u);
+  config.zone_anchors = {610, 1290};
+  const auto two = lfd::segment_multivariate(f, {1.0, 1.0}, config);
+  EXPECT_EQ(two.changepoints, (std::vector<std::size_t>{610, 1290}));
+}
+
+// A weak change (ClaSP p ~ 1e-3, under the zone threshold of 1e-5) inside a zone: accepted only
+// when the zone holds a preferred anchor and rest_edge_p_value_threshold admits it.
+TEST(MultivariateSegmentation, ARestEdgeZoneNeedsLessClaspEvidence) {
+  std::mt19937 rng(21);
+  std::normal_distribution<double> g(0.0, 1.0);
+  const int n = 600, cp = 300;
+  Eigen::MatrixXd f(n, 1);
+  for (int t = 0; t < n; ++t) f(t, 0) = (t >= cp ? 0.35 : 0.0) + g(rng);
+  lfd::MultivariateSegmentationConfig config;
+  config.min_segment_length = 60;
+  config.clasp.window_size = 10;
+  config.candidate_zones = {{250, 350}};
+  config.zone_anchors = {cp};
+  config.zone_p_value_threshold = 1e-5;
+  const auto strict = lfd::segment_multivariate(f, {}, config);
+  ASSERT_FALSE(strict.candidates.empty());
+  const double log_p = strict.candidates[0].log10_p_value;
+  ASSERT_GT(log_p, -5.0) << "the change must be weak for this test";
+  ASSERT_LT(log_p, -1.0) << "but not absent";
+  EXPECT_TRUE(strict.changepoints.empty());
+  config.rest_edge_p_value_threshold = 0.1;
+  EXPECT_TRUE(lfd::segment_multivariate(f, {}, config).changepoints.empty()) << "not preferred";
+  config.preferred_anchors = {true};
+  EXPECT_EQ(lfd::segment_multivariate(f, {}, config).changepoints,
+            (std::vector<std::size_t>{static_cast<std::size_t>(cp)}));
+}
+
+// Without zones a longer demo needs more evidence: significance_per_sample raises the threshold
+// with the length, never lowers it below p_value_threshold.
+TEST(MultivariateSegmentation, ALongDemoNeedsMoreEvidenceWithoutZones) {
+  const Eigen::MatrixXd f = changes_at_600_and_1300();
+  lfd::MultivariateSegmentationConfig config;
+  config.min_segment_length = 100;
+  const auto plain = lfd::segment_multivariate(f, {1.0, 1.0}, config);
+  ASSERT_GE(plain.changepoints.size(), 2u);
+  double strongest = 0.0;
+  for (const lfd::SplitCandidate& c : plain.candidates)
+    if (c.accepted) strongest = std::min(strongest, c.log10_p_value);
+  // A rate whose threshold over these 2000 samples lies beyond the strongest split's evidence
+  // leaves no changepoint; a rate below p_value_threshold changes nothing.
+  config.significance_per_sample = -strongest / 2000.0 * 1.01;
+  EXPECT_TRUE(lfd::segment_multivariate(f, {1.0, 1.0}, config).changepoints.empty());
+  config.significance_per_sample = 1e-6;
+  EXPECT_EQ(lfd::segment_multivariate(f, {1.0, 1.0}, config).changepoints, plain.changepoints);
+}
+
 TEST(MultivariateSegmentation, StationaryFeaturesGiveNoChangepoint) {
   const std::size_t n = 2000;
   std::mt19937 rng(9);

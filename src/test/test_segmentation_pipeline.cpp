@@ -261,6 +261,48 @@ TEST(SegmentationPipeline, DeadSensorWarnsAndGivesNoZone) {
   EXPECT_EQ(result.demos[0].changepoints.size(), 1u);
 }
 
+// The feature selection does not depend on the combination: preparing once and segmenting with
+// each method gives what a full run per method gives.
+TEST(SegmentationPipeline, OneFeatureSelectionServesEveryCombination) {
+  const auto demos = matrices(make_demos(4));
+  const lfd::PreparedSegmentation prepared = lfd::prepare_segmentation(demos, {"touch"});
+  EXPECT_TRUE(prepared.base.demos.empty());
+  for (const char* name : {"average", "weighted_product", "distance_average"}) {
+    lfd::SegmentationPipelineConfig config;
+    config.segmentation.combination = lfd::parse_profile_combination(name);
+    const auto shared = lfd::segment_prepared(prepared, demos, config);
+    const auto full = lfd::run_segmentation_pipeline(demos, {"touch"}, config);
+    EXPECT_EQ(shared.selected_features, full.selected_features) << name;
+    ASSERT_EQ(shared.demos.size(), full.demos.size());
+    for (std::size_t d = 0; d < demos.size(); ++d)
+      EXPECT_EQ(shared.demos[d].changepoints, full.demos[d].changepoints) << name << " " << d;
+  }
+}
+
+// The paper's procedure: paper_candidates candidates anywhere, none anchored, then the zone
+// filter: the accepted ones are the candidates inside a zone, the rejected ones the others.
+TEST(SegmentationPipeline, PaperProcedureFiltersCandidatesFoundAnywhere) {
+  const auto demos = matrices(make_demos(4));
+  lfd::SegmentationPipelineConfig config;
+  config.procedure = lfd::SegmentationProcedure::kPaper;
+  config.paper_candidates = 3;
+  config.segmentation.min_segment_length = 30;
+  const auto result = lfd::run_segmentation_pipeline(demos, {"touch"}, config);
+  for (const lfd::DemoSegmentationResult& d : result.demos) {
+    EXPECT_EQ(d.clasp.changepoints.size(), 3u);
+    EXPECT_EQ(d.changepoints.size() + d.rejected.size(), 3u);
+    for (const lfd::SplitCandidate& c : d.clasp.candidates) EXPECT_FALSE(c.anchored);
+    for (std::size_t cp : d.changepoints)
+      EXPECT_TRUE(std::any_of(d.zones.begin(), d.zones.end(),
+                              [&](const lfd::Interval& z) { return z.contains(cp); }));
+    for (std::size_t cp : d.rejected)
+      EXPECT_TRUE(std::none_of(d.zones.begin(), d.zones.end(),
+                               [&](const lfd::Interval& z) { return z.contains(cp); }));
+  }
+  EXPECT_EQ(lfd::parse_segmentation_procedure("paper"), lfd::SegmentationProcedure::kPaper);
+  EXPECT_THROW(lfd::parse_segmentation_procedure("papers"), std::invalid_argument);
+}
+
 // Consensus counts only the demos with evidence: three demos whose sensor is dead (no event, so
 // no changepoint) must not out-vote the one demo whose changepoint has its own sensory event.
 TEST(SegmentationPipeline, DemosWithoutEventsDoNotVote) {

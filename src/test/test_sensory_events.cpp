@@ -261,3 +261,122 @@ TEST(ConfidenceZones, FullValidationOverSeveralSensors) {
 }
 
 }  // namespace
+
+namespace {
+
+// The settings of config/segmentation.yaml at 50 Hz: quiet-excursion floor, fitted placement.
+SensoryEventConfig yaml_at_50hz() {
+  SensoryEventConfig c = config_at_50hz(lfd::EventThreshold::kRatioOfMax);
+  c.noise_floor_sigmas = 0.0;
+  c.noise_floor_excursions = 5.0;
+  c.placement = lfd::EventPlacement::kFit;
+  return c;
+}
+
+// One channel of a sensor that the contact does not reach (a torque axis, the pad on the other
+// finger) carries only drift and noise. The paper's 0.4 x max is then 0.4 x the drift's largest
+// excursion, and a sigma from the raw differences does not see a drift (its steps are tiny): both
+// put events all along. The quiet excursion is measured on the detector's own statistic, and an
+// event must clear five of them.
+TEST(SensoryEvents, DriftWithoutContactNeedsTheQuietExcursionFloor) {
+  std::mt19937 rng(11);
+  std::normal_distribution<double> g(0.0, 1.0);
+  Eigen::VectorXd x(1500);
+  double drift = 0.0;
+  for (Eigen::Index t = 0; t < x.size(); ++t) {
+    drift += 0.03 * g(rng);
+    x[t] = drift + 0.05 * g(rng);
+  }
+  SensoryEventConfig sigma = yaml_at_50hz();
+  sigma.noise_floor_excursions = 0.0;
+  sigma.noise_floor_sigmas = 5.5;
+  EXPECT_GE(lfd::detect_sensory_events(x, sigma).size(), 2u);
+  EXPECT_TRUE(lfd::detect_sensory_events(x, yaml_at_50hz()).empty());
+  // A real contact on top of the same drift still makes its events.
+  Eigen::VectorXd touched = x;
+  touched.segment(700, 300).array() += 6.0;
+  const Events events = lfd::detect_sensory_events(touched, yaml_at_50hz());
+  ASSERT_EQ(events.size(), 2u) << ::testing::PrintToString(events);
+  EXPECT_NEAR(static_cast<double>(events[0]), 700.0, 3.0);
+  EXPECT_NEAR(static_cast<double>(events[1]), 1000.0, 3.0);
+}
+
+// A contact force building up over 0.8 s (noise a tenth of its height) and fading over 0.6 s: the
+// fitted events sit where the force leaves rest and where it is back at rest, within 0.1 s.
+TEST(SensoryEvents, FittedEventsAtTheStartAndEndOfSlowRamps) {
+  std::mt19937 rng(12);
+  std::normal_distribution<double> g(0.0, 0.3);
+  Eigen::VectorXd x(800);
+  for (Eigen::Index t = 0; t < x.size(); ++t) {
+    const double up = std::clamp((t - 200.0) / 40.0, 0.0, 1.0);
+    const double down = std::clamp((t - 500.0) / 30.0, 0.0, 1.0);
+    x[t] = 3.0 * (up - down) + g(rng);
+  }
+  const auto events = lfd::detect_sensory_event_details(x, yaml_at_50hz());
+  std::vector<std::size_t> rest_edges;
+  for (const lfd::SensoryEvent& e : events)
+    if (e.rest_edge) rest_edges.push_back(e.index);
+  ASSERT_EQ(rest_edges.size(), 2u) << ::testing::PrintToString(rest_edges);
+  EXPECT_NEAR(static_cast<double>(rest_edges[0]), 200.0, 5.0);  // leaves rest
+  EXPECT_NEAR(static_cast<double>(rest_edges[1]), 530.0, 5.0);  // back at rest
+}
+
+// Two pads of one sensor: pad A touches from 4 s to 7 s, pad B from 6.5 s to 10 s. As one sensor
+// the contact starts at 4 s and ends at 10 s: A letting go while B holds is no rest edge. As two
+// sensors every edge is one.
+TEST(SensoryEvents, OnePadLettingGoWhileTheOtherHoldsIsNoRestEdge) {
+  Eigen::MatrixXd pads = Eigen::MatrixXd::Zero(700, 2);
+  pads.block(200, 0, 150, 1).setConstant(2.0);
+  pads.block(325, 1, 175, 1).setConstant(3.0);
+  const auto rest_edges = [](const lfd::SensorEvents& e) {
+    std::vector<std::size_t> out;
+    for (const lfd::SensoryEvent& d : e.details)
+      if (d.rest_edge) out.push_back(d.index);
+    return out;
+  };
+  const lfd::SensorEvents one = lfd::detect_sensor_events(pads, yaml_at_50hz(), {0, 0});
+  EXPECT_EQ(rest_edges(one), (Events{200, 500}));
+  EXPECT_EQ(one.zone_events, (Events{200, 500}));
+  EXPECT_EQ(one.all.size(), 4u);
+  const lfd::SensorEvents two = lfd::detect_sensor_events(pads, yaml_at_50hz(), {0, 1});
+  EXPECT_EQ(rest_edges(two), (Events{200, 325, 350, 500}));
+  EXPECT_THROW(lfd::detect_sensor_events(pads, yaml_at_50hz(), {0}), std::invalid_argument);
+}
+
+// A rest shorter than the merge gap is a pause inside the interaction: pad A from 2 s to 4 s and
+// pad B of the same sensor from 4.6 s to 6 s leave the sensor at rest for 0.6 s only, less than
+// the 1 s merge gap, though each pad rests for longer. With a 2 s pause both ends are rest edges.
+TEST(SensoryEvents, AShortPauseOfTheWholeSensorIsNoRestEdge) {
+  for (const int pause : {30, 100}) {
+    Eigen::MatrixXd pads = Eigen::MatrixXd::Zero(700, 2);
+    pads.block(100, 0, 100, 1).setConstant(2.0);
+    pads.block(200 + pause, 1, 70, 1).setConstant(2.0);
+    const lfd::SensorEvents e = lfd::detect_sensor_events(pads, yaml_at_50hz(), {0, 0});
+    const Events inner{200, static_cast<std::size_t>(200 + pause)};
+    const bool inner_are_rest_edges =
+        std::includes(e.zone_events.begin(), e.zone_events.end(), inner.begin(), inner.end());
+    EXPECT_EQ(inner_are_rest_edges, pause >= 50)
+        << pause << ": " << ::testing::PrintToString(e.zone_events);
+  }
+}
+
+// A gripper closes at 2 s (it leaves its rest, the open state it started in) and its effort
+// changes twice while it holds: those are no rest edges and mark no zone. A sensor with no rest
+// edge at all (here one busy over its whole first second, so that it never sits at the level it
+// started at) keeps all its events for zones.
+TEST(SensoryEvents, ZonesComeFromRestEdgesOrFromEveryEventOfASensorWithout) {
+  Eigen::MatrixXd gripper = Eigen::MatrixXd::Zero(600, 1);
+  gripper.block(100, 0, 500, 1).setConstant(5.0);
+  gripper.block(300, 0, 100, 1).setConstant(8.0);
+  const lfd::SensorEvents held = lfd::detect_sensor_events(gripper, yaml_at_50hz());
+  EXPECT_EQ(held.all, (Events{100, 300, 400}));
+  EXPECT_EQ(held.zone_events, (Events{100}));
+  Eigen::MatrixXd busy = gripper;
+  for (Eigen::Index t = 0; t < 100; ++t) busy(t, 0) = 0.05 * static_cast<double>(t);
+  const lfd::SensorEvents without = lfd::detect_sensor_events(busy, yaml_at_50hz());
+  EXPECT_EQ(without.all, (Events{1, 100, 300, 400}));  // the ramp's start and end, the pulse
+  for (const lfd::SensoryEvent& d : without.details) EXPECT_FALSE(d.rest_edge) << d.index;
+  EXPECT_EQ(without.zone_events, without.all);
+}
+
+}  // namespace

@@ -37,6 +37,22 @@ class FakeSegmenter(object):
                 "selected_features": ["f"], "selected_weights": [1.0], "warnings": []}
 
 
+class FakeMultiSegmenter(FakeSegmenter):
+    """Also answers every method at once (as the `segment` CLI does); counts its calls."""
+
+    def __init__(self, changepoints):
+        FakeSegmenter.__init__(self, changepoints)
+        self.calls = []
+
+    def __call__(self, inputs, method):
+        self.calls.append([method])
+        return FakeSegmenter.__call__(self, inputs, method)
+
+    def methods(self, inputs, methods):
+        self.calls.append(list(methods))
+        return {m: FakeSegmenter.__call__(self, inputs, m) for m in methods}
+
+
 class TruthFileScoring(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
@@ -92,6 +108,22 @@ class TruthFileScoring(unittest.TestCase):
         self.assertIsNone(out["details"][0]["time_errors_s"][0])
         self.assertAlmostEqual(out["time_error_median_s"], 0.3)
         self.assertAlmostEqual(out["details"][0]["covering"], 0.5)
+
+    def test_several_methods_ask_a_multi_method_segmenter_once(self):
+        demos = lfd_bags.load_truth_file(self.truth)
+        seg = FakeMultiSegmenter([[105.3], [203.0, 207.0]])
+        out = segmentation_scoring.evaluate_truth_file_methods(seg, demos, ["product", "average"], 0.5)
+        self.assertEqual(seg.calls, [["product", "average"]])
+        self.assertEqual(sorted(out), ["average", "product"])
+        self.assertEqual(out["average"]["correct"], 2)
+        self.assertEqual(out["product"]["details"][1]["truth_rel_s"], [3.0, 7.0])
+        # one method, or a segmenter without .methods: one call per method
+        plain = FakeSegmenter([[105.3], [203.0, 207.0]])
+        both = segmentation_scoring.evaluate_truth_file_methods(plain, demos, ["product", "average"], 0.5)
+        self.assertEqual(both["average"]["correct"], out["average"]["correct"])
+        seg.calls = []
+        segmentation_scoring.evaluate_truth_file_methods(seg, demos, ["product"], 0.5)
+        self.assertEqual(seg.calls, [["product"]])
 
     def test_labels_json_converts_to_a_truth_file(self):
         labels = {"runs": {"r2": {"parts": [{"file": "r2/p1.bag"}, {"file": "r2/p2.bag"}],

@@ -1,7 +1,10 @@
 """Scoring a segmenter's answers against the ground truth: demos whose bags carry /lfd/phase, or
 demos of a ground-truth file, through one scorer (lfd_tools.judge). A segmenter is a callable
 (inputs, method) -> {"demos": [{changepoint_times, rejected_times, pruned_times, zones}],
-selected_features, selected_weights, warnings}; an input is one demo's bag paths, comma-joined."""
+selected_features, selected_weights, warnings}; an input is one demo's bag paths, comma-joined.
+A segmenter may also offer .methods(inputs, methods) -> {method: answer}: the evaluation of
+several methods then calls it once (the feature selection does not depend on the method), and
+the ground truth of a dataset is read once for all methods."""
 import os
 import time
 
@@ -9,12 +12,9 @@ from lfd_tools import bags as lfd_bags
 from lfd_tools import judge, tasks
 
 
-def run_and_score(segment, method, inputs, truths, spans, tolerance):
-    """Segment all demos at once (inputs: one path each, parts comma-joined), score each against
-    its true windows (absolute seconds) over its span (first, last stamp)."""
-    start = time.time()
-    res = segment(inputs, method)
-    elapsed = time.time() - start
+def score_answer(res, method, inputs, truths, spans, tolerance, elapsed):
+    """One segmenter answer scored demo by demo against the true windows (absolute seconds) over
+    each demo's span (first, last stamp)."""
     if len(res["demos"]) != len(inputs):
         raise RuntimeError("segmenter returned %d demos for %d inputs" % (len(res["demos"]), len(inputs)))
     scores = []
@@ -33,31 +33,74 @@ def run_and_score(segment, method, inputs, truths, spans, tolerance):
     return out
 
 
-def evaluate_dataset(segment, folder, method, config, tolerance):
-    """A dataset folder whose bags carry /lfd/phase ground truth; the transitions to find are the
-    task file's (`config`, the evaluation protocol, is not needed for them)."""
+def run_and_score_methods(segment, methods, inputs, truths, spans, tolerance):
+    """{method: scores}: one call of segment.methods when the segmenter has it (its time shared
+    out evenly), else one call per method."""
+    if hasattr(segment, "methods") and len(methods) > 1:
+        start = time.time()
+        answers = segment.methods(inputs, methods)
+        elapsed = (time.time() - start) / len(methods)
+        return {m: score_answer(answers[m], m, inputs, truths, spans, tolerance, elapsed) for m in methods}
+    out = {}
+    for m in methods:
+        start = time.time()
+        res = segment(inputs, m)
+        out[m] = score_answer(res, m, inputs, truths, spans, tolerance, time.time() - start)
+    return out
+
+
+def run_and_score(segment, method, inputs, truths, spans, tolerance):
+    """Segment all demos at once (inputs: one path each, parts comma-joined) with one method."""
+    return run_and_score_methods(segment, [method], inputs, truths, spans, tolerance)[method]
+
+
+def dataset_truth(folder, config):
+    """(bags, true windows, spans, task) of a dataset folder whose bags carry /lfd/phase; the
+    transitions to find are the task file's (`config`, the evaluation protocol, is not needed)."""
     bags = lfd_bags.list_bags(folder)
     truth = [lfd_bags.phase_transitions(b) for b in bags]
     task = truth[0][0]
     expected = tasks.expected_transitions(task)
     windows = [judge.expected_windows(phases, expected, 0.0) for _, phases in truth]
-    spans = [lfd_bags.bag_span(b) for b in bags]
-    out = run_and_score(segment, method, bags, windows, spans, tolerance)
-    out["task"] = task
+    return bags, windows, [lfd_bags.bag_span(b) for b in bags], task
+
+
+def evaluate_dataset_methods(segment, folder, methods, config, tolerance):
+    """{method: scores} of a dataset folder, its ground truth read once."""
+    bags, windows, spans, task = dataset_truth(folder, config)
+    out = run_and_score_methods(segment, methods, bags, windows, spans, tolerance)
+    for r in out.values():
+        r["task"] = task
     return out
 
 
-def evaluate_truth_file(segment, demos, method, tolerance):
-    """Demos listed in a ground-truth file: times are relative to the first bag's start."""
+def evaluate_dataset(segment, folder, method, config, tolerance):
+    """A dataset folder whose bags carry /lfd/phase ground truth."""
+    return evaluate_dataset_methods(segment, folder, [method], config, tolerance)[method]
+
+
+def truth_file_windows(demos):
+    """(inputs, true windows, spans) of the demos of a ground-truth file: times are relative to
+    the first bag's start."""
     spans = []
     for _, bags, _ in demos:
         first, last = lfd_bags.bag_span(bags[0]), lfd_bags.bag_span(bags[-1])
         spans.append((first[0], last[1]))
     truths = [[(s[0] + t, s[0] + t) for t in cps] for (_, _, cps), s in zip(demos, spans)]
-    out = run_and_score(segment, method, [",".join(bags) for _, bags, _ in demos], truths, spans, tolerance)
-    for d, (name, _, cps) in zip(out["details"], demos):
-        d.update({"name": name, "truth_rel_s": cps})
-    out["task"] = "truth_file"
+    return [",".join(bags) for _, bags, _ in demos], truths, spans
+
+
+def evaluate_truth_file_methods(segment, demos, methods, tolerance):
+    """{method: scores} of the demos listed in a ground-truth file."""
+    inputs, truths, spans = truth_file_windows(demos)
+    out = run_and_score_methods(segment, methods, inputs, truths, spans, tolerance)
+    for r in out.values():
+        for d, (name, _, cps) in zip(r["details"], demos):
+            d.update({"name": name, "truth_rel_s": cps})
+        r["task"] = "truth_file"
     return out
 
 
+def evaluate_truth_file(segment, demos, method, tolerance):
+    """Demos listed in a ground-truth file: times are relative to the first bag's start."""
+    return evaluate_truth_file_methods(segment, demos, [method], tolerance)[method]

@@ -5,6 +5,8 @@
 
 #include <lfd_msgs/Segment.h>
 
+#include "lfd_core/segmentation_pipeline.hpp"
+#include "lfd_segmentation/bag_features.hpp"
 #include "lfd_segmentation/segmentation_params.hpp"
 
 namespace lfd_segmentation {
@@ -14,9 +16,21 @@ namespace lfd_segmentation {
 SegmentationParams apply_overrides(const SegmentationParams& params,
                                    const lfd_msgs::Segment::Request& request);
 
-/// Handles one request; always returns (success=false + error on failure).
+/// The last request's bags read and features selected (II-B), for the next request on the same
+/// bags: an evaluation asks for every combination method in turn, and neither the bags nor the
+/// selection depend on the method. Keyed by the bag paths, each file's size and modification
+/// time, and the relevance threshold; anything else may differ between the requests.
+struct PreparedCache {
+  std::string key;
+  std::vector<DemoFeatures> demos;
+  std::vector<lfd::FeatureMatrix> matrices;
+  lfd::PreparedSegmentation prepared;
+};
+
+/// Handles one request; always returns (success=false + error on failure). With a cache, a
+/// request on the bags of the previous one reuses their features and selection.
 void handle_segment_request(const SegmentationParams& params,
                             const lfd_msgs::Segment::Request& request,
-                            lfd_msgs::Segment::Response& response);
+                            lfd_msgs::Segment::Response& response, PreparedCache* cache = nullptr);
 
 }  // namespace lfd_segmentation

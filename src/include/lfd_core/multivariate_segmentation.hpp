@@ -74,8 +74,9 @@ struct MultivariateSegmentationConfig {
   /// Optional extension (empty = the paper: candidates anywhere, validated afterwards). When
   /// given, e.g. the confidence zones of sensory_events.hpp, each recursion step takes the argmax
   /// of its penalized profile only inside these intervals, so a strong peak outside every zone
-  /// cannot hide a weaker in-zone changepoint of the same range. Each zone then holds at most one
-  /// changepoint (a zone marks one sensory interaction).
+  /// cannot hide a weaker in-zone changepoint of the same range. Without zone_anchors each zone
+  /// holds at most one changepoint (a zone marks one sensory interaction); with them, one per
+  /// anchor (zones closer than min_s merge and may hold several interactions).
   std::vector<Interval> candidate_zones;
   /// Alternative to candidate_zones for zones that depend on min_s (eq. 1): called once min_s is
   /// known, its result replaces candidate_zones. Empty result = no zone, hence no changepoint.
@@ -84,6 +85,8 @@ struct MultivariateSegmentationConfig {
   /// threshold). The sensory event is independent evidence of a change there, so ClaSP's own
   /// evidence may be weaker than for a candidate anywhere.
   double zone_p_value_threshold = 0.0;
+  /// The same for a zone that holds a preferred anchor (0 = as zone_p_value_threshold).
+  double rest_edge_p_value_threshold = 0.0;
   /// Sensory events that anchor the zones (zone-guided search only; empty = off). ClaSP still
   /// decides whether a zone holds a changepoint (its in-zone argmax and that argmax's
   /// significance), but the changepoint is placed at the zone's event nearest to the argmax. The
@@ -91,6 +94,15 @@ struct MultivariateSegmentationConfig {
   /// peaks up to a window away from the interaction, often on the zone's edge and at a different
   /// point of the skill in every demo; the sensors time an interaction to a few samples.
   std::vector<std::size_t> zone_anchors;
+  /// Per zone_anchors entry (empty = none): a zone's preferred anchors are taken before its
+  /// others (the sensory events where a signal leaves or regains its rest level: contact made or
+  /// lost, rather than a force ramp reaching its plateau).
+  std::vector<bool> preferred_anchors;
+  /// Candidates outside zones (no sensors) need log10 p <= -significance_per_sample x the
+  /// demo's length (samples) when that is stricter than clasp.p_value_threshold; 0 = off. The
+  /// log p of ClaSP's rank-sum test grows with the number of subsequences for the same split
+  /// quality, so a fixed threshold over-segments long or densely sampled demos.
+  double significance_per_sample = 0.0;
   int num_changepoints = -1;          ///< < 0: stop with the significance test; >= 0: exact count
   std::size_t max_changepoints = 16;  ///< safety cap when the test decides
 };

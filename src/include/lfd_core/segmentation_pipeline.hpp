@@ -37,6 +37,22 @@ struct TimeParameters {
   double event_noise_block = 1.0;     ///< block length of the local noise estimate (s)
 };
 
+/// How ClaSP's candidates meet the sensory zones.
+enum class SegmentationProcedure {
+  /// Ours: the zones first, each recursion step takes its argmax inside them, the changepoint
+  /// sits on a sensory event of its zone (anchor_to_events), the demos agree on their count
+  /// (consensus_count).
+  kZoneSearch,
+  /// The paper's (II-C, Fig. 8): `paper_candidates` candidates anywhere from the recursive,
+  /// Kaiser-penalized combined profile, then the zone filter (eq. 1): those inside a zone are
+  /// the changepoints.
+  kPaper,
+};
+
+/// "zone_search" or "paper" (throws std::invalid_argument otherwise).
+SegmentationProcedure parse_segmentation_procedure(const std::string& name);
+std::string to_string(SegmentationProcedure procedure);
+
 struct SegmentationPipelineConfig {
   /// Time parameters in seconds (see TimeParameters); when unset, the sample counts of
   /// `segmentation`, `window_size` and `events` are used as they are (index-only series).
@@ -52,19 +68,25 @@ struct SegmentationPipelineConfig {
   SensoryEventConfig events;
   /// false: every ClaSP changepoint is accepted (no sensor validation).
   bool validate_with_sensors = true;
-  /// true: the zones are computed first and ClaSP searches its candidates only inside them, one
-  /// changepoint per zone (MultivariateSegmentationConfig::candidate_zones). false: the paper's
-  /// order, candidates anywhere and then validated, where a strong out-of-zone peak can hide the
-  /// in-zone change of its range. Needs validate_with_sensors.
-  bool search_in_zones = true;
-  /// With search_in_zones: each changepoint sits on the sensory event of its zone nearest to
-  /// ClaSP's in-zone argmax (MultivariateSegmentationConfig::zone_anchors).
+  /// How candidates meet zones (needs validate_with_sensors; without sensors ClaSP's
+  /// changepoints are taken as they are).
+  SegmentationProcedure procedure = SegmentationProcedure::kZoneSearch;
+  /// kPaper: the number of candidates the recursion proposes (no significance test; fewer when
+  /// the ranges are too short for min_s). The paper's Fig. 8 shows five.
+  std::size_t paper_candidates = 5;
+  /// kZoneSearch: each changepoint sits on the sensory event of its zone nearest to ClaSP's
+  /// in-zone argmax, rest edges first (MultivariateSegmentationConfig::zone_anchors).
   bool anchor_to_events = true;
-  /// Demonstrations of one task hold the same skills: when more than half of the demos (at least
-  /// 3) agree on K validated changepoints, a demo with more keeps its K most significant ones and
-  /// reports the others as `pruned` (a hesitation mid-skill is then not a skill boundary). Demos
-  /// with fewer changepoints are left as they are.
+  /// Demonstrations of one task hold the same skills: when the most common count K of validated
+  /// changepoints is held by at least 3 voting demos and by more than any other count, a demo
+  /// with more keeps its K most significant ones and reports the others as `pruned` (a hesitation
+  /// mid-skill is then not a skill boundary). With sensor validation only demos with a sensory
+  /// event vote.
   bool consensus_count = true;
+  /// With consensus_count and sensor validation: a demo with fewer than K changepoints takes its
+  /// best in-zone candidates down to this p-value (0 = never), one per free zone: the agreement
+  /// of the other demos is evidence that a skill boundary is there.
+  double consensus_fill_p_value = 0.0;
   /// Worker threads for DTW and the per-demonstration segmentations (<= 0 = all cores).
   int threads = 0;
 };
@@ -84,9 +106,14 @@ struct DemoSegmentationResult {
   std::vector<double> rejected_times;
   std::vector<std::size_t> pruned;  ///< validated, dropped to the consensus count (consensus_count)
   std::vector<double> pruned_times;
-  std::vector<Interval> zones;         ///< confidence zones (row indices, closed)
-  std::vector<std::size_t> events;     ///< sensory events (row indices)
-  std::size_t min_segment_length = 0;  ///< the min_s used for ClaSP and the zones
+  /// In-zone candidates accepted because the other demos agree on more changepoints
+  /// (consensus_fill_p_value); also in `changepoints`.
+  std::vector<std::size_t> added;
+  std::vector<double> added_times;
+  std::vector<Interval> zones;              ///< confidence zones (row indices, closed)
+  std::vector<std::size_t> events;          ///< sensory events (row indices)
+  std::vector<SensoryEvent> event_details;  ///< the same with rest edges and strengths
+  std::size_t min_segment_length = 0;       ///< the min_s used for ClaSP and the zones
   std::size_t num_samples = 0;
   double sample_rate = 0.0;        ///< Hz of the demonstration's clock (0 = index-only series)
   MultivariateSegmentation clasp;  ///< candidates, windows, profiles (paper Fig. 5, 8)
@@ -105,9 +132,29 @@ struct SegmentationPipelineResult {
   double segmentation_seconds = 0;  ///< wall time of II-C (ClaSP + validation, all demos)
 };
 
-/// Runs the pipeline. `sensor_features` name the sensor columns; `state_features` name the
-/// candidates for segmentation (empty = every column that is not a sensor). Every demonstration
-/// must have the same set of features (any column order).
+/// The part of the pipeline that does not depend on the combination method nor on any II-C
+/// setting: input checks, constant features, II-B feature relevance. `base` holds everything of
+/// the result but the demos.
+struct PreparedSegmentation {
+  SegmentationPipelineResult base;
+};
+
+/// Checks and II-B of run_segmentation_pipeline (same arguments, same errors).
+PreparedSegmentation prepare_segmentation(const std::vector<FeatureMatrix>& demos,
+                                          const std::vector<std::string>& sensor_features,
+                                          const SegmentationPipelineConfig& config = {},
+                                          const std::vector<std::string>& state_features = {});
+
+/// II-C on prepared demos: `config` may differ from the one prepared with in its II-C settings
+/// only (combination, ClaSP, events, procedure), e.g. to compare the combinations on one feature
+/// selection. `demos` must be the prepared ones.
+SegmentationPipelineResult segment_prepared(const PreparedSegmentation& prepared,
+                                            const std::vector<FeatureMatrix>& demos,
+                                            const SegmentationPipelineConfig& config = {});
+
+/// Runs the pipeline (prepare_segmentation, then segment_prepared). `sensor_features` name the
+/// sensor columns; `state_features` name the candidates for segmentation (empty = every column that
+/// is not a sensor). Every demonstration must have the same set of features (any column order).
 /// Throws std::invalid_argument (with the demonstration and feature named) for: no
 /// demonstrations, features that differ between demonstrations, unknown feature names, NaN/Inf
 /// samples, empty demonstrations, demonstrations shorter than 2 * min_s, no state feature, or

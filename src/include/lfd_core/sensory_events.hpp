@@ -10,14 +10,18 @@
 //   and the ending of each sensory event); an activity still on at the end yields no off-event.
 // Robustness (real sensors are noisy; the paper's real-data failure mode is too many events):
 //   - median_window: running median before differencing; removes spikes but keeps step edges;
-//   - noise_floor_sigmas: thr is raised to at least that many robust noise sigmas (1.4826 * MAD)
-//     of the raw first difference, so a sensor carrying only noise produces no event at all;
+//   - noise floors: thr is raised to at least noise_floor_excursions quiet excursions (the largest
+//     lagged difference within a quiet block) and/or noise_floor_sigmas robust sigmas of the raw
+//     first difference, so a sensor carrying only noise or drift produces no event at all;
 //   - hysteresis: activity switches off below hysteresis * thr (1 = the paper's single threshold);
 //   - min_active_samples / merge_gap: drop one-sample blips, merge bursts closer than merge_gap;
-//   - difference_lag: level change over a lag instead of the sample-to-sample difference. With a
-//     lag L > 1 a step at t0 keeps the lagged difference high from t0 - L/2 to t0 + L/2, so the
-//     events are moved back onto the change: the on-event by +L/2, the off-event by -L/2 (a step
-//     gives one event at t0, a ramp one at its start and one at its end).
+//   - difference_lag: level change over a lag instead of the sample-to-sample difference. A step
+//     at t0 keeps the lagged difference high from t0 - L/2 to t0 + L/2; `placement` says where in
+//     the burst the events go (where the thresholds are crossed, shifted back by L/2, or fitted
+//     where the level starts to change and where it settles);
+//   - rest edges: the events where a sensor (all channels of it) leaves its rest level or settles
+//     back at it for at least merge_gap (contact made or lost) can be the only ones that make
+//     zones (zones_from_rest_edges);
 //   - threshold kNoise + noise_block: the threshold is a statistic of the noise measured where the
 //     sensor is quiet (see EventThreshold).
 #pragma once
@@ -40,16 +44,38 @@ enum class EventThreshold {
   kNoise,
 };
 
+/// Where an event is placed within the burst of activity that found it.
+enum class EventPlacement {
+  kThreshold,  ///< where the activity crosses the thresholds (the paper)
+  /// Moved back onto the change: a burst starts where the activity left the off level, the lag
+  /// shifts are undone (on +L/2, off -L/2), and a burst shorter than half a lag is one event.
+  kShift,
+  /// Fitted: a flat-ramp-flat curve (ramp_fit.hpp) around each end of the burst says where the
+  /// level starts to change and where it settles; a short ramp or a step is one event. Exact on
+  /// slow ramps, where a lag shift is off by the ramp's duration.
+  kFit,
+};
+
+/// "threshold", "shift", "fit" (throws std::invalid_argument otherwise).
+EventPlacement parse_event_placement(const std::string& name);
+std::string to_string(EventPlacement placement);
+
 /// "ratio_of_max" (the paper's 0.4 x max) or "noise" (throws std::invalid_argument otherwise).
 EventThreshold parse_event_threshold(const std::string& name);
 std::string to_string(EventThreshold threshold);
 
 struct SensoryEventConfig {
   EventThreshold threshold = EventThreshold::kRatioOfMax;
-  double threshold_ratio = 0.4;        ///< paper's 0.4 x max |first difference|
-  double relative_floor = 0.1;         ///< kNoise: threshold >= this x the largest difference
-  std::size_t median_window = 5;       ///< odd; 0 or 1 = no smoothing (paper-literal)
-  double noise_floor_sigmas = 6.0;     ///< 0 = paper-literal (no noise floor)
+  double threshold_ratio = 0.4;     ///< paper's 0.4 x max |first difference|
+  double relative_floor = 0.1;      ///< kNoise: threshold >= this x the largest difference
+  std::size_t median_window = 5;    ///< odd; 0 or 1 = no smoothing (paper-literal)
+  double noise_floor_sigmas = 6.0;  ///< 0 = paper-literal (no noise floor)
+  /// The threshold is also at least this many quiet excursions (0 = off; needs noise_block): the
+  /// largest lagged difference within a block, 0 for a block whose raw signal does not move at
+  /// all, 10th percentile over the blocks. Measured on the detector's own statistic, so drift,
+  /// clipped, quantized or correlated noise needs no model (a sigma of the raw differences does
+  /// not see a drift).
+  double noise_floor_excursions = 0.0;
   double hysteresis = 0.5;             ///< in (0, 1]; 1 = paper-literal single threshold
   std::size_t min_active_samples = 1;  ///< bursts shorter than this are ignored
   std::size_t merge_gap = 0;           ///< bursts separated by <= merge_gap quiet samples merge
@@ -59,15 +85,28 @@ struct SensoryEventConfig {
   /// zero-mean vibration (a swinging load, chattering contact) is not an event, while contact
   /// made or lost is. The noise floor then comes from these lagged differences themselves.
   std::size_t difference_lag = 1;
-  /// Local noise estimate: the differences are cut into blocks of this many samples, each block's
-  /// robust sigma (1.4826 x MAD about its median) is taken, blocks that do not move at all (a
-  /// sensor holding a stale value, a quantized sensor at rest) are left out, and the noise sigma
-  /// is the 10th percentile of the others: the quiet stretches set it, however long the busy
-  /// ones. 0 = one robust sigma over the whole demo.
+  /// Local noise estimates, in blocks of this many samples: the quiet excursion above, and the
+  /// sigma of noise_floor_sigmas (each block's robust sigma, 1.4826 x MAD about its median, of
+  /// the raw differences, blocks that do not move at all left out, the 10th percentile of the
+  /// others). Either way the quiet stretches set it, however long the busy ones. 0 = one robust
+  /// sigma over the whole demo, no excursion floor.
   std::size_t noise_block = 0;
-  /// Events placed on the change (a burst's start taken where it left the off level, lag shifts
-  /// undone, a single-edge burst one event); false = where the thresholds are crossed.
-  bool place_on_change = true;
+  EventPlacement placement = EventPlacement::kShift;
+  /// Confidence zones only around SensorEvents::zone_events (rest edges): a force that varies
+  /// while in contact, or a ramp reaching its plateau, is no new phase. false = every event.
+  bool zones_from_rest_edges = false;
+};
+
+/// One sensory event, with what a zone needs to weigh it.
+struct SensoryEvent {
+  std::size_t index = 0;
+  /// The signal leaves its rest level here, or settles back at it (kFit only): contact made or
+  /// lost, a motion started from rest or ended at rest. The rest level is the sensor's level at
+  /// the start of the demonstration, "at" meaning within the activity threshold of it. A change
+  /// between two other levels (a force ramp reaching its plateau, a contact that weakens) is not.
+  bool rest_edge = false;
+  /// Largest lagged difference of its burst over the activity threshold (>= 1).
+  double strength = 1.0;
 };
 
 /// A closed interval of sample indices [begin, end] (eq. 1 uses closed intervals).
@@ -82,6 +121,10 @@ struct Interval {
 /// the difference x[t] - x[t-1] switches the activity on (or the first quiet sample after it).
 std::vector<std::size_t> detect_sensory_events(const Eigen::Ref<const Eigen::VectorXd>& signal,
                                                const SensoryEventConfig& config = {});
+
+/// The same events with their rest-edge flag and strength (sorted by index, unique).
+std::vector<SensoryEvent> detect_sensory_event_details(
+    const Eigen::Ref<const Eigen::VectorXd>& signal, const SensoryEventConfig& config = {});
 
 /// Eq. (1): union over events s of [max(0, s - min_s/2), min(s + min_s/2, length)], merged into
 /// disjoint sorted intervals (touching or overlapping intervals merge). min_s/2 uses integer
@@ -100,12 +143,19 @@ struct ChangepointValidation {
 struct SensorEvents {
   std::vector<std::size_t> all;                      ///< every sensor's events (sorted, unique)
   std::vector<std::vector<std::size_t>> per_sensor;  ///< per column of `sensors`
+  std::vector<SensoryEvent> details;  ///< every sensor's events (sorted by index, unique)
+  /// The events that mark a sensory interaction (sorted, unique): each sensor's rest edges, or
+  /// all its events when it has none (a sensor that never rests, or kThreshold/kShift placement).
+  std::vector<std::size_t> zone_events;
 };
 
-/// Events of every sensor column (rows = samples); they do not depend on min_s. Throws
-/// std::invalid_argument on non-finite sensor values or bad config.
+/// Events of every sensor column (rows = samples); they do not depend on min_s. `groups` gives
+/// each column's sensor (empty = every column its own): the channels of one sensor are at rest
+/// only together, so a rest edge is where the whole sensor leaves or regains rest. Throws
+/// std::invalid_argument on non-finite sensor values, bad config or a wrong number of groups.
 SensorEvents detect_sensor_events(const Eigen::MatrixXd& sensors,
-                                  const SensoryEventConfig& config = {});
+                                  const SensoryEventConfig& config = {},
+                                  const std::vector<std::size_t>& groups = {});
 
 /// Keeps the candidates that lie in a zone. Candidates are a sample index each.
 ChangepointValidation validate_with_zones(const std::vector<std::size_t>& candidates,
