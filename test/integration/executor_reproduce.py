@@ -8,10 +8,8 @@ import threading
 import time
 import unittest
 
-import rospkg
 import rospy
 import rostest
-import yaml
 from geometry_msgs.msg import Point, Pose, PoseStamped, Quaternion
 from lfd_msgs.msg import DemoSegmentation
 from lfd_msgs.srv import ExecuteTask, LearnSkills, ResetSim, SetScene
@@ -31,8 +29,7 @@ class ExecutorReproduce(unittest.TestCase):
     def setUpClass(cls):
         rospy.init_node("executor_test", anonymous=True)
         cls.out = rospy.get_param("executor_test/output_dir")
-        with open(os.path.join(rospkg.RosPack().get_path("lfd_config"), "tasks.yaml")) as f:
-            cls.tasks = yaml.safe_load(f)
+        cls.tasks = lfd_config.load_tasks()
         for name in ("/executor/execute", "/learner/learn", "/bridge/reset", "/bridge/set_scene"):
             rospy.wait_for_service(name, timeout=120)
         cls.execute = rospy.ServiceProxy("/executor/execute", ExecuteTask)
