@@ -11,9 +11,9 @@ its own (so one stage's /use_sim_time never leaks into the next):
              ground truth) and learn the skill library from the validated changepoints
              (/learner/learn) -> DIR/skills/<task>_<mode>.json
   reproduce  launch/reproduce.launch + lfd_dmp/scripts/reproduce_goals.py: per learned library,
-             reproduce every unseen goal of the task (lfd_tools.tasks) in MuJoCo through the
-             /executor/execute action, the simulation stepped in lockstep on sim time, and judge
-             the object's final pose with config/evaluation.yaml `reproduction` (lfd_tools.judge)
+             reproduce every unseen goal of the task's file (`unseen.<mode>`) in MuJoCo through
+             the /executor/execute action, the simulation stepped in lockstep on sim time, and
+             judge it with the task file's success criterion (lfd_tools.judge)
              -> DIR/reproduction/<task>_<mode>.json
   figures    no master: the paper's figures per dataset (skill map, correlation matrix, relevance
              histograms, ClaSP profile with the Kaiser filter, segmentation with its zones; from
@@ -47,13 +47,14 @@ carries LFD_PIPELINE_TAG=<pid>:<stage> in its environment; whatever still runs w
 (however it ends) is killed, roslaunch's nodes included.
 A task that cannot be learned or reproduced (e.g. push while its segmentation finds another number of
 changepoints than the task has transitions) is recorded with its error and listed under `problems`;
-the other tasks go on. <dataset> is <mode>_<task> (sim_grasp, sim_push, teleop_grasp, teleop_push).
+the other tasks go on. <dataset> is <mode>_<task>, for every task file (config/tasks/*.yaml) and
+both modes by default (sim_grasp, ..., teleop_wipe).
 
 Resumable: the datasets stage keeps existing bags, learn keeps existing libraries and reproduce
 keeps results newer than their library for the same goals; `--force` redoes learn and reproduce.
 `--stages learn,reproduce` reruns stages alone on an existing output folder. Ctrl-C stops cleanly,
 keeping everything recorded so far (reproduction results include the goals done).
-Reduced runs (CI): `--demos N` records N configurations per dataset (spread over tasks.yaml's list;
+Reduced runs (CI): `--demos N` records N configurations per dataset (spread over the task's list;
 later stages use the bags present), `--goals N` reproduces N unseen goals per task (spread).
 """
 import argparse
@@ -65,17 +66,13 @@ import subprocess
 import sys
 import time
 
-import yaml
-from lfd_tools import config as lfd_config
-from lfd_tools import judge, report as records, tasks as lfd_tasks
+from lfd_tools import judge, report as records, tasks
 from lfd_tools.jobs import run_parallel, run_tool, split, workers
 from lfd_tools.master import background_launch, private_master
 from lfd_tools.processes import TAG_VAR, kill_tagged
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.abspath(os.path.join(HERE, "..", ".."))
-DATASETS = ("sim_grasp", "sim_push", "teleop_grasp", "teleop_push")
-TASKS_FILE = os.path.join(ROOT, "config", "tasks.yaml")
 LEARN_SKILLS = os.path.join(ROOT, "lfd_dmp", "scripts", "learn_skills.py")
 REPRODUCE_GOALS = os.path.join(ROOT, "lfd_dmp", "scripts", "reproduce_goals.py")
 
@@ -95,41 +92,14 @@ def count_bags(folder):
     return len([f for f in os.listdir(folder) if f.endswith(".bag")])
 
 
-def spread(items, n):
-    """n items evenly spread over the list (all of them when n <= 0 or n >= len)."""
-    if n <= 0 or n >= len(items):
-        return list(items)
-    if n == 1:
-        return [items[len(items) // 2]]
-    return [items[round(i * (len(items) - 1) / (n - 1))] for i in range(n)]
-
-
-def reduced_tasks_file(out, demos):
-    """tasks.yaml with `demos` configurations per demonstrated dataset (--demos), or the original."""
-    if demos <= 0:
-        return TASKS_FILE
-    with open(TASKS_FILE) as f:
-        tasks = yaml.safe_load(f)
-    for task in ("grasp", "push"):
-        for mode in ("sim", "teleop"):
-            tasks[task][mode] = spread(tasks[task][mode], demos)
-    path = os.path.join(out, "tasks_%d_demos.yaml" % demos)
-    with open(path, "w") as f:
-        f.write("# config/tasks.yaml reduced by `pipeline.py --demos %d` (written by the pipeline)\n"
-                % demos)
-        yaml.safe_dump(tasks, f, default_flow_style=None, sort_keys=False)
-    return path
-
-
 def stage_datasets(out, args, report):
     """The datasets dealt over the workers, each worker a simulation on a master of its own."""
     data = os.path.join(out, "datasets")
-    tasks_file = reduced_tasks_file(out, args.demos)
     groups = split(args.datasets, workers(args.jobs))
 
     def generate(names):
         cmd = ["/usr/bin/python3", os.path.join(ROOT, "lfd_sim_bridge", "scripts", "generate_datasets.py"),
-               "--out", data, "--datasets", ",".join(names), "--tasks-file", tasks_file]
+               "--out", data, "--datasets", ",".join(names), "--demos", str(args.demos)]
         with private_master() as env:
             return run_tool(cmd, env, label="+".join(names) if len(groups) > 1 else None)
 
@@ -226,7 +196,7 @@ def stage_learn(out, args, report):
 
 
 def goal_ids(task, mode, n):
-    return [s["id"] for s in spread(lfd_tasks.unseen_scenes(task, mode), n)]
+    return [e["id"] for e in tasks.spread(tasks.unseen_scenes(task, mode), n)]
 
 
 def task_record(result_path, mode, task):
@@ -437,9 +407,8 @@ def write_report(out, report):
                 "-" if e.get("execution_time_ratio") is None else "%.2f" % e["execution_time_ratio"],
                 mm(e.get("mean_object_position_error_m")), mm(e.get("mean_tcp_position_error_m")),
                 (e.get("error") or "").replace("|", "/")))
-        criteria = lfd_config.load_evaluation()["reproduction"]
-        lines += ["", "Success (config/evaluation.yaml): " + "; ".join(
-            judge.describe_criteria(t, criteria[t]) for t in sorted(report[key]) if t in criteria)
+        lines += ["", "Success (the task files): " + "; ".join(
+            judge.describe_criteria(t, tasks.success_criterion(t)) for t in sorted(report[key]))
             + ". Time ratio: executed / mean demonstrated duration.", ""]
         for task, e in sorted(report[key].items()):
             if not e.get("goals"):
@@ -475,12 +444,13 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--out", default=os.path.join(ROOT, "lfd_output"), help="report and data folder")
     ap.add_argument("--stages", default=",".join(STAGES), help="comma list of " + ",".join(STAGES))
-    ap.add_argument("--datasets", default=",".join(DATASETS), type=lambda s: [x for x in s.split(",") if x],
-                    help="comma list of " + ",".join(DATASETS))
+    datasets = tasks.datasets()
+    ap.add_argument("--datasets", default=",".join(datasets), type=lambda s: [x for x in s.split(",") if x],
+                    help="comma list of " + ",".join(datasets))
     ap.add_argument("--demos", type=int, default=0,
-                    help="datasets stage: record N configurations per dataset (0 = all of tasks.yaml)")
+                    help="datasets stage: record N configurations per dataset (0 = all of the task file)")
     ap.add_argument("--goals", type=int, default=0,
-                    help="reproduce stage: N unseen goals per task (0 = all of tasks.yaml)")
+                    help="reproduce stage: N unseen goals per task (0 = all of the task file)")
     ap.add_argument("--reproduce-modes", default="sim", type=lambda s: [x for x in s.split(",") if x],
                     help="reproduce stage: libraries of these modes (sim, teleop); the paper "
                          "reproduces the simulated tasks; teleop adds ~3.5 min")
@@ -494,9 +464,9 @@ def main():
     # run like Ctrl-C: masters and launches are torn down, the report is written.
     signal.signal(signal.SIGINT, signal.default_int_handler)
     signal.signal(signal.SIGTERM, lambda *_: signal.default_int_handler(signal.SIGINT, None))
-    bad = [d for d in args.datasets if d not in DATASETS]
+    bad = [d for d in args.datasets if d not in datasets]
     if bad:
-        say("error: unknown dataset(s) %s; known: %s" % (",".join(bad), ",".join(DATASETS)))
+        say("error: unknown dataset(s) %s; known: %s" % (",".join(bad), ",".join(datasets)))
         return 2
 
     out = os.path.abspath(args.out)

@@ -1,5 +1,6 @@
 #include "lfd_segmentation/segmentation_json.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 namespace lfd_segmentation {
@@ -14,6 +15,67 @@ json vector_json(const Eigen::VectorXd& v) {
     out.push_back(std::isfinite(v[k]) ? json(v[k]) : json(nullptr));
   }
   return out;
+}
+
+// Decimals of a feature's rounding step (10^-decimals <= kFeatureResolution x its range, or its
+// magnitude when constant); kKeepDigits when there is nothing to scale by.
+constexpr int kKeepDigits = 99;
+int feature_decimals(const Eigen::VectorXd& values) {
+  if (values.size() == 0 || !values.allFinite()) return kKeepDigits;
+  const double lo = values.minCoeff(), hi = values.maxCoeff();
+  const double span = hi > lo ? hi - lo : std::max(std::abs(lo), std::abs(hi));
+  if (!(span > 0)) return kKeepDigits;
+  return static_cast<int>(-std::floor(std::log10(span * kFeatureResolution)));
+}
+
+// x as the double nearest to a multiple of 10^-decimals, which the JSON writer (shortest round
+// trip) prints with no more digits than the step: n / 10^k and n * 10^k are correctly rounded
+// operations on exact integers (|n| < 2^53, 10^k exact for k <= 22).
+double round_decimals(double x, int decimals) {
+  if (!std::isfinite(x) || std::abs(decimals) > 22) return x;
+  double scale = 1;
+  for (int k = 0; k < std::abs(decimals); ++k) scale *= 10;
+  const double n = std::round(decimals >= 0 ? x * scale : x / scale);
+  if (std::abs(n) >= 9007199254740992.0) return x;
+  return (decimals >= 0 ? n / scale : n * scale) + 0.0;  // + 0.0: -0 prints as 0
+}
+
+json rounded_json(const Eigen::VectorXd& v) {
+  const int decimals = feature_decimals(v);
+  json out = json::array();
+  for (Eigen::Index k = 0; k < v.size(); ++k) {
+    out.push_back(std::isfinite(v[k]) ? json(round_decimals(v[k], decimals)) : json(nullptr));
+  }
+  return out;
+}
+
+const char* role_of(const std::string& name, const std::vector<std::string>& states,
+                    const std::vector<std::string>& sensors) {
+  auto in = [&](const std::vector<std::string>& list) {
+    return std::find(list.begin(), list.end(), name) != list.end();
+  };
+  return in(states) ? "state" : in(sensors) ? "sensor" : "context";
+}
+
+bool is_flat(const json& j) {
+  return !j.is_structured() || j.empty() ||
+         (j.is_array() &&
+          std::none_of(j.begin(), j.end(), [](const json& e) { return e.is_structured(); }));
+}
+
+void dump_indented(const json& j, int depth, std::string& out) {
+  if (is_flat(j)) {
+    out += j.dump();
+    return;
+  }
+  const std::string pad(static_cast<std::size_t>(depth) + 1, ' ');
+  out += j.is_object() ? '{' : '[';
+  for (auto it = j.begin(); it != j.end(); ++it) {
+    out += (it == j.begin() ? "\n" : ",\n") + pad;
+    if (j.is_object()) out += json(it.key()).dump() + ": ";
+    dump_indented(*it, depth + 1, out);
+  }
+  out += "\n" + std::string(static_cast<std::size_t>(depth), ' ') + (j.is_object() ? '}' : ']');
 }
 
 json matrix_json(const Eigen::MatrixXd& m) {
@@ -144,6 +206,31 @@ json to_json(const lfd::MultivariateSegmentation& s, const lfd::FeatureMatrix& d
   d["changepoint_times"] = times_json(s.changepoints, demo);
   out["demos"] = json::array({d});
   out["warnings"] = json::array();
+  return out;
+}
+
+json feature_matrices_json(const std::vector<lfd::FeatureMatrix>& demos,
+                           const std::vector<std::string>& states,
+                           const std::vector<std::string>& sensors) {
+  json out = json::array();
+  for (const lfd::FeatureMatrix& demo : demos) {
+    json features = json::array();
+    for (Eigen::Index c = 0; c < demo.cols(); ++c) {
+      const std::string& name = demo.names.at(static_cast<std::size_t>(c));
+      features.push_back({{"name", name},
+                          {"role", role_of(name, states, sensors)},
+                          {"values", rounded_json(demo.data.col(c))}});
+    }
+    json time = json::array();  // time_at: a series without a clock is on its row index
+    for (Eigen::Index r = 0; r < demo.rows(); ++r) time.push_back(demo.time_at(r));
+    out.push_back({{"time", time}, {"features", features}});
+  }
+  return out;
+}
+
+std::string dump_json(const json& j) {
+  std::string out;
+  dump_indented(j, 0, out);
   return out;
 }
 

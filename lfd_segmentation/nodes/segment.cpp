@@ -48,6 +48,10 @@ const char* kUsage = R"(usage: segment [options] FILE...
   --threads N               worker threads (default: parameter 'threads')
   --feature-profiles        include every selected feature's ClaSP profile
   --no-profiles             omit the combined profiles
+  --features                include what was segmented: "feature_matrices", per demo its clock
+                            "time" (s, as the changepoint times) and every feature's "name",
+                            "role" (state, sensor or context) and "values" (rounded to 1e-6 of
+                            the feature's range); plot_segmentation.py draws them
   --timing                  report the stage timings (stderr and "timing" in the JSON)
   --output PATH             write the JSON there instead of stdout
 )";
@@ -97,7 +101,7 @@ struct Options {
   std::string time_column, combination, output, procedure;
   double rate = 0, threshold = 0, min_seconds = 0, window_seconds = 0;
   long num_changepoints = 0, threads = -1;
-  bool timing = false, feature_profiles = false, profiles = true;
+  bool timing = false, feature_profiles = false, profiles = true, features = false;
 };
 
 Options parse_args(int argc, char** argv) {
@@ -154,6 +158,8 @@ Options parse_args(int argc, char** argv) {
       o.timing = true;
     } else if (arg == "--feature-profiles") {
       o.feature_profiles = true;
+    } else if (arg == "--features") {
+      o.features = true;
     } else if (arg == "--no-profiles") {
       o.profiles = false;
     } else if (arg == "--output") {
@@ -232,6 +238,7 @@ nlohmann::json run(const Options& o) {
   json_options.feature_profiles = o.feature_profiles;
 
   nlohmann::json out;
+  std::vector<std::string> used_states, used_sensors;  // the roles the segmentation gave columns
   const auto compute_start = std::chrono::steady_clock::now();
   if (!bags && demos.size() == 1 && o.sensors.empty()) {
     if (combinations.size() > 1)
@@ -246,11 +253,14 @@ nlohmann::json run(const Options& o) {
     const lfd::MultivariateSegmentation s = lfd::segment_multivariate(demo.data, {}, seg);
     out = lfd_segmentation::to_json(s, demo, o.files[0], json_options);
     out["mode"] = "clasp";
+    used_states = demo.names;
   } else if (combinations.size() <= 1) {
     const lfd::SegmentationPipelineResult r =
         lfd::run_segmentation_pipeline(demos, sensors, config, states);
     out = lfd_segmentation::to_json(r, demos, o.files, json_options);
     out["mode"] = "pipeline";
+    used_states = r.state_features;
+    used_sensors = r.sensor_features;
   } else {
     const lfd::PreparedSegmentation prepared =
         lfd::prepare_segmentation(demos, sensors, config, states);
@@ -262,8 +272,13 @@ nlohmann::json run(const Options& o) {
           lfd::segment_prepared(prepared, demos, own), demos, o.files, json_options);
     }
     out["mode"] = "pipeline";
+    used_states = prepared.base.state_features;
+    used_sensors = prepared.base.sensor_features;
   }
   const double compute_time = seconds_since(compute_start);
+  if (o.features)
+    out["feature_matrices"] =
+        lfd_segmentation::feature_matrices_json(demos, used_states, used_sensors);
   if (o.timing) {
     std::size_t samples = 0;
     for (const auto& d : demos) samples += d.rows();
@@ -303,7 +318,7 @@ int main(int argc, char** argv) {
     for (int k = 1; options.output.empty() && k + 1 < argc; ++k)
       if (std::string(argv[k]) == "--output") options.output = argv[k + 1];
   }
-  const std::string text = out.dump(1);
+  const std::string text = lfd_segmentation::dump_json(out);
   if (!options.output.empty()) {
     // A result file: replaced on every run (scripts rerun into their folder), but atomically and
     // never over one of the inputs.

@@ -51,7 +51,7 @@ import yaml
 from lfd_msgs.srv import Segment, SegmentRequest
 from lfd_tools import bags as lfd_bags
 from lfd_tools import config as lfd_config
-from lfd_tools import report, segmentation_scoring
+from lfd_tools import report, segmentation_scoring, tasks
 
 
 class CliSegmenter(object):
@@ -151,13 +151,14 @@ def datasets_to_run(args, config):
     if not args.datasets:
         raise RuntimeError("give --datasets, --truth or --labels")
     return [(n, lambda seg, ms, tol, n=n: segmentation_scoring.evaluate_dataset_methods(
-        seg, os.path.join(args.datasets, n), ms, config, tol)) for n in args.names.split(",") if n]
+        seg, os.path.join(args.datasets, n), ms, config, tol))
+            for n in (args.names.split(",") if args.names else tasks.datasets()) if n]
 
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--datasets", default="", help="folder holding one sub-folder per dataset")
-    ap.add_argument("--names", default="sim_grasp,sim_push,teleop_grasp,teleop_push")
+    ap.add_argument("--names", default="", help="comma list of <mode>_<task> (default: every task's, both modes)")
     ap.add_argument("--truth", default="", help="ground-truth file (demos, their bags, changepoint times)")
     ap.add_argument("--labels", default="", help="labels.json of phase-split runs (pr2_ikea format)")
     ap.add_argument("--runs", default="", help="with --labels: comma list of runs (default: all)")

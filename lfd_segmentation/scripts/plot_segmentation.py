@@ -14,20 +14,21 @@
                               phases from /lfd/phase as background (evaluation only)
 
   plot_segmentation.py --dataset BAG_DIR [--config ...] --out DIR [--demo ...] [--prefix NAME_]
-      the same, after running `segment --feature-profiles` on BAG_DIR/*.bag (JSON kept in DIR)
+      the same, after running `segment --features --feature-profiles` on BAG_DIR/*.bag (JSON kept
+      in DIR)
 
   plot_segmentation.py --report report.json --out DIR [--prefix NAME_]
       success_rates.png       Fig. 9: success rate per dataset and combination method, with the
                               paper's reference (~80 % simulation, ~50 % real robot)
 
-SEG.json is what `segment --feature-profiles --output SEG.json BAGS...` writes. The feature samples
-(skill map, segmentation) are read from the demos' bags (--bags, default: the JSON's demos[].source),
-with the topics, roles and rate of --config, resampled the way the segmenter does (latest start to
-earliest end, `rate` Hz, linear or zero-order hold). Time axes are seconds from the first resampled
-sample. Prints the path of each PNG written; exits 2 with a message on bad input.
+SEG.json is what `segment --features --feature-profiles --output SEG.json FILES...` writes. The
+feature samples (skill map, segmentation) are the JSON's feature_matrices: the very matrix the
+segmentation read (the C++ bag reader's resampling), so a figure shows what was segmented. Only the
+ground-truth phases behind Fig. 8 come from the demos' bags (/lfd/phase, evaluation only; --bags,
+default: the JSON's demos[].source). Time axes are seconds from each demo's first sample. Prints the
+path of each PNG written; exits 2 with a message on bad input.
 """
 import argparse
-import contextlib
 import json
 import math
 import os
@@ -42,7 +43,6 @@ plt = None  # matplotlib.pyplot, imported with the first figure: bad input fails
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 DEFAULT_CONFIG = os.path.join(HERE, "..", "..", "config", "segmentation.yaml")
-GROUND_TRUTH_TOPIC = lfd_bags.PHASE_TOPIC
 PAPER_RATE = {"sim": 0.8, "teleop": 0.5}  # Fig. 9: ~80 % in simulation, ~50 % on the real robot
 METHOD_ORDER = ["average", "product", "weighted_average", "weighted_product"]
 PHASE_COLOURS = ["#f2e2c4", "#c9dcf0", "#d5ecd0", "#ead3ea", "#f6d6d0", "#e0e0e0"]
@@ -83,19 +83,10 @@ def load_config(path):
         raise UserError("cannot read config '%s': %s" % (path, e))
     if not isinstance(config, dict):
         raise UserError("config '%s' is not a YAML map" % path)
-    rate = config.get("rate", 50.0)
-    if not isinstance(rate, (int, float)) or not rate > 0:
-        raise UserError("config '%s': rate must be a positive number, got %r" % (path, rate))
-    topics = config.get("topics")
-    if not isinstance(topics, list) or not topics:
-        raise UserError("config '%s' has no 'topics' list" % path)
-    for k, t in enumerate(topics):
-        if not isinstance(t, dict) or not t.get("topic") or not t.get("fields"):
-            raise UserError("config '%s': topics[%d] needs 'topic' and 'fields'" % (path, k))
-        if t.get("role", "state") not in ("state", "sensor", "context"):
-            raise UserError("config '%s': topics[%d] role must be state, sensor or context" % (path, k))
-        if t["topic"] == GROUND_TRUTH_TOPIC:
-            raise UserError("config '%s': %s is ground truth, not a feature" % (path, GROUND_TRUTH_TOPIC))
+    for key in ("rate", "threshold"):  # the fallback clock of Fig. 5, the T of Fig. 4
+        value = config.get(key, 1.0)
+        if not isinstance(value, (int, float)) or not value > 0:
+            raise UserError("config '%s': %s must be a positive number, got %r" % (path, key, value))
     return config
 
 
@@ -115,109 +106,40 @@ def require(obj, key, where):
 
 
 # ---------------------------------------------------------------------------------------------
-# Bag -> feature samples (mirrors lfd_segmentation/lib/bag_features.cpp)
+# What was segmented: the JSON's feature matrices; the ground truth of a bag
 # ---------------------------------------------------------------------------------------------
 
-def stamp_of(msg, t):
-    header = getattr(msg, "header", None)
-    if header is not None and (header.stamp.secs or header.stamp.nsecs):
-        return header.stamp.to_sec()
-    return t.to_sec()
+def feature_matrix(seg, d):
+    """Demo d's features as the segmentation read them (`segment --features`): dict(time (s from
+    its first sample), start (its clock's origin), names, roles, data (rows x features)); None when
+    the JSON holds none."""
+    if "feature_matrices" not in seg:
+        return None
+    where = "feature_matrices[%d]" % d
+    m = seg["feature_matrices"][d]
+    time = as_array(require(m, "time", where))
+    features = require(m, "features", where)
+    data = np.column_stack([as_array(require(f, "values", where)) for f in features])
+    if data.shape[0] != len(time) or len(time) != seg["demos"][d].get("num_samples", len(time)):
+        raise UserError("%s holds %d times and %d samples per feature for a demo of %s samples"
+                        % (where, len(time), data.shape[0], seg["demos"][d].get("num_samples")))
+    return {"time": time - time[0], "start": time[0], "names": [f["name"] for f in features],
+            "roles": [f["role"] for f in features], "data": data}
 
 
-def field_getters(topic, fields, first):
-    """[(feature name, getter(msg) -> float or None)] for a topic's configured fields."""
-    names_attr = "name" if hasattr(first, "name") and isinstance(getattr(first, "name"), list) else \
-        "names" if hasattr(first, "names") else None
-    out = []
-    for field in fields:
-        parts = field.split("/")
-        head = getattr(first, parts[0], None)
-        if names_attr and len(parts) == 2 and isinstance(head, (list, tuple)):
-            array, wanted = parts
-            keys = list(getattr(first, names_attr)) if wanted == "*" else [wanted]
-            for key in keys:
-                def get(m, array=array, key=key):
-                    names = getattr(m, names_attr)
-                    values = getattr(m, array)
-                    if key not in names:
-                        return None
-                    i = list(names).index(key)
-                    return float(values[i]) if i < len(values) else None
-                out.append(("%s/%s/%s" % (topic.rstrip("/"), array, key), get))
-            continue
-        # "<vector>/norm" is the vector's magnitude (x, y, z), as in the segmenter.
-        norm = parts[-1] == "norm"
-        path = parts[:-1] if norm else parts
-        obj = first
-        for p in path:
-            if not hasattr(obj, p):
-                raise UserError("topic %s (%s) has no field '%s'" % (topic, first._type, field))
-            obj = getattr(obj, p)
-        if norm and not all(isinstance(getattr(obj, a, None), (int, float)) for a in "xyz"):
-            raise UserError("topic %s field '%s': only x/y/z vectors have a norm" % (topic, field))
-        if not norm and not isinstance(obj, (int, float)):
-            raise UserError("topic %s field '%s' is not a number" % (topic, field))
-
-        def get(m, path=path, norm=norm):
-            for p in path:
-                m = getattr(m, p)
-            return math.sqrt(m.x * m.x + m.y * m.y + m.z * m.z) if norm else float(m)
-        out.append(("%s/%s" % (topic.rstrip("/"), field), get))
-    return out
-
-
-def resample(times, values, grid, zoh):
-    if zoh:
-        idx = np.clip(np.searchsorted(times, grid, side="right") - 1, 0, len(times) - 1)
-        return values[idx]
-    return np.interp(grid, times, values)
-
-
-def read_bag(path, config, with_ground_truth):
-    """Returns dict(time=grid (s, absolute), names, roles, data (rows x features), phases)."""
+def ground_truth_phases(args, seg, d, start):
+    """[(phase, start s from the demo's first sample)] of demo d's /lfd/phase (evaluation only: the
+    background of Fig. 8) in its bag (--bags, else the JSON's source); [] without one."""
+    path = args.bags[d] if args.bags else seg["demos"][d].get("source", "")
+    if not (path.endswith(".bag") and os.path.isfile(path)):
+        warn("demo %d has no bag '%s' (pass --bags): no ground-truth phases" % (d, path))
+        return []
     try:
-        import rosbag
-    except ImportError:
-        raise UserError("the rosbag Python module is missing (run with /usr/bin/python3 and ROS)")
-    if not os.path.isfile(path):
-        raise UserError("bag '%s' does not exist" % path)
-    streams = []  # (name, role, zoh, times, values)
-    phases = []
-    try:
-        with rosbag.Bag(path) as bag:
-            for cfg in config["topics"]:
-                topic, role = cfg["topic"], cfg.get("role", "state")
-                zoh = cfg.get("interpolation", "linear") in ("zoh", "zero_order_hold")
-                msgs = [(stamp_of(m, t), m) for _, m, t in bag.read_messages(topics=[topic])]
-                if not msgs:
-                    raise UserError("bag '%s' has no messages on topic %s" % (path, topic))
-                for name, get in field_getters(topic, cfg["fields"], msgs[0][1]):
-                    samples = [(s, get(m)) for s, m in msgs]
-                    samples = [(s, v) for s, v in samples if v is not None]
-                    if not samples:
-                        raise UserError("bag '%s': topic %s has no data for %s" % (path, topic, name))
-                    t = np.array([s for s, _ in samples])
-                    v = np.array([x for _, x in samples])
-                    order = np.argsort(t, kind="stable")
-                    streams.append((name, role, zoh, t[order], v[order]))
-        if with_ground_truth:
-            with contextlib.suppress(RuntimeError):  # no /lfd/phase: no background
-                phases = lfd_bags.phase_transitions(path)[1]
-    except UserError:
-        raise
+        return [(name, t - start) for name, t in lfd_bags.phase_transitions(path)[1]]
+    except RuntimeError:  # no /lfd/phase: no background
+        return []
     except Exception as e:  # rosbag raises several exception types for corrupt bags
         raise UserError("cannot read bag '%s': %s" % (path, e))
-    start = max(s[3][0] for s in streams)
-    end = min(s[3][-1] for s in streams)
-    if end < start:
-        raise UserError("bag '%s': the configured topics do not overlap in time" % path)
-    rate = float(config.get("rate", 50.0))
-    n = int(math.floor((end - start) * rate + 1e-9)) + 1
-    grid = start + np.arange(n) / rate
-    data = np.column_stack([resample(t, v, grid, zoh) for _, _, zoh, t, v in streams])
-    return {"time": grid, "names": [s[0] for s in streams], "roles": [s[1] for s in streams],
-            "data": data, "phases": phases, "path": path, "rate": rate}
 
 
 def normalize01(x):
@@ -266,13 +188,13 @@ def demo_label(seg, d):
     return os.path.splitext(os.path.basename(src))[0] if src else "demo %d" % d
 
 
-def plot_skill_map(bag, seg, d, out, prefix, written, tag=""):
-    roles = bag["roles"]
+def plot_skill_map(features, seg, d, out, prefix, written, tag=""):
+    roles = features["roles"]
     order = ([k for k, r in enumerate(roles) if r == "sensor"] +
              [k for k, r in enumerate(roles) if r == "state"] +
              [k for k, r in enumerate(roles) if r == "context"])
-    image = np.array([normalize01(bag["data"][:, k]) for k in order])
-    duration = bag["time"][-1] - bag["time"][0]
+    image = np.array([normalize01(features["data"][:, k]) for k in order])
+    duration = features["time"][-1]
     selected = set(seg.get("selected_features", []))
     fig = new_figure("skill_map", layout="constrained")
     ax = fig.add_subplot(111)
@@ -280,12 +202,12 @@ def plot_skill_map(bag, seg, d, out, prefix, written, tag=""):
                    extent=[0, duration, len(order), 0])
     labels = []
     for k in order:
-        name = bag["names"][k]
+        name = features["names"][k]
         labels.append(("* " if name in selected else "") + short(name))
     ax.set_yticks(np.arange(len(order)) + 0.5)
     ax.set_yticklabels(labels, fontsize=7)
     for tick, k in zip(ax.get_yticklabels(), order):
-        if bag["names"][k] in selected:
+        if features["names"][k] in selected:
             tick.set_fontweight("bold")
     row = 0
     for role in ("sensor", "state", "context"):
@@ -299,7 +221,7 @@ def plot_skill_map(bag, seg, d, out, prefix, written, tag=""):
         row += count
     cps = seg["demos"][d].get("changepoints", [])
     for i, cp in enumerate(cps):
-        ax.axvline(cp / bag["rate"], color="cyan", ls="--", lw=1.2,
+        ax.axvline(at(features["time"], cp), color="cyan", ls="--", lw=1.2,
                    label="validated changepoint" if i == 0 else None)
     if cps:
         ax.legend(loc="lower right", fontsize=8)
@@ -418,39 +340,44 @@ def plot_relevance(seg, feats, threshold, out, prefix, written):
     save(fig, out, prefix, "relevance", written)
 
 
-def shade_zones(ax, demo, rate, label=True):
+def at(seconds, index):
+    """Time of a sample index of the JSON on a demo's clock (a zone ends one past its last sample)."""
+    return seconds[min(int(index), len(seconds) - 1)]
+
+
+def shade_zones(ax, demo, seconds, label=True):
     for i, z in enumerate(demo.get("zones", [])):
-        ax.axvspan(z["begin"] / rate, z["end"] / rate, color="red", alpha=0.12, lw=0,
+        ax.axvspan(at(seconds, z["begin"]), at(seconds, z["end"]), color="red", alpha=0.12, lw=0,
                    label="confidence zone" if label and i == 0 else None)
         for edge in (z["begin"], z["end"]):
-            ax.axvline(edge / rate, color="red", lw=0.8)
+            ax.axvline(at(seconds, edge), color="red", lw=0.8)
 
 
-def mark_changepoints(ax, demo, rate, label=True):
+def mark_changepoints(ax, demo, seconds, label=True):
     for i, cp in enumerate(demo.get("changepoints", [])):
-        ax.axvline(cp / rate, color="black", lw=2.2,
+        ax.axvline(at(seconds, cp), color="black", lw=2.2,
                    label="validated changepoint" if label and i == 0 else None)
     for i, cp in enumerate(demo.get("rejected", [])):
-        ax.axvline(cp / rate, color="dimgray", lw=1.4, ls="--",
+        ax.axvline(at(seconds, cp), color="dimgray", lw=1.4, ls="--",
                    label="rejected candidate" if label and i == 0 else None)
     for i, cp in enumerate(demo.get("pruned", [])):
-        ax.axvline(cp / rate, color="purple", lw=1.4, ls=":",
+        ax.axvline(at(seconds, cp), color="purple", lw=1.4, ls=":",
                    label="pruned to the task's count" if label and i == 0 else None)
 
 
-def plot_profile(seg, d, rate, out, prefix, written, tag=""):
+def plot_profile(seg, d, seconds, out, prefix, written, tag=""):
     demo = seg["demos"][d]
     if "profile" not in demo:
         warn("the JSON holds no ClaSP profile (segment ran with --no-profiles): clasp_profile skipped")
         return
     profile = as_array(demo["profile"])
     penalized = as_array(demo.get("profile_penalized", []))
-    t = np.arange(len(profile)) / rate
+    t = seconds[:len(profile)]
     per_feature = demo.get("feature_profiles", {})
     fig = new_figure("clasp_profile", layout="constrained")
     axes = fig.subplots(2 if per_feature else 1, 1, sharex=True, squeeze=False)[:, 0]
     ax = axes[0]
-    shade_zones(ax, demo, rate)
+    shade_zones(ax, demo, seconds)
     ax.plot(t, profile, color="tab:blue", lw=1.2, label="combined ClaSP profile")
     twin = None
     if len(penalized) == len(profile):
@@ -464,14 +391,14 @@ def plot_profile(seg, d, rate, out, prefix, written, tag=""):
             twin.set_ylabel("Kaiser window", color="gray")
     cands = demo.get("candidates", [])
     for accepted in (True, False):
-        pts = [(c["index"] / rate, c["score"]) for c in cands
+        pts = [(at(seconds, c["index"]), c["score"]) for c in cands
                if c.get("score") is not None and bool(c.get("accepted_by_clasp")) == accepted]
         if pts:
             xs, ys = zip(*pts)
             ax.scatter(xs, ys, marker="v" if accepted else "x", s=60, zorder=5,
                        color="tab:green" if accepted else "tab:red",
                        label="candidate (significant)" if accepted else "candidate (not significant)")
-    mark_changepoints(ax, demo, rate)
+    mark_changepoints(ax, demo, seconds)
     ax.set_ylabel("score")
     handles, labels = ax.get_legend_handles_labels()
     if twin is not None:
@@ -484,54 +411,47 @@ def plot_profile(seg, d, rate, out, prefix, written, tag=""):
         ax2 = axes[1]
         for name, values in per_feature.items():
             v = as_array(values)
-            ax2.plot(np.arange(len(v)) / rate, v, lw=1, label=short(name),
-                     color=feature_colour(seg, name))
-        mark_changepoints(ax2, demo, rate, label=False)
+            ax2.plot(seconds[:len(v)], v, lw=1, label=short(name), color=feature_colour(seg, name))
+        mark_changepoints(ax2, demo, seconds, label=False)
         ax2.set_ylabel("per-feature score")
         ax2.legend(loc="upper left", bbox_to_anchor=(1.06, 1.0), fontsize=7)
     axes[-1].set_xlabel("time (s)")
     save(fig, out, prefix, "clasp_profile", written, tag)
 
 
-def plot_segmentation(bag, seg, d, out, prefix, written, ground_truth, tag=""):
+def plot_segmentation(features, phases, seg, d, out, prefix, written, tag=""):
     demo = seg["demos"][d]
-    rate = bag["rate"]
-    t = (bag["time"] - bag["time"][0])
+    t = features["time"]
     selected = seg.get("selected_features", [])
     weights = seg.get("feature_weights", [])
-    sensors = [k for k, r in enumerate(bag["roles"]) if r == "sensor"]
+    sensors = [k for k, r in enumerate(features["roles"]) if r == "sensor"]
     fig = new_figure("segmentation", layout="constrained")
     axes = fig.subplots(2, 1, sharex=True, gridspec_kw={"height_ratios": [3, 2]})
-    phases = bag["phases"] if ground_truth else []
     for ax_i, ax in enumerate(axes):
         for k, (name, start) in enumerate(phases):
-            end = phases[k + 1][1] if k + 1 < len(phases) else bag["time"][-1]
-            ax.axvspan(start - bag["time"][0], end - bag["time"][0],
-                       color=PHASE_COLOURS[k % len(PHASE_COLOURS)], alpha=0.7, lw=0,
+            end = phases[k + 1][1] if k + 1 < len(phases) else t[-1]
+            ax.axvspan(start, end, color=PHASE_COLOURS[k % len(PHASE_COLOURS)], alpha=0.7, lw=0,
                        label="phase: %s (ground truth)" % name if ax_i == 0 else None)
-        shade_zones(ax, demo, rate, label=ax_i == 0)
-        mark_changepoints(ax, demo, rate, label=ax_i == 0)
+        shade_zones(ax, demo, t, label=ax_i == 0)
+        mark_changepoints(ax, demo, t, label=ax_i == 0)
     for k, name in enumerate(selected):
-        if name not in bag["names"]:
-            warn("selected feature %s is not in the config's topics: not drawn" % name)
-            continue
         w = " (w=%.3f)" % weights[k] if k < len(weights) else ""
-        axes[0].plot(t, normalize01(bag["data"][:, bag["names"].index(name)]), lw=1.5,
+        axes[0].plot(t, normalize01(features["data"][:, features["names"].index(name)]), lw=1.5,
                      label=short(name) + w, color=feature_colour(seg, name))
     axes[0].set_ylabel("selected features (normalized)")
     axes[0].set_ylim(-0.05, 1.05)
     axes[0].legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=7)
     for k in sensors:
-        axes[1].plot(t, bag["data"][:, k], lw=1.2, label=short(bag["names"][k]))
+        axes[1].plot(t, features["data"][:, k], lw=1.2, label=short(features["names"][k]))
     events = demo.get("events", [])
     if events:
-        axes[1].plot(np.array(events) / rate, np.zeros(len(events)), "|", color="red",
+        axes[1].plot([at(t, e) for e in events], np.zeros(len(events)), "|", color="red",
                      markersize=14, mew=1.5, label="sensory event")
     axes[1].set_ylabel("sensor signals")
     axes[1].set_xlabel("time (s)")
     if sensors or events:
         axes[1].legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=7)
-    cps = ", ".join("%.2f s" % (c / rate) for c in demo.get("changepoints", [])) or "none"
+    cps = ", ".join("%.2f s" % at(t, c) for c in demo.get("changepoints", [])) or "none"
     axes[0].set_title("Segmentation of %s: validated changepoint(s) %s; %d rejected"
                       % (demo_label(seg, d), cps, len(demo.get("rejected", []))))
     save(fig, out, prefix, "segmentation", written, tag)
@@ -610,23 +530,18 @@ def parse_demos(spec, count):
 
 def demo_figures(args, seg, config, d, tag, written):
     """Fig. 5, 7 and 8 of demonstration d."""
-    demos = seg["demos"]
-    plot_profile(seg, d, float(config.get("rate", 50.0)), args.out, args.prefix, written, tag)
-    bag_path = args.bags[d] if args.bags else demos[d].get("source", "")
-    if not bag_path.endswith(".bag"):
-        warn("demo %d has no bag (source '%s'): skill map and segmentation skipped; pass --bags"
-             % (d, bag_path))
+    features = feature_matrix(seg, d)
+    # Without the matrix (an older JSON) Fig. 5 falls back to the config's clock.
+    seconds = features["time"] if features else \
+        np.arange(seg["demos"][d].get("num_samples", 0)) / float(config.get("rate", 50.0))
+    plot_profile(seg, d, seconds, args.out, args.prefix, written, tag)
+    if features is None:
+        warn("the JSON holds no feature matrices (run segment with --features): skill map and "
+             "segmentation skipped")
         return
-    if not args.bags and not os.path.isfile(bag_path):
-        warn("the JSON's bag '%s' is gone: skill map and segmentation skipped; pass --bags" % bag_path)
-        return
-    bag = read_bag(bag_path, config, not args.no_ground_truth)
-    expected = demos[d].get("num_samples")
-    if expected is not None and expected != len(bag["time"]):
-        warn("%s resamples to %d samples here but %d in the JSON: another config or rate?"
-             % (bag_path, len(bag["time"]), expected))
-    plot_skill_map(bag, seg, d, args.out, args.prefix, written, tag)
-    plot_segmentation(bag, seg, d, args.out, args.prefix, written, not args.no_ground_truth, tag)
+    phases = [] if args.no_ground_truth else ground_truth_phases(args, seg, d, features["start"])
+    plot_skill_map(features, seg, d, args.out, args.prefix, written, tag)
+    plot_segmentation(features, phases, seg, d, args.out, args.prefix, written, tag)
 
 
 def find_segment_cli():
@@ -649,7 +564,7 @@ def segment_dataset(args):
         raise UserError("no .bag files in --dataset '%s'" % args.dataset)
     cli = args.segment_cli or find_segment_cli()
     out = os.path.join(args.out, "%ssegment.json" % args.prefix)
-    cmd = [cli, "--config", args.config, "--feature-profiles", "--output", out] + bags
+    cmd = [cli, "--config", args.config, "--features", "--feature-profiles", "--output", out] + bags
     try:
         run = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     except OSError as e:
@@ -692,13 +607,14 @@ def segment_figures(args, written):
 
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--segment-json", help="output of `segment --feature-profiles --output`")
+    ap.add_argument("--segment-json", help="output of `segment --features --feature-profiles --output`")
     ap.add_argument("--dataset", help="folder of bags: run `segment` on DIR/*.bag first (the JSON is "
                                       "kept as OUT/<prefix>segment.json), then draw")
     ap.add_argument("--segment-cli", help="the `segment` executable (default: the catkin workspace's)")
-    ap.add_argument("--bags", nargs="+",
-                    help="the demos' bags, in the JSON's order (default: the JSON's demos[].source)")
-    ap.add_argument("--config", default=DEFAULT_CONFIG, help="segmentation.yaml (topics, roles, rate, T)")
+    ap.add_argument("--bags", nargs="+", help="the demos' bags for the ground-truth phases, in the "
+                                              "JSON's order (default: the JSON's demos[].source)")
+    ap.add_argument("--config", default=DEFAULT_CONFIG,
+                    help="segmentation.yaml (given to segment with --dataset; T of Fig. 4)")
     ap.add_argument("--demo", default="0",
                     help="demo(s) of the per-demo figures: index, comma list or 'all' (names then get "
                          "the demo's name as suffix)")

@@ -1,4 +1,5 @@
-// The `segment` CLI's CSV path (run as a subprocess, JSON parsed back) and the CSV reader.
+// The `segment` CLI's CSV path (run as a subprocess, JSON parsed back), the feature matrices it
+// emits for the figures, and the CSV reader.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -6,12 +7,16 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <random>
 
 #include <sys/stat.h>
 
+#include "demo_bag_writer.hpp"
+#include "lfd_segmentation/bag_features.hpp"
 #include "lfd_segmentation/csv_features.hpp"
+#include "lfd_segmentation/segmentation_json.hpp"
 
 namespace {
 
@@ -152,6 +157,68 @@ TEST(SegmentCli, BadInputFailsWithAnErrorInTheJson) {
   EXPECT_NE(j["error"].get<std::string>().find("cannot open"), std::string::npos);
   j = run_cli("--bogus x " + csv, &status);
   EXPECT_EQ(status, 1);
+}
+
+// Each feature's role as the bag reader gave it.
+std::map<std::string, std::string> roles_of(const lfd_segmentation::DemoFeatures& demo) {
+  std::map<std::string, std::string> roles;
+  for (const std::string& name : demo.state_features) roles[name] = "state";
+  for (const std::string& name : demo.sensor_features) roles[name] = "sensor";
+  for (const std::string& name : demo.context_features) roles[name] = "context";
+  return roles;
+}
+
+// `segment --features` emits the matrix the segmentation read, which the figures draw: the bag
+// reader's resampling of the same config, exactly its clock (that of the changepoint times),
+// every feature with its role and each value within half its rounding step, in few bytes.
+TEST(SegmentCli, FeaturesAreTheMatrixTheBagReaderGave) {
+  std::vector<std::string> bags;
+  std::string files;
+  for (unsigned d = 0; d < 3; ++d) {
+    lfd_segmentation_test::DemoBagOptions o;
+    o.seed = 40 + d;
+    o.duration = 7.0 + 0.5 * d;
+    bags.push_back((temp_dir() / ("features" + std::to_string(d) + ".bag")).string());
+    lfd_segmentation_test::write_demo_bag(bags.back(), o);
+    files += " " + bags.back();
+  }
+  int status = -1;
+  const auto j = run_cli("--features --no-profiles" + files, &status);
+  ASSERT_EQ(status, 0) << j.dump();
+  const auto params =
+      lfd_segmentation::load_params_file(std::string(LFD_CONFIG_DIR) + "/segmentation.yaml");
+  ASSERT_EQ(j["feature_matrices"].size(), bags.size());
+  for (std::size_t d = 0; d < bags.size(); ++d) {
+    const lfd_segmentation::DemoFeatures read =
+        lfd_segmentation::read_bag_features(bags[d], params.topics, params.rate, params.limits);
+    const nlohmann::json& m = j["feature_matrices"][d];
+    EXPECT_EQ(m["time"].get<std::vector<double>>(), read.matrix.time);
+    for (std::size_t k = 0; k < j["demos"][d]["changepoints"].size(); ++k) {
+      EXPECT_EQ(m["time"][j["demos"][d]["changepoints"][k].get<std::size_t>()],
+                j["demos"][d]["changepoint_times"][k]);
+    }
+    ASSERT_EQ(m["features"].size(), static_cast<std::size_t>(read.matrix.cols()));
+    std::size_t values = 0;
+    for (Eigen::Index c = 0; c < read.matrix.cols(); ++c) {
+      const nlohmann::json& f = m["features"][c];
+      const std::string name = read.matrix.names[c];
+      EXPECT_EQ(f["name"], name);
+      EXPECT_EQ(f["role"], roles_of(read)[name]) << name;
+      const std::vector<double> got = f["values"].get<std::vector<double>>();
+      const Eigen::VectorXd want = read.matrix.data.col(c);
+      ASSERT_EQ(got.size(), static_cast<std::size_t>(want.size())) << name;
+      double error = 0;
+      for (Eigen::Index r = 0; r < want.size(); ++r)
+        error = std::max(error, std::abs(got[r] - want[r]));
+      // Constant features here are 0 or 1, which any step keeps exactly.
+      const double step =
+          lfd_segmentation::kFeatureResolution * (want.maxCoeff() - want.minCoeff());
+      EXPECT_LE(error, 0.5 * step * (1 + 1e-9)) << name;
+      values += got.size();
+    }
+    // Rounded, not 17 digits: the 9 demos x 25 features x 600 samples of a dataset in ~1.5 MB.
+    EXPECT_LT(double(m["features"].dump().size()) / values, 12.0);
+  }
 }
 
 TEST(CsvFeatures, ParsesHeaderTimeAndRejectsRaggedRows) {

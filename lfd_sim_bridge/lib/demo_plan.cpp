@@ -9,15 +9,26 @@ namespace lfd_sim_bridge {
 namespace demo {
 namespace {
 
+using task::StepKind;
+
 Eigen::Quaterniond yawRotation(double yaw) {
   return Eigen::Quaterniond(Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()));
 }
 
-// Wraps a stick yaw into (-pi/2, pi/2]: the stick is symmetric, and the wrist prefers small yaws.
-double symmetricYaw(double yaw) {
-  while (yaw > M_PI / 2) yaw -= M_PI;
-  while (yaw <= -M_PI / 2) yaw += M_PI;
+// Wraps a yaw into (-pi/n, pi/n]: a tool that looks the same turned by 2 pi / n takes the turn
+// nearest the wrist's comfortable middle.
+double wrapYaw(double yaw, int n) {
+  const double period = 2.0 * M_PI / n;
+  while (yaw > period / 2) yaw -= period;
+  while (yaw <= -period / 2) yaw += period;
   return yaw;
+}
+
+Pose poseAt(const Eigen::Vector3d& position, const Eigen::Quaterniond& orientation) {
+  Pose p;
+  p.position = position;
+  p.orientation = orientation.normalized();
+  return p;
 }
 
 Segment move(const std::string& label, const Pose& target, double duration) {
@@ -34,184 +45,31 @@ Segment hold(const std::string& label, const Pose& at, double duration) {
   return s;
 }
 
-// How far behind the centre of a square (half size `half`, rotated by `yaw`) a flat pusher of
-// half width `pusher_half` first touches it, moving along the horizontal unit `dir` through the
-// centre. Off the square's axes the contact is an edge or a corner, farther out than `half`; a
-// pusher narrower than the square may still miss the corner and meet the face.
-double contactDistance(const Eigen::Vector3d& dir, double half, double yaw, double pusher_half) {
-  const double angle = std::atan2(dir.y(), dir.x()) - yaw;
-  const Eigen::Vector2d d(std::cos(angle), std::sin(angle));  // in the square's frame
-  const Eigen::Vector2d n(-d.y(), d.x());
-  // Depth of the square behind the centre along the line at lateral offset l: the largest s with
-  // -s d + l n inside, i.e. the tighter of the two axes' bounds; concave and piecewise linear in l.
-  const auto depth = [&](double l) {
-    double s = std::numeric_limits<double>::infinity();
-    for (int k = 0; k < 2; ++k)
-      if (std::abs(d[k]) > 1e-12)
-        s = std::min(s, (half + l * n[k] * (d[k] > 0 ? 1 : -1)) / std::abs(d[k]));
-    return s;
-  };
-  double best = std::max(depth(-pusher_half), depth(pusher_half));
-  // The depth is concave in l and peaks on the line through the square's rearmost corner.
-  const Eigen::Vector2d corner = -half * d.cwiseSign();
-  if (std::abs(corner.dot(n)) <= pusher_half) best = std::max(best, -corner.dot(d));
-  return best;
+Frame fromWorld(const Eigen::Isometry3d& base_from_world, const Pose& world) {
+  Frame f;
+  f.position = base_from_world * world.position;
+  f.yaw = yawOf(Eigen::Quaterniond(base_from_world.linear()) * world.orientation);
+  return f;
 }
 
-Pose poseAt(const Eigen::Vector3d& position, const Eigen::Quaterniond& orientation) {
-  Pose p;
-  p.position = position;
-  p.orientation = orientation.normalized();
-  return p;
+// `f` moved by `local` (position and yaw in f's axes).
+Frame compose(const Frame& f, const Pose& local) {
+  Frame out;
+  out.position = f.position + yawRotation(f.yaw) * local.position;
+  out.yaw = f.yaw + yawOf(local.orientation);
+  return out;
 }
 
-// Applies the speed factor and, in teleop-like mode, the operator's uneven timing and
-// hesitations (a move split into two minimum-jerk sub-movements with a pause in between, the
-// "submovement" structure of human reaching).
-class Timer {
- public:
-  Timer(double speed, const TeleopStyle& teleop, std::mt19937& rng)
-      : speed_(speed), teleop_(teleop), rng_(rng) {}
-
-  void addMove(std::vector<Segment>* out, const Pose& from, const std::string& label,
-               const Pose& to, double nominal) {
-    double duration = nominal / speed_;
-    if (!teleop_.enabled) {
-      out->push_back(move(label, to, duration));
-      return;
-    }
-    std::uniform_real_distribution<double> unit(0.0, 1.0);
-    duration *= 1.0 + teleop_.duration_jitter * (2.0 * unit(rng_) - 1.0);
-    if (unit(rng_) < teleop_.slowdown_probability) duration *= teleop_.slowdown_factor;
-    if (unit(rng_) < teleop_.hesitation_probability) {
-      const double split = 0.45 + 0.35 * unit(rng_);
-      const double pause = teleop_.pause_min + (teleop_.pause_max - teleop_.pause_min) * unit(rng_);
-      const Pose midway = interpolate(from, to, split);
-      out->push_back(move(label, midway, duration * std::sqrt(split)));
-      out->push_back(hold(label + "_hesitate", midway, pause));
-      out->push_back(move(label, to, duration * std::sqrt(1.0 - split)));
-    } else {
-      out->push_back(move(label, to, duration));
-    }
-  }
-
-  double scaled(double nominal) const { return nominal / speed_; }
-
- private:
-  double speed_;
-  const TeleopStyle& teleop_;
-  std::mt19937& rng_;
-};
-
-DemoPlan planGrasp(const TaskInstance& inst, const Pose& start, const Geometry& g, const Timing& tm,
-                   const Variation& var, const TeleopStyle& teleop, std::mt19937& rng) {
-  Timer timer(var.speed, teleop, rng);
-  const double stick_yaw = symmetricYaw(yawOf(inst.object_start.orientation));
-  const Eigen::Vector3d axis = yawRotation(stick_yaw) * Eigen::Vector3d::UnitX();
-  const Eigen::Quaterniond grip =
-      yawRotation(symmetricYaw(stick_yaw + var.grasp_yaw)) * g.grasp_orientation;
-  Eigen::Vector3d grasp_position = inst.object_start.position + var.grasp_offset_along * axis +
-                                   Eigen::Vector3d(0, 0, g.grasp_height);
-  if (teleop.enabled) {
-    std::uniform_real_distribution<double> error(-teleop.grasp_position_noise,
-                                                 teleop.grasp_position_noise);
-    grasp_position.x() += error(rng);
-    grasp_position.y() += error(rng);
-  }
-  const Pose grasp = poseAt(grasp_position, grip);
-  const Pose pregrasp = poseAt(grasp_position + Eigen::Vector3d(0, 0, g.pregrasp_height), grip);
-  const Pose lifted = poseAt(grasp_position + Eigen::Vector3d(0, 0, g.lift_height), grip);
-  // The stick moves rigidly with the hand: the TCP goal is the grasp pose carried by the
-  // transform that takes the stick's start pose to its goal pose.
-  const Eigen::Quaterniond object_motion =
-      inst.goal.orientation.normalized() * inst.object_start.orientation.normalized().inverse();
-  const Eigen::Quaterniond goal_yaw_only = yawRotation(yawOf(object_motion));
-  const Pose carried =
-      poseAt(inst.goal.position + goal_yaw_only * (grasp_position - inst.object_start.position),
-             goal_yaw_only * grip);
-
-  DemoPlan plan;
-  plan.task = "grasp";
-  plan.start = start;
-  Phase approach{"approach", 0, {}};
-  Segment open = hold("open", start, timer.scaled(tm.open));
-  open.gripper = GripperAction{g.open_opening, 0.0};
-  approach.segments.push_back(open);
-  timer.addMove(&approach.segments, start, "pregrasp", pregrasp, tm.to_pregrasp);
-  timer.addMove(&approach.segments, pregrasp, "descend", grasp, tm.descend);
-
-  Phase closing{"grasp", 1, {}};
-  if (teleop.enabled) {
-    // No force feedback: the operator closes fully after a reaction delay and waits a fixed time.
-    closing.segments.push_back(hold("react", grasp, teleop.reaction_delay));
-    Segment close = hold("close", grasp, timer.scaled(teleop.timed_close));
-    close.gripper = GripperAction{g.teleop_close_opening, g.grasp_effort};
-    closing.segments.push_back(close);
-  } else {
-    Segment close = hold("close", grasp, timer.scaled(tm.close));
-    close.gripper = GripperAction{g.grasp_opening, g.grasp_effort};
-    close.until_contact = true;
-    close.settle = tm.settle;
-    closing.segments.push_back(close);
-  }
-
-  Phase carry{"move", 2, {}};
-  timer.addMove(&carry.segments, grasp, "lift", lifted, tm.lift);
-  timer.addMove(&carry.segments, lifted, "carry", carried, tm.carry);
-  carry.segments.push_back(hold("hold", carried, timer.scaled(tm.hold)));
-
-  plan.phases = {approach, closing, carry};
-  return plan;
-}
-
-DemoPlan planPush(const TaskInstance& inst, const Pose& start, const Geometry& g, const Timing& tm,
-                  const Variation& var, const TeleopStyle& teleop, std::mt19937& rng) {
-  Timer timer(var.speed, teleop, rng);
-  Eigen::Vector3d travel = inst.goal.position - inst.object_start.position;
-  travel.z() = 0.0;
-  if (travel.norm() < 1e-3)
-    throw std::invalid_argument("push target is within 1 mm of the box start: nothing to push");
-  const Eigen::Vector3d dir = travel.normalized();
-  const Eigen::Quaterniond hand =
-      yawRotation(std::atan2(dir.y(), dir.x())) * g.push_orientation.normalized();
-  const Eigen::Vector3d height(0, 0, g.push_height);
-  // TCP-to-box-centre distance along the push when the fist touches the box.
-  // The fist is a square block of half size tcp_to_face, squarely facing the push.
-  const double face =
-      contactDistance(dir, g.box_half_length, yawOf(inst.object_start.orientation), g.tcp_to_face) +
-      g.tcp_to_face;
-  const Pose behind =
-      poseAt(inst.object_start.position + height - (face + g.push_clearance) * dir, hand);
-  const Pose above = poseAt(behind.position + Eigen::Vector3d(0, 0, g.push_prelift), hand);
-  // The paper's push phase is the time in contact: the approach ends with the fist on the face,
-  // so the box starts moving (and the touch sensors fire) as the push phase starts.
-  const Pose touching =
-      poseAt(inst.object_start.position + height - (face - g.push_contact_depth) * dir, hand);
-  const Pose pushed = poseAt(inst.goal.position + height - face * dir, hand);
-  const Pose retreated =
-      poseAt(pushed.position - g.retreat * dir + Eigen::Vector3d(0, 0, g.retreat), hand);
-
-  DemoPlan plan;
-  plan.task = "push";
-  plan.start = start;
-  Phase approach{"approach", 0, {}};
-  Segment fist = hold("close", start, timer.scaled(tm.open));
-  fist.gripper = GripperAction{0.0, 0.0};  // a closed hand gives a flat, stiff pushing face
-  approach.segments.push_back(fist);
-  timer.addMove(&approach.segments, start, "prepush", above, tm.to_prepush);
-  timer.addMove(&approach.segments, above, "lower", behind, tm.lower);
-  timer.addMove(&approach.segments, behind, "touch", touching, tm.touch);
-
-  Phase push{"push", 1, {}};
-  timer.addMove(&push.segments, touching, "push", pushed, tm.push);
-
-  Phase back{"return", 2, {}};
-  timer.addMove(&back.segments, pushed, "retreat", retreated, tm.retreat);
-  timer.addMove(&back.segments, retreated, "home", start, tm.go_home);
-  (void)var;
-
-  plan.phases = {approach, push, back};
-  return plan;
+// `f` moved by a uniform draw within the object's +- ranges (none listed: unchanged).
+Frame jittered(const Frame& f, const std::map<std::string, task::Jitter>& ranges,
+               const std::string& object, std::mt19937& rng) {
+  const auto j = ranges.find(object);
+  if (j == ranges.end()) return f;
+  std::uniform_real_distribution<double> sym(-1.0, 1.0);
+  Pose local;
+  for (int i = 0; i < 3; ++i) local.position[i] = j->second.position[i] * sym(rng);
+  local.orientation = yawRotation(j->second.yaw * sym(rng));
+  return compose(f, local);
 }
 
 }  // namespace
@@ -233,17 +91,229 @@ double yawOf(const Eigen::Quaterniond& q) {
   return std::atan2(x.y(), x.x());
 }
 
-DemoPlan planDemo(const TaskInstance& instance, const Pose& start, const Geometry& geometry,
-                  const Timing& timing, const Variation& variation, const TeleopStyle& teleop,
-                  std::mt19937& rng) {
-  if (!(variation.speed > 0.0) || !std::isfinite(variation.speed))
-    throw std::invalid_argument("demo speed factor must be > 0, got " +
-                                std::to_string(variation.speed));
-  if (instance.task == "grasp")
-    return planGrasp(instance, start, geometry, timing, variation, teleop, rng);
-  if (instance.task == "push")
-    return planPush(instance, start, geometry, timing, variation, teleop, rng);
-  throw std::invalid_argument("unknown task '" + instance.task + "' (expected grasp or push)");
+double contactDistance(const Eigen::Vector3d& dir, const Eigen::Vector2d& half, double yaw,
+                       double pusher_half) {
+  const double angle = std::atan2(dir.y(), dir.x()) - yaw;
+  const Eigen::Vector2d d(std::cos(angle), std::sin(angle));  // in the box's frame
+  const Eigen::Vector2d n(-d.y(), d.x());
+  // Depth of the box behind the centre along the line at lateral offset l: the largest s with
+  // -s d + l n inside, i.e. the tighter of the two axes' bounds; concave and piecewise linear in l.
+  const auto depth = [&](double l) {
+    double s = std::numeric_limits<double>::infinity();
+    for (int k = 0; k < 2; ++k)
+      if (std::abs(d[k]) > 1e-12)
+        s = std::min(s, (half[k] + l * n[k] * (d[k] > 0 ? 1 : -1)) / std::abs(d[k]));
+    return s;
+  };
+  double best = std::max(depth(-pusher_half), depth(pusher_half));
+  // The depth is concave in l and peaks on the line through the box's rearmost corner.
+  const Eigen::Vector2d corner = -half.cwiseProduct(d.cwiseSign());
+  if (std::abs(corner.dot(n)) <= pusher_half) best = std::max(best, -corner.dot(d));
+  return best;
+}
+
+TaskInterpreter::TaskInterpreter(task::TaskDefinition task, task::Scene scene,
+                                 lfd::GripperSetup gripper, ToolGeometry tool, TeleopStyle teleop)
+    : task_(std::move(task)),
+      scene_(std::move(scene)),
+      gripper_(std::move(gripper)),
+      tool_(tool),
+      teleop_(teleop) {}
+
+StepTiming TaskInterpreter::drawTiming(const task::Step& step, double speed,
+                                       std::mt19937& rng) const {
+  StepTiming t;
+  t.duration = step.duration / speed;
+  const bool moves =
+      step.kind == StepKind::kMove || step.kind == StepKind::kCarry || step.kind == StepKind::kPush;
+  if (!teleop_.enabled || !moves) return t;
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  t.duration *= 1.0 + teleop_.duration_jitter * (2.0 * unit(rng) - 1.0);
+  if (unit(rng) < teleop_.slowdown_probability) t.duration *= teleop_.slowdown_factor;
+  if (unit(rng) < teleop_.hesitation_probability) {
+    t.hesitate = true;
+    t.split = 0.45 + 0.35 * unit(rng);
+    t.pause = teleop_.pause_min + (teleop_.pause_max - teleop_.pause_min) * unit(rng);
+  }
+  return t;
+}
+
+DemoState TaskInterpreter::begin(const task::Configuration& c,
+                                 const Eigen::Isometry3d& world_from_base, const Pose& start,
+                                 double speed, std::mt19937& rng) const {
+  if (!(speed > 0.0) || !std::isfinite(speed))
+    throw std::invalid_argument("demo speed factor must be > 0, got " + std::to_string(speed));
+  const Eigen::Isometry3d base_from_world = world_from_base.inverse();
+  DemoState s;
+  s.start = start;
+  s.grasp_tcp = start;
+  Frame base;
+  s.frames["base"] = base;
+  s.frames["goal"] = fromWorld(base_from_world, c.goal);
+  Frame tcp_start{start.position, yawOf(start.orientation), start.orientation};
+  s.frames["start"] = tcp_start;
+  s.frames["tcp"] = tcp_start;
+  for (const std::string& name : task_.objects) {
+    const Frame truth = fromWorld(base_from_world, c.objects.at(name));
+    // Where the hand takes it: the task's variation and, in teleop mode, the operator's error.
+    Frame aim = jittered(truth, task_.variation, name, rng);
+    if (teleop_.enabled) aim = jittered(aim, task_.teleop_placement, name, rng);
+    s.frames[name] = aim;
+    s.true_starts[name] = truth;
+    // The object's own frames (a drawer's handle), moved by their joint's start value.
+    for (const auto& [part, f] : scene_.find(name)->frames) {
+      Pose local = f.pose;
+      if (!f.joint.empty()) {
+        const auto q = c.joints.find(f.joint);
+        const double value = q == c.joints.end() ? 0.0 : q->second;
+        local.position += value * scene_.find(name)->joints.at(f.joint).axis;
+      }
+      s.frames[name + "." + part] = compose(aim, local);
+      s.true_starts[name + "." + part] = compose(truth, local);
+    }
+  }
+  for (const auto& [name, spec] : task_.frames) s.frames[name] = resolveFrame(s, spec);
+  for (const task::PhaseSpec& phase : task_.phases) {
+    s.timings.emplace_back();
+    for (const task::Step& step : phase.steps)
+      s.timings.back().push_back(drawTiming(step, speed, rng));
+  }
+  return s;
+}
+
+const Frame& TaskInterpreter::frame(const DemoState& s, const std::string& name) const {
+  const auto it = s.frames.find(name);
+  if (it == s.frames.end())
+    throw std::invalid_argument("task file '" + task_.path + "': no frame '" + name + "'");
+  return it->second;
+}
+
+Frame TaskInterpreter::resolveFrame(const DemoState& s, const task::FrameSpec& f) const {
+  if (f.kind == task::FrameSpec::Kind::kRelative) return targetFrame(s, f.relative);
+  if (f.kind == task::FrameSpec::Kind::kHeading) {
+    Frame out = frame(s, f.from);
+    const Eigen::Vector3d d = frame(s, f.to).position - out.position;
+    if (d.head<2>().norm() < 1e-3)
+      throw std::invalid_argument("task file '" + task_.path + "': " + f.where + ": '" + f.to +
+                                  "' is within 1 mm of '" + f.from + "': no heading");
+    out.yaw = std::atan2(d.y(), d.x());
+    out.orientation.reset();
+    return out;
+  }
+  // kTouch: the closed fist's face on the object, approaching along `along`'s x axis.
+  const Frame& object = frame(s, f.object);
+  const Frame& along = frame(s, f.along);
+  const Eigen::Vector3d dir(std::cos(along.yaw), std::sin(along.yaw), 0.0);
+  const Eigen::Vector3d& half = scene_.find(f.object)->half_size;
+  const double face = contactDistance(dir, half.head<2>(), object.yaw, tool_.fist_half_width) +
+                      tool_.fist_half_width;
+  Frame out;
+  out.position = object.position - face * dir;
+  out.yaw = along.yaw;
+  return out;
+}
+
+Frame TaskInterpreter::targetFrame(const DemoState& s, const task::PoseSpec& spec) const {
+  const Frame& f = frame(s, spec.frame);
+  const Frame& axes = spec.axes.empty() ? f : frame(s, spec.axes);
+  Frame out;
+  out.position = f.position + yawRotation(axes.yaw) * spec.position;
+  out.yaw = f.yaw + spec.yaw;
+  if (f.orientation) out.orientation = yawRotation(spec.yaw) * *f.orientation;
+  return out;
+}
+
+Pose TaskInterpreter::target(const DemoState& s, const task::PoseSpec& spec) const {
+  const Frame t = targetFrame(s, spec);
+  if (t.orientation) return poseAt(t.position, *t.orientation);
+  return poseAt(t.position, yawRotation(wrapYaw(t.yaw, spec.symmetry)) * scene_.tool_orientation);
+}
+
+void TaskInterpreter::addStep(DemoState& s, const task::Step& step, const StepTiming& timing,
+                              Pose* tcp, std::vector<Segment>* out) const {
+  s.frames["tcp"] = Frame{tcp->position, yawOf(tcp->orientation), tcp->orientation};
+  Pose to = *tcp;
+  switch (step.kind) {
+    case StepKind::kHold:
+      out->push_back(hold(step.label, *tcp, timing.duration));
+      return;
+    case StepKind::kGripper: {
+      if (!step.open) s.grasp_tcp = *tcp;  // what the hand closes on moves with it from here
+      const GripperAction action =
+          step.open ? GripperAction{gripper_.open_opening, 0.0}
+                    : GripperAction{gripper_.close_opening, gripper_.close_effort};
+      if (step.until_contact != Contact::kNone && teleop_.enabled) {
+        // No force feedback: the operator closes after a reaction delay and waits a fixed time.
+        out->push_back(hold("react", *tcp, teleop_.reaction_delay));
+        Segment close =
+            hold(step.label, *tcp, teleop_.timed_close * timing.duration / step.duration);
+        close.gripper = action;
+        out->push_back(close);
+        return;
+      }
+      Segment g = hold(step.label, *tcp, timing.duration);
+      g.gripper = action;
+      g.until_contact = step.until_contact;
+      g.settle = step.settle;
+      out->push_back(g);
+      return;
+    }
+    case StepKind::kMove:
+      to = target(s, step.target);
+      break;
+    case StepKind::kCarry: {  // the held thing keeps its place in the hand
+      const Frame goal = targetFrame(s, step.target);
+      const Frame& held = s.true_starts.at(step.held);
+      const Eigen::Quaterniond turn = yawRotation(goal.yaw - held.yaw);
+      to = poseAt(goal.position + turn * (s.grasp_tcp.position - held.position),
+                  turn * s.grasp_tcp.orientation);
+      break;
+    }
+    case StepKind::kPush: {  // the hand moves the object along the table by its displacement
+      Eigen::Vector3d travel =
+          targetFrame(s, step.target).position - s.true_starts.at(step.held).position;
+      travel.z() = 0.0;
+      to = poseAt(tcp->position + travel, tcp->orientation);
+      break;
+    }
+  }
+  std::vector<Segment> moves;
+  if (timing.hesitate) {  // two minimum-jerk sub-movements with a pause: human reaching
+    const Pose midway = interpolate(*tcp, to, timing.split);
+    moves.push_back(move(step.label, midway, timing.duration * std::sqrt(timing.split)));
+    moves.push_back(hold(step.label + "_hesitate", midway, timing.pause));
+    moves.push_back(move(step.label, to, timing.duration * std::sqrt(1.0 - timing.split)));
+  } else {
+    moves.push_back(move(step.label, to, timing.duration));
+  }
+  for (Segment& m : moves) m.until_contact = step.until_contact;
+  moves.back().settle = step.settle;
+  out->insert(out->end(), moves.begin(), moves.end());
+  *tcp = to;
+}
+
+Phase TaskInterpreter::planPhase(DemoState& s, size_t i, const Pose& tcp) const {
+  const task::PhaseSpec& spec = task_.phases.at(i);
+  Phase phase;
+  phase.name = spec.name;
+  phase.index = static_cast<int>(i);
+  phase.window = spec.window;
+  Pose at = tcp;
+  for (size_t k = 0; k < spec.steps.size(); ++k)
+    addStep(s, spec.steps[k], s.timings[i][k], &at, &phase.segments);
+  return phase;
+}
+
+DemoPlan TaskInterpreter::planAll(DemoState s) const {
+  DemoPlan plan;
+  plan.task = task_.name;
+  plan.start = s.start;
+  Pose at = s.start;
+  for (size_t i = 0; i < task_.phases.size(); ++i) {
+    plan.phases.push_back(planPhase(s, i, at));
+    at = plan.phases.back().segments.back().target;
+  }
+  return plan;
 }
 
 Pose phasePoseAt(const Pose& start, const Phase& phase, double t) {

@@ -158,9 +158,8 @@ WorkcellSim::WorkcellSim(const std::string& mjcf_path, const WorkcellConfig& con
 
   for (const std::string& name : config_.objects) {
     const int body = mj_name2id(m_, mjOBJ_BODY, name.c_str());
-    if (body < 0 || m_->body_jntnum[body] < 1 ||
-        m_->jnt_type[m_->body_jntadr[body]] != mjJNT_FREE) {
-      this->log(LogLevel::kWarn, "no free body '" + name + "'; it will not be reported");
+    if (body <= 0) {
+      this->log(LogLevel::kWarn, "no body '" + name + "'; it will not be reported");
       continue;
     }
     objects_.emplace_back(name, body);
@@ -174,6 +173,13 @@ WorkcellSim::WorkcellSim(const std::string& mjcf_path, const WorkcellConfig& con
 
   initial_qpos_.assign(m_->qpos0, m_->qpos0 + m_->nq);
   scene_qpos_ = initial_qpos_;
+  scene_mocap_.assign(7 * m_->nmocap, 0.0);
+  for (int b = 0; b < m_->nbody; ++b) {
+    const int id = m_->body_mocapid[b];
+    if (id < 0) continue;
+    std::copy(m_->body_pos + 3 * b, m_->body_pos + 3 * b + 3, scene_mocap_.begin() + 7 * id);
+    std::copy(m_->body_quat + 4 * b, m_->body_quat + 4 * b + 4, scene_mocap_.begin() + 7 * id + 3);
+  }
   for (const auto& [name, value] : config_.initial_posture) {
     if (!hasJoint(name)) {
       this->log(LogLevel::kWarn, "initial posture names unknown joint '" + name + "'; ignored");
@@ -494,9 +500,12 @@ void WorkcellSim::recoverFromDivergence(const std::string& why) {
   mj_resetData(m_, d_);
   touch_filtered_.assign(touch_adr_.size(), 0.0);
   for (const auto& [name, body] : objects_) {
-    const int adr = m_->jnt_qposadr[m_->body_jntadr[body]];
+    const int jnt = freeJointOf(body);
+    if (jnt < 0) continue;
+    const int adr = m_->jnt_qposadr[jnt];
     std::copy(scene_qpos_.begin() + adr, scene_qpos_.begin() + adr + 7, d_->qpos + adr);
   }
+  restoreMocap();
   applyPosture({});
   d_->time = t;
   mj_forward(m_, d_);
@@ -537,10 +546,22 @@ void WorkcellSim::reset(const std::map<std::string, double>& posture, bool reset
   }
   const double t = d_->time;
   std::vector<mjtNum> qpos(d_->qpos, d_->qpos + m_->nq), qvel(d_->qvel, d_->qvel + m_->nv);
-  mj_resetData(m_, d_);
+  mj_resetData(m_, d_);  // fixed (mocap) objects back at their model poses
   touch_filtered_.assign(touch_adr_.size(), 0.0);
+  if (reset_objects) {
+    for (int b = 0; b < m_->nbody; ++b) {
+      const int id = m_->body_mocapid[b];
+      if (id < 0) continue;
+      std::copy(d_->mocap_pos + 3 * id, d_->mocap_pos + 3 * id + 3, scene_mocap_.begin() + 7 * id);
+      std::copy(d_->mocap_quat + 4 * id, d_->mocap_quat + 4 * id + 4,
+                scene_mocap_.begin() + 7 * id + 3);
+    }
+  } else {
+    restoreMocap();
+  }
   for (const auto& [name, body] : objects_) {
-    const int jnt = m_->body_jntadr[body];
+    const int jnt = freeJointOf(body);
+    if (jnt < 0) continue;
     const int qadr = m_->jnt_qposadr[jnt], vadr = m_->jnt_dofadr[jnt];
     if (reset_objects) {
       std::copy(initial_qpos_.begin() + qadr, initial_qpos_.begin() + qadr + 7, d_->qpos + qadr);
@@ -557,11 +578,30 @@ void WorkcellSim::reset(const std::map<std::string, double>& posture, bool reset
   mj_forward(m_, d_);
 }
 
+int WorkcellSim::freeJointOf(int body) const {
+  const int jnt = m_->body_jntadr[body];
+  return m_->body_jntnum[body] >= 1 && m_->jnt_type[jnt] == mjJNT_FREE ? jnt : -1;
+}
+
+void WorkcellSim::restoreMocap() {
+  for (int id = 0; id < m_->nmocap; ++id) {
+    std::copy(scene_mocap_.begin() + 7 * id, scene_mocap_.begin() + 7 * id + 3,
+              d_->mocap_pos + 3 * id);
+    std::copy(scene_mocap_.begin() + 7 * id + 3, scene_mocap_.begin() + 7 * id + 7,
+              d_->mocap_quat + 4 * id);
+  }
+}
+
 void WorkcellSim::checkObjectPose(const std::string& object, const Pose& pose) const {
-  if (std::none_of(objects_.begin(), objects_.end(),
-                   [&](const auto& o) { return o.first == object; }))
+  const auto it = std::find_if(objects_.begin(), objects_.end(),
+                               [&](const auto& o) { return o.first == object; });
+  if (it == objects_.end())
     throw std::invalid_argument("unknown object '" + object.substr(0, 64) +
                                 (object.size() > 64 ? "...'" : "'"));
+  if (freeJointOf(it->second) < 0 && m_->body_mocapid[it->second] < 0)
+    throw std::invalid_argument("object '" + object +
+                                "' is part of an articulated object and moves with its joint; "
+                                "it cannot be placed");
   for (int i = 0; i < 3; ++i) {
     const double v = pose.position[i];
     if (!std::isfinite(v)) throw std::invalid_argument("non-finite position for " + object);
@@ -590,13 +630,23 @@ void WorkcellSim::setObjectPose(const std::string& object, const Pose& pose) {
   mjtNum quat[4] = {pose.orientation[0], pose.orientation[1], pose.orientation[2],
                     pose.orientation[3]};
   mju_scl(quat, quat, 1.0 / std::sqrt(mju_dot(quat, quat, 4)), 4);
-  const int jnt = m_->body_jntadr[it->second];
+  ActiveSimGuard guard(this, &log_);
+  const int mocap = m_->body_mocapid[it->second];
+  if (mocap >= 0) {  // a fixed object: placed, never moved by contact
+    for (int i = 0; i < 3; ++i) d_->mocap_pos[3 * mocap + i] = pose.position[i];
+    for (int i = 0; i < 4; ++i) d_->mocap_quat[4 * mocap + i] = quat[i];
+    std::copy(d_->mocap_pos + 3 * mocap, d_->mocap_pos + 3 * mocap + 3,
+              scene_mocap_.begin() + 7 * mocap);
+    std::copy(quat, quat + 4, scene_mocap_.begin() + 7 * mocap + 3);
+    mj_forward(m_, d_);
+    return;
+  }
+  const int jnt = freeJointOf(it->second);
   const int qadr = m_->jnt_qposadr[jnt], vadr = m_->jnt_dofadr[jnt];
   for (int i = 0; i < 3; ++i) d_->qpos[qadr + i] = pose.position[i];
   for (int i = 0; i < 4; ++i) d_->qpos[qadr + 3 + i] = quat[i];
   mju_zero(d_->qvel + vadr, 6);
   std::copy(d_->qpos + qadr, d_->qpos + qadr + 7, scene_qpos_.begin() + qadr);
-  ActiveSimGuard guard(this, &log_);
   mj_forward(m_, d_);
 }
 

@@ -4,10 +4,14 @@
 Writes, next to this file:
   jvrc1_like.urdf  plain URDF of a JVRC-1-like humanoid with a fixed pelvis and a right gripper
   jvrc1_like.xml   the same robot in MJCF (to be <include>d), with actuators, sites and sensors
-  workcell.xml     the MuJoCo scene: robot, floor, table, graspable stick and pushable box
+  workcell.xml     the MuJoCo scene: robot, floor, table, the stick, the box, the block and the
+                   drawer cabinet
 
-Every number lives in the tables below; both robot files are emitted from the same link list, so
-the URDF and MJCF cannot drift apart (lfd_sim_bridge/test/test_model_consistency.cpp checks it).
+The workcell's shared facts (table, the robot's placement, object sizes, park poses, the drawer's
+joint and handle) are read from config/scene.yaml, which the task files and the demonstrator read
+too; every other number lives in the tables below. Both robot files are emitted from the same link
+list, so the URDF and MJCF cannot drift apart (lfd_sim_bridge/test/test_model_consistency.cpp
+checks it, and that workcell.xml is what this script makes of scene.yaml).
 
 Conventions: every joint frame is aligned with its parent (no rotation offsets), "P" joints turn
 about y, "R" about x, "Y" about z. In the zero pose the robot stands upright with the arms hanging
@@ -16,15 +20,51 @@ gripper centre plane: 0 = closed, 0.045 = fully open (gap = 2 * R_GRIPPER).
 Run: /usr/bin/python3 lfd_sim_bridge/models/generate_models.py
 """
 
+import math
 import os
+import sys
+
+import yaml
 
 HERE = os.path.dirname(os.path.abspath(__file__))
-PELVIS_HEIGHT = 0.85  # world z of base_link (the pelvis is fixed in the world)
-TABLE_TOP = 0.80  # world z of the table surface
-TABLE_CENTER = (0.50, -0.10)  # world xy of the table centre
-TABLE_HALF = (0.35, 0.50, 0.02)  # half sizes of the table top
-STICK_HALF, STICK_MASS = (0.125, 0.015, 0.015), 0.12  # square bar 25 x 3 x 3 cm
-BOX_HALF, BOX_MASS = (0.04, 0.04, 0.04), 1.0  # 8 cm cube
+SCENE_FILE = os.path.join(HERE, '..', '..', 'config', 'scene.yaml')
+
+
+def load_scene(path=SCENE_FILE):
+    with open(path) as f:
+        return yaml.safe_load(f)
+
+
+SCENE = load_scene()
+PELVIS_HEIGHT = SCENE['base_link_in_world'][2]  # world z of base_link (the pelvis is fixed)
+TABLE_TOP = SCENE['table_top']  # world z of the table surface
+TABLE_CENTER = tuple(SCENE['table']['center'])  # world xy of the table centre
+TABLE_HALF = tuple(SCENE['table']['half_size'])  # half sizes of the table top
+# Free objects: mass (kg), colour, contact dimension and friction (sliding, torsional, rolling).
+# The stick and the block are grippy; the box slides under a push (the table's friction, 0.4,
+# rules every contact with it, so a push or a wipe slides and stops on release).
+FREE_OBJECTS = {
+    'stick': (0.12, '0.85 0.55 0.15 1', 4, '1.2 0.02 0.001'),
+    'box': (1.0, '0.2 0.7 0.3 1', 3, '0.4 0.005 0.0001'),
+    'block': (0.10, '0.8 0.2 0.25 1', 4, '1.2 0.02 0.001'),
+}
+# The drawer: the tray and the handle fin (half sizes, m), the drawer's mass (kg) and its slide's
+# damping (N s/m) and dry friction (N): a light pull opens it and it stops when let go. The fin is
+# 3 cm thick like the stick: the gripper's position servo closing on it then reaches the effort
+# limit (robot.yaml close_effort), where a 1.5 cm fin got half the squeeze.
+DRAWER_TRAY_HALF = (0.085, 0.10, 0.035)
+DRAWER_FRONT_HALF = (0.005, 0.105, 0.045)
+DRAWER_FIN_HALF = (0.035, 0.015, 0.01)
+DRAWER_MASS, DRAWER_DAMPING, DRAWER_FRICTION = 0.4, 8.0, 1.5
+# The finger tips on the table (wiping): a soft, slippery contact, like a cloth on a wet table
+# (MuJoCo impedance 0.5-0.9 over 5 mm: a 6 mm press of the stiff arm gives ~8 N; friction 0.05).
+# With the rigid, grippy default the stiff arm hopped on one finger edge (the touch pads read
+# 28 N and 0 N in turn), and table friction pushed the hand down by the stroke's speed (3-10 N
+# with 0.4): the press must be steady for its touch-down and lift-off to stand out. No grasp
+# touches the table with the fingers.
+FINGER_TABLE_CONTACT = ('solref="0.02 1" solimp="0.5 0.9 0.005" friction="0.05 0.05 0.005 0.0001 0.0001" '
+                        'condim="3"')
+FINGERS = (('r_gripper_finger_l', 'r_finger_l_pad'), ('r_gripper_finger_r', 'r_finger_r_pad'))
 
 # Per-joint-group actuation: (kp, damping, armature, velocity limit, effort limit).
 # Gains are stiff, like a high-ratio position-controlled humanoid servo, so that gravity sag stays
@@ -208,13 +248,49 @@ def fmt(v):
     return ' '.join(f'{x:.6g}' for x in v)
 
 
-def free_box(name, pos, mass, half, rgba, condim, friction):
-    """MJCF of a free-floating box-shaped object (solid inertia) that the robot manipulates."""
-    return f'''    <body name="{name}" pos="{pos}">
+def quat_of_yaw(yaw):
+    return (math.cos(yaw / 2), 0.0, 0.0, math.sin(yaw / 2))
+
+
+def free_box(name, park, mass, half, rgba, condim, friction):
+    """MJCF of a free-floating box-shaped object (solid inertia) that the robot manipulates, at its
+    park pose [x, y, z, yaw]."""
+    return f'''    <body name="{name}" pos="{fmt(park[:3])}" quat="{fmt(quat_of_yaw(park[3]))}">
       <joint name="{name}_free" type="free" damping="0.0005"/>
       <inertial pos="0 0 0" mass="{mass}" diaginertia="{fmt(box_inertia(mass, half))}"/>
       <geom name="{name}_geom" type="box" size="{fmt(half)}" rgba="{rgba}"
             contype="1" conaffinity="1" condim="{condim}" friction="{friction}"/>
+    </body>'''
+
+
+def drawer_cabinet(name, spec):
+    """MJCF of the drawer cabinet (a mocap body: placed, never pushed) with its sliding drawer and
+    the handle fin (body drawer_handle, framed at the grip point of config/scene.yaml). The drawer
+    slides through the solid cabinet (their contact is excluded, write_workcell)."""
+    half, park = spec['half_size'], spec['park']
+    (joint, j), = spec['joints'].items()
+    hx, hy, hz = half
+    handle = spec['frames']['handle']
+    grip = handle['pose'][:3]
+    tray = (round(hx - DRAWER_TRAY_HALF[0] - 0.005, 6) + 0.0, 0.0, 0.01 + DRAWER_TRAY_HALF[2])
+    front = (hx + DRAWER_FRONT_HALF[0], 0.0, DRAWER_FRONT_HALF[2] + 0.005)
+    fin_x = hx + 2 * DRAWER_FRONT_HALF[0] + DRAWER_FIN_HALF[0]  # the fin starts at the front
+    fin = (fin_x - grip[0], 0.0, 0.0)
+    wood = 'rgba="0.55 0.4 0.3 1" contype="1" conaffinity="1" condim="3"'
+    return f'''    <body name="{name}" mocap="true" pos="{fmt(park[:3])}" quat="{fmt(quat_of_yaw(park[3]))}">
+      <geom name="drawer_cabinet" type="box" size="{fmt(half)}" pos="0 0 {hz:.6g}" {wood}/>
+      <body name="{name}_tray" pos="0 0 0">
+        <joint name="{joint}" type="slide" axis="{fmt(j['axis'])}" limited="true" range="{fmt(j['range'])}"
+               damping="{DRAWER_DAMPING}" frictionloss="{DRAWER_FRICTION}" armature="0.05"/>
+        <inertial pos="{fmt(tray)}" mass="{DRAWER_MASS}" diaginertia="{fmt(box_inertia(DRAWER_MASS, DRAWER_TRAY_HALF))}"/>
+        <geom name="drawer_tray" type="box" size="{fmt(DRAWER_TRAY_HALF)}" pos="{fmt(tray)}" {wood}/>
+        <geom name="drawer_front" type="box" size="{fmt(DRAWER_FRONT_HALF)}" pos="{fmt(front)}"
+              rgba="0.7 0.55 0.4 1" contype="1" conaffinity="1" condim="3"/>
+        <body name="{handle['body']}" pos="{fmt(grip)}">
+          <geom name="drawer_fin" type="box" size="{fmt(DRAWER_FIN_HALF)}" pos="{fmt(fin)}"
+                rgba="0.3 0.3 0.35 1" contype="1" conaffinity="1" condim="4" friction="1.2 0.02 0.001"/>
+        </body>
+      </body>
     </body>'''
 
 
@@ -385,7 +461,23 @@ def write_workcell(path):
             legs.append(f'      <geom type="box" size="0.025 0.025 {leg_half:.4g}" '
                         f'pos="{sx * (hx - 0.05):.4g} {sy * (hy - 0.05):.4g} {-hz - leg_half:.4g}" '
                         'rgba="0.45 0.32 0.2 1" contype="0" conaffinity="0"/>')
-    out = f'''<!-- GENERATED by generate_models.py; edit the generator, not this file. -->
+    objects = []
+    for name, spec in SCENE['objects'].items():
+        if spec.get('fixed'):
+            objects.append(drawer_cabinet(name, spec))
+        else:
+            mass, rgba, condim, friction = FREE_OBJECTS[name]
+            objects.append(free_box(name, spec['park'], mass, spec['half_size'], rgba, condim, friction))
+    objects = '\n'.join(objects)
+    # A mocap body counts as welded to the world, so MuJoCo's parent filter does not keep its
+    # child from colliding with it: the drawer slides through its solid cabinet by exclusion.
+    excludes = [f'    <exclude body1="{name}" body2="{name}_tray"/>'
+                for name, spec in SCENE['objects'].items() if spec.get('fixed')]
+    for body, geom in FINGERS:  # the tips' own contact with the table replaces the default one
+        excludes.append(f'    <exclude body1="{body}" body2="table"/>')
+        excludes.append(f'    <pair geom1="{geom}" geom2="table_top" {FINGER_TABLE_CONTACT}/>')
+    excludes = '\n'.join(excludes)
+    out = f'''<!-- GENERATED by generate_models.py from config/scene.yaml; edit those, not this file. -->
 <mujoco model="lfd_workcell">
   <include file="jvrc1_like.xml"/>
   <!-- 1 kHz physics. Elliptic friction cones with a high impratio keep a pinch grasp from creeping;
@@ -409,31 +501,32 @@ def write_workcell(path):
     <!-- Table: top surface at z = {TABLE_TOP} m, spans x [{tx - hx:.2f}, {tx + hx:.2f}], y [{ty - hy:.2f}, {ty + hy:.2f}]. -->
     <body name="table" pos="{tx} {ty} {top_center_z:.4g}">
       <geom name="table_top" type="box" size="{hx} {hy} {hz}" rgba="0.6 0.45 0.3 1" contype="1" conaffinity="1"
-            friction="0.4 0.005 0.0001" condim="3"/>
+            friction="0.4 0.005 0.0001" condim="3" priority="1"/>
 {chr(10).join(legs)}
     </body>
-    <!-- Graspable square bar 25 x 3 x 3 cm (a stick that cannot roll), 120 g, grippy surface.
-         Default pose: parked at the far left of the table, out of the robot's way. -->
-{free_box("stick", f"0.78 0.33 {TABLE_TOP + 0.015:.4f}", STICK_MASS, STICK_HALF, "0.85 0.55 0.15 1", 4,
-          "1.2 0.02 0.001")}
-    <!-- Pushable 8 cm cube, 1 kg; table friction 0.4 lets it slide under a push and stop on release. -->
-{free_box("box", f"0.78 0.14 {TABLE_TOP + 0.04:.4f}", BOX_MASS, BOX_HALF, "0.2 0.7 0.3 1", 3,
-          "0.4 0.005 0.0001")}
+    <!-- The objects of config/scene.yaml at their park poses (far left of the table, out of the
+         robot's way): the stick (a square bar that cannot roll), the box, the block, the drawer. -->
+{objects}
   </worldbody>
+  <contact>
+{excludes}
+  </contact>
 </mujoco>
 '''
     with open(path, 'w') as f:
         f.write(out)
 
 
-def main():
+def main(out_dir=HERE):
+    """Writes the three model files into out_dir (default: next to this script; the consistency
+    test writes them elsewhere and compares)."""
     links = robot_links()
     total = sum(l.mass for l in links)
-    write_urdf(links, os.path.join(HERE, 'jvrc1_like.urdf'))
-    write_mjcf_robot(links, os.path.join(HERE, 'jvrc1_like.xml'))
-    write_workcell(os.path.join(HERE, 'workcell.xml'))
+    write_urdf(links, os.path.join(out_dir, 'jvrc1_like.urdf'))
+    write_mjcf_robot(links, os.path.join(out_dir, 'jvrc1_like.xml'))
+    write_workcell(os.path.join(out_dir, 'workcell.xml'))
     print(f'wrote jvrc1_like.urdf, jvrc1_like.xml, workcell.xml ({len(links)} links, {total:.1f} kg)')
 
 
 if __name__ == '__main__':
-    main()
+    main(*sys.argv[1:])

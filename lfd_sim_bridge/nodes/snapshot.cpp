@@ -5,9 +5,10 @@
 //            [--width 960] [--height 720] [--camera overview|free] [--lookat x,y,z]
 //            [--distance d] [--azimuth deg] [--elevation deg]
 //
-// For each time the scene is rebuilt from the bag, not simulated: the robot joints by name from
-// /joint_states, the free objects from /objects/<body>/pose (the latest message at or before the
-// time), then mj_forward and one offscreen render. Times are bag time (the recorded stamps, as
+// For each time the scene is rebuilt from the bag, not simulated: the joints by name from
+// /joint_states (the robot's and the scene's, a drawer's slide), the free and the fixed objects
+// from /objects/<body>/pose (the latest message at or before the time), then mj_forward and one
+// offscreen render. Times are bag time (the recorded stamps, as
 // the `segment` CLI reports changepoint_times), or seconds from the bag's start with --relative.
 // Writes DIR/snapshot_<k>_<t>s.png and prints one "t file" line per picture.
 //
@@ -213,6 +214,17 @@ std::vector<double> requested_times(const Options& o, const Recording& r) {
 
 // ---- scene ------------------------------------------------------------------------------------
 
+void setPose(const geometry_msgs::Pose& p, mjtNum* pos, mjtNum* quat) {
+  pos[0] = p.position.x;
+  pos[1] = p.position.y;
+  pos[2] = p.position.z;
+  quat[0] = p.orientation.w;
+  quat[1] = p.orientation.x;
+  quat[2] = p.orientation.y;
+  quat[3] = p.orientation.z;
+  mju_normalize4(quat);
+}
+
 void apply_state(const mjModel* m, mjData* d, const Recording& r, double t) {
   const sensor_msgs::JointState& js = latest(r.joints, t);
   for (std::size_t k = 0; k < js.name.size() && k < js.position.size(); ++k) {
@@ -222,18 +234,16 @@ void apply_state(const mjModel* m, mjData* d, const Recording& r, double t) {
     d->qpos[m->jnt_qposadr[id]] = js.position[k];
   }
   for (const auto& [name, samples] : r.objects) {
-    int id = mj_name2id(m, mjOBJ_JOINT, (name + "_free").c_str());
-    if (id < 0 || m->jnt_type[id] != mjJNT_FREE) continue;
     const geometry_msgs::Pose& p = latest(samples, t).pose;
-    mjtNum* q = d->qpos + m->jnt_qposadr[id];
-    q[0] = p.position.x;
-    q[1] = p.position.y;
-    q[2] = p.position.z;
-    q[3] = p.orientation.w;
-    q[4] = p.orientation.x;
-    q[5] = p.orientation.y;
-    q[6] = p.orientation.z;
-    mju_normalize4(q + 3);
+    const int body = mj_name2id(m, mjOBJ_BODY, name.c_str());
+    if (body >= 0 && m->body_mocapid[body] >= 0) {  // a fixed object (the drawer's cabinet)
+      const int k = m->body_mocapid[body];
+      setPose(p, d->mocap_pos + 3 * k, d->mocap_quat + 4 * k);
+      continue;
+    }
+    int id = mj_name2id(m, mjOBJ_JOINT, (name + "_free").c_str());
+    if (id < 0 || m->jnt_type[id] != mjJNT_FREE) continue;  // a part moved by its joint (handle)
+    setPose(p, d->qpos + m->jnt_qposadr[id], d->qpos + m->jnt_qposadr[id] + 3);
   }
   mj_forward(m, d);
 }

@@ -1,15 +1,18 @@
 #!/usr/bin/python3
-"""Generate the four demonstration datasets of the paper's evaluation, then summarise them.
+"""Generate the demonstration datasets of every task (sim and teleop-like), then summarise them.
 
-  generate_datasets.py --out DIR [--datasets sim_grasp,sim_push,teleop_grasp,teleop_push]
-                       [--seed N] [--tasks-file PATH] [--timeout S] [--force]
+  generate_datasets.py --out DIR [--datasets sim_grasp,teleop_wipe,...] [--seed N]
+                       [--tasks-dir DIR] [--demos N] [--timeout S] [--force]
 
-Each dataset <DIR>/<mode>_<task> gets one bag per configuration of config/tasks.yaml, produced by
-`roslaunch lfd_launch demonstrate.launch` (bridge as fast as possible + recorder + demonstrator).
-A dataset that already holds every bag is skipped, and the demonstrator skips bags that exist,
-so a rerun resumes where an interrupted one stopped (*.bag.active leftovers are removed first).
+Each dataset <DIR>/<mode>_<task> gets one bag per configuration of the task's file
+(config/tasks/<task>.yaml, or --tasks-dir), produced by `roslaunch lfd_launch demonstrate.launch`
+(bridge as fast as possible + recorder + demonstrator). The datasets default to every task in both
+modes. A dataset that already holds every bag is skipped, and the demonstrator skips bags that
+exist, so a rerun resumes where an interrupted one stopped (*.bag.active leftovers are removed
+first). --demos N records N configurations per dataset, spread over the task's list.
 Uses the ROS master of ROS_MASTER_URI when one is running, else starts a private one.
-Prints a table: dataset, demos, mean duration, physical successes, recorded topics.
+Prints a table: dataset, demos, mean duration, physical successes (the task file's criterion,
+judged from each bag by lfd_tools.judge), recorded topics.
 Exit status 0 only if every dataset is complete, every demo succeeded physically and no node of
 the launch crashed (a crash is reported even when the retry recorded the missing demos).
 """
@@ -25,17 +28,12 @@ import time
 import yaml
 
 from lfd_tools import bags as lfd_bags
-from lfd_tools import config as lfd_config
+from lfd_tools import tasks
 from lfd_tools.master import master_for_this_process
 
-DATASETS = ("sim_grasp", "sim_push", "teleop_grasp", "teleop_push")
 
-
-def configurations(tasks_file, task, mode):
-    with open(tasks_file) as f:
-        tasks = yaml.safe_load(f)
-    entries = (tasks.get(task) or {}).get(mode) or []
-    return [e.get("id", i) for i, e in enumerate(entries)]
+def configurations(task, mode, demos=0):
+    return [s["id"] for s in tasks.spread(tasks.scenes(task, mode), demos)]
 
 
 def bag_name(out, task, mode, config):
@@ -76,9 +74,9 @@ def generate(name, out_root, args, log_dir, crashes):
 
 
 def record_missing(name, out_root, args, log_dir, attempt, crashes):
-    mode, task = name.split("_")
+    mode, task = name.split("_", 1)
     out = os.path.join(out_root, name)
-    ids = configurations(args.tasks_file, task, mode)
+    ids = configurations(task, mode, args.demos)
     os.makedirs(out, exist_ok=True)
     for stale in glob.glob(os.path.join(out, "*.bag.active")):
         os.remove(stale)  # an interrupted demo: recorded again below
@@ -94,7 +92,7 @@ def record_missing(name, out_root, args, log_dir, attempt, crashes):
                   % (name, i, errors.get(i, "no error reported")), flush=True)
     print("[datasets] %s: recording %d of %d demos" % (name, len(missing), len(ids)), flush=True)
     cmd = ["roslaunch", "lfd_launch", "demonstrate.launch", "task:=" + task, "mode:=" + mode,
-           "output_dir:=" + out, "seed:=%d" % args.seed, "tasks_file:=" + args.tasks_file,
+           "output_dir:=" + out, "seed:=%d" % args.seed, "tasks_dir:=" + os.path.dirname(tasks.task_file(task)),
            "configurations:=[%s]" % ",".join(str(i) for i in missing)]
     start = time.time()
     log_path = os.path.join(log_dir, name + ".log")
@@ -120,12 +118,11 @@ def record_missing(name, out_root, args, log_dir, attempt, crashes):
 
 def summarize(out_root, names, args):
     rows, all_ok, all_topics = [], True, set()
-    evaluation = lfd_config.load_evaluation()
     for name in names:
-        mode, task = name.split("_")
-        ids = configurations(args.tasks_file, task, mode)
+        mode, task = name.split("_", 1)
+        ids = configurations(task, mode, args.demos)
         bags = [bag_name(os.path.join(out_root, name), task, mode, i) for i in ids]
-        results = [lfd_bags.demo_outcome(b, evaluation) for b in bags if os.path.exists(b)]
+        results = [lfd_bags.demo_outcome(b) for b in bags if os.path.exists(b)]
         ok = sum(bool(r["success"]) for r in results)
         durations = [r["duration"] for r in results if "duration" in r]
         topics = sorted({t for r in results for t in r.get("topics", {})})
@@ -151,19 +148,27 @@ def summarize(out_root, names, args):
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--out", required=True, help="folder receiving one subfolder per dataset")
-    parser.add_argument("--datasets", default=",".join(DATASETS),
-                        help="comma-separated subset of " + ",".join(DATASETS))
+    parser.add_argument("--datasets", default="", help="comma-separated <mode>_<task> (default: every task, both modes)")
     parser.add_argument("--seed", type=int, default=1)
-    parser.add_argument("--tasks-file", default=None, help="default: lfd_config/tasks.yaml")
+    parser.add_argument("--tasks-dir", default=None,
+                        help="also find task files here (searched first; $%s)" % tasks.TASKS_PATH_VAR)
+    parser.add_argument("--demos", type=int, default=0, help="configurations per dataset, spread (0 = all)")
     parser.add_argument("--timeout", type=float, default=600.0, help="s per dataset")
     parser.add_argument("--force", action="store_true", help="delete and regenerate")
     args = parser.parse_args()
-    names = [n.strip() for n in args.datasets.split(",") if n.strip()]
-    for n in names:
-        if n not in DATASETS:
-            parser.error("unknown dataset '%s' (choose from %s)" % (n, ", ".join(DATASETS)))
-    if args.tasks_file is None:
-        args.tasks_file = lfd_config.config_path("tasks.yaml")
+    if args.tasks_dir:
+        os.environ[tasks.TASKS_PATH_VAR] = ":".join(
+            [os.path.abspath(args.tasks_dir)] + [d for d in os.environ.get(tasks.TASKS_PATH_VAR, "").split(":") if d])
+    try:
+        known = tasks.datasets()
+        names = [n.strip() for n in args.datasets.split(",") if n.strip()] or known
+        for n in names:
+            if n not in known:
+                parser.error("unknown dataset '%s' (choose from %s)" % (n, ", ".join(known)))
+            tasks.scenes(n.split("_", 1)[1], n.split("_", 1)[0])  # the task file is valid
+    except RuntimeError as exc:
+        print("error: %s" % exc, file=sys.stderr)
+        return 2
     out_root = os.path.abspath(args.out)
     log_dir = os.path.join(out_root, "logs")
     os.makedirs(log_dir, exist_ok=True)

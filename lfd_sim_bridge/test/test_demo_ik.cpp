@@ -1,9 +1,8 @@
 // Unit test of the demonstrator's Cartesian -> joint conversion on the real robot model: a whole
-// grasp demonstration is planned, sampled and solved, and forward kinematics of the joint path
-// must reproduce the Cartesian path.
+// grasp demonstration of config/tasks/grasp.yaml is planned by the task interpreter, sampled and
+// solved, and forward kinematics of the joint path must reproduce the Cartesian path.
 #include <fstream>
 #include <iterator>
-#include <limits>
 #include <random>
 
 #include <gtest/gtest.h>
@@ -11,9 +10,9 @@
 #include "lfd_core/cartesian_path.hpp"
 #include "lfd_core/robot_setup.hpp"
 #include "lfd_sim_bridge/demo_plan.hpp"
-#include "lfd_sim_bridge/demo_tasks.hpp"
 
 namespace demo = lfd_sim_bridge::demo;
+namespace task = lfd_sim_bridge::task;
 
 namespace {
 
@@ -32,25 +31,25 @@ Eigen::VectorXd readyPosture(const lfd::KinematicChain& chain) {
 }  // namespace
 
 // Configured like the demonstrator node: the IK of config/robot.yaml, a configuration of the
-// simulated grasp dataset moved from world to base_link.
+// simulated grasp dataset, base_link 0.85 m above the world origin.
 TEST(CartesianToJoints, GraspDemoIsTrackedByTheJointPath) {
   const std::string config = std::string(LFD_SIM_MODEL_DIR) + "/../../config/";
-  const demo::TaskSetup setup = demo::loadTaskSetup(config + "tasks.yaml", "grasp", "sim");
+  const task::Scene scene = task::loadScene(config + "scene.yaml");
+  const task::TaskDefinition grasp = task::loadTask(config + "tasks/grasp.yaml", scene);
   std::ifstream urdf_file(std::string(LFD_SIM_MODEL_DIR) + "/jvrc1_like.urdf");
   const std::string urdf((std::istreambuf_iterator<char>(urdf_file)), {});
-  lfd::CartesianToJoints converter =
-      lfd::makeCartesianToJoints(urdf, lfd::loadRobotSetup(config + "robot.yaml"));
+  const lfd::RobotSetup robot = lfd::loadRobotSetup(config + "robot.yaml");
+  lfd::CartesianToJoints converter = lfd::makeCartesianToJoints(urdf, robot);
   const lfd::KinematicChain& chain = converter.chain();
   const Eigen::VectorXd q0 = readyPosture(chain);
   const demo::Pose start = converter.forward(q0);
-  const Eigen::Vector3d base_in_world(0.0, 0.0, 0.85);
-  demo::TaskInstance inst{"grasp", setup.configurations.at(4).object_start,
-                          setup.configurations.at(4).goal};
-  inst.object_start.position -= base_in_world;
-  inst.goal.position -= base_in_world;
+  Eigen::Isometry3d world_from_base = Eigen::Isometry3d::Identity();
+  world_from_base.translation() = scene.base_in_world;
+  const demo::TaskInterpreter interpreter(grasp, scene, robot.gripper, demo::ToolGeometry{},
+                                          demo::TeleopStyle{});
   std::mt19937 rng(1);
-  const demo::DemoPlan plan = demo::planDemo(inst, start, demo::Geometry{}, demo::Timing{},
-                                             demo::Variation{}, demo::TeleopStyle{}, rng);
+  const demo::DemoPlan plan = interpreter.planAll(
+      interpreter.begin(grasp.configurations.at("sim").at(4), world_from_base, start, 1.0, rng));
   demo::Pose from = start;
   Eigen::VectorXd seed = q0;
   for (const demo::Phase& phase : plan.phases) {

@@ -1,6 +1,7 @@
 // The URDF (used by every kinematics consumer) and the MJCF workcell (used by the simulator) are
 // generated from one source; this test proves they describe the same robot: same joints, axes,
-// limits, actuators and sensors, and the same tool pose for random configurations.
+// limits, actuators and sensors, and the same tool pose for random configurations; that the scene's
+// objects and joints are those of config/scene.yaml; and that the files are up to date with it.
 #include <gtest/gtest.h>
 
 #include <mujoco/mujoco.h>
@@ -14,12 +15,20 @@
 #include <set>
 #include <string>
 
+#include <cstdlib>
+#include <fstream>
+#include <iterator>
+
 #include "lfd_core/kinematic_chain.hpp"
+#include "lfd_sim_bridge/task_file.hpp"
+
+namespace task = lfd_sim_bridge::task;
 
 namespace {
 
 const std::string kModelDir = LFD_SIM_MODEL_DIR;
 const std::string kUrdfPath = kModelDir + "/jvrc1_like.urdf";
+const std::string kSceneFile = kModelDir + "/../../config/scene.yaml";
 const std::string kScenePath = kModelDir + "/workcell.xml";
 
 struct MjModelDeleter {
@@ -97,16 +106,52 @@ TEST(ModelConsistency, SameJointsAxesAndLimits) {
     EXPECT_NEAR(m->actuator_forcerange[2 * act], -joint->limits->effort, 1e-9) << name;
   }
   EXPECT_EQ(urdf_movable.size(), 34u);  // 12 legs + 3 waist + 3 neck + 14 arms + 2 fingers
-  // Every hinge/slide joint of the MJCF exists in the URDF (the free objects are scene joints).
+  // Every hinge/slide joint of the robot's MJCF bodies exists in the URDF; the others (free
+  // objects, the drawer's slide) are the scene's, declared in config/scene.yaml.
+  const int base = mj_name2id(m.get(), mjOBJ_BODY, "base_link");
+  const task::Scene scene = task::loadScene(kSceneFile);
   for (int j = 0; j < m->njnt; ++j) {
     if (m->jnt_type[j] == mjJNT_FREE) continue;
-    EXPECT_TRUE(urdf_movable.count(mj_id2name(m.get(), mjOBJ_JOINT, j)))
-        << "MJCF joint " << mj_id2name(m.get(), mjOBJ_JOINT, j) << " missing in the URDF";
+    const std::string name = mj_id2name(m.get(), mjOBJ_JOINT, j);
+    int body = m->jnt_bodyid[j];
+    while (body > 0 && body != base) body = m->body_parentid[body];
+    if (body == base) {
+      EXPECT_TRUE(urdf_movable.count(name)) << "MJCF joint " << name << " missing in the URDF";
+      continue;
+    }
+    bool declared = false;
+    for (const task::SceneObject& o : scene.objects) declared = declared || o.joints.count(name);
+    EXPECT_TRUE(declared) << "scene joint " << name << " is not in " << kSceneFile;
   }
-  EXPECT_GE(mj_name2id(m.get(), mjOBJ_JOINT, "stick_free"), 0);
-  EXPECT_GE(mj_name2id(m.get(), mjOBJ_JOINT, "box_free"), 0);
+  for (const task::SceneObject& o : scene.objects) {  // every object of the scene file is there
+    const int body = mj_name2id(m.get(), mjOBJ_BODY, o.name.c_str());
+    ASSERT_GE(body, 0) << o.name;
+    EXPECT_EQ(m->body_mocapid[body] >= 0, o.fixed) << o.name;
+    if (!o.fixed)
+      EXPECT_GE(mj_name2id(m.get(), mjOBJ_JOINT, (o.name + "_free").c_str()), 0) << o.name;
+    for (const auto& [name, frame] : o.frames)
+      if (!frame.body.empty()) EXPECT_GE(mj_name2id(m.get(), mjOBJ_BODY, frame.body.c_str()), 0);
+  }
   EXPECT_GE(mj_name2id(m.get(), mjOBJ_BODY, "table"), 0);
   EXPECT_EQ(m->opt.timestep, 0.001);
+}
+
+std::string readFile(const std::string& path) {
+  std::ifstream f(path);
+  return std::string((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+}
+
+// The committed model files are what generate_models.py makes of config/scene.yaml now: an edit of
+// the scene file that was not regenerated would let the simulator and the task files disagree.
+TEST(ModelConsistency, GeneratedFilesAreUpToDate) {
+  const std::string out = testing::TempDir() + "lfd_models";
+  ASSERT_EQ(std::system(("mkdir -p " + out + " && /usr/bin/python3 " + kModelDir +
+                         "/generate_models.py " + out + " > /dev/null")
+                            .c_str()),
+            0);
+  for (const char* file : {"workcell.xml", "jvrc1_like.xml", "jvrc1_like.urdf"})
+    EXPECT_EQ(readFile(out + "/" + file), readFile(kModelDir + "/" + file))
+        << file << " differs from what generate_models.py writes: run it and commit the result";
 }
 
 TEST(ModelConsistency, SensorsSitesAndMassesMatchTheContract) {

@@ -1,264 +1,204 @@
-// config/tasks.yaml is consistent with the protocol (counts, workspace sizes, unseen goals inside
-// the demonstrated workspace and different from every demo) and every pose the demonstrator and
-// the executor will ask for is reachable by the core IK along continuous paths, with margin from
-// the joint limits. The path geometry mirrors test_grasp_feasibility.cpp and the tasks.yaml header.
+// Every task file (config/tasks/*.yaml) follows the protocol -- counts, unseen goals inside the
+// demonstrated range and different from every demonstration, parked objects out of the way -- and
+// every path the demonstrator plans for any of its scenes, demonstrated or unseen, sim or teleop,
+// whatever the per-demo variation draws, is reachable by the IK of config/robot.yaml along a
+// continuous branch with margin from the joint limits (as the demonstrator converts it).
 #include <gtest/gtest.h>
 
-#include <yaml-cpp/yaml.h>
+#include <dirent.h>
 
 #include <cmath>
-#include <map>
+#include <fstream>
+#include <iterator>
+#include <random>
 #include <set>
 #include <string>
 #include <vector>
 
-#include "lfd_core/inverse_kinematics.hpp"
-#include "lfd_core/kinematic_chain.hpp"
+#include <yaml-cpp/yaml.h>
+
+#include "lfd_core/robot_setup.hpp"
+#include "lfd_sim_bridge/demo_plan.hpp"
+
+namespace demo = lfd_sim_bridge::demo;
+namespace task = lfd_sim_bridge::task;
 
 namespace {
 
 const std::string kModelDir = LFD_SIM_MODEL_DIR;
-const std::string kTasksPath = kModelDir + "/../../config/tasks.yaml";
-const std::string kRobotPath = kModelDir + "/../../config/robot.yaml";
+const std::string kConfig = kModelDir + "/../../config/";
 
-constexpr double kGraspAboveCenter = 0.005, kPregrasp = 0.10, kLift = 0.15;
-constexpr double kPushFace = 0.04 + 0.012, kPushClearance = 0.02, kPushPrelift = 0.08;
-constexpr double kRetreat = 0.06;
-
-struct Pose4 {
-  Eigen::Vector3d p;
-  double yaw = 0.0;
-};
-
-struct Entry {
-  int id = 0;
-  Pose4 start, goal;  // stick/box start, stick goal/box target
-};
-
-Pose4 readPose(const YAML::Node& n) {
-  if (!n.IsSequence() || n.size() != 4) throw std::runtime_error("pose must be [x, y, z, yaw]");
-  return {Eigen::Vector3d(n[0].as<double>(), n[1].as<double>(), n[2].as<double>()),
-          n[3].as<double>()};
+std::vector<std::string> taskNames() {
+  std::vector<std::string> names;
+  if (DIR* d = opendir((kConfig + "tasks").c_str())) {
+    while (dirent* e = readdir(d)) {
+      const std::string f = e->d_name;
+      if (f.size() > 5 && f.substr(f.size() - 5) == ".yaml")
+        names.push_back(f.substr(0, f.size() - 5));
+    }
+    closedir(d);
+  }
+  std::sort(names.begin(), names.end());
+  return names;
 }
 
-std::vector<Entry> readList(const YAML::Node& list, const std::string& object,
-                            const std::string& goal_key) {
-  std::vector<Entry> out;
-  for (const auto& e : list)
-    out.push_back({e["id"].as<int>(), readPose(e[object]), readPose(e[goal_key])});
-  return out;
-}
-
-class Tasks : public ::testing::Test {
+class TaskFiles : public ::testing::Test {
  protected:
   void SetUp() override {
-    root_ = YAML::LoadFile(kTasksPath);
-    table_ = root_["table_top"].as<double>();
-    base_z_ = root_["base_link_in_world"][2].as<double>();
-    const YAML::Node ik = YAML::LoadFile(kRobotPath)["ik"];
-    chain_ = std::make_unique<lfd::KinematicChain>(lfd::KinematicChain::fromUrdfFile(
-        kModelDir + "/jvrc1_like.urdf", ik["base_link"].as<std::string>(),
-        ik["tip_link"].as<std::string>()));
-    lfd::IkOptions options;
-    options.joint_costs = Eigen::VectorXd::Ones(chain_->dof());
-    for (const auto& kv : ik["joint_costs"]) {
-      const int i = chain_->jointIndex(kv.first.as<std::string>());
-      ASSERT_GE(i, 0) << kv.first.as<std::string>();
-      options.joint_costs[i] = kv.second.as<double>();
-    }
-    home_ = Eigen::VectorXd::Zero(chain_->dof());
-    for (const auto& kv : ik["preferred_posture"]) {
-      const int i = chain_->jointIndex(kv.first.as<std::string>());
-      ASSERT_GE(i, 0) << kv.first.as<std::string>();
-      home_[i] = kv.second.as<double>();
-    }
-    min_margin_ = ik["min_limit_margin"].as<double>();
-    ik_ = std::make_unique<lfd::InverseKinematics>(*chain_, options);
-    ik_->setPreferredPosture(home_);
+    scene_ = task::loadScene(kConfig + "scene.yaml");
+    robot_ = lfd::loadRobotSetup(kConfig + "robot.yaml");
+    std::ifstream f(kModelDir + "/jvrc1_like.urdf");
+    urdf_.assign(std::istreambuf_iterator<char>(f), {});
+    min_margin_ = YAML::LoadFile(kConfig + "robot.yaml")["ik"]["min_limit_margin"].as<double>();
+    world_from_base_.translation() = scene_.base_in_world;
   }
 
-  // TCP target in base_link for a world position and yaw (fingers down).
-  Eigen::Isometry3d tcp(const Eigen::Vector3d& world, double yaw) const {
-    Eigen::Isometry3d t = Eigen::Isometry3d::Identity();
-    t.translation() = world - Eigen::Vector3d(0, 0, base_z_);
-    t.linear() = Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix();
-    return t;
+  // The demonstrator's start: the bridge's ready posture (config/bridge.yaml).
+  Eigen::VectorXd ready(const lfd::KinematicChain& chain) const {
+    Eigen::VectorXd q = Eigen::VectorXd::Zero(chain.dof());
+    for (const auto& kv : YAML::LoadFile(kConfig + "bridge.yaml")["initial_posture"]) {
+      const int i = chain.jointIndex(kv.first.as<std::string>());
+      if (i >= 0) q[i] = kv.second.as<double>();
+    }
+    return q;
   }
 
-  // Follows waypoints (straight lines, `samples` per leg) from home, warm-started like the
-  // demonstrator; every sample must converge, keep the margin and not jump branches.
-  void expectPath(const std::vector<Eigen::Isometry3d>& waypoints, const std::string& what) {
-    Eigen::Isometry3d from = chain_->forward(home_);
-    lfd::IkResult r;
-    r.q = home_;
-    for (size_t w = 0; w < waypoints.size(); ++w) {
-      const Eigen::Quaterniond qa(from.linear()), qb(waypoints[w].linear());
-      const int samples = 25;
-      for (int k = 1; k <= samples; ++k) {
-        const double s = static_cast<double>(k) / samples;
-        Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
-        pose.translation() =
-            from.translation() + s * (waypoints[w].translation() - from.translation());
-        pose.linear() = qa.slerp(s, qb).toRotationMatrix();
-        const Eigen::VectorXd previous = r.q;
-        ik_->solve(pose, previous, r);
-        ASSERT_TRUE(r.converged) << what << " waypoint " << w << " sample " << k << ": "
-                                 << r.position_error << " m, " << r.orientation_error << " rad";
-        const double margin = chain_->limitMargin(r.q);
+  // Plans and converts one scene's demonstration like the demonstrator; every sample within the
+  // IK tolerance (convert throws otherwise), the margin kept, no jump between samples.
+  void expectReachable(const task::TaskDefinition& t, const task::Configuration& c, bool teleop,
+                       uint32_t seed, const std::string& what) {
+    demo::TeleopStyle style;
+    style.enabled = teleop;
+    const demo::TaskInterpreter in(t, scene_, robot_.gripper, demo::ToolGeometry{}, style);
+    lfd::CartesianToJoints converter = lfd::makeCartesianToJoints(urdf_, robot_);
+    const lfd::KinematicChain& chain = converter.chain();
+    Eigen::VectorXd q = ready(chain);
+    const demo::Pose start = converter.forward(q);
+    std::mt19937 rng(seed);
+    const demo::DemoPlan plan = in.planAll(in.begin(c, world_from_base_, start, 1.0, rng));
+    demo::Pose from = start;
+    for (const demo::Phase& phase : plan.phases) {
+      lfd::JointPath path;
+      try {
+        path = converter.convert(demo::samplePhase(from, phase, 0.02, 0.0), q);
+      } catch (const std::exception& e) {
+        ADD_FAILURE() << what << " phase " << phase.name << ": " << e.what();
+        return;
+      }
+      for (size_t k = 0; k < path.positions.size(); ++k) {
+        const double margin = chain.limitMargin(path.positions[k]);
         worst_margin_ = std::min(worst_margin_, margin);
-        if (w > 0)  // the move from the arbitrary home may swing further
-          EXPECT_LT((r.q - previous).cwiseAbs().maxCoeff(), 0.25)
-              << what << " waypoint " << w << " sample " << k << " jumps";
         if (margin < min_margin_) {
           int worst = 0;
-          (r.q - chain_->lowerLimits()).cwiseMin(chain_->upperLimits() - r.q).minCoeff(&worst);
-          ADD_FAILURE() << what << " waypoint " << w << " sample " << k << ": "
-                        << chain_->jointNames()[worst] << " only " << margin
-                        << " rad from its limit";
+          (path.positions[k] - chain.lowerLimits())
+              .cwiseMin(chain.upperLimits() - path.positions[k])
+              .minCoeff(&worst);
+          ADD_FAILURE() << what << " phase " << phase.name << " sample " << k << ": "
+                        << chain.jointNames()[worst] << " only " << margin << " rad from its limit";
           return;
         }
+        if (k > 0 && (phase.index > 0 || k > 5))  // the first move from the ready posture may swing
+          ASSERT_LT((path.positions[k] - path.positions[k - 1]).cwiseAbs().maxCoeff(), 0.25)
+              << what << " phase " << phase.name << " sample " << k << " jumps";
       }
-      from = waypoints[w];
+      q = path.positions.back();
+      from = phase.segments.back().target;
     }
   }
 
-  void expectGraspReachable(const std::vector<Entry>& list, const std::string& what) {
-    for (const auto& e : list) {
-      const std::string name = what + " id " + std::to_string(e.id);
-      EXPECT_NEAR(e.start.p.z(), table_ + 0.015, 1e-6) << name << ": stick not on the table";
-      EXPECT_GE(e.goal.p.z() - table_, 0.10) << name << ": goal not lifted";
-      EXPECT_GE((e.goal.p - e.start.p).head<2>().norm(), 0.08) << name << ": goal too close";
-      const Eigen::Vector3d above(0, 0, kGraspAboveCenter);
-      // The demonstrator varies the grasp point along the stick and the gripper yaw a little.
-      for (const double along : {-0.015, 0.0, 0.015}) {
-        for (const double dyaw : {-0.08, 0.0, 0.08}) {
-          const double yaw = e.start.yaw + dyaw;
-          const Eigen::Vector3d grasp =
-              e.start.p + above + along * Eigen::Vector3d(std::cos(yaw), std::sin(yaw), 0);
-          const Eigen::Vector3d lifted = grasp + Eigen::Vector3d(0, 0, kLift);
-          expectPath({tcp(grasp + Eigen::Vector3d(0, 0, kPregrasp), yaw), tcp(grasp, yaw),
-                      tcp(lifted, yaw), tcp(e.goal.p + above, e.goal.yaw + dyaw)},
-                     name);
-          if (HasFailure()) return;
-        }
-      }
-    }
-  }
-
-  void expectPushReachable(const std::vector<Entry>& list, const std::string& what) {
-    for (const auto& e : list) {
-      const std::string name = what + " id " + std::to_string(e.id);
-      EXPECT_NEAR(e.start.p.z(), table_ + 0.04, 1e-6) << name << ": box not on the table";
-      Eigen::Vector3d dir = e.goal.p - e.start.p;
-      dir.z() = 0;
-      EXPECT_GE(dir.norm(), 0.10) << name << ": push too short";
-      dir.normalize();
-      // The closed fingers are a square block: any face pushes, so the yaw is taken modulo pi/2.
-      const double yaw = std::remainder(std::atan2(dir.y(), dir.x()), M_PI / 2);
-      const Eigen::Vector3d behind = e.start.p - (kPushFace + kPushClearance) * dir;
-      const Eigen::Vector3d pushed = e.goal.p - kPushFace * dir;
-      const Eigen::Vector3d up(0, 0, 1);
-      expectPath({tcp(behind + kPushPrelift * up, yaw), tcp(behind, yaw), tcp(pushed, yaw),
-                  tcp(pushed - kRetreat * dir + kRetreat * up, yaw)},
-                 name);
-      if (HasFailure()) return;
-    }
-  }
-
-  YAML::Node root_;
-  double table_ = 0.0, base_z_ = 0.0, min_margin_ = 0.0;
-  double worst_margin_ = 1e9;
-  std::unique_ptr<lfd::KinematicChain> chain_;
-  std::unique_ptr<lfd::InverseKinematics> ik_;
-  Eigen::VectorXd home_;
+  task::Scene scene_;
+  lfd::RobotSetup robot_;
+  std::string urdf_;
+  double min_margin_ = 0.0, worst_margin_ = 1e9;
+  Eigen::Isometry3d world_from_base_ = Eigen::Isometry3d::Identity();
 };
 
-Eigen::Vector4d boundsOf(const std::vector<Entry>& list, bool goals) {
-  Eigen::Vector4d b(1e9, -1e9, 1e9, -1e9);  // xmin xmax ymin ymax
-  for (const auto& e : list) {
-    const Eigen::Vector3d& p = goals ? e.goal.p : e.start.p;
+// Horizontal bounds (x min, x max, y min, y max) of the scenes' poses of `key` (an object or goal).
+Eigen::Vector4d boundsOf(const std::vector<task::Configuration>& list, const std::string& key) {
+  Eigen::Vector4d b(1e9, -1e9, 1e9, -1e9);
+  for (const auto& c : list) {
+    const Eigen::Vector3d& p = key == "goal" ? c.goal.position : c.objects.at(key).position;
     b << std::min(b[0], p.x()), std::max(b[1], p.x()), std::min(b[2], p.y()), std::max(b[3], p.y());
   }
   return b;
 }
 
-TEST_F(Tasks, CountsWorkspacesAndUnseenGoalsFollowTheProtocol) {
-  struct Spec {
-    std::string task, object, goal_key;
-  };
-  for (const Spec& s : {Spec{"grasp", "stick", "goal"}, Spec{"push", "box", "target"}}) {
+TEST_F(TaskFiles, TheShippedTasksAreThere) {
+  const std::vector<std::string> names = taskNames();
+  for (const char* t : {"drawer", "grasp", "place", "push", "wipe"})
+    EXPECT_TRUE(std::count(names.begin(), names.end(), t)) << t;
+}
+
+TEST_F(TaskFiles, CountsAndUnseenGoalsFollowTheProtocol) {
+  for (const std::string& name : taskNames()) {
+    const task::TaskDefinition t =
+        task::loadTask(task::taskFilePath(kConfig + "tasks", name), scene_);
     for (const std::string mode : {"sim", "teleop"}) {
-      const auto demos = readList(root_[s.task][mode], s.object, s.goal_key);
-      const auto unseen = readList(root_[s.task]["unseen"][mode], s.object, s.goal_key);
-      const std::string what = s.task + "." + mode;
-      if (s.task == "grasp") {
-        EXPECT_EQ(demos.size(), 9u) << what;
-      } else {
-        EXPECT_GE(demos.size(), 6u) << what;
-      }
+      const auto& demos = t.configurations.at(mode);
+      const auto& unseen = t.unseen.at(mode);
+      const std::string what = name + "." + mode;
+      EXPECT_GE(demos.size(), mode == "sim" ? 9u : 6u) << what;
       EXPECT_EQ(unseen.size(), 10u) << what;
-      std::set<int> ids;
-      for (const auto& e : demos) ids.insert(e.id);
-      for (const auto& e : unseen) ids.insert(e.id);
-      EXPECT_EQ(ids.size(), demos.size() + unseen.size()) << what << ": duplicate ids";
-      // Workspace of the object starts: 40 x 40 cm (sim grasp), within 15 x 15 cm (teleop).
-      const Eigen::Vector4d b = boundsOf(demos, false);
-      const Eigen::Vector4d g = boundsOf(demos, true);
-      if (mode == "teleop") {
-        for (const Eigen::Vector4d& box : {b, g}) {
-          EXPECT_LE(box[1] - box[0], 0.15 + 1e-9) << what;
-          EXPECT_LE(box[3] - box[2], 0.15 + 1e-9) << what;
+      std::vector<std::string> keys = t.objects;
+      keys.push_back("goal");
+      for (const std::string& key : keys) {
+        const Eigen::Vector4d b = boundsOf(demos, key);
+        if (mode == "teleop") {  // the teleop-like workspace: at most 15 x 15 cm
+          EXPECT_LE(b[1] - b[0], 0.15 + 1e-9) << what << " " << key;
+          EXPECT_LE(b[3] - b[2], 0.15 + 1e-9) << what << " " << key;
         }
-      } else if (s.task == "grasp") {
-        EXPECT_NEAR(b[1] - b[0], 0.40, 1e-9) << what;
-        EXPECT_NEAR(b[3] - b[2], 0.40, 1e-9) << what;
-      }
-      // Unseen goals: inside the demonstrated ranges, and never a demonstrated situation.
-      for (const auto& u : unseen) {
-        for (const bool goal : {false, true}) {
-          const Eigen::Vector3d& p = goal ? u.goal.p : u.start.p;
-          const Eigen::Vector4d& box = goal ? g : b;
-          EXPECT_TRUE(p.x() >= box[0] - 1e-9 && p.x() <= box[1] + 1e-9 && p.y() >= box[2] - 1e-9 &&
-                      p.y() <= box[3] + 1e-9)
-              << what << " unseen id " << u.id << (goal ? " goal" : " start")
-              << " outside the demonstrated workspace";
+        for (const auto& u : unseen) {  // inside the demonstrated range
+          const Eigen::Vector3d& p = key == "goal" ? u.goal.position : u.objects.at(key).position;
+          EXPECT_TRUE(p.x() >= b[0] - 1e-9 && p.x() <= b[1] + 1e-9 && p.y() >= b[2] - 1e-9 &&
+                      p.y() <= b[3] + 1e-9)
+              << what << " unseen id " << u.id << " " << key << " outside the demonstrated range";
         }
-        for (const auto& d : demos)
-          EXPECT_GT((u.start.p - d.start.p).norm() + (u.goal.p - d.goal.p).norm(), 0.02)
-              << what << " unseen id " << u.id << " repeats demo " << d.id;
       }
+      for (const auto& u : unseen)  // never a demonstrated situation
+        for (const auto& d : demos) {
+          double distance = (u.goal.position - d.goal.position).norm();
+          for (const std::string& o : t.objects)
+            distance += (u.objects.at(o).position - d.objects.at(o).position).norm();
+          EXPECT_GT(distance, 0.02) << what << " unseen id " << u.id << " repeats demo " << d.id;
+        }
     }
   }
 }
 
-TEST_F(Tasks, EveryGraspPathIsReachableWithMargin) {
-  for (const std::string mode : {"sim", "teleop"}) {
-    expectGraspReachable(readList(root_["grasp"][mode], "stick", "goal"), "grasp." + mode);
-    expectGraspReachable(readList(root_["grasp"]["unseen"][mode], "stick", "goal"),
-                         "grasp.unseen." + mode);
+TEST_F(TaskFiles, EveryPlannedPathIsReachableWithMargin) {
+  for (const std::string& name : taskNames()) {
+    const task::TaskDefinition t =
+        task::loadTask(task::taskFilePath(kConfig + "tasks", name), scene_);
+    for (const std::string mode : {"sim", "teleop"}) {
+      for (const auto* list : {&t.configurations.at(mode), &t.unseen.at(mode)}) {
+        for (const task::Configuration& c : *list) {
+          for (uint32_t seed : {1u, 2u}) {  // the per-demo variation and the operator's draws
+            expectReachable(t, c, mode == "teleop", seed,
+                            name + "." + mode + " id " + std::to_string(c.id));
+            if (HasFailure()) return;
+          }
+        }
+      }
+    }
   }
-  std::printf("grasp paths: smallest joint-limit margin %.3f rad\n", worst_margin_);
+  std::printf("task paths: smallest joint-limit margin %.3f rad\n", worst_margin_);
 }
 
-TEST_F(Tasks, EveryPushPathIsReachableWithMargin) {
-  for (const std::string mode : {"sim", "teleop"}) {
-    expectPushReachable(readList(root_["push"][mode], "box", "target"), "push." + mode);
-    expectPushReachable(readList(root_["push"]["unseen"][mode], "box", "target"),
-                        "push.unseen." + mode);
+TEST_F(TaskFiles, ParkedObjectsAreOnTheTableAndOutOfTheWorkspace) {
+  for (const task::SceneObject& o : scene_.objects) {
+    const Eigen::Vector3d& p = o.park.position;
+    EXPECT_GT(p.y(), 0.05) << o.name;  // left of the work area (y < -0.05)
+    EXPECT_NEAR(p.z(), scene_.table_top + (o.fixed ? 0.0 : o.half_size.z()), 1e-9) << o.name;
+    for (const task::SceneObject& other : scene_.objects) {
+      if (&other == &o) continue;
+      const double gap = (p - other.park.position).head<2>().cwiseAbs().maxCoeff() -
+                         o.half_size.head<2>().maxCoeff() - other.half_size.head<2>().maxCoeff();
+      EXPECT_GT(gap, 0.02) << o.name << " and " << other.name << " parked on each other";
+    }
   }
-  std::printf("push paths: smallest joint-limit margin %.3f rad\n", worst_margin_);
 }
 
-TEST_F(Tasks, ParkedObjectsAreOnTheTableAndOutOfTheWorkspace) {
-  const Pose4 stick = readPose(root_["park"]["stick"]), box = readPose(root_["park"]["box"]);
-  EXPECT_NEAR(stick.p.z(), table_ + 0.015, 1e-6);
-  EXPECT_NEAR(box.p.z(), table_ + 0.04, 1e-6);
-  EXPECT_GT(stick.p.y(), 0.05);
-  EXPECT_GT(box.p.y(), 0.05);
-  EXPECT_GT((stick.p - box.p).head<2>().norm(), 0.15);
-}
-
-TEST(TasksFile, IkRefusesAnUnreachableGoal) {
+TEST(TaskReachability, IkRefusesAnUnreachableGoal) {
   // Guard for the executor: a goal far outside the workspace is reported, not silently clipped.
   const auto chain = lfd::KinematicChain::fromUrdfFile(kModelDir + "/jvrc1_like.urdf", "base_link",
                                                        "r_gripper_tcp");

@@ -411,6 +411,43 @@ TEST(WorkcellSim, RecoversFromDivergenceWithoutCrashing) {
   EXPECT_NEAR(sim.jointPosition("R_ELBOW_P"), -1.3, 5e-3);
 }
 
+// The articulated drawer: its cabinet is placed like an object but never pushed (mocap), its
+// handle is reported but cannot be placed, its slide is a scene joint that a reset closes again
+// (or sets, when named) and a divergence leaves the cabinet where the scene put it.
+TEST(WorkcellSim, DrawerIsPlacedReportedAndResetLikeTheOtherObjects) {
+  lfd_sim::WorkcellConfig c = readyConfig();
+  c.objects = {"stick", "drawer", "drawer_handle"};
+  lfd_sim::WorkcellSim sim(kModel, c);
+  ASSERT_TRUE(sim.hasJoint("drawer_slide"));
+  lfd_sim::Pose cabinet;
+  cabinet.position = {0.70, -0.30, 0.80};
+  cabinet.orientation = {0.0, 0.0, 0.0, 1.0};  // turned by pi: its front faces the robot
+  sim.setObjectPose("drawer", cabinet);
+  lfd_sim::Pose handle = sim.readState().object_poses[2];
+  EXPECT_NEAR(handle.position[0], 0.70 - 0.145, 1e-6);  // config/scene.yaml frames.handle
+  EXPECT_NEAR(handle.position[2], 0.87, 1e-6);
+  EXPECT_THROW(sim.setObjectPose("drawer_handle", cabinet), std::invalid_argument);
+  // Pulled open by hand (its joint set), the handle moves with it; the cabinet never moves.
+  sim.reset({{"drawer_slide", 0.1}});
+  sim.step(200);
+  const lfd_sim::WorkcellState open = sim.readState();
+  EXPECT_NEAR(sim.jointPosition("drawer_slide"), 0.1, 1e-3);
+  EXPECT_NEAR(open.object_poses[2].position[0], 0.70 - 0.245, 1e-3);
+  EXPECT_NEAR(open.object_poses[1].position[0], 0.70, 1e-9);
+  const auto names = open.joint_names;
+  EXPECT_NE(std::find(names.begin(), names.end(), "drawer_slide"),
+            names.end());  // on /joint_states
+  sim.reset();             // closed again, the cabinet where the scene put it
+  EXPECT_NEAR(sim.jointPosition("drawer_slide"), 0.0, 1e-9);
+  EXPECT_NEAR(sim.readState().object_poses[1].position[0], 0.70, 1e-9);
+  sim.injectNaNForTest();
+  sim.step();
+  EXPECT_EQ(sim.divergenceCount(), 1);
+  EXPECT_NEAR(sim.readState().object_poses[1].position[0], 0.70, 1e-9);
+  sim.reset({}, true);  // objects back to the model's (park) poses
+  EXPECT_NEAR(sim.readState().object_poses[1].position[0], 0.38, 1e-9);
+}
+
 TEST(WorkcellSim, SimTimeIsStrictlyMonotonic) {
   lfd_sim::WorkcellSim sim(kModel, readyConfig());
   double t = sim.time();

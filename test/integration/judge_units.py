@@ -3,11 +3,14 @@
 its readers and records) on hand-made cases worked out by hand: the paper's segmentation success
 rule and its tolerance edges, missing and extra changepoints, Covering, margin F1 and time errors;
 physical success at its distance and lift edges, 3-D against horizontal distance, yaw symmetry;
-criteria and segment names read from evaluation.yaml; a demo bag judged end to end; the report
-records. Pure Python: no node, no simulation (rostest's master is not used)."""
+every rule type of a task file (object at its goal, height, joint, sustained contact along a path);
+criteria, skills and transitions read from the task files (a task file written here changes the
+verdict; a bad one is a clear error naming the file and the key); a demo bag judged end to end;
+the report records. Pure Python: no node, no simulation (rostest's master is not used)."""
 import json
 import math
 import os
+import shutil
 import tempfile
 import unittest
 
@@ -17,7 +20,7 @@ import rostest
 import yaml
 from geometry_msgs.msg import PoseStamped
 from lfd_msgs.msg import DemoMetadata, Phase
-from lfd_tools import bags, config, judge, report
+from lfd_tools import bags, config, judge, report, tasks
 
 GRASP = {"object": "stick", "distance": "xyz", "tolerance_m": 0.03, "min_lift_m": 0.10, "yaw_symmetry": 2}
 PUSH = {"object": "box", "distance": "xy", "tolerance_m": 0.03, "yaw_symmetry": 4}
@@ -143,41 +146,145 @@ class PhysicalSuccess(unittest.TestCase):
         self.assertIsNone(judge.physical_outcome(PUSH, g, g, TABLE)["yaw_error_rad"])
 
 
-class CriteriaFromTheFile(unittest.TestCase):
-    def write(self, content):
-        path = os.path.join(tempfile.mkdtemp(), "evaluation.yaml")
-        with open(path, "w") as f:
+class Rules(unittest.TestCase):
+    """The rule types of a task file's criterion, at their edges (judge_rules)."""
+    GOAL = {"position": [0.0, 0.0, 0.5], "orientation": [1.0, 0.0, 0.0, 0.0]}
+
+    def judge(self, rules, objects=None, joints=None, contact=None):
+        measured = {"objects": {k: {"position": list(v), "orientation": [1.0, 0.0, 0.0, 0.0]}
+                                for k, v in (objects or {}).items()},
+                    "joints": joints or {}, "contact": contact or []}
+        return judge.judge_rules({"rules": rules}, measured, {"goal": self.GOAL}, 0.0)
+
+    def test_every_rule_must_hold(self):
+        at_goal = {"rule": "object_at_goal", "object": "block", "distance": "xyz", "tolerance_m": 0.02}
+        resting = {"rule": "height", "object": "block", "max_m": 0.03}
+        self.assertTrue(self.judge([at_goal], {"block": (0.02, 0.0, 0.5)})["success"])
+        out = self.judge([at_goal, resting], {"block": (0.02, 0.0, 0.5)})  # at the goal, but held up
+        self.assertFalse(out["success"])
+        self.assertEqual([r["success"] for r in out["rules"]], [True, False])
+        self.assertIn("block above the table 50", out["reason"])
+        self.assertTrue(self.judge([resting], {"block": (0.3, 0.0, 0.03)})["success"])
+        self.assertFalse(self.judge([at_goal], {})["success"])  # not recorded: never a success
+
+    def test_joint_bounds(self):
+        rule = {"rule": "joint", "joint": "drawer_slide", "min": 0.05}
+        self.assertTrue(self.judge([rule], joints={"drawer_slide": 0.05})["success"])
+        self.assertFalse(self.judge([rule], joints={"drawer_slide": 0.0499})["success"])
+        both = dict(rule, max=0.1)
+        self.assertFalse(self.judge([both], joints={"drawer_slide": 0.11})["success"])
+        self.assertIn("was not recorded", self.judge([rule])["reason"])
+
+    WIPE = {"rule": "contact_path", "min_force_n": 2.0, "length_m": 0.16, "tolerance_m": 0.02, "passes": 3,
+            "max_gap_s": 0.3}
+
+    def strokes(self, ends, force=8.0, beside=0.0, gap=None, dt=0.01):
+        """Samples going through the x positions `ends` at 20 cm/s (the goal's axis is x)."""
+        out, t = [], 0.0
+        for a, b in zip(ends, ends[1:]):
+            n = int(abs(b - a) / (0.2 * dt))
+            for k in range(n):
+                x = a + (b - a) * k / n
+                f = 0.0 if gap and gap[0] <= t < gap[1] else force
+                out.append((t, f, [x, beside, 0.5]))
+                t += dt
+        return out
+
+    def test_contact_path_counts_end_to_end_passes(self):
+        three = self.strokes([-0.08, 0.08, -0.08, 0.08])
+        out = self.judge([self.WIPE], contact=three)
+        self.assertTrue(out["success"], out["reason"])
+        self.assertEqual(out["rules"][0]["passes"], 3)
+        self.assertFalse(self.judge([self.WIPE], contact=self.strokes([-0.08, 0.08, -0.08]))["success"])
+        # each end within 2 cm: 6.5 cm short of an end misses it
+        short = self.strokes([-0.08, 0.055, -0.08, 0.055])
+        self.assertLess(self.judge([self.WIPE], contact=short)["rules"][0]["passes"], 3)
+        self.assertTrue(self.judge([self.WIPE], contact=self.strokes([-0.065, 0.065, -0.065, 0.065]))["success"])
+
+    def test_contact_must_be_sustained_pressed_and_on_the_path(self):
+        light = self.strokes([-0.08, 0.08, -0.08, 0.08], force=1.9)
+        self.assertIn("never in contact", self.judge([self.WIPE], contact=light)["reason"])
+        aside = self.strokes([-0.08, 0.08, -0.08, 0.08], beside=0.021)
+        self.assertFalse(self.judge([self.WIPE], contact=aside)["success"])
+        bridged = self.strokes([-0.08, 0.08, -0.08, 0.08], gap=(1.0, 1.25))  # a 0.25 s break
+        self.assertTrue(self.judge([self.WIPE], contact=bridged)["success"])
+        broken = self.strokes([-0.08, 0.08, -0.08, 0.08], gap=(1.0, 1.4))  # lifted for 0.4 s mid-wipe
+        self.assertFalse(self.judge([self.WIPE], contact=broken)["success"])
+
+    def test_bad_rules_are_refused(self):
+        for bad, says in (({"rule": "teleport"}, "expected"),
+                          ({"rule": "height", "object": "block"}, "minimum or a maximum"),
+                          ({"rule": "joint", "joint": "lid", "min": 0}, "not a joint"),
+                          ({"rule": "object_at_goal", "object": "mug", "distance": "xy", "tolerance_m": 0.1}, "mug"),
+                          (dict(self.WIPE, passes="3"), "passes must be a number"),
+                          (dict(self.WIPE, speed=1), "unknown key")):
+            with self.assertRaisesRegex(ValueError, says):
+                judge.check_rule(bad, {"block"}, ["drawer_slide"])
+
+
+class CriteriaFromTheTaskFiles(unittest.TestCase):
+    def setUp(self):
+        self.folder = tempfile.mkdtemp()
+        os.environ[tasks.TASKS_PATH_VAR] = self.folder
+
+    def tearDown(self):
+        del os.environ[tasks.TASKS_PATH_VAR]
+        shutil.rmtree(self.folder)
+
+    def write(self, name, content):
+        with open(os.path.join(self.folder, name + ".yaml"), "w") as f:
             yaml.safe_dump(content, f)
-        return path
 
-    def test_the_shipped_file_is_what_the_judges_read(self):
-        evaluation = config.load_evaluation()
-        grasp = config.criteria_of(evaluation, "grasp")
-        self.assertEqual((grasp["object"], grasp["distance"]), ("stick", "xyz"))
-        self.assertEqual(config.segment_names(evaluation, "grasp"), ["approach", "move"])
-        self.assertEqual(config.segment_names(evaluation, "push"), ["approach", "push", "return"])
+    def shipped(self, name):
+        return config.load_yaml(os.path.join(config.config_path("tasks"), name + ".yaml"))
 
-    def test_other_numbers_in_the_file_change_the_verdict(self):
-        strict = {"segmentation": {"expected": {}}, "reproduction": {"grasp": dict(GRASP, tolerance_m=0.01)}}
-        criteria = config.criteria_of(config.load_evaluation(self.write(strict)), "grasp")
+    def test_the_shipped_files_are_what_the_judges_read(self):
+        grasp = tasks.success_criterion("grasp")
+        self.assertEqual((grasp["object"], grasp["distance"], grasp["min_lift_m"]), ("stick", "xyz", 0.10))
+        self.assertEqual(tasks.segment_names("grasp"), ["approach", "move"])
+        self.assertEqual(tasks.expected_transitions("grasp"), GRASP_EXPECTED)
+        self.assertEqual(tasks.expected_transitions("push"), PUSH_EXPECTED)
+        self.assertEqual(tasks.segment_names("drawer"), ["approach", "pull", "retreat"])
+        self.assertEqual(tasks.success_criterion("drawer")["object"], "drawer_handle")  # the reported body
+        self.assertEqual(config.segment_names(config.load_evaluation(), "push"), ["approach", "push", "return"])
+        for t in ("grasp", "push", "place", "wipe", "drawer"):
+            self.assertIn(t, tasks.names())
+            self.assertGreaterEqual(len(tasks.scenes(t, "sim")), 9, t)
+            self.assertGreaterEqual(len(tasks.scenes(t, "teleop")), 6, t)
+            for mode in tasks.MODES:
+                self.assertEqual(len(tasks.unseen_scenes(t, mode)), 10, t)
+
+    def test_a_task_file_of_ones_own_changes_the_verdict(self):
+        strict = self.shipped("grasp")
+        strict["success"][0]["tolerance_m"] = 0.01
+        self.write("grasp", strict)  # $LFD_TASKS_PATH is searched first
+        criteria = tasks.success_criterion("grasp")
         self.assertFalse(judge.physical_outcome(criteria, (0.52, 0, 1.0), (0.5, 0, 1.0), TABLE)["success"])
         self.assertTrue(judge.physical_outcome(GRASP, (0.52, 0, 1.0), (0.5, 0, 1.0), TABLE)["success"])
 
-    def test_bad_criteria_are_a_clear_error(self):
-        for bad, says in ((dict(GRASP, distance="xz"), "distance"), ({"object": "stick", "distance": "xy"}, "tolerance_m")):
-            path = self.write({"segmentation": {}, "reproduction": {"grasp": bad}})
-            with self.assertRaisesRegex(RuntimeError, says):
-                config.load_evaluation(path)
-        with self.assertRaisesRegex(RuntimeError, "no reproduction criteria for task 'wipe'"):
-            config.criteria_of(config.load_evaluation(), "wipe")
+    def test_bad_task_files_are_a_clear_error(self):
+        grasp = self.shipped("grasp")
+        cases = ((dict(grasp, success=[dict(grasp["success"][0], distance="xz")]), r"success\[0\]: distance"),
+                 (dict(grasp, objects=["mug"]), "objects: 'mug' is not an object of the scene"),
+                 (dict(grasp, speed=2), "unknown key"),
+                 (dict(grasp, configurations={"sim": grasp["configurations"]["sim"]}), "configurations.teleop"),
+                 (dict(grasp, configurations={"sim": [{"id": 0, "goal": [0, 0, 0]}], "teleop": []}),
+                  r"configurations.sim\[0\]: lacks stick"))
+        for i, (content, says) in enumerate(cases):
+            self.write("bad%d" % i, content)
+            with self.assertRaisesRegex(RuntimeError, "bad%d.yaml.*%s" % (i, says)):
+                tasks.scenes("bad%d" % i, "sim")
+        with self.assertRaisesRegex(RuntimeError, "no task file wipes.yaml"):
+            tasks.success_criterion("wipes")
 
 
 class DemoBagJudged(unittest.TestCase):
-    """A hand-written demo bag: metadata goal, ground-truth phases and the stick's last pose."""
+    """A hand-written demo bag: metadata scene, ground-truth phases and the stick's last pose."""
 
     def bag(self, final_z):
         path = os.path.join(tempfile.mkdtemp(), "grasp_sim_00.bag")
-        extra = {"object": "stick", "goal": {"position": [0.5, -0.3, 0.95]}, "table_top": TABLE}
+        goal = {"position": [0.5, -0.3, 0.95], "orientation": [1.0, 0.0, 0.0, 0.0]}
+        extra = {"task": "grasp", "scene": {"frame": "world", "objects": {}, "goal": goal, "joints": {}}}
         with rosbag.Bag(path, "w") as b:
             b.write("/lfd/metadata", DemoMetadata(task="grasp", mode="sim", configuration=0, speed=1.0,
                                                   extra_json=json.dumps(extra)), rospy.Time(10.0))
@@ -191,11 +298,10 @@ class DemoBagJudged(unittest.TestCase):
         return path
 
     def test_success_and_failure_from_the_bag(self):
-        evaluation = config.load_evaluation()
-        ok = bags.demo_outcome(self.bag(0.95), evaluation)
+        ok = bags.demo_outcome(self.bag(0.95))
         self.assertTrue(ok["success"], ok["reason"])
         self.assertEqual((ok["task"], ok["mode"]), ("grasp", "sim"))
-        dropped = bags.demo_outcome(self.bag(TABLE + 0.015), evaluation)  # the stick fell back
+        dropped = bags.demo_outcome(self.bag(TABLE + 0.015))  # the stick fell back
         self.assertFalse(dropped["success"])
         self.assertAlmostEqual(dropped["height_m"], 0.015)
 
@@ -249,7 +355,8 @@ class Records(unittest.TestCase):
 
 def all_tests():
     return unittest.TestSuite([unittest.defaultTestLoader.loadTestsFromTestCase(c) for c in (
-        SegmentationRule, SegmentationFigures, PhysicalSuccess, CriteriaFromTheFile, DemoBagJudged, Records)])
+        SegmentationRule, SegmentationFigures, PhysicalSuccess, Rules, CriteriaFromTheTaskFiles, DemoBagJudged,
+        Records)])
 
 
 if __name__ == "__main__":

@@ -14,10 +14,10 @@ import rostest
 from lfd_tools import config as lfd_config
 
 PIPELINE = os.path.join(rospkg.RosPack().get_path("lfd_launch"), "scripts", "pipeline.py")
-DEMOS = 3                 # sim grasp demonstrations recorded (spread over tasks.yaml's 9)
-GOALS = 3                 # unseen grasp goals reproduced (spread over tasks.yaml's 10)
+DEMOS = 3                 # sim grasp demonstrations recorded (spread over the task file's 9)
+GOALS = 3                 # unseen grasp goals reproduced (spread over the task file's 10)
 MIN_SEGMENTATION = 2 / 3  # sim grasp demos with exactly one changepoint at approach->move
-MIN_REPRODUCTION = 2 / 3  # unseen goals reached (config/evaluation.yaml's grasp criteria)
+MIN_REPRODUCTION = 2 / 3  # unseen goals reached (config/tasks/grasp.yaml success criterion)
 PIPELINE_TIMEOUT = 270    # s of wall time for the full run (the rostest limit is 360)
 
 

@@ -1,15 +1,18 @@
 #!/usr/bin/python3
 """rostest (plot_figures.test): lfd_segmentation/scripts/plot_segmentation.py draws every paper
-figure from a real `segment` run on synthetic grasp bags written here, plus the success-rate bars
-from a report; each PNG has its size and real content; bad input gives a one-line error, no
-traceback."""
+figure from a real `segment --features` run on synthetic grasp bags written here, plus the
+success-rate bars from a report; each PNG has its size and real content; the skill map and the
+segmentation figure draw the JSON's feature matrix sample for sample (test_segment_cli checks that
+it is the C++ bag reader's); bad input gives a one-line error, no traceback."""
 import json
 import os
+import runpy
 import shutil
 import subprocess
 import sys
 import tempfile
 import unittest
+from unittest import mock
 
 import numpy as np
 import rosbag
@@ -23,6 +26,7 @@ from lfd_msgs.msg import Phase, Touch
 from lfd_tools import figures
 from lfd_tools import report as report_records
 from matplotlib import image as mpimg
+from matplotlib.axes import Axes
 from sensor_msgs.msg import JointState
 
 RATE_HZ = 100.0  # recording rate of the synthetic topics
@@ -125,8 +129,8 @@ class PlotFigures(unittest.TestCase):
             write_grasp_bag(path, grasp, duration, d)
             cls.bags.append(path)
         cls.seg_json = os.path.join(cls.tmp, "seg.json")
-        seg = subprocess.run([cls.segment, "--config", cls.config, "--feature-profiles", "--output",
-                              cls.seg_json] + cls.bags, stdout=subprocess.PIPE,
+        seg = subprocess.run([cls.segment, "--config", cls.config, "--features", "--feature-profiles",
+                              "--output", cls.seg_json] + cls.bags, stdout=subprocess.PIPE,
                              stderr=subprocess.STDOUT, text=True, timeout=60)
         assert seg.returncode == 0, "segment failed:\n" + seg.stdout
 
@@ -143,8 +147,7 @@ class PlotFigures(unittest.TestCase):
         r = self.plot("--segment-json", self.seg_json, "--config", self.config, "--out", out,
                       "--prefix", "grasp_", "--demo", "1", "--bags", *self.bags)
         self.assertEqual(r.returncode, 0, r.stderr)
-        # The bag reader resamples exactly like the segmenter (otherwise it warns).
-        self.assertNotIn("resamples to", r.stderr)
+        self.assertNotIn("warning", r.stderr)
         printed = r.stdout.split()
         for kind, size in SEGMENT_FIGURES.items():
             path = os.path.join(out, "grasp_%s.png" % kind)
@@ -164,6 +167,60 @@ class PlotFigures(unittest.TestCase):
         red = np.sum((rgb[:, 0] > 200) & (rgb[:, 1] < 80) & (rgb[:, 2] < 80))
         if zones:
             self.assertGreater(red, 500, "zones %s are not drawn" % zones)
+
+    def test_figures_draw_the_segmented_matrix(self):
+        """Every sample of the skill map and of the segmentation figure's curves is the JSON's: a
+        plotter that read or resampled the bags itself differs by the JSON's rounding at least."""
+        plotter = runpy.run_path(self.script, run_name="plot_segmentation")  # main() in-process
+        drawn = []  # (method, positional arguments) of every Axes.plot / Axes.imshow call
+
+        def recorded(method):
+            original = getattr(Axes, method)
+
+            def record(ax, *args, **kwargs):
+                drawn.append((method, args))
+                return original(ax, *args, **kwargs)
+            return mock.patch.object(Axes, method, record)
+        d = 2
+        with recorded("plot"), recorded("imshow"):
+            status = plotter["main"](["--segment-json", self.seg_json, "--config", self.config,
+                                      "--out", os.path.join(self.tmp, "figs_drawn"), "--demo", str(d)])
+        self.assertEqual(status, 0)
+        with open(self.seg_json) as f:
+            seg = json.load(f)
+        matrix = seg["feature_matrices"][d]
+        features = matrix["features"]
+        normalized = {f["name"]: plotter["normalize01"](np.array(f["values"])) for f in features}
+        t = np.array(matrix["time"]) - matrix["time"][0]
+        image = [args[0] for method, args in drawn  # the correlation matrices are images too
+                 if method == "imshow" and np.shape(args[0]) == (len(features), len(t))]
+        self.assertEqual(len(image), 1, "one skill map")
+        by_role = [f["name"] for role in ("sensor", "state", "context") for f in features
+                   if f["role"] == role]
+        self.assertEqual(len(by_role), len(features), "a role that is not state, sensor or context")
+        np.testing.assert_array_equal(image[0], np.array([normalized[n] for n in by_role]))
+        curves = [np.asarray(args[1], dtype=float) for method, args in drawn
+                  if method == "plot" and len(args) >= 2 and np.array_equal(args[0], t)]
+        expected = [normalized[n] for n in seg["selected_features"]]
+        expected += [np.array(f["values"]) for f in features if f["role"] == "sensor"]
+        self.assertGreaterEqual(len(expected), 3)
+        for y in expected:
+            self.assertTrue(any(np.array_equal(c, y) for c in curves), "a curve is not the JSON's")
+
+    def test_without_matrices_the_rest_is_drawn(self):
+        """A JSON of `segment` without --features: Fig. 3, 4, 5 and a warning naming the flag."""
+        with open(self.seg_json) as f:
+            seg = json.load(f)
+        del seg["feature_matrices"]
+        path = os.path.join(self.tmp, "no_matrices.json")
+        with open(path, "w") as f:
+            json.dump(seg, f)
+        out = os.path.join(self.tmp, "figs_no_matrices")
+        r = self.plot("--segment-json", path, "--config", self.config, "--out", out)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        self.assertIn("--features", r.stderr)
+        self.assertEqual(sorted(os.listdir(out)), sorted(
+            "%s.png" % k for k in ("correlation_best", "correlation_all", "relevance", "clasp_profile")))
 
     def test_dataset_folder_and_several_demos(self):
         out = os.path.join(self.tmp, "figs_dataset")
@@ -212,12 +269,19 @@ class PlotFigures(unittest.TestCase):
         empty = os.path.join(self.tmp, "empty.json")
         with open(empty, "w") as f:
             f.write("{}")
+        with open(self.seg_json) as f:
+            seg = json.load(f)
+        seg["feature_matrices"][0]["time"].pop()
+        short_time = os.path.join(self.tmp, "short_time.json")
+        with open(short_time, "w") as f:
+            json.dump(seg, f)
         out = os.path.join(self.tmp, "figs_bad")
         cases = [
             (["--segment-json", os.path.join(self.tmp, "missing.json")], "does not exist"),
             (["--segment-json", bad_json], "not valid JSON"),
             (["--segment-json", empty], "no key 'demos'"),
             (["--segment-json", self.seg_json, "--config", self.config, "--demo", "9"], "out of range"),
+            (["--segment-json", short_time, "--config", self.config], "feature_matrices[0] holds"),
             (["--segment-json", self.seg_json, "--config", self.config, "--bags", "/nonexistent.bag"],
              "1 --bags for 4"),
             (["--segment-json", self.seg_json, "--config", self.config, "--bags"] +

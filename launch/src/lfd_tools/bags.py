@@ -1,13 +1,13 @@
 """The readers of recorded data: ground truth on /lfd/phase, ground-truth files (for recordings
-without it), bag spans, and a demonstration's outcome (its metadata goal and the object's final
-pose, judged by lfd_tools.judge)."""
+without it), bag spans, and the physical outcome of a recording (what the task's success rules
+need, measured from the bag and judged by lfd_tools.judge)."""
 import glob
 import json
 import os
 
 import rosbag
 
-from lfd_tools import config, judge
+from lfd_tools import config, judge, tasks
 
 PHASE_TOPIC = "/lfd/phase"
 METADATA_TOPIC = "/lfd/metadata"
@@ -101,14 +101,67 @@ def truth_from_labels(path, runs=None):
     return {"demos": demos}
 
 
-# ---- a demonstration's physical outcome ----------------------------------------------------------
+# ---- a recording's physical outcome -------------------------------------------------------------
+
+TOUCH_TOPIC, EE_TOPIC, JOINTS_TOPIC = "/touch", "/ee_pose", "/joint_states"
 
 
-def demo_outcome(path, evaluation):
-    """Physical success of a recorded demonstration, from its bag alone: the goal from its metadata
-    (the first message, /lfd/metadata extra_json) and the object's last pose, judged with the
-    task's criteria of evaluation.yaml. A dict: bag, task, mode, configuration, speed, success,
-    distance_m, height_m, duration, topics (name -> count), reason."""
+def topics_for(criterion):
+    """The topics a criterion's rules read."""
+    topics = set()
+    for rule in criterion["rules"]:
+        if "object" in rule:
+            topics.add("/objects/%s/pose" % tasks.body_of(rule["object"]))
+        if rule["rule"] == "joint":
+            topics.add(JOINTS_TOPIC)
+        if rule["rule"] == "contact_path":
+            topics.update((TOUCH_TOPIC, EE_TOPIC))
+    return sorted(topics)
+
+
+def measure(bag, criterion, base_in_world):
+    """What the rules of `criterion` judge, from an open bag: the last pose of each judged object
+    (by its name in the task file), the last value of each judged joint, and for a contact path
+    every (time, the pads' mean force, TCP world position) at the same stamp."""
+    wanted = topics_for(criterion)
+    names = {"/objects/%s/pose" % tasks.body_of(r["object"]): r["object"]
+             for r in criterion["rules"] if "object" in r}
+    joint_names = {r["joint"] for r in criterion["rules"] if r["rule"] == "joint"}
+    out = {"objects": {}, "joints": {}, "contact": []}
+    touch, tcp = {}, {}
+    for topic, msg, t in bag.read_messages(topics=wanted):
+        if topic in names:
+            p, q = msg.pose.position, msg.pose.orientation
+            out["objects"][names[topic]] = {"position": [p.x, p.y, p.z], "orientation": [q.w, q.x, q.y, q.z]}
+        elif topic == JOINTS_TOPIC:
+            for name, value in zip(msg.name, msg.position):
+                if name in joint_names:
+                    out["joints"][name] = value
+        elif topic == TOUCH_TOPIC and msg.values:
+            touch[round(msg.header.stamp.to_sec(), 4)] = sum(msg.values) / len(msg.values)
+        elif topic == EE_TOPIC:
+            p = msg.pose.position
+            tcp[round(msg.header.stamp.to_sec(), 4)] = [p.x + base_in_world[0], p.y + base_in_world[1],
+                                                         p.z + base_in_world[2]]
+    out["contact"] = [(stamp, touch[stamp], tcp[stamp]) for stamp in sorted(touch) if stamp in tcp]
+    return out
+
+
+def physical_outcome(path, task, scene):
+    """Physical success of any recording of `task` (a demonstration or a reproduction) toward
+    `scene` (tasks.scenes: its goal), judged with the task's rules from the bag at `path`.
+    Raises rosbag/OS errors for an unreadable bag."""
+    criterion = tasks.success_criterion(task)
+    with rosbag.Bag(path) as bag:
+        measured = measure(bag, criterion, tasks.base_in_world())
+    return judge.judge_rules(criterion, measured, scene, tasks.table_top())
+
+
+def demo_outcome(path):
+    """Physical success of a recorded demonstration, from its bag alone: the task and the scene
+    (goal) from its metadata (the first message, /lfd/metadata extra_json), judged with the task
+    file's criterion. A dict: bag, task, mode, configuration, speed, success, distance_m, height_m,
+    rules, duration, topics (name -> count), reason."""
     result = {"bag": path, "success": False, "reason": ""}
     try:
         with rosbag.Bag(path) as bag:
@@ -120,21 +173,14 @@ def demo_outcome(path, evaluation):
                 result["reason"] = "the first message is not %s" % METADATA_TOPIC
                 return result
             meta = first.message
-            extra = json.loads(meta.extra_json)
+            scene = json.loads(meta.extra_json)["scene"]
             result.update(task=meta.task, mode=meta.mode, configuration=meta.configuration, speed=meta.speed)
-            criteria = config.criteria_of(evaluation, meta.task)
-            table_top = float(extra["table_top"])
-            last = None
-            for _, msg, _ in bag.read_messages(topics=["/objects/%s/pose" % criteria["object"]]):
-                last = msg
+            criterion = tasks.success_criterion(meta.task)
+            measured = measure(bag, criterion, tasks.base_in_world())
     except (rosbag.ROSBagException, OSError, ValueError, KeyError, RuntimeError) as exc:
         result["reason"] = "unreadable: %s" % exc
         return result
-    if last is None:
-        result["reason"] = "no /objects/%s/pose message" % criteria["object"]
-        return result
-    p = last.pose.position
-    outcome = judge.physical_outcome(criteria, (p.x, p.y, p.z), extra["goal"]["position"], table_top)
-    result.update(success=outcome["success"], distance_m=outcome["distance_m"],
-                  height_m=outcome["height_m"], reason=outcome["reason"])
+    outcome = judge.judge_rules(criterion, measured, scene, tasks.table_top())
+    result.update(success=outcome["success"], distance_m=outcome["distance_m"], height_m=outcome["height_m"],
+                  rules=outcome["rules"], reason=outcome["reason"])
     return result

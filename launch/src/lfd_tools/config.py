@@ -1,11 +1,16 @@
-"""The project's configuration files (config/, the lfd_config package), read and checked once."""
+"""The project's configuration files (config/, the lfd_config package), read and checked once.
+The tasks (their scenes, skills and success criteria) are lfd_tools.tasks."""
+import functools
 import os
 
 import yaml
 
-DISTANCES = ("xyz", "xy")  # physical criteria: 3-D distance to the goal, or horizontal distance
+from lfd_tools import judge
+
+DISTANCES = judge.DISTANCES
 
 
+@functools.lru_cache(maxsize=None)
 def config_dir():
     import rospkg
     return rospkg.RosPack().get_path("lfd_config")
@@ -20,53 +25,73 @@ def load_yaml(path):
         return yaml.safe_load(f)
 
 
-def load_tasks(path=None):
-    return load_yaml(path or config_path("tasks.yaml"))
-
-
 def load_evaluation(path=None):
-    """config/evaluation.yaml, with its reproduction criteria checked (a clear error, not a
-    KeyError in the middle of a run)."""
+    """config/evaluation.yaml (the segmentation protocol: tolerance_s, methods), checked (a clear
+    error, not a KeyError in the middle of a run)."""
     path = path or config_path("evaluation.yaml")
     evaluation = load_yaml(path)
-    for section in ("segmentation", "reproduction"):
-        if not isinstance(evaluation, dict) or not isinstance(evaluation.get(section), dict):
-            raise RuntimeError("%s: no '%s:' section" % (path, section))
-    for task, criteria in evaluation["reproduction"].items():
-        check_criteria(task, criteria, path)
+    if not isinstance(evaluation, dict) or not isinstance(evaluation.get("segmentation"), dict):
+        raise RuntimeError("%s: no 'segmentation:' section" % path)
+    for key in ("tolerance_s", "methods"):
+        if key not in evaluation["segmentation"]:
+            raise RuntimeError("%s: segmentation.%s is missing" % (path, key))
+    evaluation = dict(evaluation, reproduction=_legacy_criteria())
     return evaluation
 
 
-def check_criteria(task, criteria, where):
-    if not isinstance(criteria, dict):
-        raise RuntimeError("%s: reproduction.%s is not a mapping" % (where, task))
-    for key in ("object", "distance", "tolerance_m"):
-        if key not in criteria:
-            raise RuntimeError("%s: reproduction.%s lacks '%s'" % (where, task, key))
-    if criteria["distance"] not in DISTANCES:
-        raise RuntimeError("%s: reproduction.%s.distance is '%s', expected one of %s"
-                           % (where, task, criteria["distance"], ", ".join(DISTANCES)))
-
+# The task's facts live in its task file; these keep their former callers working.
 
 def criteria_of(evaluation, task):
-    """The physical success criteria of a task (evaluation.yaml `reproduction.<task>`)."""
-    try:
-        return evaluation["reproduction"][task]
-    except KeyError:
-        raise RuntimeError("config/evaluation.yaml has no reproduction criteria for task '%s' (known: %s)"
-                           % (task, ", ".join(sorted(evaluation["reproduction"]))))
+    """The physical success criterion of a task (tasks.success_criterion)."""
+    from lfd_tools import tasks
+    return tasks.success_criterion(task)
 
 
 def expected_transitions(evaluation, task):
-    """The ground-truth transitions [{from, to}] a task's segmentation must find."""
-    try:
-        return evaluation["segmentation"]["expected"][task]
-    except KeyError:
-        raise RuntimeError("config/evaluation.yaml has no segmentation expectations for task '%s'" % task)
+    """The ground-truth transitions [{from, to}] of a task (tasks.expected_transitions)."""
+    from lfd_tools import tasks
+    return tasks.expected_transitions(task)
 
 
 def segment_names(evaluation, task):
-    """Names of a task's segments in order: the phase before the first transition, then the phase
-    each transition leads to (grasp: approach, move)."""
-    transitions = expected_transitions(evaluation, task)
-    return [transitions[0]["from"]] + [t["to"] for t in transitions]
+    """A task's skills in order (tasks.segment_names)."""
+    from lfd_tools import tasks
+    return tasks.segment_names(task)
+
+
+# ---- legacy views for lfd_dmp/scripts until they read lfd_tools.tasks (issue 15): remove then ----
+
+def _single_object_tasks():
+    from lfd_tools import tasks
+    placeable = {n for n, o in tasks.scene()["objects"].items() if not o.get("fixed")}
+    return [t for t in tasks.names()
+            if len(tasks.objects(t)) == 1 and tasks.objects(t)[0] in placeable
+            and tasks.success_criterion(t)["object"] == tasks.objects(t)[0]]
+
+
+def _legacy_criteria():
+    try:
+        from lfd_tools import tasks
+        return {t: tasks.success_criterion(t) for t in _single_object_tasks()}
+    except (RuntimeError, OSError, ImportError):
+        return {}
+
+
+def load_tasks(path=None):
+    """The former config/tasks.yaml layout, built from the task files of the tasks that move one
+    free object: {task: {sim|teleop: [{id, <object>: [x, y, z, yaw], goal}], unseen: {...}},
+    park: {object: [x, y, z, yaw]}, table_top}."""
+    from lfd_tools import tasks
+
+    def flat(p):
+        return p["position"] + [tasks.yaw_of(p)]
+
+    def entries(task, scenes):
+        return [dict({o: flat(p) for o, p in s["objects"].items()}, id=s["id"], goal=flat(s["goal"]))
+                for s in scenes]
+    out = {"table_top": tasks.table_top(),
+           "park": {n: flat(tasks.pose(o["park"])) for n, o in tasks.scene()["objects"].items()}}
+    for t in _single_object_tasks():
+        out[t] = {m: entries(t, tasks.scenes(t, m)) for m in tasks.MODES}
+        out[t]["unseen"] = {m: entries(t, tasks.unseen_scenes(t, m)) for m in tasks.MODES}
+    return out

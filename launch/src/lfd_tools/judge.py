@@ -1,12 +1,23 @@
 """The one judge of lfd's results: segmentation success against the ground truth, and physical
-success of an object's final pose. Pure Python (no ROS): the criteria come in as the dicts of
-config/evaluation.yaml (lfd_tools.config), the times and poses as plain numbers.
+success of a demonstration or a reproduction. Pure Python (no ROS): the criteria come in as the
+rules of a task file (lfd_tools.tasks.success_criterion), the times and poses as plain numbers.
 
 Segmentation (the paper's rule): a demo is correct when it has exactly one changepoint per expected
 transition, in order, each inside its transition's window widened by the tolerance. Also TSSB's
 Covering and margin F1, and the time error of each transition.
-Physical: the object ends within `tolerance_m` of its goal (3-D for distance xyz, horizontal for
-xy) and, when `min_lift_m` is given, at least that far above the table top.
+Physical: every rule of the task's criterion holds (judge_rules). The rule types, each with its
+parameters in the task file:
+  object_at_goal  {object, distance: xyz | xy, tolerance_m, yaw_symmetry}: the object (or an
+                  object's frame, e.g. drawer.handle) ends within tolerance_m of the goal, 3-D or
+                  horizontally (yaw_symmetry: how many yaws look alike, for the reported yaw error)
+  height          {object, min_m and/or max_m}: its centre ends that high above the table top
+                  (lifted; or resting on the table, let go)
+  joint           {joint, min and/or max}: an articulated joint's final value (m or rad)
+  contact_path    {min_force_n, length_m, tolerance_m, passes, max_gap_s}: one sustained contact
+                  (the finger pads' mean force >= min_force_n, breaks up to max_gap_s bridged)
+                  during which the TCP covers the goal's stroke (length_m along the goal's x axis,
+                  centred on it) end to end `passes` times, each end reached within tolerance_m,
+                  never farther than tolerance_m beside it
 """
 import math
 
@@ -117,14 +128,168 @@ def summarize_scores(scores, tolerance):
 
 # ---- physical success ----------------------------------------------------------------------------
 
+RULE_PARAMETERS = {  # rule -> (required, optional)
+    "object_at_goal": ({"object", "distance", "tolerance_m"}, {"yaw_symmetry"}),
+    "height": ({"object"}, {"min_m", "max_m"}),
+    "joint": ({"joint"}, {"min", "max"}),
+    "contact_path": ({"min_force_n", "length_m", "tolerance_m", "passes"}, {"max_gap_s"}),
+}
+DISTANCES = ("xyz", "xy")  # 3-D distance to the goal, or horizontal distance
+
+
+def check_rule(rule, objects, joints):
+    """Raises ValueError naming what is wrong with one rule of a criterion; `objects` are the names
+    a rule may judge (the task's objects and their frames), `joints` its articulated joints."""
+    if not isinstance(rule, dict) or rule.get("rule") not in RULE_PARAMETERS:
+        raise ValueError("expected {rule: %s, ...}" % " | ".join(sorted(RULE_PARAMETERS)))
+    required, optional = RULE_PARAMETERS[rule["rule"]]
+    keys = set(rule) - {"rule"}
+    if required - keys:
+        raise ValueError("rule %s lacks %s" % (rule["rule"], ", ".join(sorted(required - keys))))
+    if keys - required - optional:
+        raise ValueError("rule %s: unknown key(s) %s" % (rule["rule"], ", ".join(sorted(keys - required - optional))))
+    if "object" in rule and rule["object"] not in objects:
+        raise ValueError("'%s' is not an object (or object.frame) of the task (%s)"
+                         % (rule["object"], ", ".join(sorted(objects)) or "none"))
+    if "joint" in rule and rule["joint"] not in joints:
+        raise ValueError("'%s' is not a joint of the task's objects (%s)" % (rule["joint"], ", ".join(joints) or "none"))
+    if rule["rule"] == "object_at_goal" and rule["distance"] not in DISTANCES:
+        raise ValueError("distance is '%s', expected one of %s" % (rule["distance"], ", ".join(DISTANCES)))
+    if rule["rule"] in ("height", "joint") and not ({"min_m", "max_m", "min", "max"} & keys):
+        raise ValueError("rule %s needs a minimum or a maximum" % rule["rule"])
+    for key in keys - {"object", "distance", "joint"}:
+        if not isinstance(rule[key], (int, float)) or isinstance(rule[key], bool) or not math.isfinite(rule[key]):
+            raise ValueError("%s must be a number" % key)
+
+
+def _yaw(q):
+    w, x, y, z = q
+    return math.atan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z))
+
+
+def _object_at_goal(rule, measured, scene, table_top):
+    p = measured["objects"].get(rule["object"])
+    if p is None:
+        return {"success": False, "reason": "%s was not recorded" % rule["object"]}
+    goal = scene["goal"]
+    criteria = {"object": rule["object"], "distance": rule["distance"], "tolerance_m": rule["tolerance_m"],
+                "yaw_symmetry": rule.get("yaw_symmetry", 1)}
+    return physical_outcome(criteria, p["position"], goal["position"], table_top,
+                            _yaw(p["orientation"]), _yaw(goal["orientation"]))
+
+
+def _bounded(value, lo, hi, unit_scale, unit, what):
+    ok = (lo is None or value >= lo) and (hi is None or value <= hi)
+    need = " and ".join(s for s in (lo is not None and ">= %g" % (lo * unit_scale),
+                                     hi is not None and "<= %g" % (hi * unit_scale)) if s)
+    return ok, "%s %.3g%s (need %s%s)" % (what, value * unit_scale, (" " + unit) if unit else "", need,
+                                          (" " + unit) if unit else "")
+
+
+def _height(rule, measured, scene, table_top):
+    p = measured["objects"].get(rule["object"])
+    if p is None:
+        return {"success": False, "reason": "%s was not recorded" % rule["object"]}
+    height = p["position"][2] - table_top
+    ok, why = _bounded(height, rule.get("min_m"), rule.get("max_m"), 100, "cm",
+                       "%s above the table" % rule["object"])
+    return {"success": ok, "height_m": height, "reason": why}
+
+
+def _joint(rule, measured, scene, table_top):
+    value = measured["joints"].get(rule["joint"])
+    if value is None:
+        return {"success": False, "reason": "joint %s was not recorded" % rule["joint"]}
+    ok, why = _bounded(value, rule.get("min"), rule.get("max"), 1, "", "joint %s ends at" % rule["joint"])
+    return {"success": ok, "joint_value": value, "reason": why}
+
+
+def contact_runs(samples, min_force, max_gap):
+    """[(first, last)] index spans of the samples (t, force, position) in contact (force >=
+    min_force), breaks up to max_gap seconds bridged."""
+    runs = []
+    for i, (t, f, _) in enumerate(samples):
+        if f < min_force:
+            continue
+        if runs and t - samples[runs[-1][1]][0] <= max_gap:
+            runs[-1][1] = i
+        else:
+            runs.append([i, i])
+    return [tuple(r) for r in runs]
+
+
+def stroke_passes(along, half, tolerance):
+    """End-to-end traversals of a stroke [-half, half] by positions along it: each arrival in one
+    end zone (within tolerance of its end) after being in the other counts one."""
+    passes, zone = 0, None
+    for a in along:
+        here = -1 if a <= -half + tolerance else (1 if a >= half - tolerance else None)
+        if here is not None and here != zone:
+            passes += zone is not None
+            zone = here
+    return passes
+
+
+def _contact_path(rule, measured, scene, table_top):
+    samples = measured.get("contact") or []
+    if not samples:
+        return {"success": False, "reason": "no touch and TCP samples were recorded"}
+    goal = scene["goal"]
+    yaw = _yaw(goal["orientation"])
+    u, v = (math.cos(yaw), math.sin(yaw)), (-math.sin(yaw), math.cos(yaw))
+    gx, gy = goal["position"][:2]
+    best = None
+    for lo, hi in contact_runs(samples, rule["min_force_n"], rule.get("max_gap_s", 0.0)):
+        rel = [(p[0] - gx, p[1] - gy) for _, _, p in samples[lo:hi + 1]]
+        along = [d[0] * u[0] + d[1] * u[1] for d in rel]
+        beside = max(abs(d[0] * v[0] + d[1] * v[1]) for d in rel)
+        n = stroke_passes(along, rule["length_m"] / 2, rule["tolerance_m"])
+        run = (n, samples[hi][0] - samples[lo][0], beside)
+        if best is None or run[:2] > best[:2]:
+            best = run
+    if best is None:
+        return {"success": False, "passes": 0,
+                "reason": "never in contact (pad force >= %g N)" % rule["min_force_n"]}
+    passes, duration, beside = best
+    ok = passes >= rule["passes"] and beside <= rule["tolerance_m"]
+    return {"success": ok, "passes": passes, "contact_s": duration, "beside_m": beside,
+            "reason": "a %.1f s contact (>= %g N) covers the %.0f cm stroke %d time(s) (need %d), at most "
+                      "%.1f cm beside it (need <= %.1f)" % (
+                          duration, rule["min_force_n"], 100 * rule["length_m"], passes, rule["passes"],
+                          100 * beside, 100 * rule["tolerance_m"])}
+
+
+RULES = {"object_at_goal": _object_at_goal, "height": _height, "joint": _joint,
+         "contact_path": _contact_path}
+
+
+def judge_rules(criterion, measured, scene, table_top):
+    """Physical success of one demonstration or reproduction: every rule of `criterion`
+    (tasks.success_criterion) against what was measured at its end, `measured` =
+    {"objects": {name: pose}, "joints": {name: value}, "contact": [(t, pad force, TCP world
+    position)]} (lfd_tools.bags.measure), for `scene` = {"goal": pose, ...}. Returns success,
+    reason (every rule's, joined), rules (each rule's outcome) and, from the object rules,
+    distance_m, height_m, yaw_error_rad."""
+    outcomes = []
+    for rule in criterion["rules"]:
+        o = RULES[rule["rule"]](rule, measured, scene, table_top)
+        o["rule"] = rule["rule"]
+        outcomes.append(o)
+    first = lambda key: next((o[key] for o in outcomes if o.get(key) is not None), None)  # noqa: E731
+    return {"success": all(o["success"] for o in outcomes), "rules": outcomes,
+            "reason": "; ".join(o["reason"] for o in outcomes),
+            "distance_m": first("distance_m"), "height_m": first("height_m"),
+            "yaw_error_rad": first("yaw_error_rad")}
+
 
 def wrap(angle, period):
     return (angle + period / 2) % period - period / 2
 
 
 def physical_outcome(criteria, object_position, goal_position, table_top, object_yaw=None, goal_yaw=None):
-    """Judges an object's final pose against its goal with a task's criteria (evaluation.yaml
-    `reproduction.<task>`). Returns success, distance_m, height_m (above the table top),
+    """Judges an object's final pose against its goal: the object_at_goal rule (and, with
+    min_lift_m, a height rule) of a task's criterion, as tasks.success_criterion also gives them:
+    {object, distance, tolerance_m, min_lift_m, yaw_symmetry}. Returns success, distance_m, height_m (above the table top),
     yaw_error_rad (None without both yaws; modulo the object's symmetry) and a reason."""
     d = [a - b for a, b in zip(object_position[:3], goal_position[:3])]
     horizontal = criteria["distance"] == "xy"
@@ -143,11 +308,23 @@ def physical_outcome(criteria, object_position, goal_position, table_top, object
             "yaw_error_rad": yaw_error, "reason": reason}
 
 
+def describe_rule(rule):
+    """A rule of a task file in words."""
+    kind = rule["rule"]
+    if kind == "object_at_goal":
+        return "the %s ends within %.1f cm of its goal (%s)" % (
+            rule["object"], 100 * rule["tolerance_m"], "horizontal distance" if rule["distance"] == "xy" else "3-D")
+    if kind == "height":
+        return "the %s ends %s above the table" % (rule["object"], " and ".join(
+            s for s in ("min_m" in rule and ">= %.0f cm" % (100 * rule["min_m"]),
+                        "max_m" in rule and "<= %.0f cm" % (100 * rule["max_m"])) if s))
+    if kind == "joint":
+        return "the joint %s ends %s" % (rule["joint"], " and ".join(
+            s for s in ("min" in rule and ">= %g" % rule["min"], "max" in rule and "<= %g" % rule["max"]) if s))
+    return ("a sustained contact (>= %g N) covers the %.0f cm stroke %d times within %.0f cm"
+            % (rule["min_force_n"], 100 * rule["length_m"], rule["passes"], 100 * rule["tolerance_m"]))
+
+
 def describe_criteria(task, criteria):
-    """One line for reports: what success means for a task."""
-    text = "%s: the %s ends within %.0f cm of its goal (%s)" % (
-        task, criteria["object"], 100 * criteria["tolerance_m"],
-        "horizontal distance" if criteria["distance"] == "xy" else "3-D")
-    if criteria.get("min_lift_m") is not None:
-        text += ", >= %.0f cm above the table" % (100 * criteria["min_lift_m"])
-    return text
+    """One line for reports: what success means for a task (tasks.success_criterion)."""
+    return "%s: %s" % (task, ", ".join(describe_rule(r) for r in criteria["rules"]))

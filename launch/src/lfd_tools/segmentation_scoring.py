@@ -9,8 +9,7 @@ import os
 import time
 
 from lfd_tools import bags as lfd_bags
-from lfd_tools import config as lfd_config
-from lfd_tools import judge
+from lfd_tools import judge, tasks
 
 
 def score_answer(res, method, inputs, truths, spans, tolerance, elapsed):
@@ -56,11 +55,12 @@ def run_and_score(segment, method, inputs, truths, spans, tolerance):
 
 
 def dataset_truth(folder, config):
-    """(bags, true windows, spans, task) of a dataset folder whose bags carry /lfd/phase."""
+    """(bags, true windows, spans, task) of a dataset folder whose bags carry /lfd/phase; the
+    transitions to find are the task file's (`config`, the evaluation protocol, is not needed)."""
     bags = lfd_bags.list_bags(folder)
     truth = [lfd_bags.phase_transitions(b) for b in bags]
     task = truth[0][0]
-    expected = lfd_config.expected_transitions(config, task)
+    expected = tasks.expected_transitions(task)
     windows = [judge.expected_windows(phases, expected, 0.0) for _, phases in truth]
     return bags, windows, [lfd_bags.bag_span(b) for b in bags], task
 

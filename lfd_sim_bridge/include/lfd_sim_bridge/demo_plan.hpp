@@ -1,20 +1,28 @@
-// The demonstrator's finite-state machine as a plan (ROS-free): the phases of a grasp or push
-// demonstration, each a list of Cartesian segments of the gripper TCP (in base_link) with the
-// gripper actions attached, timed by the minimum-jerk law and scaled by the demo's speed.
+// The demonstrator's one interpreter of task files (ROS-free): the phases of a demonstration, each
+// a list of Cartesian segments of the gripper TCP (in base_link) with the gripper actions
+// attached, timed by the minimum-jerk law and scaled by the demo's speed, built from the task
+// file's primitives (move to a pose relative to a named frame, carry, push, open or close the
+// gripper, close until contact, move until contact, hold, release, retreat).
 // Teleop-like mode adds what a human operator does: hesitations (a move split into two
-// sub-movements with a pause), uneven segment durations, hand tremor and a timed gripper close.
+// sub-movements with a pause), uneven segment durations, a misjudged object position (the task
+// file's teleop_placement), hand tremor and a timed gripper close without force feedback.
 #pragma once
 
 #include <cstdint>
+#include <map>
 #include <optional>
 #include <random>
 #include <string>
 #include <vector>
 
+#include "lfd_core/robot_setup.hpp"
 #include "lfd_sim_bridge/demo_motion.hpp"
+#include "lfd_sim_bridge/task_file.hpp"
 
 namespace lfd_sim_bridge {
 namespace demo {
+
+using task::Contact;
 
 struct GripperAction {
   double opening = 0.0;     // m between the fingers
@@ -22,64 +30,30 @@ struct GripperAction {
 };
 
 struct Segment {
-  std::string label;  // e.g. "pregrasp", "descend", "close", "lift"
+  std::string label;  // the step's label, e.g. "pregrasp", "close", "lift"
   Pose target;        // TCP pose (base_link) at the end of the segment (= start pose for a hold)
   double duration = 0.0;                 // s, speed scaling and hesitations included
   bool is_move = true;                   // false: hold the pose (e.g. while the gripper closes)
   std::optional<GripperAction> gripper;  // sent when the segment starts
-  // Sim mode: the segment (a hold) ends once both finger pads touch, plus `settle` seconds;
-  // `duration` is then the timeout.
-  bool until_contact = false;
+  // The phase ends once the pads touch (any or both), plus `settle` seconds; a guarded move stops
+  // where it is. Without contact the segment runs its course (`duration` is the timeout).
+  Contact until_contact = Contact::kNone;
   double settle = 0.0;
 };
 
 struct Phase {
-  std::string name;  // "approach", "grasp", "move" | "approach", "push", "return"
+  std::string name;  // from the task file
   int index = 0;
+  bool window = false;  // a transition window between two skills
   std::vector<Segment> segments;
   double duration() const;
 };
 
 struct DemoPlan {
-  std::string task;  // "grasp" or "push"
-  Pose start;        // TCP pose when the demo starts
+  std::string task;
+  Pose start;  // TCP pose when the demo starts
   std::vector<Phase> phases;
   double duration() const;
-};
-
-// One demonstration's situation, in base_link.
-struct TaskInstance {
-  std::string task;   // "grasp" or "push"
-  Pose object_start;  // stick or box pose on the table
-  Pose goal;          // grasp: where the stick must end (lifted); push: box target pose
-};
-
-// Gripper and task geometry (see config/demonstrator.yaml).
-struct Geometry {
-  Eigen::Quaterniond grasp_orientation = Eigen::Quaterniond::Identity();  // TCP, stick yaw 0
-  Eigen::Quaterniond push_orientation = Eigen::Quaterniond::Identity();   // TCP, push along +x
-  double pregrasp_height = 0.10;                                          // m above the grasp pose
-  double grasp_height = 0.0;          // TCP height above the stick's centre at the grasp
-  double lift_height = 0.15;          // m, lift before carrying (>= 0.10 per the protocol)
-  double open_opening = 0.08;         // m
-  double grasp_opening = 0.0;         // m commanded to close on the stick (sim)
-  double grasp_effort = 20.0;         // N
-  double teleop_close_opening = 0.0;  // m, the operator closes fully (overshoot)
-  double box_half_length = 0.05;      // m, box half extent along the push direction
-  double push_clearance = 0.02;       // m, fingers to box face when lowered behind the box
-  double push_contact_depth = 0.0;    // m past the face the approach ends (0 = just touching)
-  double tcp_to_face = 0.015;         // m, TCP centre to the gripper's pushing face
-  double push_height = 0.0;           // TCP height above the box centre while pushing
-  double push_prelift = 0.08;         // m, approach from above before lowering behind the box
-  double retreat = 0.06;              // m, back-off after the push
-};
-
-// Nominal durations (s) at speed 1.
-struct Timing {
-  double to_pregrasp = 2.0, descend = 1.2, close = 1.0, settle = 0.3, lift = 1.2, carry = 2.0,
-         hold = 0.6;
-  double to_prepush = 2.0, lower = 1.0, touch = 0.8, push = 2.5, retreat = 1.0, go_home = 2.0;
-  double open = 0.5;  // opening the gripper at the start
 };
 
 // Human-operator behaviour of the teleop-like mode.
@@ -94,23 +68,84 @@ struct TeleopStyle {
   double timed_close = 0.9;      // s the operator waits after commanding the close
   double tremor_rms = 0.002;     // m per axis
   double tremor_low_hz = 8.0, tremor_high_hz = 12.0;
-  double grasp_position_noise = 0.01;  // m, operator's placement error (uniform +-)
 };
 
-struct Variation {
-  double speed = 1.0;               // time scaling: durations divided by speed
-  double grasp_offset_along = 0.0;  // m along the stick axis
-  double grasp_yaw = 0.0;           // rad added to the stick's yaw for the gripper
+// The closed fingers form a square block: TCP to any of its faces (m), for touch frames.
+struct ToolGeometry {
+  double fist_half_width = 0.012;
 };
 
-// Builds the phases of one demonstration from the start TCP pose. `rng` draws the teleop
-// behaviour (ignored in sim mode). Throws std::invalid_argument on an unknown task or speed <= 0.
-DemoPlan planDemo(const TaskInstance& instance, const Pose& start, const Geometry& geometry,
-                  const Timing& timing, const Variation& variation, const TeleopStyle& teleop,
-                  std::mt19937& rng);
+// A horizontal frame in base_link: a position and a yaw; TCP poses (tcp, start) also keep their
+// orientation, which targets relative to them inherit.
+struct Frame {
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();
+  double yaw = 0.0;
+  std::optional<Eigen::Quaterniond> orientation;
+};
 
-// Yaw (rad) of a pose about the base z axis (the stick's axis direction on the table).
+// The operator's timing of one step, drawn when the demo starts, so that a phase planned again
+// after an early contact keeps it.
+struct StepTiming {
+  double duration = 0.0;  // s
+  bool hesitate = false;
+  double split = 0.5, pause = 0.0;
+};
+
+// One demonstration being planned.
+struct DemoState {
+  std::map<std::string, Frame> frames;       // every named frame, as the demonstrator aims at it
+  std::map<std::string, Frame> true_starts;  // objects and object frames where they really start
+  std::vector<std::vector<StepTiming>> timings;  // per phase, per step
+  Pose start;                                    // TCP at the demo's start
+  Pose grasp_tcp;  // TCP when the gripper last closed: the hand's hold on what it carries
+};
+
+class TaskInterpreter {
+ public:
+  TaskInterpreter(task::TaskDefinition task, task::Scene scene, lfd::GripperSetup gripper,
+                  ToolGeometry tool, TeleopStyle teleop);
+
+  // A demonstration of configuration `c` (world poses) with base_link at `world_from_base` and
+  // the TCP at `start` (base_link), at `speed` (durations divided by it): draws the demo's
+  // variation and the operator's timing from `rng`. Throws std::invalid_argument (naming the task
+  // file and the frame) when a frame is degenerate (a heading toward its own origin) or speed <= 0.
+  DemoState begin(const task::Configuration& c, const Eigen::Isometry3d& world_from_base,
+                  const Pose& start, double speed, std::mt19937& rng) const;
+
+  // Phase `i`, with the TCP at `tcp` (base_link) where the previous phase ended (or where its
+  // guarded move stopped). Updates the state's hold on a carried object.
+  Phase planPhase(DemoState& state, size_t i, const Pose& tcp) const;
+
+  // Every phase, each guarded move running its course: the plan checked before recording.
+  DemoPlan planAll(DemoState state) const;
+
+  const task::TaskDefinition& task() const { return task_; }
+  const task::Scene& scene() const { return scene_; }
+
+ private:
+  Frame resolveFrame(const DemoState& s, const task::FrameSpec& f) const;
+  Pose target(const DemoState& s, const task::PoseSpec& spec) const;
+  Frame targetFrame(const DemoState& s, const task::PoseSpec& spec) const;
+  const Frame& frame(const DemoState& s, const std::string& name) const;
+  void addStep(DemoState& s, const task::Step& step, const StepTiming& timing, Pose* tcp,
+               std::vector<Segment>* out) const;
+  StepTiming drawTiming(const task::Step& step, double speed, std::mt19937& rng) const;
+
+  task::TaskDefinition task_;
+  task::Scene scene_;
+  lfd::GripperSetup gripper_;
+  ToolGeometry tool_;
+  TeleopStyle teleop_;
+};
+
+// Yaw (rad) of an orientation about z (the axis of a stick on the table).
 double yawOf(const Eigen::Quaterniond& q);
+
+// How far behind the centre of a box (horizontal half sizes `half`, turned by `yaw`) a flat
+// pusher of half width `pusher_half` first touches it, moving along the horizontal unit `dir`
+// through the centre. Off the box's axes the contact is an edge or a corner, farther than a face.
+double contactDistance(const Eigen::Vector3d& dir, const Eigen::Vector2d& half, double yaw,
+                       double pusher_half);
 
 using TimedPose = lfd::TimedPose;
 

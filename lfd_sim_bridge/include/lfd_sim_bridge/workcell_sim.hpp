@@ -67,6 +67,8 @@ struct WorkcellConfig {
   // Frames of the contract.
   std::string base_body = "base_link";
   std::string ee_site = "r_gripper_tcp";
+  // Bodies reported as objects (world poses). Free bodies and mocap bodies (fixed objects such as
+  // a cabinet) can be placed by setObjectPose; any other body (a drawer's handle) is reported only.
   std::vector<std::string> objects = {"stick", "box"};
   // Touch pads: first-order response (s) of the reported normal force. A rigid simulated contact
   // pushed by a stiff position controller chatters at the physics rate (impacts of 0-5 N); a real
@@ -144,8 +146,10 @@ class WorkcellSim {
   double time() const;
   double timestep() const;
   // Robot to a posture (empty = configured initial posture; unlisted joints take the initial
-  // posture), zero velocities, targets = posture, trajectory cancelled. Objects return to their
-  // initial poses if reset_objects. Sim time keeps running (never goes backwards).
+  // posture), zero velocities, targets = posture, trajectory cancelled. Every hinge/slide joint is
+  // reset this way, the joints of articulated objects (a drawer) included: they return to the
+  // model's qpos0 unless `posture` names them. Objects return to their initial poses if
+  // reset_objects, else keep their scene poses. Sim time keeps running (never goes backwards).
   void reset(const std::map<std::string, double>& posture = {}, bool reset_objects = false);
   void setObjectPose(const std::string& object, const Pose& pose_in_world);
   // Throws std::invalid_argument (naming the object and the bound) unless `object` exists and the
@@ -208,7 +212,10 @@ class WorkcellSim {
   void updateTouch();
   std::vector<std::pair<std::string, int>> objects_;  // name, body id
   std::vector<double> initial_qpos_;                  // model qpos0: initial object poses
-  std::vector<double> scene_qpos_;  // object poses last set (divergence recovery restores them)
+  std::vector<double> scene_qpos_;   // object poses last set (divergence recovery restores them)
+  std::vector<double> scene_mocap_;  // fixed objects' poses last set, 7 per mocap body
+  int freeJointOf(int body) const;   // the body's free joint, or -1
+  void restoreMocap();
   int divergence_count_ = 0;
   std::mt19937_64 rng_;
   bool noisy_ = false;
