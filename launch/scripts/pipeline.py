@@ -383,7 +383,7 @@ def write_report(out, report):
                 " ".join(str(c) for c in e.get("changepoint_counts", [])), notes))
         lines += ["", "Segment goals learned from the demos' scenes: the frame in which each segment's end "
                   "varies least, and that spread (RMS across the demos).", "",
-                  "| dataset | segment | position frame (spread) | orientation frame (spread) | heading |",
+                  "| dataset | segment | position frame (spread) | orientation frame (spread) | generalized along |",
                   "| --- | --- | --- | --- | --- |"]
         for name, e in sorted(report["learning"].items()):
             for g in e.get("segment_goals", []):
@@ -391,7 +391,7 @@ def write_report(out, report):
                     continue
                 lines.append("| %s | %s | %s (%.1f mm) | %s (%.3f rad) | %s |" % (
                     name, g["segment"], g["position_frame"], 1e3 * g["position_spread_m"],
-                    g["orientation_frame"], g["orientation_spread_rad"], g.get("heading_object") or "-"))
+                    g["orientation_frame"], g["orientation_spread_rad"], g.get("motion_frame") or "-"))
         lines.append("")
     for key, title in (("reproduction", "sim"), ("reproduction_teleop", "teleop")):
         if not report.get(key):

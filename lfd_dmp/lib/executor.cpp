@@ -44,26 +44,29 @@ std::map<std::string, Eigen::VectorXd> allSegmentParameters(const SkillLibrary& 
   return out;
 }
 
-// The heading frame a segment is generalized in: the new scene's heading and each demo's own.
+// The frame a segment is generalized in (its motion follows the frame's x axis): the frame's yaw
+// in the new scene and in each demo's.
 HeadingFrame headingFrame(const SkillLibrary& lib, const SegmentSkills& seg,
-                          const lfd::Scene& scene, const lfd::FrameOptions& frames,
-                          std::vector<std::string>* warnings) {
+                          const lfd::Scene& scene, const TcpPose& start,
+                          const lfd::FrameOptions& frames, std::vector<std::string>* warnings) {
+  const lfd::SceneFrame& frame = *seg.goal->motion_frame;
   HeadingFrame h;
-  h.object = seg.goal->heading_object;
-  h.yaw = lfd::sceneHeading(scene, h.object, frames);
+  h.frame = frame.name();
+  h.yaw = lfd::poseYaw(lfd::framePose(frame, scene, start, frames));
   for (const DemoSkill& d : seg.demos) {
     const auto it = lib.demo_scenes.find(d.demo_id);
     if (it == lib.demo_scenes.end()) continue;
     try {
-      h.demo_yaw[d.demo_id] = lfd::sceneHeading(it->second.scene, h.object, frames);
+      h.demo_yaw[d.demo_id] =
+          lfd::poseYaw(lfd::framePose(frame, it->second.scene, it->second.start, frames));
     } catch (const std::invalid_argument& e) {
-      warnings->push_back("segment '" + seg.name + "': demo " + d.demo_id +
-                          " left out of the heading frame: " + e.what());
+      warnings->push_back("segment '" + seg.name + "': demo " + d.demo_id + " left out of " +
+                          h.frame + ": " + e.what());
     }
   }
   if (h.demo_yaw.empty())
-    throw std::invalid_argument("segment '" + seg.name + "': no demo has a heading of '" +
-                                h.object + "' (the library's demo_scenes)");
+    throw std::invalid_argument("segment '" + seg.name + "': no demo has a defined " + h.frame +
+                                " (the library's demo_scenes)");
   return h;
 }
 
@@ -238,9 +241,9 @@ std::vector<SegmentTarget> segmentTargets(const SkillLibrary& library, const lfd
     t.frames = g.position_frame.name() + " / " + g.orientation_frame.name();
     try {
       t.goal = lfd::segmentGoal(g, scene, start, options.frames);
-      if (options.heading_frames && !g.heading_object.empty()) {
-        t.heading = headingFrame(library, seg, scene, options.frames, warnings);
-        t.frames += " (heading:" + g.heading_object + ")";
+      if (options.heading_frames && g.motion_frame) {
+        t.heading = headingFrame(library, seg, scene, start, options.frames, warnings);
+        t.frames += " (along " + g.motion_frame->name() + ")";
       }
     } catch (const std::invalid_argument& e) {
       throw std::invalid_argument("segment '" + seg.name + "' (goal frames " + t.frames +

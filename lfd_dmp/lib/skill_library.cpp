@@ -140,17 +140,18 @@ json goalJson(const lfd::SegmentGoalModel& g) {
     candidates.push_back(json{{"frame", c.frame.name()},
                               {"position_spread_m", spreadJson(c.position_m)},
                               {"orientation_spread_rad", spreadJson(c.orientation_rad)}});
-  return json{
-      {"position",
-       {{"frame", g.position_frame.name()},
-        {"offset", vectorJson(g.position_offset)},
-        {"spread_m", spreadJson(g.position_spread)}}},
-      {"orientation",
-       {{"frame", g.orientation_frame.name()},
-        {"offset", quaternionJson(g.orientation_offset)},
-        {"spread_rad", spreadJson(g.orientation_spread)}}},
-      {"heading", {{"object", g.heading_object}, {"spread_rad", spreadJson(g.heading_spread)}}},
-      {"candidates", candidates}};
+  return json{{"position",
+               {{"frame", g.position_frame.name()},
+                {"offset", vectorJson(g.position_offset)},
+                {"spread_m", spreadJson(g.position_spread)}}},
+              {"orientation",
+               {{"frame", g.orientation_frame.name()},
+                {"offset", quaternionJson(g.orientation_offset)},
+                {"spread_rad", spreadJson(g.orientation_spread)}}},
+              {"heading",
+               {{"frame", g.motion_frame ? g.motion_frame->name() : ""},
+                {"spread_rad", spreadJson(g.motion_spread)}}},
+              {"candidates", candidates}};
 }
 
 lfd::SegmentGoalModel goalFromJson(const json& j, const std::string& w) {
@@ -170,8 +171,9 @@ lfd::SegmentGoalModel goalFromJson(const json& j, const std::string& w) {
   g.orientation_spread =
       spreadFromJson(member(o, "spread_rad", w + ".orientation"), w + ".orientation.spread_rad");
   const json& h = member(j, "heading", w);
-  g.heading_object = text(member(h, "object", w + ".heading"), w + ".heading.object");
-  g.heading_spread =
+  const std::string motion = text(member(h, "frame", w + ".heading"), w + ".heading.frame");
+  if (!motion.empty()) g.motion_frame = frameFromJson(motion, w + ".heading.frame");
+  g.motion_spread =
       spreadFromJson(member(h, "spread_rad", w + ".heading"), w + ".heading.spread_rad");
   if (j.contains("candidates")) {
     const json& c = j["candidates"];

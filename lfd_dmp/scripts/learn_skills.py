@@ -57,8 +57,8 @@ def segment_goals(library):
                     "position_frame": g["position"]["frame"], "position_spread_m": g["position"]["spread_m"],
                     "orientation_frame": g["orientation"]["frame"],
                     "orientation_spread_rad": g["orientation"]["spread_rad"],
-                    "heading_object": g["heading"]["object"] or None,
-                    "heading_spread_rad": g["heading"]["spread_rad"]})
+                    "motion_frame": g["heading"]["frame"] or None,
+                    "motion_spread_rad": g["heading"]["spread_rad"]})
     return out
 
 
@@ -130,7 +130,7 @@ def main():
                         print("%-5s   %-10s ends in %s (spread %.1f mm) / %s (%.3f rad)%s" % (
                             task, g["segment"], g["position_frame"], 1e3 * g["position_spread_m"],
                             g["orientation_frame"], g["orientation_spread_rad"],
-                            ", follows heading:" + g["heading_object"] if g["heading_object"] else ""),
+                            ", moves along " + g["motion_frame"] if g["motion_frame"] else ""),
                             flush=True)
     return status
 

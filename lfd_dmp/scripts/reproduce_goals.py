@@ -7,10 +7,11 @@
                      [--record-dir DIR] [--real-time] [--attach] [--out FILE.json]
 
 The scenes, the parked objects and what counts as success come from lfd_tools.tasks (nothing here
-is task-specific; --tasks defaults to every task). Per goal: /bridge/reset, /bridge/set_scene (the
-scene's objects at their start, the others parked), then the executor's action /executor/execute
-(lfd_msgs/ExecuteTaskAction) with the scene and the goal; the judged object's final pose is scored
-by lfd_tools.judge.
+is task-specific; --tasks defaults to every task). Per goal: /bridge/reset (the articulated joints
+at their start), /bridge/set_scene (the scene's objects at their start, the others parked), then
+the executor's action /executor/execute (lfd_msgs/ExecuteTaskAction) with the scene and the goal;
+what the task's success rules read is measured meanwhile (lfd_tools.bags.measure, as for a
+demonstration) and judged by lfd_tools.judge.
 
 Lockstep (default, lfd_tools.lockstep): the simulation is paused and stepped while the goal moves,
 so a goal costs its physics and planning, not its duration in wall time, and runs the same
@@ -31,7 +32,7 @@ import subprocess
 import sys
 import time
 
-from lfd_tools import judge, lockstep, master, report, tasks
+from lfd_tools import bags, judge, lockstep, master, report, tasks
 
 SETTLE_BEFORE_S = 0.3  # sim s after placing the objects, before executing
 SETTLE_AFTER_S = 1.0   # sim s for the objects to come to rest before they are judged
@@ -70,22 +71,26 @@ class BagRecording(object):
 
 
 def reproduce(cell, task, scene, library, demo_duration, args, record_path=None):
-    """One unseen scene: a goal record (report.goal_record)."""
+    """One unseen scene: a goal record (report.goal_record), judged with the task's success rules
+    on what was measured during and after the motion (as a demonstration is judged)."""
     criterion = tasks.success_criterion(task)
-    cell.set_scene(dict(tasks.parked(task), **scene["objects"]), SETTLE_BEFORE_S)
+    cell.set_scene(dict(tasks.parked(task), **scene["objects"]), SETTLE_BEFORE_S, scene.get("joints"))
     recording = BagRecording(record_path, list(scene["objects"]) + list(tasks.parked(task))) \
         if record_path else None
+    measured = cell.record(bags.topics_for(criterion))
     try:
         res, wall = cell.execute(lockstep.execute_goal(library, scene, args.duration_scale,
                                                        args.allow_extrapolation))
         if res is None:
             raise RuntimeError("the executor gave no result")
         cell.advance(SETTLE_AFTER_S)
+        if not measured.wait_until(cell.now()):
+            raise RuntimeError("the final state was not published (%s)" % ", ".join(measured.messages))
     finally:
+        measured.close()
         bag = recording.stop() if recording else None
-    final = cell.object_pose(criterion["object"])
-    outcome = judge.physical_outcome(criterion, final["position"], scene["goal"]["position"],
-                                     tasks.table_top(), tasks.yaw_of(final), tasks.yaw_of(scene["goal"]))
+    outcome = judge.judge_rules(criterion, bags.measure(measured, criterion, tasks.base_in_world()),
+                                scene, tasks.table_top())
     g = report.goal_record(scene["id"], res, outcome, demo_duration=demo_duration, wall_time=wall)
     if bag and res.success:  # sim times at which each segment ended (snapshots per segment)
         t = res.motion_start.to_sec()
@@ -147,8 +152,6 @@ def main():
             scenes[t] = [s for s in tasks.unseen_scenes(t, args.mode) if not wanted or s["id"] in wanted]
         except (KeyError, TypeError) as exc:
             raise RuntimeError("task %s has no unseen %s scenes (%s: %s)" % (t, args.mode, type(exc).__name__, exc))
-    objects = sorted({o for t in names for s in scenes[t] for o in s["objects"]} |
-                     {o for t in names for o in tasks.parked(t)})
     key = report.reproduction_key(args.mode)
     results, status = {key: {}}, 0
     launch = ["lfd_launch", "reproduce.launch", "library_dir:=" + lib_dir]
@@ -156,7 +159,7 @@ def main():
         launch.append("real_time_factor:=1.0")
     with report.written_on_exit(out, results):
         with master.graph_for_this_process(launch, args.attach):
-            cell = lockstep.Cell(objects, lockstep=not args.real_time, node_name="reproduce_goals")
+            cell = lockstep.Cell(lockstep=not args.real_time, node_name="reproduce_goals")
             for task in names:
                 record = results[key][task] = {}
                 library = os.path.join(lib_dir, args.library_name.format(task=task, mode=args.mode))

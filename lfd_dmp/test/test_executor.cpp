@@ -263,7 +263,7 @@ TEST_F(PlannerTest, HeadingFrameKeepsAPushStraightInANewDirection) {
   const Eigen::Vector3d end = contact + 0.1 * Eigen::Vector3d(std::cos(-0.5), std::sin(-0.5), 0);
   std::vector<lfd_dmp::SegmentTarget> t = {target("approach", contact), target("push", end)};
   lfd_dmp::HeadingFrame heading;  // the demos' own headings: +x, -y, +x+y
-  heading.object = "box";
+  heading.frame = "heading:box";
   heading.yaw = -0.5;
   heading.demo_yaw = {{"push_0", 0.0}, {"push_1", -M_PI / 2}, {"push_2", M_PI / 4}};
   lfd_dmp::ExecutorOptions opt;
@@ -391,8 +391,9 @@ TEST_F(PlannerTest, SegmentGoalsFollowTheFramesLearnedFromTheDemos) {
   const lfd_dmp::SkillLibrary& lib = learned.library;
   EXPECT_EQ(lib.segments[0].goal->position_frame.name(), "heading:box");
   EXPECT_EQ(lib.segments[1].goal->position_frame.name(), "goal_heading:box");
-  EXPECT_EQ(lib.segments[1].goal->heading_object, "box");  // the stroke follows the box's way
-  EXPECT_EQ(lib.segments[0].goal->heading_object, "");
+  ASSERT_TRUE(lib.segments[1].goal->motion_frame.has_value());  // the stroke follows the box's way
+  EXPECT_EQ(lib.segments[1].goal->motion_frame->name(), "heading:box");
+  EXPECT_FALSE(lib.segments[0].goal->motion_frame.has_value());
   // A new scene, pushing in a direction no demo pushed in.
   lfd::Scene scene;
   const Eigen::Vector3d box = home_.position + Eigen::Vector3d(0.07, -0.03, -0.06);
@@ -408,7 +409,7 @@ TEST_F(PlannerTest, SegmentGoalsFollowTheFramesLearnedFromTheDemos) {
   EXPECT_LT((t[1].goal.position - (scene.goal.position - 0.052 * u)).norm(), 1e-6);
   EXPECT_LT((t[2].goal.position - home_.position).norm(), 1e-6);
   EXPECT_EQ(t[1].frames.rfind("goal_heading:box / ", 0), 0u) << t[1].frames;
-  EXPECT_NE(t[1].frames.find("(heading:box)"), std::string::npos) << t[1].frames;
+  EXPECT_NE(t[1].frames.find("(along heading:box)"), std::string::npos) << t[1].frames;
   ASSERT_TRUE(t[1].heading.has_value());
   EXPECT_NEAR(t[1].heading->yaw, -0.3, 1e-9);
   EXPECT_EQ(t[1].heading->demo_yaw.size(), 4u);

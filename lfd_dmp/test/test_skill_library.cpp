@@ -56,8 +56,8 @@ SkillLibrary makeLibrary() {
     goal.orientation_frame = lfd::SceneFrame::parse("heading:stick");
     goal.orientation_offset = Eigen::Quaterniond(Eigen::AngleAxisd(0.1, Eigen::Vector3d::UnitZ()));
     goal.orientation_spread = 0.05;
-    goal.heading_object = s == 1 ? "stick" : "";
-    goal.heading_spread = 0.1;
+    if (s == 1) goal.motion_frame = lfd::SceneFrame::parse("heading:stick");
+    goal.motion_spread = 0.1;
     goal.candidates = {
         {lfd::SceneFrame::parse("base"), 0.2, 0.3},
         {lfd::SceneFrame::parse("heading:stick"), std::numeric_limits<double>::infinity(), 0.05}};
@@ -105,7 +105,9 @@ TEST(SkillLibrary, RoundTripKeepsEverything) {
   EXPECT_EQ(back.demo_scenes.at("demo_1.bag").scene.objects.at("stick").position.x(), 0.6);
   ASSERT_TRUE(back.segments[1].goal.has_value());
   EXPECT_EQ(back.segments[1].goal->position_frame.name(), "goal");
-  EXPECT_EQ(back.segments[1].goal->heading_object, "stick");
+  ASSERT_TRUE(back.segments[1].goal->motion_frame.has_value());
+  EXPECT_EQ(back.segments[1].goal->motion_frame->name(), "heading:stick");
+  EXPECT_FALSE(back.segments[0].goal->motion_frame.has_value());
   EXPECT_TRUE(std::isinf(back.segments[1].goal->candidates[1].position_m));  // undefined frame
   ASSERT_EQ(back.segments.size(), 2u);
   EXPECT_EQ(back.segments[1].name, "move");

@@ -121,16 +121,17 @@ bool better(double spread, double distance, double best_spread, double best_dist
   return spread <= best_spread + tie && distance < best_distance - 1e-6;
 }
 
-// RMS angle between each demo's horizontal motion and the object's heading (infinite when either
+// RMS angle between each demo's horizontal motion and the x axis of `frame` (infinite when either
 // is undefined in some demo).
-double headingSpread(const std::string& object, const std::vector<SegmentDemoEnds>& demos,
-                     const FrameSelectionOptions& options) {
+double motionSpread(const SceneFrame& frame, const std::vector<SegmentDemoEnds>& demos,
+                    const FrameSelectionOptions& options) {
   double sum = 0.0;
   for (const SegmentDemoEnds& d : demos) {
     try {
       const double motion =
           headingYaw(d.segment_start.position, d.segment_end.position, options.min_motion_length);
-      const double a = wrapAngle(motion - sceneHeading(d.scene, object, options.frames));
+      const double a =
+          wrapAngle(motion - poseYaw(framePose(frame, d.scene, d.task_start, options.frames)));
       sum += a * a;
     } catch (const std::invalid_argument&) {
       return kInf;
@@ -194,6 +195,13 @@ double sceneHeading(const Scene& scene, const std::string& object, const FrameOp
   } catch (const std::invalid_argument& e) {
     throw std::invalid_argument("no heading of '" + object + "' toward the goal: " + e.what());
   }
+}
+
+double poseYaw(const Pose& pose) {
+  const Eigen::Vector3d x = pose.orientation * Eigen::Vector3d::UnitX();
+  if (!x.allFinite() || x.head<2>().norm() < std::abs(x.z()))
+    throw std::invalid_argument("the frame's x axis is closer to vertical than horizontal: no yaw");
+  return std::atan2(x.y(), x.x());
 }
 
 Pose framePose(const SceneFrame& frame, const Scene& scene, const Pose& start,
@@ -265,16 +273,18 @@ SegmentGoalModel learnSegmentGoal(const std::vector<SegmentDemoEnds>& demos,
   // `base` is always defined, so both were chosen.
   model.position_spread = best_position.position_rms;
   model.orientation_spread = best_orientation.orientation_rms;
-  double best_heading = kInf;
-  for (const auto& [name, pose] : common.objects) {
-    const double spread = headingSpread(name, demos, options);
-    if (spread < best_heading) {
-      best_heading = spread;
-      model.heading_object = name;
+  // The frame whose x axis the motion follows best (the base frame's would change nothing).
+  double best_motion = kInf;
+  for (const SceneFrame& frame : candidateFrames(common)) {
+    if (frame.kind == SceneFrame::Kind::kBase) continue;
+    const double spread = motionSpread(frame, demos, options);
+    if (spread < best_motion) {
+      best_motion = spread;
+      model.motion_frame = frame;
     }
   }
-  model.heading_spread = best_heading;
-  if (!(best_heading <= options.heading_tolerance)) model.heading_object.clear();
+  model.motion_spread = best_motion;
+  if (!(best_motion <= options.heading_tolerance)) model.motion_frame.reset();
   return model;
 }
 

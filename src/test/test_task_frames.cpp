@@ -80,12 +80,13 @@ TEST(TaskFrames, PushGoalsAreLearnedInTheFramesTheDemosImply) {
   EXPECT_EQ(approach.position_frame.name(), "heading:box");
   EXPECT_NEAR((approach.position_offset - Eigen::Vector3d(-0.072, 0, 0)).norm(), 0.0, 0.002);
   EXPECT_LT(approach.position_spread, 0.002);
-  EXPECT_EQ(approach.heading_object, "");  // home -> behind the box is not along the push
+  EXPECT_FALSE(approach.motion_frame.has_value());  // home -> behind the box is not along it
   const lfd::SegmentGoalModel push = lfd::learnSegmentGoal(segs[1], opt);
   EXPECT_EQ(push.position_frame.name(), "goal_heading:box");
   EXPECT_NEAR((push.position_offset - Eigen::Vector3d(-0.052, 0, 0)).norm(), 0.0, 0.002);
-  EXPECT_EQ(push.heading_object, "box");  // the stroke follows the box's way to its goal
-  EXPECT_LT(push.heading_spread, 0.05);
+  ASSERT_TRUE(push.motion_frame.has_value());  // the stroke follows the box's way to its goal
+  EXPECT_EQ(push.motion_frame->name(), "heading:box");
+  EXPECT_LT(push.motion_spread, 0.05);
   const lfd::SegmentGoalModel ret = lfd::learnSegmentGoal(segs[2], opt);
   EXPECT_EQ(ret.position_frame.name(), "start");  // as still as the base frame, and nearer
   EXPECT_LT(ret.position_spread, 1e-9);

@@ -17,7 +17,7 @@ import rostest
 from actionlib_msgs.msg import GoalStatus
 from lfd_msgs.msg import DemoSegmentation, ExecuteTaskFeedback
 from lfd_msgs.srv import LearnSkills
-from lfd_tools import bags as lfd_bags
+from lfd_tools import bags
 from lfd_tools import judge, lockstep, tasks
 
 TASK = "grasp"
@@ -47,10 +47,10 @@ class ExecutorAction(unittest.TestCase):
         bags = sorted(glob.glob(os.path.join(out, "*.bag")))
         assert len(bags) == 4, bags
         # The lockstep client (it pauses the simulation) once the demonstrator is done with it.
-        cls.cell = lockstep.Cell(list(cls.scene["objects"]) + list(cls.parked), node_name="executor_test")
+        cls.cell = lockstep.Cell(node_name="executor_test")
         cls.library = os.path.join(out, "%s.json" % TASK)
         rospy.wait_for_service("/learner/learn", timeout=120)
-        segs = [DemoSegmentation(source=b, changepoint_times=lfd_bags.ground_truth_changepoints(
+        segs = [DemoSegmentation(source=b, changepoint_times=bags.ground_truth_changepoints(
             b, tasks.expected_transitions(TASK))) for b in bags]
         res = rospy.ServiceProxy("/learner/learn", LearnSkills)(
             task=TASK, output_path=cls.library, segmentations=segs,
@@ -60,7 +60,8 @@ class ExecutorAction(unittest.TestCase):
 
     # ---- helpers --------------------------------------------------------------------------------
     def place(self, scene=None):
-        self.cell.set_scene(dict(self.parked, **(scene or self.scene)["objects"]), 0.3)
+        scene = scene or self.scene
+        self.cell.set_scene(dict(self.parked, **scene["objects"]), 0.3, scene.get("joints"))
 
     def goal(self, scene=None, **kw):
         return lockstep.execute_goal(self.library, scene or self.scene, **kw)
@@ -102,6 +103,8 @@ class ExecutorAction(unittest.TestCase):
     # ---- tests ----------------------------------------------------------------------------------
     def test_1_reproduces_an_unseen_goal_with_feedback(self):
         self.place()
+        criterion = tasks.success_criterion(TASK)
+        measured = self.cell.record(bags.topics_for(criterion))
         result, wall = self.cell.execute(self.goal())
         self.assertTrue(result.success, result.error)
         self.assertEqual(list(result.segment_names), tasks.segment_names(TASK))
@@ -128,9 +131,10 @@ class ExecutorAction(unittest.TestCase):
         self.assertLess(max(f.tcp_position_error for f in fb), 0.01)  # tracked the plan
         self.assertEqual(fb[-1].motion_start, result.motion_start)
         self.cell.advance(1.0)
-        final = self.cell.object_pose(tasks.success_criterion(TASK)["object"])
-        outcome = judge.physical_outcome(tasks.success_criterion(TASK), final["position"],
-                                         self.scene["goal"]["position"], tasks.table_top())
+        self.assertTrue(measured.wait_until(self.cell.now()))
+        measured.close()
+        outcome = judge.judge_rules(criterion, bags.measure(measured, criterion, tasks.base_in_world()),
+                                    self.scene, tasks.table_top())
         self.assertTrue(outcome["success"], outcome["reason"])
 
     def test_2_preempted_while_moving_then_answers(self):

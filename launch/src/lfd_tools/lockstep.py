@@ -28,6 +28,55 @@ def stamped(p, frame="world"):
     return msg
 
 
+def message_type(topic):
+    """The message type of a topic of the work cell's contract (DESIGN.md)."""
+    from geometry_msgs.msg import PoseStamped
+    from lfd_msgs.msg import Touch
+    from sensor_msgs.msg import JointState
+    if topic.startswith("/objects/") or topic == "/ee_pose":
+        return PoseStamped
+    types = {"/joint_states": JointState, "/touch": Touch}
+    if topic not in types:
+        raise RuntimeError("no message type known for topic %s" % topic)
+    return types[topic]
+
+
+class LiveRecording(object):
+    """The messages of some topics from now on, read like a rosbag (lfd_tools.bags.measure judges
+    them as it judges a recorded demonstration): one judge for demonstrations and reproductions,
+    without a bag file per goal."""
+
+    def __init__(self, topics, since):
+        import rospy
+        self.since, self.messages = since, {t: [] for t in topics}
+        self.subs = [rospy.Subscriber(t, message_type(t), self._on, t, queue_size=10000) for t in topics]
+
+    def _on(self, msg, topic):
+        if msg.header.stamp.to_sec() >= self.since:
+            self.messages[topic].append(msg)
+
+    def wait_until(self, stamp, timeout=30.0):
+        """Every topic has delivered a message stamped at or after `stamp` (sim s): the last
+        published state is in (False after `timeout` wall s)."""
+        deadline = time.time() + timeout
+        while time.time() < deadline:
+            if all(m and m[-1].header.stamp.to_sec() >= stamp - 1e-6 for m in self.messages.values()):
+                return True
+            time.sleep(0.005)
+        return False
+
+    def close(self):
+        for sub in self.subs:
+            sub.unregister()
+
+    def read_messages(self, topics=None):
+        """(topic, message, stamp) in stamp order, as rosbag.Bag.read_messages."""
+        items = [(m.header.stamp, t, m) for t, ms in self.messages.items()
+                 if topics is None or t in topics for m in ms]
+        for stamp, topic, msg in sorted(items, key=lambda x: x[0]):
+            yield topic, msg, stamp
+
+
 def execute_goal(library, scene, duration_scale=1.0, allow_extrapolation=False, dry_run=False):
     """An lfd_msgs/ExecuteTaskGoal for a scene {"objects": {name: pose}, "goal": pose} (world)."""
     from lfd_msgs.msg import ExecuteTaskGoal
@@ -42,10 +91,9 @@ class Cell(object):
     `lockstep`: pause the bridge and step it; otherwise it runs on its own (e.g. paced at
     real time for rviz). Starts this process's rospy node."""
 
-    def __init__(self, objects, lockstep=True, node_name="lockstep_client"):
+    def __init__(self, lockstep=True, node_name="lockstep_client"):
         import actionlib
         import rospy
-        from geometry_msgs.msg import PoseStamped
         from lfd_msgs.msg import ExecuteTaskAction
         from lfd_msgs.srv import ResetSim, SetScene, StepSim
         from std_srvs.srv import SetBool
@@ -64,9 +112,7 @@ class Cell(object):
             if time.time() > deadline:
                 raise RuntimeError("the executor's action /executor/execute did not come up in 120 s")
             time.sleep(0.01)
-        self.goal_handle, self.poses, self.feedback = None, {}, []
-        self.subs = [rospy.Subscriber("/objects/%s/pose" % o, PoseStamped, self._on_pose, o,
-                                      queue_size=5) for o in objects]
+        self.goal_handle, self.feedback = None, []
         self.srv["/bridge/pause"](data=lockstep)
         self.sim_time = self.step(1) if lockstep else None
         while rospy.Time.now().is_zero():
@@ -82,9 +128,6 @@ class Cell(object):
         return (a.pub_goal.impl.has_connection(server) and a.pub_cancel.impl.has_connection(server)
                 and any(c.callerid_pub == server for c in a.result_sub.impl.connections)
                 and any(c.callerid_pub == server for c in a.feedback_sub.impl.connections))
-
-    def _on_pose(self, msg, name):
-        self.poses[name] = msg
 
     def step(self, steps):
         r = self.srv["/bridge/step"](steps=steps)
@@ -108,9 +151,12 @@ class Cell(object):
         while self.rospy.get_time() < end and not self.rospy.is_shutdown():
             time.sleep(0.002)
 
-    def set_scene(self, placed, settle):
-        """Resets the robot and the objects, places {name: pose}, lets them settle (sim s)."""
-        r = self.srv["/bridge/reset"](joint_names=[], positions=[], reset_objects=True)
+    def set_scene(self, placed, settle, joints=None):
+        """Resets the robot and the objects (the articulated joints {name: value} at their start),
+        places {name: pose}, lets them settle (sim s)."""
+        joints = joints or {}
+        r = self.srv["/bridge/reset"](joint_names=list(joints), positions=[float(v) for v in joints.values()],
+                                      reset_objects=True)
         if not r.success:
             raise RuntimeError("reset failed: " + r.message)
         s = self.srv["/bridge/set_scene"](object_names=list(placed),
@@ -119,17 +165,9 @@ class Cell(object):
             raise RuntimeError("set_scene failed: " + s.message)
         self.advance(settle)
 
-    def object_pose(self, name):
-        """The object's pose published at or after the current sim time (wall-bounded wait)."""
-        now = self.now()
-        deadline = time.time() + 30
-        while time.time() < deadline:
-            msg = self.poses.get(name)
-            if msg is not None and msg.header.stamp.to_sec() >= now - 1e-6:
-                p, q = msg.pose.position, msg.pose.orientation
-                return {"position": [p.x, p.y, p.z], "orientation": [q.w, q.x, q.y, q.z]}
-            time.sleep(0.005)
-        raise RuntimeError("no /objects/%s/pose at the current sim time" % name)
+    def record(self, topics):
+        """A LiveRecording of `topics` from the current sim time on."""
+        return LiveRecording(topics, self.now())
 
     def send(self, goal):
         """Sends a goal; its feedback is collected in self.feedback."""

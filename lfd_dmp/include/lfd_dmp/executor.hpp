@@ -28,12 +28,13 @@ namespace lfd_dmp {
 
 using TcpPose = lfd::Pose;  // position + unit quaternion, in the library's Cartesian frame
 
-/// Generalize a segment in a heading frame: each demo's DMP is rotated about z so that its own
-/// heading points along x, interpolated there, and rotated into the new heading. Why: a push
-/// stroke has the same shape in its own frame whatever its direction, while in the base frame the
-/// forcing terms of pushes in different directions point different ways and their mix bends it.
+/// Generalize a segment in the frame its motion follows (learned: SegmentGoalModel::motion_frame):
+/// each demo's DMP is rotated about z so that that frame's x axis (in the demo's scene) points
+/// along x, interpolated there, and rotated into the frame's new yaw. Why: a push stroke has the
+/// same shape in its own frame whatever its direction, while in the base frame the forcing terms
+/// of pushes in different directions point different ways and their mix bends it.
 struct HeadingFrame {
-  std::string object;
+  std::string frame;
   double yaw = 0.0;                        ///< the new scene's heading
   std::map<std::string, double> demo_yaw;  ///< each demo's heading, by demo id
 };

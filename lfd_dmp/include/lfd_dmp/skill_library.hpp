@@ -15,7 +15,7 @@
 //      "goal": {"position": {"frame": "object:stick", "offset": [x, y, z], "spread_m": 0.008},
 //               "orientation": {"frame": "object:stick", "offset": [w, x, y, z],
 //                               "spread_rad": 0.04},
-//               "heading": {"object": "", "spread_rad": 1.2},   // "" = not generalized there
+//               "heading": {"frame": "", "spread_rad": 1.2},   // motion follows its x ("": none)
 //               "candidates": [{"frame": "base", "position_spread_m": 0.1,
 //                               "orientation_spread_rad": 0.2}, ...]},  // null = undefined
 //      "demos": [{"demo_id": "grasp_03.bag", "start_time": 0.0, "end_time": 4.1,

@@ -7,9 +7,10 @@
 // Position and orientation choose their frames separately (a push ends behind the box along its
 // heading, while the closed fist keeps about the same yaw in the base frame whatever the heading).
 //
-// A segment whose motion follows an object's way to the goal (its start -> end direction stays
-// along the object -> goal heading in every demo) is also flagged with that heading, so its DMPs
-// can be generalized in the heading frame (a push stroke has one shape along its own direction).
+// A segment whose motion follows a frame's x axis (its start -> end direction stays along it in
+// every demo: a push along the box's way to its goal, a wipe along the goal's stroke) is also
+// flagged with that frame, so its DMPs can be generalized there (one shape along its own
+// direction).
 #pragma once
 
 #include "lfd_core/pose.hpp"
@@ -18,6 +19,7 @@
 #include <Eigen/Geometry>
 
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -66,6 +68,10 @@ double headingYaw(const Eigen::Vector3d& from, const Eigen::Vector3d& to, double
 /// The heading yaw of object `object` in `scene` (its horizontal direction to the goal).
 double sceneHeading(const Scene& scene, const std::string& object, const FrameOptions& options);
 
+/// The yaw of a pose's x axis about the vertical; throws std::invalid_argument when the x axis is
+/// closer to vertical than to horizontal (no yaw).
+double poseYaw(const Pose& pose);
+
 /// The pose of `frame` in a scene whose task starts with the TCP at `start`. Throws
 /// std::invalid_argument naming a missing object or an undefined heading.
 Pose framePose(const SceneFrame& frame, const Scene& scene, const Pose& start,
@@ -95,18 +101,19 @@ struct SegmentGoalModel {
   SceneFrame orientation_frame;
   Eigen::Quaterniond orientation_offset = Eigen::Quaterniond::Identity();
   double orientation_spread = 0.0;  ///< rad, RMS across the demos in that frame
-  /// The object whose heading the segment's motion follows ("" = none): generalize there.
-  std::string heading_object;
-  double heading_spread = 0.0;          ///< rad, RMS angle between the motion and that heading
+  /// The frame whose x axis the segment's horizontal motion follows (none: the base frame):
+  /// generalize there.
+  std::optional<SceneFrame> motion_frame;
+  double motion_spread = 0.0;  ///< rad, RMS angle between the motion and that frame's x axis
   std::vector<FrameSpread> candidates;  ///< every frame tried, for reports
 };
 
 struct FrameSelectionOptions {
   FrameOptions frames;
-  /// rad: the RMS angle between a segment's horizontal motion and an object's heading below which
-  /// the segment follows that heading.
+  /// rad: the RMS angle between a segment's horizontal motion and a frame's x axis below which the
+  /// segment follows that frame.
   double heading_tolerance = 0.25;
-  /// m: a segment that moves less than this horizontally in some demo follows no heading.
+  /// m: a segment that moves less than this horizontally in some demo follows no frame.
   double min_motion_length = 0.02;
 };
 
