@@ -121,7 +121,8 @@ def reproduce_task(cell, task, mode, library, scenes, args, record):
             task, g["id"], n, len(scenes), "OK" if g["success"] else "FAILED",
             "-" if g["object_position_error_m"] is None else "%.1f mm" % (1e3 * g["object_position_error_m"]),
             "-" if g["time_ratio"] is None else "%.3f" % g["time_ratio"],
-            "-" if g["wall_time_s"] is None else "%.1f s" % g["wall_time_s"], g["error"]), flush=True)
+            "-" if g["wall_time_s"] is None else "%.1f s" % g["wall_time_s"],
+            g["error"] or ("" if g["success"] else g["judged"])), flush=True)
 
 
 def main():

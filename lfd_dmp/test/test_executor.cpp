@@ -281,6 +281,9 @@ TEST_F(PlannerTest, HeadingFrameKeepsAPushStraightInANewDirection) {
       EXPECT_GT(strokeDeviation(world, contact, end), 0.005);
     }
   }
+  // A one-way stroke is averaged over the demos (their shapes agree along the frame).
+  t[1].heading = heading;
+  EXPECT_EQ(planner_.plan(lib, t, q0_, std::nullopt, opt).segments[1].demos.size(), 3u);
   // No demo with a heading: a clear refusal.
   heading.demo_yaw = {{"another_demo", 0.0}};
   t[1].heading = heading;
@@ -449,6 +452,72 @@ TEST_F(PlannerTest, SegmentGoalsFollowTheFramesLearnedFromTheDemos) {
   } catch (const std::invalid_argument& e) {
     EXPECT_NE(std::string(e.what()).find("relearn"), std::string::npos) << e.what();
   }
+}
+
+// Three wipe strokes along x, timed differently in each demo (a teleoperator): averaged they
+// shrink; the segment goes back and forth along its frame, so the nearest demo's shape is kept.
+TEST_F(PlannerTest, BackAndForthAlongItsFrameKeepsTheNearestDemosStrokes) {
+  lfd_dmp::SkillLibrary lib;
+  lib.segments.resize(1);
+  lib.segments[0].name = "wipe";
+  const double pauses[3] = {0.0, 0.6, 1.2};  // s of hesitation before the second stroke
+  for (int j = 0; j < 3; ++j) {
+    const Eigen::Vector3d c = home_.position + Eigen::Vector3d(0.02 * j, -0.01 * j, -0.05);
+    const Eigen::Vector3d a = c - Eigen::Vector3d(0.08, 0, 0), b = c + Eigen::Vector3d(0.08, 0, 0);
+    const Eigen::Vector3d via[4] = {a, b, a, b};
+    const double span[3] = {1.5, 1.5 + pauses[j], 1.5};
+    lfd::SegmentDemo d;
+    const int m = 601;
+    const double total = span[0] + span[1] + span[2];
+    d.times = Eigen::VectorXd::LinSpaced(m, 0.0, total);
+    d.positions.resize(m, 3);
+    d.quaternions.resize(m, 4);
+    for (int k = 0; k < m; ++k) {
+      double t = d.times[k];
+      int s = 0;
+      while (s < 2 && t > span[s]) t -= span[s++];
+      const double hold = s == 1 ? pauses[j] : 0.0;  // the hesitation starts the stroke
+      const double u = minJerk(std::clamp((t - hold) / (span[s] - hold), 0.0, 1.0));
+      d.positions.row(k) = (via[s] + u * (via[s + 1] - via[s])).transpose();
+      d.quaternions.row(k) << home_.orientation.w(), home_.orientation.x(), home_.orientation.y(),
+          home_.orientation.z();
+    }
+    lfd::DmpParameters params;
+    params.num_basis = 60;
+    lfd_dmp::DemoSkill skill;
+    skill.demo_id = "wipe_" + std::to_string(j);
+    skill.dmp = lfd::SegmentDmp::learn(d, params);
+    skill.parameters = lfd::goalParameters(skill.dmp);
+    lib.dmp_parameters = params;
+    lib.segments[0].demos.push_back(skill);
+  }
+  const Eigen::Vector3d goal = home_.position + Eigen::Vector3d(0.09, 0.0, -0.05);
+  std::vector<lfd_dmp::SegmentTarget> t = {target("wipe", goal)};
+  lfd_dmp::HeadingFrame frame;
+  frame.frame = "goal";
+  frame.demo_yaw = {{"wipe_0", 0.0}, {"wipe_1", 0.0}, {"wipe_2", 0.0}};
+  t[0].heading = frame;
+  lfd_dmp::ExecutorOptions opt;
+  opt.dt = 0.004;
+  opt.allow_extrapolation = true;
+  // Start where the strokes start.
+  lfd::CartesianToJoints ik = converter(chain_, q0_);
+  lfd::TimedPose start{0.0, home_};
+  start.pose.position = goal - Eigen::Vector3d(0.16, 0, 0);
+  const lfd::JointPath to_start = ik.convert({start}, q0_);
+  const lfd_dmp::ExecutionPlan plan =
+      planner_.plan(lib, t, to_start.positions[0], std::nullopt, opt);
+  ASSERT_EQ(plan.segments[0].demos.size(), 1u);  // the nearest demo's shape, whole
+  double lo = 1e9, hi = -1e9;
+  for (const auto& p : plan.poses) {
+    lo = std::min(lo, p.position.x());
+    hi = std::max(hi, p.position.x());
+  }
+  EXPECT_GT(hi - lo, 0.15);                // the full 16 cm stroke
+  opt.nearest_shape_along_motion = false;  // averaged: the strokes of different timing shrink
+  const lfd_dmp::ExecutionPlan mixed =
+      planner_.plan(lib, t, to_start.positions[0], std::nullopt, opt);
+  EXPECT_EQ(mixed.segments[0].demos.size(), 3u);
 }
 
 // Nothing is task-specific: a task no code knows (four segments, objects named "cup" and "tray")

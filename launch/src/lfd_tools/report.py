@@ -55,6 +55,7 @@ def goal_record(goal_id, response=None, outcome=None, error="", demo_duration=No
          "object_position_error_m": outcome.get("distance_m"),
          "object_height_m": outcome.get("height_m"),
          "object_yaw_error_rad": outcome.get("yaw_error_rad"),
+         "judged": outcome.get("reason", ""),
          "tcp_position_error_m": response.final_position_error if executed else None,
          "tcp_orientation_error_rad": response.final_orientation_error if executed else None,
          "execution_time_s": response.execution_time if executed else None,
