@@ -202,7 +202,7 @@ class Executor {
   Eigen::Isometry3d transform(const std::string& target, const std::string& source) {
     std::string why;
     const auto t0 = Clock::now();
-    while (!tf_buffer_.canTransform(target, source, ros::Time(0), &why)) {
+    while (why.clear(), !tf_buffer_.canTransform(target, source, ros::Time(0), &why)) {
       if (wallSince(t0) > tf_timeout_ || !ros::ok())
         throw std::invalid_argument("no transform from '" + source + "' to '" + target +
                                     "' on tf: " + why);

@@ -125,7 +125,7 @@ class Learner {
   Eigen::Isometry3d liveTransform(const std::string& target, const std::string& source) {
     std::string why;
     const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(tf_timeout_);
-    while (!tf_buffer_.canTransform(target, source, ros::Time(0), &why)) {
+    while (why.clear(), !tf_buffer_.canTransform(target, source, ros::Time(0), &why)) {
       if (ros::WallTime::now() > deadline || !ros::ok())
         throw std::runtime_error("no transform from '" + source + "' to '" + target + "' (" + why +
                                  ")");

@@ -44,14 +44,14 @@ class ExecutorAction(unittest.TestCase):
             assert time.time() < deadline, "the demonstrator did not finish the dataset"
             time.sleep(1)
         time.sleep(1)
-        bags = sorted(glob.glob(os.path.join(out, "*.bag")))
-        assert len(bags) == 4, bags
+        recorded = sorted(glob.glob(os.path.join(out, "*.bag")))
+        assert len(recorded) == 4, recorded
         # The lockstep client (it pauses the simulation) once the demonstrator is done with it.
         cls.cell = lockstep.Cell(node_name="executor_test")
         cls.library = os.path.join(out, "%s.json" % TASK)
         rospy.wait_for_service("/learner/learn", timeout=120)
         segs = [DemoSegmentation(source=b, changepoint_times=bags.ground_truth_changepoints(
-            b, tasks.expected_transitions(TASK))) for b in bags]
+            b, tasks.expected_transitions(TASK))) for b in recorded]
         res = rospy.ServiceProxy("/learner/learn", LearnSkills)(
             task=TASK, output_path=cls.library, segmentations=segs,
             segment_names=tasks.segment_names(TASK))
