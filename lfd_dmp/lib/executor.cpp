@@ -391,6 +391,8 @@ ExecutionPlan TaskPlanner::plan(const SkillLibrary& library,
                               "': its goal lies beyond the demos' goals: "
                               "generalized by the kernel average");
     }
+    // The duration is every demo's, kernel-weighted, even when one demo gives the shape.
+    const double tau = lfd::generalizeSegment(dmps, params, query, gen_options).dmp.tau;
     if (heading && options.nearest_shape_along_motion && backAndForth(dmps))
       keepNearest(query, &dmps, &params, &planned);
     lfd::GeneralizationResult gen = lfd::generalizeSegment(dmps, params, query, gen_options);
@@ -398,7 +400,7 @@ ExecutionPlan TaskPlanner::plan(const SkillLibrary& library,
 
     lfd::SegmentRolloutOptions ro;
     ro.dt = options.dt;
-    ro.tau = gen.dmp.tau * options.duration_scale;
+    ro.tau = tau * options.duration_scale;
     // Refuse before allocating: the rollout, IK and trajectory all grow with the samples.
     samples += *ro.tau / options.dt;
     if (!(samples <= static_cast<double>(options.max_samples))) {
