@@ -52,6 +52,7 @@ from lfd_msgs.srv import Segment, SegmentRequest
 from lfd_tools import bags as lfd_bags
 from lfd_tools import config as lfd_config
 from lfd_tools import report, segmentation_scoring, tasks
+from lfd_tools.master import master_online
 
 
 class CliSegmenter(object):
@@ -125,6 +126,11 @@ def call_service(segment, bags, method):
 def make_segmenter(args):
     if args.cli:
         return CliSegmenter(args.cli, args.seg_config, args.no_sensors, args.topics, args.procedure)
+    # rospy.init_node waits for a master forever: without one, say so (or use --cli).
+    if not master_online():
+        raise RuntimeError("no ROS master at %s for the segmentation service %s (start segment.launch, "
+                           "or use --cli)" % (os.environ.get("ROS_MASTER_URI"), args.service))
+    rospy.init_node("evaluate_segmentation", anonymous=True, disable_signals=True)
     try:
         rospy.wait_for_service(args.service, timeout=30.0)
     except rospy.ROSException:
@@ -216,6 +222,4 @@ def main():
 
 
 if __name__ == "__main__":
-    if "--cli" not in sys.argv:
-        rospy.init_node("evaluate_segmentation", anonymous=True, disable_signals=True)
     sys.exit(main())
