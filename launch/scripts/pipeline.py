@@ -86,6 +86,12 @@ def failed(what, rc, tail):
     return RuntimeError("%s (exit %d)%s" % (what, rc, (": " + tail.replace("\n", " / ")) if tail else ""))
 
 
+def roots_arg(folder):
+    """The services of a stage may read and write only inside the run's output folder, wherever
+    it is (the config's default roots are for users calling them by hand)."""
+    return "allowed_roots:=[%s]" % json.dumps(os.path.abspath(folder))
+
+
 def count_bags(folder):
     if not os.path.isdir(folder):
         return 0
@@ -125,7 +131,7 @@ def stage_segment(out, args, report):
     require_bags(data, args.datasets)
     result = os.path.join(out, "segmentation.json")
     with private_master() as env:
-        with background_launch(["roslaunch", "lfd_launch", "segment.launch"], env):
+        with background_launch(["roslaunch", "lfd_launch", "segment.launch", roots_arg(out)], env):
             rc, tail = run_tool(["/usr/bin/python3", os.path.join(ROOT, "lfd_segmentation", "scripts",
                                                               "evaluate_segmentation.py"),
                             "--datasets", data, "--names", ",".join(args.datasets), "--out", result], env)
@@ -175,7 +181,7 @@ def stage_learn(out, args, report):
     if not todo:
         return "skipped"
     with private_master() as env:
-        with background_launch(["roslaunch", "lfd_launch", "learn.launch", "output:=log"], env):
+        with background_launch(["roslaunch", "lfd_launch", "learn.launch", "output:=log", roots_arg(out)], env):
             for mode, tasks in todo.items():
                 result = os.path.join(skills, "learning_%s.json" % mode)
                 with contextlib.suppress(FileNotFoundError):
@@ -238,7 +244,8 @@ def stage_reproduce(out, args, report):
 
     def reproduce(group):  # one simulation and executor for the worker's libraries
         with private_master() as env:
-            with background_launch(["roslaunch", "lfd_launch", "reproduce.launch", "library_dir:=" + skills], env):
+            with background_launch(["roslaunch", "lfd_launch", "reproduce.launch", "library_dir:=" + skills,
+                                     roots_arg(out)], env):
                 for mode, task, ids in group:
                     reproduce_one(results, skills, mode, task, ids, report, env,
                                   "%s_%s" % (mode, task) if len(groups) > 1 else None)
