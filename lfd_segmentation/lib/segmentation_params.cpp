@@ -172,6 +172,8 @@ SegmentationParams params_from_yaml(const YAML::Node& root) {
       get<double>(events, "noise_floor_excursions", ev.noise_floor_excursions);
   ev.hysteresis = get<double>(events, "hysteresis", ev.hysteresis);
   ev.zones_from_rest_edges = get<bool>(events, "zones_from_rest_edges", ev.zones_from_rest_edges);
+  ev.rest_edge_sigmas = non_negative(get<double>(events, "rest_edge_sigmas", ev.rest_edge_sigmas),
+                                     "events/rest_edge_sigmas");
   ev.placement = lfd::parse_event_placement(
       get<std::string>(events, "placement", lfd::to_string(ev.placement)));
   if (events && events["place_on_change"])

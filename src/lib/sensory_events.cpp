@@ -22,9 +22,11 @@ void check_config(const SensoryEventConfig& c) {
   if (!(c.hysteresis > 0.0 && c.hysteresis <= 1.0))
     throw std::invalid_argument("sensory events: hysteresis must be in (0, 1], got " +
                                 std::to_string(c.hysteresis));
-  if (!(c.noise_floor_sigmas >= 0.0) || !(c.noise_floor_excursions >= 0.0))
+  if (!(c.noise_floor_sigmas >= 0.0) || !(c.noise_floor_excursions >= 0.0) ||
+      !(c.rest_edge_sigmas >= 0.0))
     throw std::invalid_argument(
-        "sensory events: noise_floor_sigmas and noise_floor_excursions must be >= 0");
+        "sensory events: noise_floor_sigmas, noise_floor_excursions and rest_edge_sigmas must be "
+        ">= 0");
   if (c.difference_lag < 1)
     throw std::invalid_argument("sensory events: difference_lag must be >= 1");
 }
@@ -247,6 +249,55 @@ void place_at_burst_ends(const Burst& b, std::size_t n, const SensoryEventConfig
     events->push_back({{b.end - (shift ? behind : 0), false, strength}, false, false});
 }
 
+// SensoryEventConfig::rest_edge_sigmas: Page's CUSUM change time of the raw samples x against
+// the rest level. S accumulates x - reference and is reset at 0, the reference lying
+// rest_edge_sigmas rest sigmas above the rest mean: at rest S keeps returning to 0, in contact it
+// grows. A contact's onset is then the sample after S's last reset before the fitted ramp is under
+// way, and its release (time reversed) the first sample of the last stretch that looks like rest.
+// A weak first touch (or a fading last one) under noise moves S long before one sample or the
+// smoothed level shows it, where the fit sees only the main change. The edge moves only outwards
+// (an earlier onset, a later release), within merge_gap (activity separated by less is one
+// activity) and never past the channel's neighbouring events.
+void place_rest_edges_by_cusum(const Eigen::Ref<const Eigen::VectorXd>& x, std::size_t head,
+                               double peak, const SensoryEventConfig& config, Channel* c) {
+  const std::size_t n = static_cast<std::size_t>(x.size()), lag = config.difference_lag,
+                    gap = config.merge_gap;
+  const auto rest = x.head(static_cast<Eigen::Index>(head));
+  const double mean = rest.mean();
+  const double sigma = std::sqrt((rest.array() - mean).square().mean());
+  // A noise-free sensor has no statistical band: its exponential settling would otherwise look
+  // like contact for ever; relative_floor x the largest difference stands for its resolution.
+  const double reference =
+      mean + std::max(config.rest_edge_sigmas * sigma, config.relative_floor * peak);
+  std::vector<PlacedEvent>& events = c->events;
+  for (std::size_t i = 0; i < events.size(); ++i) {
+    PlacedEvent& p = events[i];
+    const std::size_t e = p.event.index;
+    const std::size_t previous = i > 0 ? events[i - 1].event.index : 0;
+    const std::size_t next = i + 1 < events.size() ? events[i + 1].event.index : n;
+    double s = 0.0;
+    bool reset = false;
+    if (p.from_rest && !p.to_rest) {
+      const std::size_t lo = std::max(i > 0 ? previous + 1 : 0, e > gap ? e - gap : 0);
+      std::size_t last_reset = lo;
+      for (std::size_t t = lo; t < std::min(n, e + lag); ++t) {
+        s = std::max(0.0, s + x[static_cast<Eigen::Index>(t)] - reference);
+        if (s == 0.0) reset = true, last_reset = t;
+      }
+      if (s > 0.0 && reset && last_reset + 1 < e) p.event.index = last_reset + 1;
+    } else if (p.to_rest && !p.from_rest) {
+      const std::size_t lo = std::max(previous, e > lag ? e - lag : 0);
+      const std::size_t hi = std::min(next, e + gap + 1);
+      std::size_t first_reset = hi;
+      for (std::size_t t = hi; t-- > lo;) {
+        s = std::max(0.0, s + x[static_cast<Eigen::Index>(t)] - reference);
+        if (s == 0.0) reset = true, first_reset = t;
+      }
+      if (s > 0.0 && reset && first_reset > e) p.event.index = first_reset;
+    }
+  }
+}
+
 // One channel: smoothed signal, rest level, activity threshold and its events.
 Channel analyse_channel(const Eigen::Ref<const Eigen::VectorXd>& signal,
                         const SensoryEventConfig& config) {
@@ -278,6 +329,8 @@ Channel analyse_channel(const Eigen::Ref<const Eigen::VectorXd>& signal,
   std::sort(c.events.begin(), c.events.end(), [](const PlacedEvent& a, const PlacedEvent& b) {
     return a.event.index < b.event.index;
   });
+  if (fit && config.rest_edge_sigmas > 0.0)
+    place_rest_edges_by_cusum(signal, head, peak, config, &c);
   return c;
 }
 

@@ -379,4 +379,41 @@ TEST(SensoryEvents, ZonesComeFromRestEdgesOrFromEveryEventOfASensorWithout) {
   EXPECT_EQ(without.zone_events, without.all);
 }
 
+// A teleoperated push as the pads feel it at 50 Hz: clipped noise (a pad reads no less than 0 N)
+// of 0.4 N, a light first touch of 0.8 N at 3 s that the force builds on only at 3.6 s (the push
+// accelerating the box), and a fade to 0.8 N at 7 s before the hand leaves at 7.6 s. The fitted
+// ramps start and end at the strong change, 0.6 s off; where the samples stop being consistent
+// with rest (CUSUM, one rest sigma above the rest mean) is the touch and the leaving, within
+// 0.2 s, in 50 noise draws out of 50.
+TEST(SensoryEvents, WeakFirstAndLastContactUnderNoiseByTheRestEdgeCusum) {
+  const auto rest_edges = [](const Eigen::VectorXd& x, const SensoryEventConfig& config) {
+    std::vector<double> out;
+    for (const lfd::SensoryEvent& e : lfd::detect_sensory_event_details(x, config))
+      if (e.rest_edge) out.push_back(static_cast<double>(e.index));
+    return out;
+  };
+  SensoryEventConfig cusum = yaml_at_50hz();
+  cusum.rest_edge_sigmas = 1.0;
+  int fit_late = 0;
+  for (unsigned seed = 0; seed < 50; ++seed) {
+    std::mt19937 rng(seed);
+    std::normal_distribution<double> noise(0.0, 0.4);
+    Eigen::VectorXd x(500);
+    for (Eigen::Index t = 0; t < x.size(); ++t) {
+      double force = 0.0;
+      if (t >= 150 && t < 380) force = 0.8;
+      if (t >= 180 && t < 350) force = 0.8 + 3.2 * std::min(1.0, (t - 180) / 15.0);
+      if (t >= 335 && t < 350) force = 0.8 + 3.2 * (350 - t) / 15.0;
+      x[t] = std::max(0.0, force + noise(rng));
+    }
+    const std::vector<double> found = rest_edges(x, cusum);
+    ASSERT_EQ(found.size(), 2u) << seed << ": " << ::testing::PrintToString(found);
+    EXPECT_NEAR(found[0], 150.0, 10.0) << seed;  // the touch
+    EXPECT_NEAR(found[1], 380.0, 10.0) << seed;  // the hand leaves
+    const std::vector<double> fitted = rest_edges(x, yaml_at_50hz());
+    fit_late += fitted.size() == 2 && fitted[0] > 170.0 && fitted[1] < 360.0;
+  }
+  EXPECT_GE(fit_late, 45);  // the fit alone places both at the strong change
+}
+
 }  // namespace

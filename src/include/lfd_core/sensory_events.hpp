@@ -21,7 +21,8 @@
 //     where the level starts to change and where it settles);
 //   - rest edges: the events where a sensor (all channels of it) leaves its rest level or settles
 //     back at it for at least merge_gap (contact made or lost) can be the only ones that make
-//     zones (zones_from_rest_edges);
+//     zones (zones_from_rest_edges), and are placed where the samples stop being consistent with
+//     rest when that is earlier (rest_edge_sigmas, a CUSUM change time);
 //   - threshold kNoise + noise_block: the threshold is a statistic of the noise measured where the
 //     sensor is quiet (see EventThreshold).
 #pragma once
@@ -95,6 +96,14 @@ struct SensoryEventConfig {
   /// Confidence zones only around SensorEvents::zone_events (rest edges): a force that varies
   /// while in contact, or a ramp reaching its plateau, is no new phase. false = every event.
   bool zones_from_rest_edges = false;
+  /// kFit: a rest edge is also sought where the raw samples stop (start) being consistent with
+  /// the rest level, by Page's CUSUM change time with the reference rest mean + rest_edge_sigmas
+  /// x the rest sigma (both of the raw samples of the first noise_block, at least relative_floor
+  /// x the largest difference for a noise-free sensor), within merge_gap of the fitted edge; the
+  /// edge is the earlier onset (the later release) of the two. Under noise a weak first contact,
+  /// or a weak last one, is statistically clear before the fitted ramp of the main change starts
+  /// (after it ends). 0 = the fit alone.
+  double rest_edge_sigmas = 0.0;
 };
 
 /// One sensory event, with what a zone needs to weigh it.
