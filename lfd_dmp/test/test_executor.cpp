@@ -18,7 +18,7 @@ lfd::KinematicChain chain() {
   return lfd::KinematicChain::fromUrdfFile(kUrdf, "base_link", "r_gripper_tcp");
 }
 
-// tasks.yaml preferred posture (TCP fingers-down above the workspace centre).
+// config/robot.yaml preferred posture (TCP fingers-down above the workspace centre).
 Eigen::VectorXd homePosture(const lfd::KinematicChain& c) {
   const std::map<std::string, double> p = {
       {"WAIST_Y", 0.08},       {"WAIST_P", 0.24},       {"R_SHOULDER_P", -0.72},
