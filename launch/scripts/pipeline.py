@@ -66,7 +66,7 @@ import subprocess
 import sys
 import time
 
-from lfd_tools import judge, report as records, tasks
+from lfd_tools import config, judge, report as records, tasks
 from lfd_tools.jobs import run_parallel, run_tool, split, workers
 from lfd_tools.master import background_launch, private_master
 from lfd_tools.processes import TAG_VAR, kill_tagged
@@ -87,9 +87,8 @@ def failed(what, rc, tail):
 
 
 def roots_arg(folder):
-    """The services of a stage may read and write only inside the run's output folder, wherever
-    it is (the config's default roots are for users calling them by hand)."""
-    return "allowed_roots:=[%s]" % json.dumps(os.path.abspath(folder))
+    """The services of a stage may read and write only inside the run (config.run_roots)."""
+    return "allowed_roots:=[%s]" % ",".join(json.dumps(r) for r in config.run_roots(folder))
 
 
 def count_bags(folder):

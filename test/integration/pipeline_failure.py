@@ -13,7 +13,7 @@ import uuid
 
 import rospkg
 import rostest
-from lfd_tools import processes
+from lfd_tools import config, processes
 
 PIPELINE = os.path.join(rospkg.RosPack().get_path("lfd_launch"), "scripts", "pipeline.py")
 TIMEOUT = 120  # s for the pipeline to fail and clean up
@@ -119,9 +119,31 @@ class StageCleanup(unittest.TestCase):
         self.assertEqual(processes.tagged_processes(tag), [])
 
 
+class RunRoots(unittest.TestCase):
+    """The folders a run's services may use (config.run_roots): the output folder by its path and
+    by what it resolves to, and datasets recorded elsewhere and linked in, whole or one by one
+    (the services resolve links, so a linked dataset was refused as outside the run)."""
+
+    def test_linked_output_folder_and_datasets_are_roots(self):
+        base = tempfile.mkdtemp()
+        self.addCleanup(shutil.rmtree, base)
+        for d in ("real_out", "elsewhere/all", "elsewhere/one", "unrelated"):
+            os.makedirs(os.path.join(base, d))
+        out = os.path.join(base, "out")
+        os.symlink(os.path.join(base, "real_out"), out)
+        self.assertEqual(config.run_roots(out), [out, os.path.join(base, "real_out")])
+        os.symlink(os.path.join(base, "elsewhere", "all"), os.path.join(out, "datasets"))
+        os.symlink(os.path.join(base, "elsewhere", "one"), os.path.join(base, "elsewhere", "all", "sim_x"))
+        roots = config.run_roots(out)
+        self.assertIn(os.path.join(base, "elsewhere", "all"), roots)
+        self.assertIn(os.path.join(base, "elsewhere", "one"), roots)
+        self.assertNotIn(os.path.join(base, "unrelated"), roots)
+        self.assertEqual(len(roots), len(set(roots)))
+
+
 def all_tests():
     return unittest.TestSuite([unittest.defaultTestLoader.loadTestsFromTestCase(c)
-                               for c in (ClientDiesAtOnce, ClientFailsOnData, StageCleanup)])
+                               for c in (ClientDiesAtOnce, ClientFailsOnData, StageCleanup, RunRoots)])
 
 
 if __name__ == "__main__":

@@ -95,3 +95,17 @@ def load_tasks(path=None):
         out[t] = {m: entries(t, tasks.scenes(t, m)) for m in tasks.MODES}
         out[t]["unseen"] = {m: entries(t, tasks.unseen_scenes(t, m)) for m in tasks.MODES}
     return out
+
+
+def run_roots(folder):
+    """The folders a pipeline run's services may read and write: the run's output folder, wherever
+    it is (the config's default roots are for users calling the services by hand), and what its
+    datasets link to (DIR/datasets, or one dataset in it, recorded elsewhere and linked in is the
+    user's choice; the services resolve links before they check a path)."""
+    roots = [os.path.abspath(folder), os.path.realpath(folder)]
+    datasets = os.path.join(folder, "datasets")
+    linked = [datasets]
+    if os.path.isdir(datasets):
+        linked += [os.path.join(datasets, d) for d in sorted(os.listdir(datasets))]
+    roots += [os.path.realpath(p) for p in linked if os.path.islink(p)]
+    return list(dict.fromkeys(roots))
