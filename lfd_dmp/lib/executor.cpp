@@ -204,55 +204,6 @@ void appendRollout(const lfd::SegmentTrajectory& traj, bool first, double t_offs
   }
 }
 
-// How many times a demo (already turned into the frame its motion follows) reverses along the
-// frame's x axis, with `hysteresis` m (a wipe's three strokes: 2; a push: 0).
-int reversals(const lfd::SegmentDmp& dmp, double hysteresis) {
-  lfd::SegmentRolloutOptions ro;
-  ro.dt = std::max(0.01, dmp.tau / 2000.0);
-  const Eigen::MatrixXd x = dmp.rollout(ro).positions;
-  int count = 0, direction = 0;
-  double extreme = x(0, 0);
-  for (Eigen::Index k = 1; k < x.rows(); ++k) {
-    const double v = x(k, 0);
-    if (direction == 0) {  // until it has left its start by the hysteresis
-      if (std::abs(v - extreme) > hysteresis) {
-        direction = v > extreme ? 1 : -1;
-        extreme = v;
-      }
-    } else if (direction * (v - extreme) > 0.0) {
-      extreme = v;  // still going the same way
-    } else if (std::abs(v - extreme) > hysteresis) {
-      ++count;
-      direction = -direction;
-      extreme = v;
-    }
-  }
-  return count;
-}
-
-// A segment that goes back and forth along the frame its motion follows has one shape in every
-// demo, but not one timing: a teleoperator's three wipe strokes at different phases averaged into
-// one stroke of a third the length. Then the demo nearest the query keeps its shape whole (its
-// start and goal still move); a one-way motion (a push, a carry) is averaged as before (the
-// nearest teleop carry replayed its hesitations: 6/10 placed).
-bool backAndForth(const std::vector<lfd::SegmentDmp>& dmps) {
-  constexpr double kHysteresis = 0.01;  // m, above a teleoperator's tremor and hesitations
-  std::vector<int> counts;
-  for (const lfd::SegmentDmp& d : dmps) counts.push_back(reversals(d, kHysteresis));
-  std::nth_element(counts.begin(), counts.begin() + counts.size() / 2, counts.end());
-  return counts[counts.size() / 2] >= 1;
-}
-
-void keepNearest(const Eigen::VectorXd& query, std::vector<lfd::SegmentDmp>* dmps,
-                 std::vector<Eigen::VectorXd>* params, PlannedSegment* planned) {
-  size_t best = 0;
-  for (size_t j = 1; j < params->size(); ++j)
-    if (((*params)[j] - query).squaredNorm() < ((*params)[best] - query).squaredNorm()) best = j;
-  *dmps = {(*dmps)[best]};
-  *params = {(*params)[best]};
-  planned->demos = {planned->demos[best]};
-}
-
 }  // namespace
 
 std::vector<GripperEvent> gripperEvents(const std::vector<double>& values, double fraction,
@@ -391,16 +342,14 @@ ExecutionPlan TaskPlanner::plan(const SkillLibrary& library,
                               "': its goal lies beyond the demos' goals: "
                               "generalized by the kernel average");
     }
-    // The duration is every demo's, kernel-weighted, even when one demo gives the shape.
-    const double tau = lfd::generalizeSegment(dmps, params, query, gen_options).dmp.tau;
-    if (heading && options.nearest_shape_along_motion && backAndForth(dmps))
-      keepNearest(query, &dmps, &params, &planned);
+    // The demos' sub-motions come at the same phases (the learner aligned their timing), so
+    // their mix keeps them: a wipe's three strokes stay three full strokes.
     lfd::GeneralizationResult gen = lfd::generalizeSegment(dmps, params, query, gen_options);
     if (heading) gen.dmp = gen.dmp.rotated(yawMatrix(heading->yaw));
 
     lfd::SegmentRolloutOptions ro;
     ro.dt = options.dt;
-    ro.tau = tau * options.duration_scale;
+    ro.tau = gen.dmp.tau * options.duration_scale;
     // Refuse before allocating: the rollout, IK and trajectory all grow with the samples.
     samples += *ro.tau / options.dt;
     if (!(samples <= static_cast<double>(options.max_samples))) {

@@ -3,6 +3,7 @@
 #include <lfd_core/dmp_generalization.hpp>
 #include <lfd_core/quaternion_log.hpp>
 #include <lfd_core/smooth_derivatives.hpp>
+#include <lfd_core/time_alignment.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -100,6 +101,66 @@ void learnGoals(const std::vector<DemoEnds>& ends, const lfd::FrameSelectionOpti
   }
 }
 
+// A demo kept for learning: its (smoothed) recording and the sample index of every segment
+// boundary (num_segments + 1; segments share boundary samples so consecutive DMPs join).
+struct UsedDemo {
+  DemoRecording rec;
+  std::vector<Eigen::Index> bounds;
+};
+
+// Sample indices nearest to each changepoint, with the first and last sample.
+std::vector<Eigen::Index> boundaries(const DemoRecording& rec, const std::vector<double>& cps) {
+  const Eigen::Index m = rec.times.size();
+  std::vector<Eigen::Index> bounds = {0};
+  for (double t : cps) {
+    if (!std::isfinite(t) || t <= rec.times[0] || t >= rec.times[m - 1]) {
+      std::ostringstream msg;
+      msg << "demo " << rec.id << ": changepoint at " << t << " s is outside the recording ["
+          << rec.times[0] << ", " << rec.times[m - 1] << "]";
+      throw std::invalid_argument(msg.str());
+    }
+    const auto it = std::lower_bound(rec.times.data(), rec.times.data() + m, t);
+    Eigen::Index idx = it - rec.times.data();
+    if (idx > 0 && t - rec.times[idx - 1] < rec.times[idx] - t) --idx;
+    if (idx <= bounds.back())
+      throw std::invalid_argument("demo " + rec.id + ": changepoints are not increasing");
+    bounds.push_back(idx);
+  }
+  bounds.push_back(m - 1);
+  return bounds;
+}
+
+// Segment s of every used demo, re-timed onto one timing when asked (lfd_core time_alignment:
+// mixed later, demos timed differently would blur each other's sub-motions), one DMP each.
+void learnSegment(const std::vector<UsedDemo>& used, size_t s, const LearnOptions& options,
+                  SegmentSkills* seg, std::vector<std::string>* warnings) {
+  std::vector<lfd::SegmentDemo> pieces;
+  for (const UsedDemo& u : used) pieces.push_back(cut(u.rec, u.bounds[s], u.bounds[s + 1]));
+  if (options.time_alignment) {
+    const lfd::TimeAlignment aligned = lfd::alignDemoTiming(pieces, *options.time_alignment);
+    pieces = aligned.demos;
+    seg->time_reference = used[aligned.reference].rec.id;
+  }
+  for (size_t j = 0; j < used.size(); ++j) {
+    const DemoRecording& rec = used[j].rec;
+    DemoSkill skill;
+    skill.demo_id = rec.id;
+    skill.start_time = rec.times[used[j].bounds[s]];
+    skill.end_time = rec.times[used[j].bounds[s + 1]];
+    try {
+      skill.dmp = lfd::SegmentDmp::learn(pieces[j], options.params);
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument("demo " + rec.id + ", segment " + std::to_string(s) + " [" +
+                                  std::to_string(skill.start_time) + ", " +
+                                  std::to_string(skill.end_time) + "] s: " + e.what());
+    }
+    skill.parameters = lfd::goalParameters(skill.dmp);
+    for (const auto& w : skill.dmp.warnings)
+      warnings->push_back("demo " + rec.id + ", segment " + std::to_string(s) + ": " + w);
+    seg->demos.push_back(std::move(skill));
+  }
+}
+
 }  // namespace
 
 LearnOutcome learnSkillLibrary(const std::vector<DemoRecording>& demos,
@@ -140,6 +201,7 @@ LearnOutcome learnSkillLibrary(const std::vector<DemoRecording>& demos,
   lib.features = options.features;
   lib.dmp_parameters = options.params;
   lib.smoothing_sigma = options.smoothing_sigma;
+  lib.time_alignment = options.time_alignment;
   lib.position_names = {"x", "y", "z"};
   lib.generalization_parameters = "goal_position";
   lib.cartesian_frame = frame;
@@ -151,6 +213,7 @@ LearnOutcome learnSkillLibrary(const std::vector<DemoRecording>& demos,
     lib.segments.push_back(seg);
   }
 
+  std::vector<UsedDemo> used;
   for (size_t d = 0; d < demos.size(); ++d) {
     checkRecording(demos[d]);
     const auto& cps = changepoint_times[d];
@@ -159,54 +222,19 @@ LearnOutcome learnSkillLibrary(const std::vector<DemoRecording>& demos,
                                  " changepoints, the other demos have " + std::to_string(cp_count));
       continue;
     }
-    const DemoRecording rec = smoothed(demos[d], options.smoothing_sigma, &outcome.warnings);
-    // Boundaries: sample indices nearest to each changepoint; segments share boundary samples so
-    // consecutive DMPs join at the same pose.
-    const Eigen::Index m = rec.times.size();
-    std::vector<Eigen::Index> bounds = {0};
-    for (double t : cps) {
-      if (!std::isfinite(t) || t <= rec.times[0] || t >= rec.times[m - 1]) {
-        std::ostringstream msg;
-        msg << "demo " << rec.id << ": changepoint at " << t << " s is outside the recording ["
-            << rec.times[0] << ", " << rec.times[m - 1] << "]";
-        throw std::invalid_argument(msg.str());
-      }
-      const auto it = std::lower_bound(rec.times.data(), rec.times.data() + m, t);
-      Eigen::Index idx = it - rec.times.data();
-      if (idx > 0 && t - rec.times[idx - 1] < rec.times[idx] - t) --idx;
-      if (idx <= bounds.back()) {
-        throw std::invalid_argument("demo " + rec.id + ": changepoints are not increasing");
-      }
-      bounds.push_back(idx);
-    }
-    bounds.push_back(m - 1);
+    used.push_back({smoothed(demos[d], options.smoothing_sigma, &outcome.warnings), {}});
+    const DemoRecording& rec = used.back().rec;
+    used.back().bounds = boundaries(rec, cps);
     if (with_scenes) {
       DemoEnds e{*rec.scene, poseAt(rec, 0), {}};
-      for (Eigen::Index b : bounds) e.bounds.push_back(poseAt(rec, b));
+      for (Eigen::Index b : used.back().bounds) e.bounds.push_back(poseAt(rec, b));
       lib.demo_scenes[rec.id] = {e.scene, e.start};
       ends.push_back(std::move(e));
     }
-    for (size_t s = 0; s < num_segments; ++s) {
-      const Eigen::Index a = bounds[s], b = bounds[s + 1];
-      DemoSkill skill;
-      skill.demo_id = rec.id;
-      skill.start_time = rec.times[a];
-      skill.end_time = rec.times[b];
-      try {
-        skill.dmp = lfd::SegmentDmp::learn(cut(rec, a, b), options.params);
-      } catch (const std::invalid_argument& e) {
-        throw std::invalid_argument("demo " + rec.id + ", segment " + std::to_string(s) + " [" +
-                                    std::to_string(rec.times[a]) + ", " +
-                                    std::to_string(rec.times[b]) + "] s: " + e.what());
-      }
-      skill.parameters = lfd::goalParameters(skill.dmp);
-      for (const auto& w : skill.dmp.warnings) {
-        outcome.warnings.push_back("demo " + rec.id + ", segment " + std::to_string(s) + ": " + w);
-      }
-      lib.segments[s].demos.push_back(std::move(skill));
-    }
-    ++outcome.demos_used;
   }
+  outcome.demos_used = used.size();
+  for (size_t s = 0; s < num_segments && !used.empty(); ++s)
+    learnSegment(used, s, options, &lib.segments[s], &outcome.warnings);
   if (outcome.demos_used == 0) {
     throw std::invalid_argument("learnSkillLibrary: no demonstration could be used");
   }

@@ -209,6 +209,19 @@ std::pair<std::string, DemoScene> sceneFromJson(const json& j, const std::string
   return {id, d};
 }
 
+lfd::TimeAlignmentOptions alignmentFromJson(const json& j) {
+  const std::string w = "time_alignment";
+  lfd::TimeAlignmentOptions a;
+  a.sample_seconds = number(member(j, "sample_seconds", w), w + ".sample_seconds");
+  if (!(a.sample_seconds > 0.0)) fail(w + ".sample_seconds", "must be > 0 (s)");
+  a.warp_sigma = number(member(j, "warp_sigma", w), w + ".warp_sigma");
+  if (!(a.warp_sigma >= 0.0)) fail(w + ".warp_sigma", "must be >= 0 (s)");
+  const json& yaw = member(j, "yaw_invariant", w);
+  if (!yaw.is_boolean()) fail(w + ".yaw_invariant", "expected true or false");
+  a.yaw_invariant = yaw.get<bool>();
+  return a;
+}
+
 }  // namespace
 
 json toJson(const lfd::DmpParameters& p) {
@@ -262,21 +275,29 @@ json toJson(const SkillLibrary& lib) {
     }
     json j{{"index", seg.index}, {"name", seg.name}, {"demos", demos}};
     if (seg.goal) j["goal"] = goalJson(*seg.goal);
+    if (!seg.time_reference.empty()) j["time_reference"] = seg.time_reference;
     segments.push_back(j);
   }
   json scenes = json::array();
   for (const auto& [id, scene] : lib.demo_scenes) scenes.push_back(sceneJson(id, scene));
-  return json{{"format", kSkillLibraryFormat},
-              {"version", lib.version},
-              {"task", lib.task},
-              {"features", lib.features},
-              {"generalization_parameters", lib.generalization_parameters},
-              {"position_names", lib.position_names},
-              {"dmp_parameters", toJson(lib.dmp_parameters)},
-              {"smoothing_sigma", lib.smoothing_sigma},
-              {"cartesian_frame", lib.cartesian_frame},
-              {"demo_scenes", scenes},
-              {"segments", segments}};
+  json out{{"format", kSkillLibraryFormat},
+           {"version", lib.version},
+           {"task", lib.task},
+           {"features", lib.features},
+           {"generalization_parameters", lib.generalization_parameters},
+           {"position_names", lib.position_names},
+           {"dmp_parameters", toJson(lib.dmp_parameters)},
+           {"smoothing_sigma", lib.smoothing_sigma},
+           {"cartesian_frame", lib.cartesian_frame},
+           {"demo_scenes", scenes},
+           {"segments", segments}};
+  if (lib.time_alignment) {
+    const lfd::TimeAlignmentOptions& a = *lib.time_alignment;
+    out["time_alignment"] = json{{"sample_seconds", a.sample_seconds},
+                                 {"warp_sigma", a.warp_sigma},
+                                 {"yaw_invariant", a.yaw_invariant}};
+  }
+  return out;
 }
 
 lfd::DmpParameters dmpParametersFromJson(const json& j, const std::string& where) {
@@ -390,6 +411,7 @@ SkillLibrary skillLibraryFromJson(const json& j) {
     lib.smoothing_sigma = number(j["smoothing_sigma"], "smoothing_sigma");
     if (!(lib.smoothing_sigma >= 0.0)) fail("smoothing_sigma", "must be >= 0 (s)");
   }
+  if (j.contains("time_alignment")) lib.time_alignment = alignmentFromJson(j["time_alignment"]);
   lib.cartesian_frame = text(member(j, "cartesian_frame", root), "cartesian_frame");
   if (j.contains("demo_scenes")) {
     const json& scenes = j["demo_scenes"];
@@ -405,6 +427,8 @@ SkillLibrary skillLibraryFromJson(const json& j) {
     seg.index = static_cast<int>(number(member(segments[s], "index", ws), ws + ".index"));
     seg.name = text(member(segments[s], "name", ws), ws + ".name");
     if (segments[s].contains("goal")) seg.goal = goalFromJson(segments[s]["goal"], ws + ".goal");
+    if (segments[s].contains("time_reference"))
+      seg.time_reference = text(segments[s]["time_reference"], ws + ".time_reference");
     const json& demos = member(segments[s], "demos", ws);
     if (!demos.is_array()) fail(ws + ".demos", "expected an array");
     long param_dims = -1;

@@ -111,8 +111,6 @@ class Executor {
     options_.dt = param(pnh, "dt", options_.dt);
     options_.all_segment_goals = param(pnh, "all_segment_goals", options_.all_segment_goals);
     options_.heading_frames = param(pnh, "heading_frames", options_.heading_frames);
-    options_.nearest_shape_along_motion =
-        param(pnh, "nearest_shape_along_motion", options_.nearest_shape_along_motion);
     options_.frames.min_heading_length =
         param(pnh, "min_heading_length", options_.frames.min_heading_length);
     options_.gripper_threshold_fraction =

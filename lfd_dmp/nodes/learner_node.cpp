@@ -3,9 +3,10 @@
 // goal frame from the demos' scenes, and writes the skill library. Thin adapter over
 // lfd_dmp::learnSkillLibrary / readDemoBag.
 // Private parameters (config/learner.yaml): ~pose_topic, ~gripper_topic, ~gripper_joint,
-// ~num_basis, ~smoothing_sigma, ~goal_frames/*, ~allowed_roots, ~limits/{max_bags, max_num_basis,
-// max_demo_seconds, max_samples_per_demo}. Paths: bags must be regular files inside the roots, the
-// library is written atomically, never over a bag, and over an existing file only with overwrite.
+// ~num_basis, ~smoothing_sigma, ~time_alignment/*, ~goal_frames/*, ~allowed_roots,
+// ~limits/{max_bags, max_num_basis, max_demo_seconds, max_samples_per_demo}. Paths: bags must be
+// regular files inside the roots, the library is written atomically, never over a bag, and over an
+// existing file only with overwrite.
 #include "lfd_dmp/demo_bag.hpp"
 #include "lfd_dmp/skill_learner.hpp"
 
@@ -32,6 +33,7 @@ class Learner {
       ROS_WARN("learner: ~smoothing_sigma %.3f < 0: smoothing off", smoothing_sigma_);
       smoothing_sigma_ = 0.0;
     }
+    readTimeAlignment(pnh);
     pnh.param("allowed_roots", paths_.allowed_roots, paths_.allowed_roots);
     pnh.param("limits/max_bags", max_bags_, max_bags_);
     pnh.param("limits/max_num_basis", max_num_basis_, max_num_basis_);
@@ -99,6 +101,7 @@ class Learner {
       opt.segment_names = req.segment_names;
       opt.params.num_basis = req.num_basis > 0 ? req.num_basis : num_basis_;
       opt.smoothing_sigma = smoothing_sigma_;
+      opt.time_alignment = time_alignment_;
       opt.frames = frames_;
       const lfd_dmp::LearnOutcome out = lfd_dmp::learnSkillLibrary(demos, cps, opt);
       lfd_dmp::saveSkillLibrary(out.library, output, req.overwrite);
@@ -164,6 +167,24 @@ class Learner {
     }
   }
 
+  // ~time_alignment/{enabled, sample_seconds, warp_sigma}; a bad value turns it off, loudly.
+  void readTimeAlignment(ros::NodeHandle& pnh) {
+    bool enabled = false;
+    pnh.param("time_alignment/enabled", enabled, enabled);
+    if (!enabled) return;
+    lfd::TimeAlignmentOptions a;
+    pnh.param("time_alignment/sample_seconds", a.sample_seconds, a.sample_seconds);
+    pnh.param("time_alignment/warp_sigma", a.warp_sigma, a.warp_sigma);
+    if (!(a.sample_seconds > 0.0) || !(a.warp_sigma >= 0.0)) {
+      ROS_WARN(
+          "learner: ~time_alignment sample_seconds %.3f (> 0), warp_sigma %.3f (>= 0): "
+          "alignment off",
+          a.sample_seconds, a.warp_sigma);
+      return;
+    }
+    time_alignment_ = a;
+  }
+
   lfd_dmp::DemoBagTopics topics_;
   lfd::PathPolicy paths_;
   int max_bags_ = 32;
@@ -172,6 +193,7 @@ class Learner {
   int max_samples_per_demo_ = 30000;
   int num_basis_ = lfd::DmpParameters().num_basis;
   double smoothing_sigma_ = 0.0;
+  std::optional<lfd::TimeAlignmentOptions> time_alignment_;
   lfd::FrameSelectionOptions frames_;
   double tf_timeout_ = 2.0;
   tf2_ros::Buffer tf_buffer_;

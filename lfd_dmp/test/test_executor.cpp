@@ -454,70 +454,102 @@ TEST_F(PlannerTest, SegmentGoalsFollowTheFramesLearnedFromTheDemos) {
   }
 }
 
-// Three wipe strokes along x, timed differently in each demo (a teleoperator): averaged they
-// shrink; the segment goes back and forth along its frame, so the nearest demo's shape is kept.
-TEST_F(PlannerTest, BackAndForthAlongItsFrameKeepsTheNearestDemosStrokes) {
-  lfd_dmp::SkillLibrary lib;
-  lib.segments.resize(1);
-  lib.segments[0].name = "wipe";
-  const double pauses[3] = {0.0, 0.6, 1.2};  // s of hesitation before the second stroke
-  for (int j = 0; j < 3; ++j) {
-    const Eigen::Vector3d c = home_.position + Eigen::Vector3d(0.02 * j, -0.01 * j, -0.05);
-    const Eigen::Vector3d a = c - Eigen::Vector3d(0.08, 0, 0), b = c + Eigen::Vector3d(0.08, 0, 0);
-    const Eigen::Vector3d via[4] = {a, b, a, b};
-    const double span[3] = {1.5, 1.5 + pauses[j], 1.5};
-    lfd::SegmentDemo d;
-    const int m = 601;
-    const double total = span[0] + span[1] + span[2];
-    d.times = Eigen::VectorXd::LinSpaced(m, 0.0, total);
-    d.positions.resize(m, 3);
-    d.quaternions.resize(m, 4);
-    for (int k = 0; k < m; ++k) {
-      double t = d.times[k];
-      int s = 0;
-      while (s < 2 && t > span[s]) t -= span[s++];
-      const double hold = s == 1 ? pauses[j] : 0.0;  // the hesitation starts the stroke
-      const double u = minJerk(std::clamp((t - hold) / (span[s] - hold), 0.0, 1.0));
-      d.positions.row(k) = (via[s] + u * (via[s + 1] - via[s])).transpose();
-      d.quaternions.row(k) << home_.orientation.w(), home_.orientation.x(), home_.orientation.y(),
-          home_.orientation.z();
+// A wipe recorded by a teleoperator: three 16 cm strokes along the yaw `heading`, centred at `c`,
+// 1.6 s each, with a hesitation of 1.6 s before stroke `pause_before` (0, 1, 2).
+lfd_dmp::DemoRecording wipeRecording(const std::string& id, const Eigen::Vector3d& c,
+                                     double heading, int pause_before,
+                                     const Eigen::Quaterniond& q) {
+  const double stroke = 1.6, pause = 1.6, total = 3 * stroke + pause;
+  const Eigen::Vector3d axis(std::cos(heading), std::sin(heading), 0.0);
+  lfd_dmp::DemoRecording rec;
+  rec.id = id;
+  const int m = static_cast<int>(total * 100) + 1;
+  rec.times = Eigen::VectorXd::LinSpaced(m, 0.0, total);
+  rec.positions.resize(m, 3);
+  rec.quaternions.resize(m, 4);
+  for (int k = 0; k < m; ++k) {
+    double t = rec.times[k], x = -0.08;
+    for (int s = 0; s < 3; ++s) {
+      const double hold = s == pause_before ? pause : 0.0, from = s % 2 == 0 ? -0.08 : 0.08;
+      x = from - 2.0 * from * minJerk(std::clamp((t - hold) / stroke, 0.0, 1.0));
+      if (t < hold + stroke) break;
+      t -= hold + stroke;
     }
-    lfd::DmpParameters params;
-    params.num_basis = 60;
-    lfd_dmp::DemoSkill skill;
-    skill.demo_id = "wipe_" + std::to_string(j);
-    skill.dmp = lfd::SegmentDmp::learn(d, params);
-    skill.parameters = lfd::goalParameters(skill.dmp);
-    lib.dmp_parameters = params;
-    lib.segments[0].demos.push_back(skill);
+    rec.positions.row(k) = (c + x * axis).transpose();
+    rec.quaternions.row(k) << q.w(), q.x(), q.y(), q.z();
+  }
+  return rec;
+}
+
+// The strokes of a planned segment along x: the shortest way between two turning points (a
+// turn needs 1 cm of way back), and how many turns.
+std::pair<double, int> shortestStroke(const lfd_dmp::ExecutionPlan& plan) {
+  std::vector<double> turns = {plan.poses.front().position.x()};
+  int direction = 0;
+  double extreme = turns[0];
+  for (const auto& p : plan.poses) {
+    const double v = p.position.x();
+    if (direction != 0 && direction * (v - extreme) > 0.0) {
+      extreme = v;
+    } else if (std::abs(v - extreme) > 0.01) {
+      if (direction != 0) turns.push_back(extreme);
+      direction = v > extreme ? 1 : -1;
+      extreme = v;
+    }
+  }
+  turns.push_back(plan.poses.back().position.x());
+  double shortest = 1e9;
+  for (size_t k = 1; k < turns.size(); ++k)
+    shortest = std::min(shortest, std::abs(turns[k] - turns[k - 1]));
+  return {shortest, static_cast<int>(turns.size()) - 2};
+}
+
+// Three wipe demos, each hesitating before another stroke, in other places and headings. Learned
+// as recorded, the executor's mix puts one demo's strokes on another's returns and they shrink;
+// learned with their timing aligned, the mix keeps three full strokes.
+TEST_F(PlannerTest, TheMixOfStrokesTimedDifferentlyKeepsThemWhenTheLearnerAlignsTheirTiming) {
+  std::vector<lfd_dmp::DemoRecording> demos;
+  const double headings[3] = {0.0, 0.4, -0.3};
+  lfd_dmp::HeadingFrame frame;
+  frame.frame = "goal";
+  for (int j = 0; j < 3; ++j) {
+    const std::string id = "wipe_" + std::to_string(j);
+    const Eigen::Vector3d c = home_.position + Eigen::Vector3d(0.02 * j, -0.01 * j, -0.05);
+    demos.push_back(wipeRecording(id, c, headings[j], j, home_.orientation));
+    frame.demo_yaw[id] = headings[j];
   }
   const Eigen::Vector3d goal = home_.position + Eigen::Vector3d(0.09, 0.0, -0.05);
   std::vector<lfd_dmp::SegmentTarget> t = {target("wipe", goal)};
-  lfd_dmp::HeadingFrame frame;
-  frame.frame = "goal";
-  frame.demo_yaw = {{"wipe_0", 0.0}, {"wipe_1", 0.0}, {"wipe_2", 0.0}};
   t[0].heading = frame;
   lfd_dmp::ExecutorOptions opt;
   opt.dt = 0.004;
-  opt.allow_extrapolation = true;
-  // Start where the strokes start.
+  opt.allow_extrapolation = true;  // the hand-made target carries no range
   lfd::CartesianToJoints ik = converter(chain_, q0_);
-  lfd::TimedPose start{0.0, home_};
+  lfd::TimedPose start{0.0, home_};  // start where the strokes start
   start.pose.position = goal - Eigen::Vector3d(0.16, 0, 0);
-  const lfd::JointPath to_start = ik.convert({start}, q0_);
-  const lfd_dmp::ExecutionPlan plan =
-      planner_.plan(lib, t, to_start.positions[0], std::nullopt, opt);
-  ASSERT_EQ(plan.segments[0].demos.size(), 1u);  // the nearest demo's shape, whole
-  double lo = 1e9, hi = -1e9;
-  for (const auto& p : plan.poses) {
-    lo = std::min(lo, p.position.x());
-    hi = std::max(hi, p.position.x());
+  const Eigen::VectorXd q_start = ik.convert({start}, q0_).positions[0];
+  lfd_dmp::LearnOptions learn;
+  learn.params.num_basis = 60;
+  for (bool local_linear : {false, true}) {
+    opt.generalization.local_linear = local_linear;
+    for (bool aligned : {false, true}) {
+      learn.time_alignment.reset();
+      if (aligned) learn.time_alignment = lfd::TimeAlignmentOptions{};
+      const lfd_dmp::LearnOutcome out =
+          lfd_dmp::learnSkillLibrary(demos, {{}, {}, {}}, learn);  // one segment, no scenes
+      const lfd_dmp::ExecutionPlan plan = planner_.plan(out.library, t, q_start, std::nullopt, opt);
+      EXPECT_EQ(plan.segments[0].demos.size(), 3u);  // every demo in the mix
+      const auto [shortest, turns] = shortestStroke(plan);
+      if (aligned) {
+        EXPECT_TRUE(out.library.time_alignment.has_value());  // recorded with the skills
+        EXPECT_FALSE(out.library.segments[0].time_reference.empty());
+        EXPECT_EQ(turns, 2) << "local_linear " << local_linear;
+        EXPECT_GT(shortest, 0.15) << "local_linear " << local_linear;  // the demos' 16 cm
+      } else if (!local_linear) {  // a convex mix: what alignment fixes
+        EXPECT_LT(shortest, 0.12);
+      }
+    }
   }
-  EXPECT_GT(hi - lo, 0.15);                // the full 16 cm stroke
-  opt.nearest_shape_along_motion = false;  // averaged: the strokes of different timing shrink
-  const lfd_dmp::ExecutionPlan mixed =
-      planner_.plan(lib, t, to_start.positions[0], std::nullopt, opt);
-  EXPECT_EQ(mixed.segments[0].demos.size(), 3u);
 }
 
 // Nothing is task-specific: a task no code knows (four segments, objects named "cup" and "tray")

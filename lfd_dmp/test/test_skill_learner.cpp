@@ -186,6 +186,39 @@ TEST(SkillLearner, SmoothingKeepsTheMotionAndDropsTheTremor) {
   EXPECT_THROW(lfd_dmp::learnSkillLibrary({clean}, {{12.0}}, opt), std::invalid_argument);
 }
 
+// Alignment re-times each segment's demos, never where a segment starts or ends: the segment times,
+// ends and goals are the recorded ones; demos timed alike keep their DMPs; the alignment and each
+// segment's reference demo are recorded with the skills.
+TEST(SkillLearner, TimeAlignmentKeepsEachSegmentsTimesAndEnds) {
+  const std::vector<lfd_dmp::DemoRecording> demos = {recording("a.bag", 0.6),
+                                                     recording("b.bag", 0.7)};
+  const std::vector<std::vector<double>> cps = {{12.0, 14.0}, {12.0, 14.0}};
+  lfd_dmp::LearnOptions opt;
+  const lfd_dmp::SkillLibrary as_recorded = lfd_dmp::learnSkillLibrary(demos, cps, opt).library;
+  opt.time_alignment = lfd::TimeAlignmentOptions{};
+  const lfd_dmp::SkillLibrary aligned = lfd_dmp::learnSkillLibrary(demos, cps, opt).library;
+  ASSERT_TRUE(aligned.time_alignment.has_value());
+  EXPECT_FALSE(as_recorded.time_alignment.has_value());
+  for (size_t s = 0; s < 3; ++s) {
+    EXPECT_FALSE(aligned.segments[s].time_reference.empty());
+    EXPECT_TRUE(as_recorded.segments[s].time_reference.empty());
+    EXPECT_EQ(aligned.segments[s].goal->position_frame.name(),
+              as_recorded.segments[s].goal->position_frame.name());
+    for (size_t d = 0; d < 2; ++d) {
+      const lfd_dmp::DemoSkill& a = aligned.segments[s].demos[d];
+      const lfd_dmp::DemoSkill& r = as_recorded.segments[s].demos[d];
+      EXPECT_EQ(a.start_time, r.start_time);
+      EXPECT_EQ(a.end_time, r.end_time);
+      EXPECT_EQ(a.dmp.tau, r.dmp.tau);
+      EXPECT_LT((a.parameters - r.parameters).norm(), 1e-12);
+      EXPECT_LT((a.dmp.position->start() - r.dmp.position->start()).norm(), 1e-12);
+      // The two demos are timed alike (their paths differ in length, not in timing).
+      EXPECT_LT((a.dmp.rollout().positions - r.dmp.rollout().positions).cwiseAbs().maxCoeff(),
+                0.002);
+    }
+  }
+}
+
 TEST(SkillLearner, RejectsUnusableInput) {
   std::vector<lfd_dmp::DemoRecording> demos = {recording("a.bag", 0.6)};
   lfd_dmp::LearnOptions opt;

@@ -36,10 +36,12 @@ SkillLibrary makeLibrary() {
   lib.task = "grasp";
   lib.features = {"gripper_opening", "ee_speed", "ee_x"};
   lib.smoothing_sigma = 0.05;
+  lib.time_alignment = lfd::TimeAlignmentOptions{0.04, 0.12, false};
   for (int s = 0; s < 2; ++s) {
     lfd_dmp::SegmentSkills seg;
     seg.index = s;
     seg.name = s == 0 ? "approach" : "move";
+    seg.time_reference = "demo_1.bag";
     for (int d = 0; d < 2; ++d) {
       lfd_dmp::DemoSkill skill;
       skill.demo_id = "demo_" + std::to_string(d) + ".bag";
@@ -100,6 +102,11 @@ TEST(SkillLibrary, RoundTripKeepsEverything) {
   EXPECT_EQ(back.task, "grasp");
   EXPECT_EQ(back.features, lib.features);
   EXPECT_EQ(back.smoothing_sigma, 0.05);
+  ASSERT_TRUE(back.time_alignment.has_value());
+  EXPECT_EQ(back.time_alignment->sample_seconds, 0.04);
+  EXPECT_EQ(back.time_alignment->warp_sigma, 0.12);
+  EXPECT_FALSE(back.time_alignment->yaw_invariant);
+  EXPECT_EQ(back.segments[1].time_reference, "demo_1.bag");
   EXPECT_EQ(back.cartesian_frame, "base_link");
   ASSERT_EQ(back.demo_scenes.size(), 2u);
   EXPECT_EQ(back.demo_scenes.at("demo_1.bag").scene.objects.at("stick").position.x(), 0.6);
@@ -205,6 +212,18 @@ TEST(SkillLibrary, ValidationNamesTheProblem) {
 
   j = good;  // libraries written before the smoothing was recorded
   j.erase("smoothing_sigma");
+  EXPECT_EQ(loadError(j), "");
+
+  j = good;
+  j["time_alignment"]["sample_seconds"] = 0.0;
+  EXPECT_NE(loadError(j).find("time_alignment.sample_seconds: must be > 0"), std::string::npos)
+      << loadError(j);
+  j = good;
+  j["time_alignment"]["yaw_invariant"] = 1;
+  EXPECT_NE(loadError(j).find("time_alignment.yaw_invariant"), std::string::npos);
+  j = good;  // learned as recorded: no alignment, no reference
+  j.erase("time_alignment");
+  j["segments"][0].erase("time_reference");
   EXPECT_EQ(loadError(j), "");
 
   j = good;

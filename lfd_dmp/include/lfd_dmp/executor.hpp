@@ -86,10 +86,7 @@ struct ExecutorOptions {
   double min_range_angle = 0.1;      ///< rad: the smallest angle margin
   bool allow_extrapolation = false;  ///< plan goals outside the demonstrated range anyway
   lfd::FrameOptions frames;
-  bool heading_frames = true;  ///< generalize segments along the frame their motion follows
-  /// ... with the shape of the demo nearest the query when it goes back and forth along that
-  /// frame (not a mix of strokes timed differently)
-  bool nearest_shape_along_motion = true;
+  bool heading_frames = true;   ///< generalize segments along the frame their motion follows
   size_t max_samples = 100000;  ///< planned samples (memory and time bound of one plan)
   double gripper_threshold_fraction = 0.5;
   double gripper_hysteresis = 0.05;

@@ -32,6 +32,10 @@ struct LearnOptions {
   /// s; Gaussian low-pass of every recorded pose before it is cut and learned (lfd::gaussianSmooth;
   /// 0 = off). Teleoperated demos carry tremor that the DMPs would otherwise replay.
   double smoothing_sigma = 0.0;
+  /// Re-time each segment's demos onto one common timing before learning them (lfd_core
+  /// time_alignment; none = learn them as recorded). The executor mixes the demos' DMPs phase by
+  /// phase: demos whose sub-motions come at different phases would blur each other.
+  std::optional<lfd::TimeAlignmentOptions> time_alignment;
   /// How each segment's goal frame is chosen from the demos' scenes (lfd_core task_frames).
   lfd::FrameSelectionOptions frames;
 };

@@ -10,8 +10,13 @@
 //   "generalization_parameters": "goal_position",
 //   "position_names": ["x", "y", "z"],
 //   "dmp_parameters": {"num_basis": 50, "alpha_x": 6.9, ...},
+//   "smoothing_sigma": 0.05,                         // s, the demos' low-pass before learning
+//   "time_alignment": {"sample_seconds": 0.05, "warp_sigma": 0.1, "yaw_invariant": true},
+//                                                    // each segment's demos re-timed onto one
+//                                                    // timing (absent: learned as recorded)
 //   "segments": [
 //     {"index": 0, "name": "approach",
+//      "time_reference": "grasp_05.bag",              // the demo the timing was aligned to
 //      "goal": {"position": {"frame": "object:stick", "offset": [x, y, z], "spread_m": 0.008},
 //               "orientation": {"frame": "object:stick", "offset": [w, x, y, z],
 //                               "spread_rad": 0.04},
@@ -37,6 +42,7 @@
 
 #include <lfd_core/segment_dmp.hpp>
 #include <lfd_core/task_frames.hpp>
+#include <lfd_core/time_alignment.hpp>
 
 #include <nlohmann/json.hpp>
 
@@ -64,6 +70,7 @@ struct SegmentSkills {
   std::string name;  ///< e.g. "approach", or "segment_0"
   std::vector<DemoSkill> demos;
   std::optional<lfd::SegmentGoalModel> goal;  ///< where the segment ends, learned from the scenes
+  std::string time_reference;  ///< the demo whose DTW the others were aligned to ("": none)
 };
 
 /// Where a demonstration happened (Cartesian frame): its scene and the TCP pose when it started.
@@ -82,6 +89,8 @@ struct SkillLibrary {
   /// s; the Gaussian low-pass applied to the demos before learning (LearnOptions; 0 = none).
   /// Optional in the file (absent = 0, as written before it was recorded).
   double smoothing_sigma = 0.0;
+  /// How each segment's demos were re-timed onto one timing before learning (none: as recorded).
+  std::optional<lfd::TimeAlignmentOptions> time_alignment;
   std::string cartesian_frame = "base_link";     ///< frame of the poses (DMPs, scenes, goals)
   std::map<std::string, DemoScene> demo_scenes;  ///< by demo_id
   std::vector<SegmentSkills> segments;
