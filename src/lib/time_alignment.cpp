@@ -42,15 +42,23 @@ Eigen::RowVectorXd interpolateQuaternion(const Eigen::VectorXd& t, const Eigen::
   return r / r.norm();
 }
 
-// The demo's path relative to its start, resampled every `step` s (at least 2 samples), in units
-// of its length: demos of one segment go different distances (to objects nearer or farther), and
-// DTW on the raw paths would re-time one to make its positions meet the other's.
+// What DTW compares of a demo: its hand position and, when recorded, its gripper opening (a
+// distance too), relative to their start and resampled every `step` s (at least 2 samples), in
+// units of the path's length (the hand's and the gripper's travel). The gripper is what moves
+// while the hand holds still (a grasp, a release): without it, DTW could place the closing of one
+// demo after the lift of another. In units of the length because demos of one segment go
+// different distances (to objects nearer or farther), and DTW on the raw paths would re-time one
+// to make its positions meet the other's.
 Eigen::MatrixXd comparedPath(const SegmentDemo& d, double step) {
   const double t0 = d.times[0], duration = d.times[d.times.size() - 1] - t0;
   const int n = std::max(2, static_cast<int>(std::lround(duration / step)) + 1);
-  Eigen::MatrixXd out(n, d.positions.cols());
-  for (int i = 0; i < n; ++i)
-    out.row(i) = interpolateRow(d.times, d.positions, t0 + duration * i / (n - 1.0));
+  const Eigen::Index dp = d.positions.cols(), dg = d.gripper.size() > 0 ? 1 : 0;
+  Eigen::MatrixXd out(n, dp + dg);
+  for (int i = 0; i < n; ++i) {
+    const double t = t0 + duration * i / (n - 1.0);
+    out.row(i).head(dp) = interpolateRow(d.times, d.positions, t);
+    if (dg) out(i, dp) = interpolate(d.times, d.gripper, t);
+  }
   out.rowwise() -= out.row(0).eval();
   double length = 0.0;
   for (int i = 1; i < n; ++i) length += (out.row(i) - out.row(i - 1)).norm();
@@ -87,9 +95,10 @@ struct Match {
 // fitted on the matched samples: a sample-by-sample fit alone can be fooled by strokes at
 // different times, which match a forward stroke to a return).
 Match compare(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b, bool yaw_invariant) {
+  // yaw_invariant: the first three columns are a 3-D position (the caller checks)
   const double norm = static_cast<double>(a.rows() + b.rows());
   Match best{dtwRows(a, b) / norm, 0.0};
-  if (!yaw_invariant || a.cols() != 3) return best;
+  if (!yaw_invariant) return best;
   for (int k = 1; k < kYawCandidates; ++k) {
     const double yaw = 2.0 * M_PI * k / kYawCandidates;
     const double cost = dtwRows(a, turned(b, yaw)) / norm;
@@ -187,7 +196,11 @@ void checkInput(const std::vector<SegmentDemo>& demos, const TimeAlignmentOption
       throw std::invalid_argument(which + ": quaternions must be M x 4");
     if (d.gripper.size() > 0 && d.gripper.size() != d.times.size())
       throw std::invalid_argument(which + ": gripper and times differ in length");
+    if ((d.gripper.size() > 0) != (demos[0].gripper.size() > 0))
+      throw std::invalid_argument(which + (d.gripper.size() > 0 ? " has" : " has no") +
+                                  " gripper, demo 0 the opposite");
     requireFinite(d.positions, which.c_str());
+    requireFinite(d.gripper, which.c_str());
   }
 }
 
@@ -243,7 +256,8 @@ TimeAlignment alignDemoTiming(const std::vector<SegmentDemo>& demos,
 
   std::vector<Eigen::MatrixXd> paths;
   for (const SegmentDemo& d : demos) paths.push_back(comparedPath(d, options.sample_seconds));
-  const std::size_t r = medoid(paths, options.yaw_invariant);
+  const bool turn = options.yaw_invariant && demos[0].positions.cols() == 3;
+  const std::size_t r = medoid(paths, turn);
   out.reference = r;
   const Eigen::Index n_ref = paths[r].rows();
   const double ref_duration = demos[r].times[demos[r].times.size() - 1] - demos[r].times[0];
@@ -254,7 +268,7 @@ TimeAlignment alignDemoTiming(const std::vector<SegmentDemo>& demos,
   Eigen::VectorXd common = ref_progress;
   for (std::size_t j = 0; j < demos.size(); ++j) {
     if (j == r) continue;
-    out.yaw[j] = compare(paths[r], paths[j], options.yaw_invariant).yaw;
+    out.yaw[j] = compare(paths[r], paths[j], turn).yaw;
     std::vector<std::pair<int, int>> path;
     dtwRows(paths[r], turned(paths[j], out.yaw[j]), &path);
     warp[j] =

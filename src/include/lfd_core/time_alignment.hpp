@@ -7,16 +7,16 @@
 // and three 16 cm strokes averaged into one of a third the length. Re-timed onto one common
 // timing, the same sub-motion has the same phase in every demo and the mix keeps it.
 //
-// Method: every demo's path (position relative to its start, in units of the path's length,
-// turned about z onto a reference demo's when the position is 3-D: demos of one segment differ in
-// where, in which heading and how far they go; z is up) is compared with dynamic time warping
-// (DTW) to a reference, the medoid (least summed DTW distance to the others). Each DTW path gives
-// a warp, the demo's progress (fraction of its duration) at each progress of the reference,
-// smoothed and monotone. The common timing is the mean of all warps, the reference's own included,
-// so that no demo's timing is preferred (a hesitation of one demo becomes a small slow-down, not a
-// pause of the others). Each demo is then resampled at its own time stamps from the progress the
-// common timing gives it: it keeps its duration, start, end and path; only when it gets where
-// changes.
+// Method: every demo's path (hand position and gripper opening relative to their start, in units
+// of the path's length, turned about z onto a reference demo's when the position is 3-D: demos of
+// one segment differ in where, in which heading and how far they go; z is up) is compared with
+// dynamic time warping (DTW) to a reference, the medoid (least summed DTW distance to the others).
+// Each DTW path gives a warp, the demo's progress (fraction of its duration) at each progress of
+// the reference, smoothed and monotone. The common timing is the mean of all warps, the
+// reference's own included, so that no demo's timing is preferred (a hesitation of one demo
+// becomes a small slow-down, not a pause of the others). Each demo is then resampled at its own
+// time stamps from the progress the common timing gives it: it keeps its duration, start, end and
+// path; only when it gets where changes.
 #pragma once
 
 #include "lfd_core/segment_dmp.hpp"
@@ -50,8 +50,9 @@ double dtwRows(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b,
                std::vector<std::pair<int, int>>* path = nullptr);
 
 /// Re-times the demos of one segment onto one common timing (above). The demos need positions
-/// (the compared path); time stamps strictly increasing. One demo, or demos without positions, are
-/// returned unchanged. Throws std::invalid_argument on bad options or shapes.
+/// (the compared path; a gripper in all of them or in none); time stamps strictly increasing. One
+/// demo, or demos without positions, are returned unchanged. Throws std::invalid_argument on bad
+/// options or shapes.
 TimeAlignment alignDemoTiming(const std::vector<SegmentDemo>& demos,
                               const TimeAlignmentOptions& options = {});
 
