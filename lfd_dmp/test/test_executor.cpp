@@ -2,6 +2,7 @@
 // planned path, and refusal of unreachable goals / mismatched libraries before anything moves.
 #include "lfd_dmp/executor.hpp"
 #include "lfd_dmp/skill_learner.hpp"
+#include "strokes.hpp"
 
 #include <gtest/gtest.h>
 
@@ -484,24 +485,10 @@ lfd_dmp::DemoRecording wipeRecording(const std::string& id, const Eigen::Vector3
 // The strokes of a planned segment along x: the shortest way between two turning points (a
 // turn needs 1 cm of way back), and how many turns.
 std::pair<double, int> shortestStroke(const lfd_dmp::ExecutionPlan& plan) {
-  std::vector<double> turns = {plan.poses.front().position.x()};
-  int direction = 0;
-  double extreme = turns[0];
-  for (const auto& p : plan.poses) {
-    const double v = p.position.x();
-    if (direction != 0 && direction * (v - extreme) > 0.0) {
-      extreme = v;
-    } else if (std::abs(v - extreme) > 0.01) {
-      if (direction != 0) turns.push_back(extreme);
-      direction = v > extreme ? 1 : -1;
-      extreme = v;
-    }
-  }
-  turns.push_back(plan.poses.back().position.x());
-  double shortest = 1e9;
-  for (size_t k = 1; k < turns.size(); ++k)
-    shortest = std::min(shortest, std::abs(turns[k] - turns[k - 1]));
-  return {shortest, static_cast<int>(turns.size()) - 2};
+  std::vector<double> x;
+  for (const auto& p : plan.poses) x.push_back(p.position.x());
+  const lfd_testing::Strokes s = lfd_testing::countStrokes(x);
+  return {s.shortest, s.reversals};
 }
 
 // Three wipe demos, each hesitating before another stroke, in other places and headings. Learned

@@ -3,6 +3,7 @@
 #include "lfd_core/dmp_generalization.hpp"
 #include "lfd_core/dtw.hpp"
 #include "lfd_core/time_alignment.hpp"
+#include "strokes.hpp"
 
 #include <gtest/gtest.h>
 
@@ -44,33 +45,12 @@ lfd::SegmentDemo strokes(const std::vector<double>& stroke, const std::vector<do
   return d;
 }
 
-// The strokes along x: the turning points (a reversal needs 1 cm of way back) and the shortest
-// stroke between two of them (three 16 cm strokes: 2 reversals, 0.16 m).
-struct Strokes {
-  int reversals = 0;
-  double shortest = 0.0;
-};
+using lfd_testing::Strokes;
+
+// The strokes along x (the first column; three 16 cm strokes: 2 reversals, 0.16 m).
 Strokes countStrokes(const Eigen::MatrixXd& y) {
-  std::vector<double> turns = {y(0, 0)};
-  int direction = 0;
-  double extreme = y(0, 0);
-  for (Eigen::Index k = 1; k < y.rows(); ++k) {
-    const double v = y(k, 0);
-    if (direction != 0 && direction * (v - extreme) > 0.0) {
-      extreme = v;
-    } else if (std::abs(v - extreme) > 0.01) {
-      if (direction != 0) turns.push_back(extreme);
-      direction = v > extreme ? 1 : -1;
-      extreme = v;
-    }
-  }
-  turns.push_back(y(y.rows() - 1, 0));
-  Strokes out;
-  out.reversals = static_cast<int>(turns.size()) - 2;
-  out.shortest = 1e9;
-  for (size_t k = 1; k < turns.size(); ++k)
-    out.shortest = std::min(out.shortest, std::abs(turns[k] - turns[k - 1]));
-  return out;
+  const Eigen::VectorXd x = y.col(0);
+  return lfd_testing::countStrokes(std::vector<double>(x.data(), x.data() + x.size()));
 }
 
 // The two demos learned (after alignment or not) and mixed half and half, rolled out.

@@ -31,7 +31,9 @@ double sigma(const Eigen::VectorXd& x) {
 
 // The clock of these tests: a 50 Hz stream from 0 s. A 200 Hz stream from -1.2 ms has no sample
 // on a period's edge (k / 50 s +- 10 ms).
-lfd::Stream clock_stream(double seconds) { return sampled(50.0, seconds, 0.0, 1e9, 0); }
+lfd::Stream clock_stream(double seconds) {
+  return sampled(50.0, seconds, 0.0, 1e9, 0);
+}
 constexpr double kOffGrid = -0.0012;
 
 // A 200 Hz noisy sensor read at 50 Hz: each row is the mean of the four samples of its period,
@@ -62,8 +64,8 @@ TEST(Resample, AveragingKeepsStepsInPlaceAndSlowerStreamsAreInterpolated) {
 
 // A discrete stream (flags, commands) is never averaged: a mean of two states is no state.
 TEST(Resample, DiscreteStreamsAreHeldNotAveraged) {
-  const lfd::FeatureMatrix m = lfd::resample(
-      {sampled(200.0, 4.0, 0.0, 2.0, 1, lfd::Interpolation::kZeroOrderHold)}, 50.0);
+  const lfd::FeatureMatrix m =
+      lfd::resample({sampled(200.0, 4.0, 0.0, 2.0, 1, lfd::Interpolation::kZeroOrderHold)}, 50.0);
   for (Eigen::Index r = 0; r < m.rows(); ++r)
     EXPECT_TRUE(m.data(r, 0) == 0.0 || m.data(r, 0) == 1.0) << r;
 }

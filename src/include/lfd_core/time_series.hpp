@@ -46,8 +46,8 @@ struct FeatureMatrix {
 /// Resamples streams onto one uniform clock at `rate_hz`, spanning the interval where every
 /// stream has data (latest start .. earliest end). A continuous stream sampled faster than the
 /// clock is averaged over each clock sample's period (centred on it), otherwise interpolated;
-/// a discrete (zero-order-hold) stream holds its last value. Throws std::invalid_argument on empty or
-/// non-finite streams, decreasing timestamps, or streams that do not overlap in time.
+/// a discrete (zero-order-hold) stream holds its last value. Throws std::invalid_argument on empty
+/// or non-finite streams, decreasing timestamps, or streams that do not overlap in time.
 FeatureMatrix resample(const std::vector<Stream>& streams, double rate_hz);
 
 /// Evaluates one stream at the given query times (queries outside the stream are clamped).
