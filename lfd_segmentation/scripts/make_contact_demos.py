@@ -11,10 +11,10 @@ tuned on (contact onset and release, and pose-only over-segmentation of periodic
     segment OUT_DIR/demo_0.csv OUT_DIR/demo_1.csv ...                     (pose only)
 truth.csv holds each demo's contact onset and release (s).
 """
-import argparse
 import os
 
 import numpy as np
+from lfd_tools import synthetic
 
 POSE = ["x", "y", "z", "qx", "qy", "qz", "qw"]
 WRENCH = ["fx", "fy", "fz", "tx", "ty", "tz"]
@@ -69,19 +69,11 @@ def demo(rng, rate):
 
 
 def main():
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("out")
-    ap.add_argument("--demos", type=int, default=8)
-    ap.add_argument("--rate", type=float, default=100.0)
-    ap.add_argument("--seed", type=int, default=0)
-    args = ap.parse_args()
-    os.makedirs(args.out, exist_ok=True)
-    rng = np.random.default_rng(args.seed)
+    args, rng = synthetic.parse_demo_args(__doc__, demos=8, rate=100.0)
     truth = []
     for d in range(args.demos):
         t, pose, wrench, on, off = demo(rng, args.rate)
-        np.savetxt(os.path.join(args.out, "demo_%d.csv" % d), np.column_stack([t, pose, wrench]),
-                   delimiter=",", header=",".join(["time"] + POSE + WRENCH), comments="", fmt="%.6g")
+        synthetic.write_demo_csv(args.out, d, t, POSE + WRENCH, [pose, wrench])
         truth.append((d, on, off))
     np.savetxt(os.path.join(args.out, "truth.csv"), np.array(truth), delimiter=",",
                header="demo,contact_onset_s,release_s", comments="", fmt=["%d", "%.3f", "%.3f"])

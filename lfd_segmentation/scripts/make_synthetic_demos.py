@@ -5,10 +5,10 @@
 then
     segment --timing --sensor-columns $(cat OUT_DIR/sensor_columns.txt) OUT_DIR/demo_*.csv
 """
-import argparse
 import os
 
 import numpy as np
+from lfd_tools import synthetic
 
 STATE = ([f"/ee_pose/pose/position/{a}" for a in "xyz"] +
          [f"/ee_pose/pose/orientation/{a}" for a in "xyzw"] +
@@ -45,22 +45,14 @@ def demo(rng, n, rate):
 
 
 def main():
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("out")
-    ap.add_argument("--demos", type=int, default=9)
-    ap.add_argument("--samples", type=int, default=2000)
-    ap.add_argument("--rate", type=float, default=50.0)
-    ap.add_argument("--seed", type=int, default=0)
-    args = ap.parse_args()
-    os.makedirs(args.out, exist_ok=True)
-    rng = np.random.default_rng(args.seed)
+    args, rng = synthetic.parse_demo_args(
+        __doc__, demos=9, rate=50.0,
+        extra=lambda ap: ap.add_argument("--samples", type=int, default=2000))
     for d in range(args.demos):
         n = int(args.samples * rng.uniform(0.85, 1.15))
         t, cols, grasp = demo(rng, n, args.rate)
         names = STATE + SENSOR
-        data = np.column_stack([t] + [cols[c] for c in names])
-        np.savetxt(os.path.join(args.out, f"demo_{d}.csv"), data, delimiter=",",
-                   header=",".join(["time"] + names), comments="", fmt="%.6g")
+        synthetic.write_demo_csv(args.out, d, t, names, [cols[c] for c in names])
         print(f"demo_{d}.csv: {n} samples, grasp at sample {grasp}")
     with open(os.path.join(args.out, "sensor_columns.txt"), "w") as f:
         f.write(",".join(SENSOR))
