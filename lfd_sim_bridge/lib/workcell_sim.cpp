@@ -165,11 +165,7 @@ WorkcellSim::WorkcellSim(const std::string& mjcf_path, const WorkcellConfig& con
     objects_.emplace_back(name, body);
   }
 
-  noisy_ = config_.noise.joint_position > 0 || config_.noise.joint_velocity > 0 ||
-           config_.noise.joint_effort > 0 || config_.noise.force > 0 || config_.noise.torque > 0 ||
-           config_.noise.touch > 0 || config_.noise.gyro > 0 || config_.noise.accel > 0 ||
-           config_.noise.ee_position > 0 || config_.noise.ee_orientation > 0 ||
-           config_.noise.gripper > 0 || config_.noise.object_position > 0;
+  setNoise(config_.noise, config_.noise_seed);
 
   initial_qpos_.assign(m_->qpos0, m_->qpos0 + m_->nq);
   scene_qpos_ = initial_qpos_;
@@ -666,6 +662,16 @@ Pose WorkcellSim::bodyPose(int body) const {
 
 Pose WorkcellSim::basePoseInWorld() const {
   return bodyPose(base_body_);
+}
+
+void WorkcellSim::setNoise(const SensorNoise& noise, uint64_t seed) {
+  config_.noise = noise;
+  config_.noise_seed = seed;
+  rng_.seed(seed);
+  const SensorNoise& n = config_.noise;
+  noisy_ = n.joint_position > 0 || n.joint_velocity > 0 || n.joint_effort > 0 || n.force > 0 ||
+           n.torque > 0 || n.touch > 0 || n.gyro > 0 || n.accel > 0 || n.ee_position > 0 ||
+           n.ee_orientation > 0 || n.gripper > 0 || n.object_position > 0;
 }
 
 double WorkcellSim::noise(double std) {

@@ -14,8 +14,10 @@
 //   rtf_report_period     wall seconds between "real-time factor" INFO lines (0 = never)
 //   initial_posture, kp, kd, damping_ratio, velocity_limits, default_velocity_limit,
 //   effort_limits, default_effort_limit, gravity_compensation, gripper_opening_scale,
-//   objects, max_abs_velocity, touch_time_constant, noise/{joint_position,...}, noise_seed (see
-//   WorkcellConfig)
+//   objects, max_abs_velocity, touch_time_constant (see WorkcellConfig)
+//   noise_profiles        {name: {seed, joint_position, ...}}: readings noise
+//   (lfd_sim::SensorNoise) noise_profile         the profile at startup; a /bridge/reset request
+//   may select another
 #include <geometry_msgs/PoseStamped.h>
 #include <geometry_msgs/TransformStamped.h>
 #include <geometry_msgs/TwistStamped.h>
@@ -66,6 +68,58 @@ std::map<std::string, double> mapParam(ros::NodeHandle& pnh, const std::string& 
   return value;
 }
 
+// A named readings noise of ~noise_profiles: the noise and the seed its generator restarts from.
+struct NoiseProfile {
+  lfd_sim::SensorNoise noise;
+  uint64_t seed = 1;
+};
+
+double number(XmlRpc::XmlRpcValue& v, const std::string& where) {
+  if (v.getType() == XmlRpc::XmlRpcValue::TypeInt) return static_cast<int>(v);
+  if (v.getType() == XmlRpc::XmlRpcValue::TypeDouble) return static_cast<double>(v);
+  throw std::invalid_argument(where + " must be a number");
+}
+
+// ~noise_profiles: {name: {seed: N, joint_position: std, ...}}; a reading not listed is exact.
+// Unknown keys are refused: a misspelt one would silently record exact readings.
+std::map<std::string, NoiseProfile> loadNoiseProfiles(ros::NodeHandle& pnh) {
+  std::map<std::string, NoiseProfile> profiles;
+  XmlRpc::XmlRpcValue all;
+  if (!pnh.getParam("noise_profiles", all)) return profiles;
+  if (all.getType() != XmlRpc::XmlRpcValue::TypeStruct)
+    throw std::invalid_argument("~noise_profiles must be a map of name to profile");
+  for (auto& [name, entry] : all) {
+    const std::string where = "~noise_profiles/" + name;
+    if (entry.getType() != XmlRpc::XmlRpcValue::TypeStruct)
+      throw std::invalid_argument(where + " must be a map");
+    NoiseProfile p;
+    lfd_sim::SensorNoise& n = p.noise;
+    const std::map<std::string, double*> fields = {{"joint_position", &n.joint_position},
+                                                   {"joint_velocity", &n.joint_velocity},
+                                                   {"joint_effort", &n.joint_effort},
+                                                   {"force", &n.force},
+                                                   {"torque", &n.torque},
+                                                   {"touch", &n.touch},
+                                                   {"gyro", &n.gyro},
+                                                   {"accel", &n.accel},
+                                                   {"ee_position", &n.ee_position},
+                                                   {"ee_orientation", &n.ee_orientation},
+                                                   {"gripper", &n.gripper},
+                                                   {"object_position", &n.object_position}};
+    for (auto& [key, value] : entry) {
+      if (key == "seed") {
+        p.seed = static_cast<uint64_t>(number(value, where + "/seed"));
+      } else if (fields.count(key)) {
+        *fields.at(key) = number(value, where + "/" + key);
+      } else {
+        throw std::invalid_argument(where + " has an unknown key '" + key + "'");
+      }
+    }
+    profiles[name] = p;
+  }
+  return profiles;
+}
+
 lfd_sim::WorkcellConfig loadConfig(ros::NodeHandle& pnh) {
   lfd_sim::WorkcellConfig c;
   c.initial_posture = mapParam(pnh, "initial_posture");
@@ -93,20 +147,6 @@ lfd_sim::WorkcellConfig loadConfig(ros::NodeHandle& pnh) {
     if (v.size() != 3) throw std::invalid_argument(std::string("~") + key + " needs [x, y, z]");
     std::copy(v.begin(), v.end(), bound->begin());
   }
-  c.noise_seed = static_cast<uint64_t>(param(pnh, "noise_seed", 1));
-  lfd_sim::SensorNoise& n = c.noise;
-  n.joint_position = param(pnh, "noise/joint_position", 0.0);
-  n.joint_velocity = param(pnh, "noise/joint_velocity", 0.0);
-  n.joint_effort = param(pnh, "noise/joint_effort", 0.0);
-  n.force = param(pnh, "noise/force", 0.0);
-  n.torque = param(pnh, "noise/torque", 0.0);
-  n.touch = param(pnh, "noise/touch", 0.0);
-  n.gyro = param(pnh, "noise/gyro", 0.0);
-  n.accel = param(pnh, "noise/accel", 0.0);
-  n.ee_position = param(pnh, "noise/ee_position", 0.0);
-  n.ee_orientation = param(pnh, "noise/ee_orientation", 0.0);
-  n.gripper = param(pnh, "noise/gripper", 0.0);
-  n.object_position = param(pnh, "noise/object_position", 0.0);
   return c;
 }
 
@@ -176,7 +216,12 @@ class BridgeNode {
   BridgeNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh) {
     const std::string model_path = param<std::string>(pnh, "model_path", "");
     if (model_path.empty()) throw std::runtime_error("~model_path is not set");
-    sim_ = std::make_unique<lfd_sim::WorkcellSim>(model_path, loadConfig(pnh), rosLogSink);
+    noise_profiles_ = loadNoiseProfiles(pnh);
+    lfd_sim::WorkcellConfig config = loadConfig(pnh);
+    const NoiseProfile& start = noiseProfile(param<std::string>(pnh, "noise_profile", ""));
+    config.noise = start.noise;
+    config.noise_seed = start.seed;
+    sim_ = std::make_unique<lfd_sim::WorkcellSim>(model_path, config, rosLogSink);
     if (param(pnh, "use_urdf_limits", true)) {
       std::string urdf;
       if (nh.getParam("robot_description", urdf)) {
@@ -470,17 +515,36 @@ class BridgeNode {
       for (size_t i = 0; i < req.joint_names.size(); ++i) {
         posture[req.joint_names[i]] = req.positions[i];
       }
+      // Looked up first: an unknown profile fails the request before anything changes.
+      const NoiseProfile* noise =
+          req.noise_profile.empty() ? nullptr : &noiseProfile(req.noise_profile);
       sim_->reset(posture, req.reset_objects);
+      if (noise) sim_->setNoise(noise->noise, noise->seed);
       pending_gripper_.clear();  // a reset robot has no plan left
       publishState();
       res.success = true;
-      res.message = "reset at t=" + std::to_string(sim_->time());
+      res.message = "reset at t=" + std::to_string(sim_->time()) +
+                    (noise ? ", noise profile " + req.noise_profile : "");
     } catch (const std::exception& e) {
       res.success = false;
       res.message = e.what();
       ROS_ERROR("/bridge/reset failed: %s", e.what());
     }
     return true;
+  }
+
+  // "" = exact readings (no profile configured), else a name of ~noise_profiles.
+  const NoiseProfile& noiseProfile(const std::string& name) const {
+    static const NoiseProfile kExact;
+    if (name.empty()) return kExact;
+    const auto it = noise_profiles_.find(name);
+    if (it == noise_profiles_.end()) {
+      std::string known;
+      for (const auto& [n, p] : noise_profiles_) known += (known.empty() ? "" : ", ") + n;
+      throw std::invalid_argument("no noise profile '" + name + "' in ~noise_profiles (" + known +
+                                  ")");
+    }
+    return it->second;
   }
 
   bool onSetScene(lfd_msgs::SetScene::Request& req, lfd_msgs::SetScene::Response& res) {
@@ -562,6 +626,7 @@ class BridgeNode {
   tf2_ros::StaticTransformBroadcaster static_tf_;
   ros::Subscriber joint_command_sub_, trajectory_sub_, gripper_sub_;
   ros::ServiceServer reset_srv_, scene_srv_, pause_srv_, step_srv_;
+  std::map<std::string, NoiseProfile> noise_profiles_;
 };
 
 }  // namespace

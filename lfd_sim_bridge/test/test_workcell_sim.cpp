@@ -477,6 +477,27 @@ TEST(WorkcellSim, NoiseIsSeededAndOnlyInReadings) {
   EXPECT_LT(diff / sa.joint_names.size(), 0.03);
 }
 
+// One simulation records datasets of different modes in turn: switching the noise restarts its
+// generator, so what follows does not depend on the readings taken before.
+TEST(WorkcellSim, SetNoiseSwitchesAndReseeds) {
+  lfd_sim::WorkcellSim quiet(kModel, readyConfig()), noisy(kModel, readyConfig());
+  lfd_sim::SensorNoise teleop;
+  teleop.joint_position = 0.01;
+  teleop.touch = 0.8;
+  noisy.setNoise(teleop, 7);
+  for (int i = 0; i < 5; ++i) noisy.readState();  // readings of "an earlier dataset"
+  noisy.setNoise(teleop, 7);
+  quiet.setNoise(teleop, 7);
+  const lfd_sim::WorkcellState a = noisy.readState(), b = quiet.readState();
+  EXPECT_EQ(a.joint_positions, b.joint_positions);
+  EXPECT_EQ(a.touch_values, b.touch_values);
+  EXPECT_EQ(noisy.sensorNoise().touch, 0.8);
+  noisy.setNoise(lfd_sim::SensorNoise(), 7);  // back to exact readings
+  const lfd_sim::WorkcellState exact = noisy.readState();
+  for (size_t j = 0; j < exact.joint_names.size(); ++j)
+    EXPECT_EQ(exact.joint_positions[j], noisy.jointPosition(exact.joint_names[j]));
+}
+
 TEST(WorkcellSim, UrdfLimitsOverrideVelocityAndEffort) {
   lfd_sim::WorkcellSim sim(kModel, readyConfig());
   const std::string urdf =

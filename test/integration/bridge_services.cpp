@@ -1,6 +1,7 @@
 // rostest: the bridge's services. Pause and step advance sim time by exactly steps x 1 ms and
 // announce it on /clock; set_scene places objects (read back on /objects/<name>/pose) and
-// rejects bad requests atomically; reset restores a posture and, on request, the objects.
+// rejects bad requests atomically; reset restores a posture and, on request, the objects, and
+// selects a noise profile.
 #include <gtest/gtest.h>
 #include <lfd_msgs/ResetSim.h>
 #include <lfd_msgs/SetScene.h>
@@ -191,6 +192,39 @@ TEST_F(BridgeServices, ResetRestoresPostureAndObjects) {
   ASSERT_TRUE(call("/bridge/reset", &bad));
   EXPECT_FALSE(bad.response.success);
   EXPECT_EQ(probe_.clockViolations(), 0);  // resets never move time backwards
+}
+
+// One simulation records sim and teleop-like datasets in turn: a reset naming a noise profile
+// (config/bridge.yaml noise_profiles) switches the readings' noise and restarts its generator.
+TEST_F(BridgeServices, ResetSelectsTheNoiseProfile) {
+  ASSERT_TRUE(setPaused(true));
+  ros::WallDuration(0.3).sleep();  // the states published before the pause have arrived
+  // The first joint state after a reset (paused: the only one) at R_SHOULDER_Y = 0.3.
+  auto readingAfterReset = [&](const std::string& profile, bool* ok) {
+    probe_.record("R_SHOULDER_Y");
+    lfd_msgs::ResetSim reset;
+    reset.request.joint_names = {"R_SHOULDER_Y"};
+    reset.request.positions = {0.3};
+    reset.request.noise_profile = profile;
+    *ok = call("/bridge/reset", &reset) && reset.response.success;
+    EXPECT_TRUE(*ok) << reset.response.message;
+    EXPECT_TRUE(waitFor([&] { return !probe_.history().empty(); }, 10.0));
+    return probe_.history().empty() ? std::nan("") : probe_.history().front().q;
+  };
+  bool ok = false;
+  const double teleop = readingAfterReset("teleop", &ok);
+  EXPECT_GT(std::abs(teleop - 0.3), 1e-7) << "no noise in the teleop profile";
+  EXPECT_LT(std::abs(teleop - 0.3), 0.02);                 // 2 mrad std
+  EXPECT_NE(readingAfterReset("", &ok), teleop);           // kept: the generator goes on
+  EXPECT_EQ(readingAfterReset("teleop", &ok), teleop);     // selected again: restarted
+  EXPECT_NEAR(readingAfterReset("sim", &ok), 0.3, 1e-12);  // exact readings
+  EXPECT_NEAR(readingAfterReset("", &ok), 0.3, 1e-12);
+
+  lfd_msgs::ResetSim unknown;
+  unknown.request.noise_profile = "no_such_profile";
+  ASSERT_TRUE(call("/bridge/reset", &unknown));
+  EXPECT_FALSE(unknown.response.success);
+  EXPECT_NE(unknown.response.message.find("no_such_profile"), std::string::npos);
 }
 
 }  // namespace

@@ -158,6 +158,11 @@ class WorkcellSim {
 
   // --- readings ---
   WorkcellState readState();  // noisy if config.noise is non-zero
+  // Replaces the readings noise and restarts its generator from `seed`: the noise that follows
+  // depends only on (noise, seed) and the readings taken since, not on what ran before (one
+  // simulation records datasets of different modes in turn).
+  void setNoise(const SensorNoise& noise, uint64_t seed);
+  const SensorNoise& sensorNoise() const { return config_.noise; }
   void readState(WorkcellState* state);
   Pose basePoseInWorld() const;
 
