@@ -1,5 +1,8 @@
 // demonstrator_node: the FSM "demonstrator" of the paper (Sec. III) driving the MuJoCo bridge, for
-// any task file. For each configuration of the task's file (config/tasks/<task>.yaml): reset the
+// any task file. It records one dataset (~task, ~mode) or several in turn (~datasets, see
+// demo_jobs.hpp), so one simulation serves them all. Per dataset: select the bridge's noise
+// profile of its mode (its generator restarts, so the dataset's noise does not depend on the ones
+// before it), then for each configuration of the task's file (config/tasks/<task>.yaml): reset the
 // robot, place the objects (the others parked), start a bag (/recorder/start with the demo's
 // metadata and scene), run the phases (Cartesian minimum-jerk motions -> IK -> /joint_trajectory,
 // gripper via /gripper/command, ground truth on /lfd/phase), stop the bag, and log where the
@@ -12,10 +15,10 @@
 // Each phase is planned when it starts, from where the previous one ended: a guarded move that
 // stopped at contact changes where the next phase begins.
 //
-// Private parameters (config/demonstrator.yaml): task, mode, configurations, output_dir, seed,
-// tasks_dir, scene_file, robot_file, speed_min/max, sample_period, contact_threshold, lead_in,
-// tail, scene_settle, phase_rate, skip_existing, lockstep, lockstep_chunk, lockstep_contact_chunk,
-// physics_dt, tool/*, teleop/*.
+// Private parameters (config/demonstrator.yaml): task, mode, configurations, output_dir or
+// datasets, seed, tasks_dir, scene_file, robot_file, speed_min/max, sample_period,
+// contact_threshold, lead_in, tail, scene_settle, phase_rate, skip_existing, lockstep,
+// lockstep_chunk, lockstep_contact_chunk, physics_dt, tool/*, teleop/*.
 #include <atomic>
 #include <cmath>
 #include <fstream>
@@ -23,6 +26,7 @@
 #include <memory>
 #include <mutex>
 #include <random>
+#include <set>
 #include <sstream>
 #include <string>
 #include <thread>
@@ -45,6 +49,7 @@
 #include <trajectory_msgs/JointTrajectory.h>
 
 #include "lfd_core/robot_setup.hpp"
+#include "lfd_sim_bridge/demo_jobs.hpp"
 #include "lfd_sim_bridge/demo_metadata.hpp"
 #include "lfd_sim_bridge/demo_plan.hpp"
 #include "lfd_sim_bridge/pose_msg.hpp"
@@ -106,6 +111,15 @@ struct DemoResult {
   std::string error;
 };
 
+// One dataset being recorded: its job and its task, interpreted for its mode.
+struct Dataset {
+  lfd_sim_bridge::DemoJob job;
+  std::unique_ptr<demo::TaskInterpreter> interpreter;
+  demo::TeleopStyle teleop;                         // the operator's (enabled in teleop mode)
+  std::vector<task::Configuration> configurations;  // the selected ones, in the file's order
+  double contact_threshold = 0.5;                   // N on a pad (the teleop operator's is higher)
+};
+
 // How a phase ended: at its planned end, or where a guarded step felt contact.
 struct PhaseEnd {
   double elapsed = 0.0;       // s of sim time the phase took
@@ -117,33 +131,39 @@ struct PhaseEnd {
 class Demonstrator {
  public:
   Demonstrator(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh), tf_listener_(tf_buffer_) {
-    task_name_ = required<std::string>(pnh, "task");
-    mode_ = param<std::string>(pnh, "mode", "sim");
-    if (mode_ != "sim" && mode_ != "teleop")
-      throw std::invalid_argument("~mode must be sim or teleop, got '" + mode_ + "'");
-    output_dir_ = required<std::string>(pnh, "output_dir");
     seed_ = param(pnh, "seed", 1);
     const task::Scene scene = task::loadScene(required<std::string>(pnh, "scene_file"));
-    task::TaskDefinition definition = task::loadTask(
-        task::taskFilePath(required<std::string>(pnh, "tasks_dir"), task_name_), scene);
     robot_ = lfd::loadRobotSetup(required<std::string>(pnh, "robot_file"));
-    std::vector<int> wanted = param(pnh, "configurations", std::vector<int>());
-    for (const task::Configuration& c : definition.configurations.at(mode_))
-      if (wanted.empty() || std::find(wanted.begin(), wanted.end(), c.id) != wanted.end())
-        configurations_.push_back(c);
-    if (configurations_.empty())
-      throw std::invalid_argument("no configuration of " + task_name_ + "/" + mode_ + " selected");
     demo::ToolGeometry tool;
     pnh.getParam("tool/fist_half_width", tool.fist_half_width);
-    teleop_ = teleopStyle(pnh, mode_ == "teleop");
-    interpreter_ =
-        std::make_unique<demo::TaskInterpreter>(definition, scene, robot_.gripper, tool, teleop_);
+    // Every task file is loaded and checked before anything is recorded: a bad one fails the run
+    // at once, as it did when each dataset had a launch of its own.
+    std::set<std::string> objects;
+    for (const lfd_sim_bridge::DemoJob& job : lfd_sim_bridge::loadDemoJobs(pnh)) {
+      Dataset d;
+      d.job = job;
+      const task::TaskDefinition definition =
+          task::loadTask(task::taskFilePath(job.tasks_dir, job.task), scene);
+      const std::vector<int>& wanted = job.configurations;
+      for (const task::Configuration& c : definition.configurations.at(job.mode))
+        if (wanted.empty() || std::find(wanted.begin(), wanted.end(), c.id) != wanted.end())
+          d.configurations.push_back(c);
+      if (d.configurations.empty())
+        throw std::invalid_argument("no configuration of " + job.task + "/" + job.mode +
+                                    " selected");
+      const bool teleop = job.mode == "teleop";
+      d.teleop = teleopStyle(pnh, teleop);
+      d.interpreter = std::make_unique<demo::TaskInterpreter>(definition, scene, robot_.gripper,
+                                                              tool, d.teleop);
+      d.contact_threshold = teleop ? param(pnh, "teleop/contact_threshold", 4.0)
+                                   : param(pnh, "contact_threshold", 0.5);
+      objects.insert(definition.objects.begin(), definition.objects.end());
+      datasets_.push_back(std::move(d));
+    }
 
     speed_min_ = param(pnh, "speed_min", 0.7);
     speed_max_ = param(pnh, "speed_max", 1.3);
     sample_period_ = param(pnh, "sample_period", 0.02);
-    contact_threshold_ = mode_ == "teleop" ? param(pnh, "teleop/contact_threshold", 4.0)
-                                           : param(pnh, "contact_threshold", 0.5);
     lead_in_ = param(pnh, "lead_in", 0.3);
     tail_ = param(pnh, "tail", 0.5);
     settle_before_ = param(pnh, "scene_settle", 0.3);
@@ -162,7 +182,7 @@ class Demonstrator {
     const auto hints = ros::TransportHints().tcpNoDelay();
     joint_sub_ = nh.subscribe("/joint_states", 5, &Demonstrator::onJoints, this, hints);
     touch_sub_ = nh.subscribe("/touch", 5, &Demonstrator::onTouch, this, hints);
-    for (const std::string& object : definition.objects)
+    for (const std::string& object : objects)
       object_subs_.push_back(nh.subscribe<geometry_msgs::PoseStamped>(
           "/objects/" + object + "/pose", 5,
           [this, object](const geometry_msgs::PoseStamped::ConstPtr& m) {
@@ -178,28 +198,45 @@ class Demonstrator {
     step_client_ = nh.serviceClient<lfd_msgs::StepSim>("/bridge/step", true);
   }
 
-  // Runs every selected demonstration; returns how many were recorded.
+  // Runs every selected demonstration of every dataset; returns how many were recorded.
   int run() {
     waitForSystem();
+    int recorded = 0;
+    for (const Dataset& d : datasets_) {
+      if (!ros::ok()) break;
+      recorded += runDataset(d);
+    }
+    if (lockstep_) setPaused(false);  // leave the sim running for whoever comes next
+    return recorded;
+  }
+
+ private:
+  const Dataset& dataset() const { return *dataset_; }
+  const std::string& taskName() const { return dataset_->job.task; }
+  const std::string& mode() const { return dataset_->job.mode; }
+  const task::TaskDefinition& definition() const { return dataset_->interpreter->task(); }
+  const task::Scene& scene() const { return dataset_->interpreter->scene(); }
+
+  int runDataset(const Dataset& d) {
+    dataset_ = &d;
+    noise_selected_ = false;
+    // generate_datasets.py splits the launch's output into per-dataset logs at this line.
+    ROS_INFO("demonstrator: dataset %s: %zu demos -> %s", d.job.name().c_str(),
+             d.configurations.size(), d.job.output_dir.c_str());
     std::vector<DemoResult> results;
-    for (const task::Configuration& c : configurations_) {
+    for (const task::Configuration& c : d.configurations) {
       if (!ros::ok()) break;
       results.push_back(runDemo(c));
     }
-    if (lockstep_) setPaused(false);  // leave the sim running for whoever comes next
     writeSummary(results);
     int recorded = 0;
     for (const DemoResult& r : results) recorded += r.recorded ? 1 : 0;
     ROS_INFO(
         "demonstrator: %s/%s done, %d of %zu demos recorded (judge them from the bags: "
         "check_demo_bag.py)",
-        task_name_.c_str(), mode_.c_str(), recorded, results.size());
+        taskName().c_str(), mode().c_str(), recorded, results.size());
     return recorded;
   }
-
- private:
-  const task::TaskDefinition& definition() const { return interpreter_->task(); }
-  const task::Scene& scene() const { return interpreter_->scene(); }
 
   void waitForSystem() {
     ROS_INFO("demonstrator: waiting for the bridge, the recorder and sim time");
@@ -257,7 +294,7 @@ class Demonstrator {
     DemoResult result;
     result.configuration = c.id;
     std::ostringstream name;
-    name << output_dir_ << "/" << task_name_ << "_" << mode_ << "_" << std::setw(2)
+    name << dataset().job.output_dir << "/" << taskName() << "_" << mode() << "_" << std::setw(2)
          << std::setfill('0') << c.id << ".bag";
     result.bag = name.str();
     if (skip_existing_ && std::ifstream(result.bag).good()) {
@@ -269,7 +306,8 @@ class Demonstrator {
       execute(c, &result);
     } catch (const std::exception& e) {
       result.error = e.what();
-      ROS_ERROR("demonstrator: %s configuration %d failed: %s", task_name_.c_str(), c.id, e.what());
+      ROS_ERROR("demonstrator: %s/%s configuration %d failed: %s", taskName().c_str(),
+                mode().c_str(), c.id, e.what());
       stopRecordingIfActive();
     }
     return result;
@@ -290,7 +328,11 @@ class Demonstrator {
       reset.request.joint_names.push_back(joint);
       reset.request.positions.push_back(q == c.joints.end() ? 0.0 : q->second);
     }
+    // The dataset's first reset selects its mode's noise on the bridge (config/bridge.yaml
+    // noise_profiles), restarting the noise generator: one launch or several, same noise.
+    if (!noise_selected_) reset.request.noise_profile = mode();
     call(reset_client_, reset);
+    noise_selected_ = true;
     lfd_msgs::SetScene set;
     for (const task::SceneObject& o : scene().objects) {
       const auto used = c.objects.find(o.name);
@@ -306,7 +348,7 @@ class Demonstrator {
   // recorded: an unreachable pose fails here, naming the task file and the phase.
   double checkReachable(const demo::DemoState& state, const demo::Pose& start,
                         const Eigen::VectorXd& q0) {
-    const demo::DemoPlan plan = interpreter_->planAll(state);
+    const demo::DemoPlan plan = dataset().interpreter->planAll(state);
     demo::Pose from = start;
     Eigen::VectorXd seed = q0;
     for (size_t i = 0; i < plan.phases.size(); ++i) {
@@ -344,15 +386,15 @@ class Demonstrator {
   }
 
   void execute(const task::Configuration& c, DemoResult* result) {
-    std::mt19937 rng(static_cast<uint32_t>(seed_ * 1000 + c.id * 7 + (mode_ == "teleop")));
+    std::mt19937 rng(static_cast<uint32_t>(seed_ * 1000 + c.id * 7 + (mode() == "teleop")));
     std::uniform_real_distribution<double> unit(0.0, 1.0);
     const double speed = speed_min_ + (speed_max_ - speed_min_) * unit(rng);
     placeScene(c);
 
     const Eigen::VectorXd q0 = currentChainPositions();
     const demo::Pose start = converter_->forward(q0);
-    demo::DemoState state = interpreter_->begin(c, world_from_base_, start, speed, rng);
-    const demo::TeleopStyle& teleop = teleop_;
+    demo::DemoState state = dataset().interpreter->begin(c, world_from_base_, start, speed, rng);
+    const demo::TeleopStyle& teleop = dataset().teleop;
     const demo::Tremor tremor =
         teleop.enabled
             ? demo::Tremor(teleop.tremor_rms, teleop.tremor_low_hz, teleop.tremor_high_hz, rng())
@@ -364,16 +406,16 @@ class Demonstrator {
     lfd_msgs::DemoMetadata& meta = start_rec.request.metadata;
     meta.header.stamp = now();
     meta.header.frame_id = "world";
-    meta.task = task_name_;
+    meta.task = taskName();
     meta.configuration = c.id;
-    meta.mode = mode_;
+    meta.mode = mode();
     meta.speed = speed;
     meta.extra_json = metadata(c, state, speed, tremor.rms(), planned);
     call(start_client_, start_rec);
     recording_ = true;
     const ros::Time demo_start = meta.header.stamp;
     ROS_INFO("demonstrator: %s/%s configuration %d, speed %.2f, planned %.1f s -> %s",
-             task_name_.c_str(), mode_.c_str(), c.id, speed, planned, result->bag.c_str());
+             taskName().c_str(), mode().c_str(), c.id, speed, planned, result->bag.c_str());
     publishPhase(definition().phases.front().name, 0, demo_start);  // at rest during lead-in
     advanceTo(demo_start + ros::Duration(lead_in_));
 
@@ -381,7 +423,7 @@ class Demonstrator {
     Eigen::VectorXd seed = q0;
     double t0 = 0.0;
     for (size_t i = 0; i < definition().phases.size(); ++i) {
-      const demo::Phase phase = interpreter_->planPhase(state, i, from);
+      const demo::Phase phase = dataset().interpreter->planPhase(state, i, from);
       const lfd::JointPath path =
           converter_->convert(demo::samplePhase(from, phase, sample_period_, t0, &tremor), seed);
       const PhaseEnd end = runPhase(phase, path);
@@ -504,7 +546,7 @@ class Demonstrator {
   void publishPhase(const std::string& name, int index, const ros::Time& stamp) {
     publishPhaseGrid(stamp);  // the previous phase up to the transition
     std::lock_guard<std::mutex> lock(phase_mutex_);
-    phase_msg_.task = task_name_;
+    phase_msg_.task = taskName();
     phase_msg_.name = name;
     phase_msg_.index = index;
     phase_msg_.header.stamp = stamp;
@@ -622,7 +664,7 @@ class Demonstrator {
     if (touch_.values.empty()) return false;
     const auto [lo, hi] = std::minmax_element(touch_.values.begin(), touch_.values.end());
     const double value = mode == demo::Contact::kAny ? *hi : *lo;
-    return value >= contact_threshold_ &&
+    return value >= dataset().contact_threshold &&
            (mode != demo::Contact::kBoth || touch_.values.size() >= 2);
   }
 
@@ -633,6 +675,8 @@ class Demonstrator {
     s << std::setprecision(4) << "{";
     bool first = true;
     for (const auto& [name, pose] : object_poses_) {
+      const auto& used = definition().objects;  // the other datasets' objects are parked
+      if (std::find(used.begin(), used.end(), name) == used.end()) continue;
       s << (first ? "" : ", ") << name << ": [" << pose.position.x() << ", " << pose.position.y()
         << ", " << pose.position.z() << ", " << demo::yawOf(pose.orientation) << "]";
       first = false;
@@ -657,9 +701,9 @@ class Demonstrator {
 
   void writeSummary(const std::vector<DemoResult>& results) const {
     const std::string path =
-        output_dir_ + "/demonstrator_summary_" + task_name_ + "_" + mode_ + ".yaml";
+        dataset().job.output_dir + "/demonstrator_summary_" + taskName() + "_" + mode() + ".yaml";
     std::ofstream out(path);
-    out << "task: " << task_name_ << "\nmode: " << mode_ << "\ndemos:\n";
+    out << "task: " << taskName() << "\nmode: " << mode() << "\ndemos:\n";
     for (const DemoResult& r : results) {
       out << "  - {configuration: " << r.configuration << ", bag: " << demo::jsonString(r.bag)
           << ", recorded: " << (r.recorded ? "true" : "false") << ", duration: " << r.duration
@@ -671,13 +715,12 @@ class Demonstrator {
   ros::NodeHandle nh_;
   tf2_ros::Buffer tf_buffer_;
   tf2_ros::TransformListener tf_listener_;
-  std::string task_name_, mode_, output_dir_;
   int seed_ = 1;
-  std::unique_ptr<demo::TaskInterpreter> interpreter_;
-  demo::TeleopStyle teleop_;
-  std::vector<task::Configuration> configurations_;
-  double speed_min_, speed_max_, sample_period_, contact_threshold_, lead_in_, tail_,
-      settle_before_, phase_period_, opening_scale_ = 2.0;
+  std::vector<Dataset> datasets_;
+  const Dataset* dataset_ = nullptr;  // the one being recorded
+  bool noise_selected_ = false;       // its noise profile is selected on the bridge
+  double speed_min_, speed_max_, sample_period_, lead_in_, tail_, settle_before_, phase_period_,
+      opening_scale_ = 2.0;
   bool skip_existing_ = true;
   lfd::RobotSetup robot_;
   std::unique_ptr<lfd::CartesianToJoints> converter_;

@@ -5,9 +5,10 @@
                        [--tasks-dir DIR] [--demos N] [--timeout S] [--force]
 
 Each dataset <DIR>/<mode>_<task> gets one bag per configuration of the task's file
-(config/tasks/<task>.yaml, or --tasks-dir), produced by `roslaunch lfd_launch demonstrate.launch`
-(bridge as fast as possible + recorder + demonstrator). The datasets default to every task in both
-modes. A dataset that already holds every bag is skipped, and the demonstrator skips bags that
+(config/tasks/<task>.yaml, or --tasks-dir). One `roslaunch lfd_launch demonstrate.launch` (bridge as
+fast as possible + recorder + demonstrator) records every dataset in turn, and a second one the
+demos that failed; logs/<dataset>.log holds the launch's output while that dataset was recorded.
+The datasets default to every task in both modes. A dataset that already holds every bag is skipped, and the demonstrator skips bags that
 exist, so a rerun resumes where an interrupted one stopped (*.bag.active leftovers are removed
 first). --demos N records N configurations per dataset, spread over the task's list.
 Uses the ROS master of ROS_MASTER_URI when one is running, else starts a private one.
@@ -18,11 +19,14 @@ the launch crashed (a crash is reported even when the retry recorded the missing
 """
 import argparse
 import glob
+import json
 import os
 import re
 import shutil
+import signal
 import subprocess
 import sys
+import threading
 import time
 
 import yaml
@@ -61,19 +65,24 @@ def crashes_in(log_text):
     return [(m.group(1), int(m.group(2)), -int(m.group(3))) for m in CRASH_LINE.finditer(log_text)]
 
 
-def generate(name, out_root, args, log_dir, crashes):
-    """Records the missing demos of one dataset; a demo that fails is tried once more (a fresh
-    scene), as a demonstrator redoes a botched demonstration."""
-    elapsed = 0.0
+# The demonstrator's line as it starts a dataset (demonstrator_node.cpp): where the launch's
+# output is split into per-dataset logs.
+DATASET_LINE = re.compile(r"demonstrator: dataset (\S+): ")
+
+
+def generate(names, out_root, args, log_dir, crashes):
+    """Records the missing demos of the datasets `names` with one launch (one simulation records
+    them in turn); the demos that failed are tried once more in a second launch (a fresh scene),
+    as a demonstrator redoes a botched demonstration."""
     for attempt in (1, 2):
-        done, took = record_missing(name, out_root, args, log_dir, attempt, crashes)
-        elapsed += took
-        if done:
+        jobs = [job for job in (missing_demos(n, out_root, args, attempt) for n in names) if job]
+        if not jobs:
             break
-    return elapsed
+        record(jobs, args, log_dir, attempt, crashes)
 
 
-def record_missing(name, out_root, args, log_dir, attempt, crashes):
+def missing_demos(name, out_root, args, attempt):
+    """The demonstrator's job for the demos of `name` without a bag, or None when it is complete."""
     mode, task = name.split("_", 1)
     out = os.path.join(out_root, name)
     ids = configurations(task, mode, args.demos)
@@ -84,36 +93,82 @@ def record_missing(name, out_root, args, log_dir, attempt, crashes):
     if not missing:
         if attempt == 1:
             print("[datasets] %s: complete (%d bags), skipped" % (name, len(ids)), flush=True)
-        return True, 0.0
+        return None
     if attempt > 1:
         errors = demo_errors(out)
         for i in missing:
             print("[datasets] %s: configuration %d was not recorded (%s); trying again"
                   % (name, i, errors.get(i, "no error reported")), flush=True)
     print("[datasets] %s: recording %d of %d demos" % (name, len(missing), len(ids)), flush=True)
-    cmd = ["roslaunch", "lfd_launch", "demonstrate.launch", "task:=" + task, "mode:=" + mode,
-           "output_dir:=" + out, "seed:=%d" % args.seed, "tasks_dir:=" + os.path.dirname(tasks.task_file(task)),
-           "configurations:=[%s]" % ",".join(str(i) for i in missing)]
-    start = time.time()
-    log_path = os.path.join(log_dir, name + ".log")
-    log_start = os.path.getsize(log_path) if attempt > 1 and os.path.exists(log_path) else 0
-    with open(log_path, "w" if attempt == 1 else "a") as log:
+    return {"task": task, "mode": mode, "output_dir": out, "configurations": missing,
+            "tasks_dir": os.path.dirname(tasks.task_file(task))}
+
+
+def record(jobs, args, log_dir, attempt, crashes):
+    """One demonstrate.launch for every job. Its output goes to logs/<dataset>.log of the dataset
+    being recorded (the lines before the first one's start to the first), so each log, its wall
+    time and its crashes are the dataset's."""
+    names = ["%s_%s" % (j["mode"], j["task"]) for j in jobs]
+    cmd = ["roslaunch", "lfd_launch", "demonstrate.launch", "mode:=" + jobs[0]["mode"],
+           "seed:=%d" % args.seed, "datasets:=" + json.dumps(jobs)]
+    timeout = args.timeout * len(jobs)
+    logs = {n: open(os.path.join(log_dir, n + ".log"), "w" if attempt == 1 else "a") for n in names}
+    for log in logs.values():
+        log.write("# attempt %d, one launch for %s\n" % (attempt, ", ".join(names)))
+        log.flush()
+    launch_start = time.time()
+    current, started = names[0], {names[0]: launch_start}
+
+    def finished(name):
+        print("[datasets] %s: %.1f s wall" % (name, time.time() - started[name]), flush=True)
+
+    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+                            universal_newlines=True, errors="replace")
+    timed_out = threading.Event()
+
+    def expire():
+        # SIGINT first: roslaunch stops its nodes, which would otherwise hold the pipe open.
+        timed_out.set()
+        proc.send_signal(signal.SIGINT)
         try:
-            subprocess.run(cmd, stdout=log, stderr=subprocess.STDOUT, timeout=args.timeout,
-                           check=False)
+            proc.wait(timeout=30.0)
         except subprocess.TimeoutExpired:
-            print("[datasets] %s: timed out after %.0f s (see %s)" % (name, args.timeout, log.name),
-                  file=sys.stderr)
-    elapsed = time.time() - start
-    print("[datasets] %s: %.1f s wall" % (name, elapsed), flush=True)
-    with open(log_path, errors="replace") as log:
-        log.seek(log_start)
-        for process, pid, signal in crashes_in(log.read()):
-            # A crash is a bug even when the retry records the missing demos: never hide it.
-            print("[datasets] %s: CRASH: %s (pid %d) was killed by signal %d (see %s)"
-                  % (name, process, pid, signal, log_path), file=sys.stderr, flush=True)
-            crashes.append((name, process, signal))
-    return False, elapsed
+            proc.kill()
+
+    timer = threading.Timer(timeout, expire)
+    timer.daemon = True
+    timer.start()
+    try:
+        for line in proc.stdout:
+            m = DATASET_LINE.search(line)
+            if m and m.group(1) in logs and m.group(1) != current:
+                finished(current)
+                current = m.group(1)
+                started[current] = time.time()
+            logs[current].write(line)
+            for process, pid, signum in crashes_in(line):
+                # A crash is a bug even when the retry records the missing demos: never hide it.
+                print("[datasets] %s: CRASH: %s (pid %d) was killed by signal %d (see %s)"
+                      % (current, process, pid, signum, logs[current].name), file=sys.stderr, flush=True)
+                crashes.append((current, process, signum))
+        proc.wait()
+    except KeyboardInterrupt:  # Ctrl-C reached roslaunch too (same process group): let it stop
+        try:
+            proc.wait(timeout=30.0)
+        except subprocess.TimeoutExpired:
+            proc.kill()
+        raise
+    finally:
+        timer.cancel()
+        for log in logs.values():
+            log.close()
+    if timed_out.is_set():
+        print("[datasets] %s: timed out after %.0f s (%.0f s per dataset; see %s)"
+              % ("+".join(names), timeout, args.timeout, logs[current].name), file=sys.stderr)
+    finished(current)
+    if len(names) > 1:
+        print("[datasets] one launch for %s: %.1f s wall" % ("+".join(names), time.time() - launch_start),
+              flush=True)
 
 
 def summarize(out_root, names, args):
@@ -153,7 +208,8 @@ def main():
     parser.add_argument("--tasks-dir", default=None,
                         help="also find task files here (searched first; $%s)" % tasks.TASKS_PATH_VAR)
     parser.add_argument("--demos", type=int, default=0, help="configurations per dataset, spread (0 = all)")
-    parser.add_argument("--timeout", type=float, default=600.0, help="s per dataset")
+    parser.add_argument("--timeout", type=float, default=600.0,
+                        help="s per dataset (a launch of N datasets gets N times this)")
     parser.add_argument("--force", action="store_true", help="delete and regenerate")
     args = parser.parse_args()
     if args.tasks_dir:
@@ -178,8 +234,7 @@ def main():
     start = time.time()
     crashes = []
     with master_for_this_process():
-        for n in names:
-            generate(n, out_root, args, log_dir, crashes)
+        generate(names, out_root, args, log_dir, crashes)
     total = time.time() - start
     print("[datasets] generation took %.1f s wall in total (logs in %s)" % (total, log_dir))
     ok = summarize(out_root, names, args)
