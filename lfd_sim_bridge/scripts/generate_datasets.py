@@ -55,14 +55,19 @@ def demo_errors(out):
     return errors
 
 
-# roslaunch's line for a node that ended by a signal: "[demonstrator-5] process has died [pid 42,
-# exit code -6, cmd ...". A negative code is the signal number (6 SIGABRT, 11 SIGSEGV).
-CRASH_LINE = re.compile(r"\[([\w-]+)\] process has died \[pid (\d+), exit code (-\d+)")
+# roslaunch's line for a node that ended by a signal: "[recorder-3] process has died [pid 42,
+# exit code -6, cmd ... __name:=recorder ...", or for a required node (the bridge, the
+# demonstrator) "process has died [pid 42, exit code -11, cmd ... __name:=bridge ..." after a line
+# "REQUIRED process [bridge-1] has died!". A negative code is the signal number (6 SIGABRT,
+# 11 SIGSEGV).
+CRASH_LINE = re.compile(r"(?:\[([\w-]+)\] )?process has died \[pid (\d+), exit code (-\d+)"
+                        r"(?:, cmd [^\]]*?__name:=([\w-]+))?")
 
 
 def crashes_in(log_text):
     """[(process, pid, signal)] of every node of the launch that died by a signal."""
-    return [(m.group(1), int(m.group(2)), -int(m.group(3))) for m in CRASH_LINE.finditer(log_text)]
+    return [(m.group(1) or m.group(4) or "?", int(m.group(2)), -int(m.group(3)))
+            for m in CRASH_LINE.finditer(log_text)]
 
 
 # The demonstrator's line as it starts a dataset (demonstrator_node.cpp): where the launch's
@@ -112,17 +117,21 @@ def record(jobs, args, log_dir, attempt, crashes):
     cmd = ["roslaunch", "lfd_launch", "demonstrate.launch", "mode:=" + jobs[0]["mode"],
            "seed:=%d" % args.seed, "datasets:=" + json.dumps(jobs)]
     timeout = args.timeout * len(jobs)
-    logs = {n: open(os.path.join(log_dir, n + ".log"), "w" if attempt == 1 else "a") for n in names}
+    # Line-buffered: a log shows how far its dataset is (tail -f) while the launch runs.
+    logs = {n: open(os.path.join(log_dir, n + ".log"), "w" if attempt == 1 else "a", buffering=1)
+            for n in names}
     for log in logs.values():
         log.write("# attempt %d, one launch for %s\n" % (attempt, ", ".join(names)))
-        log.flush()
     launch_start = time.time()
     current, started = names[0], {names[0]: launch_start}
 
     def finished(name):
         print("[datasets] %s: %.1f s wall" % (name, time.time() - started[name]), flush=True)
 
-    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+    # Line-buffered node output: a pipe is block-buffered, and a dataset's lines (its start line
+    # included) arrived when the buffer filled, in the next dataset's log and wall time.
+    env = dict(os.environ, ROSCONSOLE_STDOUT_LINE_BUFFERED="1", PYTHONUNBUFFERED="1")
+    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, env=env,
                             universal_newlines=True, errors="replace")
     timed_out = threading.Event()
 
