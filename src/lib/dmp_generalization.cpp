@@ -206,16 +206,19 @@ GeneralizationResult generalizeSegment(const std::vector<SegmentDmp>& demos,
                             weightedQuaternionMean(goals, kw), v);
   }
   if (ref.gripper) {
+    // The gripper, whole (levels, forcing weights, start velocity), is a convex average: its shape
+    // does not follow the goal linearly (the reason for the local linear fit), and the DMP being
+    // linear in all four, the mix is then a convex mix of the demos' gripper motions, which cannot
+    // open where no demo opens. An affine mix turned one demo's closing into an opening.
     Eigen::MatrixXd w = Eigen::MatrixXd::Zero(ref.gripper->weights().rows(), 1);
     Eigen::VectorXd s = Eigen::VectorXd::Zero(1), g = s, v = s;
     for (size_t j = 0; j < nd; ++j) {
       const PositionDmp& p = *demos[j].gripper;
-      const double cj = c[static_cast<Eigen::Index>(j)];
       const double kj = kw[static_cast<Eigen::Index>(j)];
-      w += cj * p.weights();
-      s += kj * p.start();  // gripper levels: a convex average stays within the demos' range
+      w += kj * p.weights();
+      s += kj * p.start();
       g += kj * p.goal();
-      v += cj * p.startVelocity() * (demos[j].tau / out.tau);
+      v += kj * p.startVelocity() * (demos[j].tau / out.tau);
     }
     out.gripper.emplace(ref.params, out.tau, w, s, g, v);
   }

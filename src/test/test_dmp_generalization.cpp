@@ -135,6 +135,43 @@ TEST(DmpGeneralization, QueryOnADemoReproducesThatDemo) {
             1e-3 * set.dmps[1].position->weights().norm());
 }
 
+// A segment that starts as the gripper closes on an object: in one demo the segment began with the
+// fingers still open (they close within 0.2 s), in the others they were already closed. No demo
+// opens the gripper, so no mix may: the gripper's shape has nothing to do with where the segment
+// goes and is mixed as a convex average (the kernel weights). An affine (local linear) mix gave
+// that demo a negative coefficient at goals away from it and turned its closing into an opening
+// past the open/close threshold (teleop grasp: the stick dropped in 2 of 10 reproductions).
+TEST(DmpGeneralization, NoMixOpensAGripperThatNoDemoOpens) {
+  const Eigen::Vector3d start(0.3, 0.0, 0.9);
+  DemoSet set;
+  const Eigen::Vector3d goals[] = {
+      {0.5, -0.2, 0.8}, {0.9, -0.2, 0.8}, {0.5, 0.2, 0.8}, {0.9, 0.2, 0.8}, {0.8, -0.05, 0.8}};
+  for (int j = 0; j < 5; ++j) {
+    lfd::SegmentDemo demo;
+    demo.times = Eigen::VectorXd::LinSpaced(400, 0.0, kDuration);
+    demo.positions = reach(demo.times, start, goals[j]);
+    demo.gripper.resize(demo.times.size());
+    for (Eigen::Index i = 0; i < demo.times.size(); ++i)  // 0.2 s: four time constants
+      demo.gripper[i] = 0.028 + (j == 1 ? 0.052 * std::exp(-demo.times[i] / 0.05) : 0.0);
+    set.dmps.push_back(lfd::SegmentDmp::learn(demo));
+    set.params.push_back(lfd::goalParameters(set.dmps.back()));
+  }
+  // Goals where the local linear fit weighs the closing demo negatively (-0.09, -0.05, -0.03).
+  for (const Eigen::Vector3d& query :
+       {Eigen::Vector3d(0.55, 0.15, 0.8), Eigen::Vector3d(0.7, 0.2, 0.8),
+        Eigen::Vector3d(0.5, 0.0, 0.8)}) {
+    const lfd::SegmentTrajectory traj =
+        lfd::generalizeSegment(set.dmps, set.params, query).dmp.rollout();
+    double rise = 0.0;  // the most the gripper opens past its lowest opening so far
+    double lowest = traj.gripper[0];
+    for (Eigen::Index i = 0; i < traj.gripper.size(); ++i) {
+      lowest = std::min(lowest, traj.gripper[i]);
+      rise = std::max(rise, traj.gripper[i] - lowest);
+    }
+    EXPECT_LT(rise, 5e-4) << query.transpose();
+  }
+}
+
 TEST(DmpGeneralization, FlagsGoalsOutsideTheDemonstratedRange) {
   const Eigen::Vector3d start(0.3, 0.0, 0.9);
   const DemoSet set = bracketingDemos(start);

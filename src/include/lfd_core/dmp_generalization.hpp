@@ -1,8 +1,8 @@
 // Generalization of one segment to a new goal from the DMPs learned on several demonstrations
 // (paper: "we interpolate the new goal with all the precedently learned goals to find a new DMP").
 //
-// Method: locally weighted linear regression (LWR) of every learned quantity (forcing weights of
-// position, orientation and gripper, start velocities) over the task parameters of the demos
+// Method: locally weighted linear regression (LWR) of every learned quantity of the motion (forcing
+// weights of position and orientation, start velocities) over the task parameters of the demos
 // (default: the goal position), evaluated at the query. Gaussian kernel over the parameter
 // distance, bandwidth = median pairwise distance of the demos' parameters (from the data).
 // Why LWR and not a plain kernel average (Nadaraya-Watson): in the Hoffmann formulation the weights
@@ -11,8 +11,9 @@
 // linear trends exactly and still adapts locally when the relation is non-linear. The result is an
 // affine combination of the demos (coefficients sum to 1), so it is cheap and easy to inspect. A
 // small ridge on the local slope keeps it defined with fewer demos than parameter dimensions
-// (2 demos in 3-D: interpolation along the line between them). Duration and the default goal
-// orientation / gripper use the (non-negative) kernel weights.
+// (2 demos in 3-D: interpolation along the line between them). Duration, the default goal
+// orientation and the whole gripper DMP use the (non-negative) kernel weights: the gripper's shape
+// does not follow the goal, and a convex mix cannot open the gripper where no demo does.
 #pragma once
 
 #include "lfd_core/segment_dmp.hpp"
