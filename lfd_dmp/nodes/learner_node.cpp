@@ -16,6 +16,7 @@
 #include <tf2_ros/transform_listener.h>
 
 #include <lfd_core/safe_paths.hpp>
+#include <lfd_core/time_alignment.hpp>
 
 #include <chrono>
 
@@ -175,11 +176,10 @@ class Learner {
     lfd::TimeAlignmentOptions a;
     pnh.param("time_alignment/sample_seconds", a.sample_seconds, a.sample_seconds);
     pnh.param("time_alignment/warp_sigma", a.warp_sigma, a.warp_sigma);
-    if (!(a.sample_seconds > 0.0) || !(a.warp_sigma >= 0.0)) {
-      ROS_WARN(
-          "learner: ~time_alignment sample_seconds %.3f (> 0), warp_sigma %.3f (>= 0): "
-          "alignment off",
-          a.sample_seconds, a.warp_sigma);
+    try {
+      lfd::checkTimeAlignmentOptions(a, "~time_alignment/");
+    } catch (const std::invalid_argument& e) {
+      ROS_WARN("learner: %s: alignment off", e.what());
       return;
     }
     time_alignment_ = a;

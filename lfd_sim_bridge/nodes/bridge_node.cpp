@@ -15,9 +15,8 @@
 //   initial_posture, kp, kd, damping_ratio, velocity_limits, default_velocity_limit,
 //   effort_limits, default_effort_limit, gravity_compensation, gripper_opening_scale,
 //   objects, max_abs_velocity, touch_time_constant (see WorkcellConfig)
-//   noise_profiles        {name: {seed, joint_position, ...}}: readings noise
-//   (lfd_sim::SensorNoise) noise_profile         the profile at startup; a /bridge/reset request
-//   may select another
+//   noise_profiles        {name: {seed, joint_position, ...}}: readings noise (SensorNoise)
+//   noise_profile         the profile at startup; a /bridge/reset request may select another
 #include <geometry_msgs/PoseStamped.h>
 #include <geometry_msgs/TransformStamped.h>
 #include <geometry_msgs/TwistStamped.h>

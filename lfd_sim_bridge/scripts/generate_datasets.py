@@ -23,7 +23,6 @@ import json
 import os
 import re
 import shutil
-import signal
 import subprocess
 import sys
 import threading
@@ -33,7 +32,9 @@ import yaml
 
 from lfd_tools import bags as lfd_bags
 from lfd_tools import tasks
-from lfd_tools.master import master_for_this_process
+from lfd_tools.master import master_for_this_process, stop_group
+
+STOP_TIMEOUT_S = 30.0  # for a launch to stop its nodes on SIGINT before it is killed
 
 
 def configurations(task, mode, demos=0):
@@ -110,9 +111,8 @@ def missing_demos(name, out_root, args, attempt):
 
 
 def record(jobs, args, log_dir, attempt, crashes):
-    """One demonstrate.launch for every job. Its output goes to logs/<dataset>.log of the dataset
-    being recorded (the lines before the first one's start to the first), so each log, its wall
-    time and its crashes are the dataset's."""
+    """One demonstrate.launch for every job; its output goes to the log of the dataset being
+    recorded (split_output), so each log, its wall time and its crashes are the dataset's."""
     names = ["%s_%s" % (j["mode"], j["task"]) for j in jobs]
     cmd = ["roslaunch", "lfd_launch", "demonstrate.launch", "mode:=" + jobs[0]["mode"],
            "seed:=%d" % args.seed, "datasets:=" + json.dumps(jobs)]
@@ -123,61 +123,54 @@ def record(jobs, args, log_dir, attempt, crashes):
     for log in logs.values():
         log.write("# attempt %d, one launch for %s\n" % (attempt, ", ".join(names)))
     launch_start = time.time()
-    current, started = names[0], {names[0]: launch_start}
-
-    def finished(name):
-        print("[datasets] %s: %.1f s wall" % (name, time.time() - started[name]), flush=True)
-
     # Line-buffered node output: a pipe is block-buffered, and a dataset's lines (its start line
     # included) arrived when the buffer filled, in the next dataset's log and wall time.
     env = dict(os.environ, ROSCONSOLE_STDOUT_LINE_BUFFERED="1", PYTHONUNBUFFERED="1")
     proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, env=env,
-                            universal_newlines=True, errors="replace")
+                            start_new_session=True, universal_newlines=True, errors="replace")
     timed_out = threading.Event()
 
-    def expire():
-        # SIGINT first: roslaunch stops its nodes, which would otherwise hold the pipe open.
+    def expire():  # SIGINT first: roslaunch stops its nodes, which would otherwise hold the pipe
         timed_out.set()
-        proc.send_signal(signal.SIGINT)
-        try:
-            proc.wait(timeout=30.0)
-        except subprocess.TimeoutExpired:
-            proc.kill()
+        stop_group(proc, STOP_TIMEOUT_S)
 
     timer = threading.Timer(timeout, expire)
     timer.daemon = True
     timer.start()
     try:
-        for line in proc.stdout:
-            m = DATASET_LINE.search(line)
-            if m and m.group(1) in logs and m.group(1) != current:
-                finished(current)
-                current = m.group(1)
-                started[current] = time.time()
-            logs[current].write(line)
-            for process, pid, signum in crashes_in(line):
-                # A crash is a bug even when the retry records the missing demos: never hide it.
-                print("[datasets] %s: CRASH: %s (pid %d) was killed by signal %d (see %s)"
-                      % (current, process, pid, signum, logs[current].name), file=sys.stderr, flush=True)
-                crashes.append((current, process, signum))
+        split_output(proc.stdout, logs, names[0], crashes)
         proc.wait()
-    except KeyboardInterrupt:  # Ctrl-C reached roslaunch too (same process group): let it stop
-        try:
-            proc.wait(timeout=30.0)
-        except subprocess.TimeoutExpired:
-            proc.kill()
+    except KeyboardInterrupt:  # the launch has a session of its own: stop it cleanly first
+        stop_group(proc, STOP_TIMEOUT_S)
         raise
     finally:
         timer.cancel()
         for log in logs.values():
             log.close()
     if timed_out.is_set():
-        print("[datasets] %s: timed out after %.0f s (%.0f s per dataset; see %s)"
-              % ("+".join(names), timeout, args.timeout, logs[current].name), file=sys.stderr)
-    finished(current)
+        print("[datasets] %s: timed out after %.0f s (%.0f s per dataset; logs in %s)"
+              % ("+".join(names), timeout, args.timeout, log_dir), file=sys.stderr)
     if len(names) > 1:
         print("[datasets] one launch for %s: %.1f s wall" % ("+".join(names), time.time() - launch_start),
               flush=True)
+
+
+def split_output(lines, logs, first, crashes):
+    """Writes the launch's `lines` to logs[<dataset being recorded>] (the lines before the first
+    start line to `first`), prints each dataset's wall time and reports every crash under it."""
+    current, started = first, time.time()
+    for line in lines:
+        m = DATASET_LINE.search(line)
+        if m and m.group(1) in logs and m.group(1) != current:
+            print("[datasets] %s: %.1f s wall" % (current, time.time() - started), flush=True)
+            current, started = m.group(1), time.time()
+        logs[current].write(line)
+        for process, pid, signum in crashes_in(line):
+            # A crash is a bug even when the retry records the missing demos: never hide it.
+            print("[datasets] %s: CRASH: %s (pid %d) was killed by signal %d (see %s)"
+                  % (current, process, pid, signum, logs[current].name), file=sys.stderr, flush=True)
+            crashes.append((current, process, signum))
+    print("[datasets] %s: %.1f s wall" % (current, time.time() - started), flush=True)
 
 
 def summarize(out_root, names, args):

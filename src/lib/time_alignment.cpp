@@ -179,10 +179,7 @@ SegmentDemo resampled(const SegmentDemo& d, const Eigen::VectorXd& source) {
 }
 
 void checkInput(const std::vector<SegmentDemo>& demos, const TimeAlignmentOptions& o) {
-  if (!(o.sample_seconds > 0.0) || !std::isfinite(o.sample_seconds))
-    throw std::invalid_argument("alignDemoTiming: sample_seconds must be finite and > 0");
-  if (!(o.warp_sigma >= 0.0) || !std::isfinite(o.warp_sigma))
-    throw std::invalid_argument("alignDemoTiming: warp_sigma must be finite and >= 0");
+  checkTimeAlignmentOptions(o, "alignDemoTiming: ");
   for (std::size_t j = 0; j < demos.size(); ++j) {
     const SegmentDemo& d = demos[j];
     const std::string which = "alignDemoTiming: demo " + std::to_string(j);
@@ -241,6 +238,13 @@ double dtwRows(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b,
     std::reverse(path->begin(), path->end());
   }
   return at(n, m);
+}
+
+void checkTimeAlignmentOptions(const TimeAlignmentOptions& o, const std::string& where) {
+  if (!(o.sample_seconds > 0.0) || !std::isfinite(o.sample_seconds))
+    throw std::invalid_argument(where + "sample_seconds must be finite and > 0 (s)");
+  if (!(o.warp_sigma >= 0.0) || !std::isfinite(o.warp_sigma))
+    throw std::invalid_argument(where + "warp_sigma must be finite and >= 0 (s)");
 }
 
 TimeAlignment alignDemoTiming(const std::vector<SegmentDemo>& demos,

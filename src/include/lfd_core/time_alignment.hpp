@@ -24,6 +24,7 @@
 #include <Eigen/Core>
 
 #include <cstddef>
+#include <string>
 #include <vector>
 
 namespace lfd {
@@ -48,6 +49,10 @@ struct TimeAlignment {
 /// from (0, 0) to (n - 1, m - 1) when not null.
 double dtwRows(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b,
                std::vector<std::pair<int, int>>* path = nullptr);
+
+/// Throws std::invalid_argument, its message starting with `where`, unless sample_seconds is finite
+/// and > 0 and warp_sigma finite and >= 0: the one rule for options from a config or a library.
+void checkTimeAlignmentOptions(const TimeAlignmentOptions& options, const std::string& where = "");
 
 /// Re-times the demos of one segment onto one common timing (above). The demos need positions
 /// (the compared path; a gripper in all of them or in none); time stamps strictly increasing. One
