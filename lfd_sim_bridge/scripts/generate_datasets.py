@@ -8,9 +8,12 @@ Each dataset <DIR>/<mode>_<task> gets one bag per configuration of the task's fi
 (config/tasks/<task>.yaml, or --tasks-dir). One `roslaunch lfd_launch demonstrate.launch` (bridge as
 fast as possible + recorder + demonstrator) records every dataset in turn, and a second one the
 demos that failed; logs/<dataset>.log holds the launch's output while that dataset was recorded.
-The datasets default to every task in both modes. A dataset that already holds every bag is skipped, and the demonstrator skips bags that
-exist, so a rerun resumes where an interrupted one stopped (*.bag.active leftovers are removed
-first). --demos N records N configurations per dataset, spread over the task's list.
+The datasets default to every task in both modes. A dataset whose every bag is a physically
+successful demonstration is skipped, and the demonstrator skips bags that exist, so a rerun resumes
+where an interrupted one stopped. A bag that is no such demonstration (cut off when a node crashed,
+unreadable, or failed by the task's criterion) is set aside as <bag>.failed and recorded again;
+a crashed recording's *.bag.active is kept and reindexed by the recorder (.crashed, .recovered).
+--demos N records N configurations per dataset, spread over the task's list.
 Uses the ROS master of ROS_MASTER_URI when one is running, else starts a private one.
 Prints a table: dataset, demos, mean duration, physical successes (the task file's criterion,
 judged from each bag by lfd_tools.judge), recorded topics.
@@ -30,8 +33,7 @@ import time
 
 import yaml
 
-from lfd_tools import bags as lfd_bags
-from lfd_tools import tasks
+from lfd_tools import redo, tasks
 from lfd_tools.master import master_for_this_process, stop_group
 
 STOP_TIMEOUT_S = 30.0  # for a launch to stop its nodes on SIGINT before it is killed
@@ -76,26 +78,28 @@ def crashes_in(log_text):
 DATASET_LINE = re.compile(r"demonstrator: dataset (\S+): ")
 
 
-def generate(names, out_root, args, log_dir, crashes):
+def generate(names, out_root, args, log_dir, crashes, outcomes):
     """Records the missing demos of the datasets `names` with one launch (one simulation records
     them in turn); the demos that failed are tried once more in a second launch (a fresh scene),
     as a demonstrator redoes a botched demonstration."""
     for attempt in (1, 2):
-        jobs = [job for job in (missing_demos(n, out_root, args, attempt) for n in names) if job]
+        jobs = [job for job in (missing_demos(n, out_root, args, attempt, outcomes) for n in names) if job]
         if not jobs:
             break
         record(jobs, args, log_dir, attempt, crashes)
 
 
-def missing_demos(name, out_root, args, attempt):
-    """The demonstrator's job for the demos of `name` without a bag, or None when it is complete."""
+def missing_demos(name, out_root, args, attempt, outcomes):
+    """The demonstrator's job for the demos of `name` to record (no bag, or a bag set aside as no
+    usable demonstration), or None when it is complete."""
     mode, task = name.split("_", 1)
     out = os.path.join(out_root, name)
     ids = configurations(task, mode, args.demos)
     os.makedirs(out, exist_ok=True)
-    for stale in glob.glob(os.path.join(out, "*.bag.active")):
-        os.remove(stale)  # an interrupted demo: recorded again below
-    missing = [i for i in ids if not os.path.exists(bag_name(out, task, mode, i))]
+    missing, aside = redo.demos_to_record({i: bag_name(out, task, mode, i) for i in ids}, outcomes)
+    for i, path, reason in aside:
+        print("[datasets] %s: configuration %d is no usable demonstration (%s): kept as %s, recorded again"
+              % (name, i, reason, path), flush=True)
     if not missing:
         if attempt == 1:
             print("[datasets] %s: complete (%d bags), skipped" % (name, len(ids)), flush=True)
@@ -173,13 +177,13 @@ def split_output(lines, logs, first, crashes):
     print("[datasets] %s: %.1f s wall" % (current, time.time() - started), flush=True)
 
 
-def summarize(out_root, names, args):
+def summarize(out_root, names, args, outcomes):
     rows, all_ok, all_topics = [], True, set()
     for name in names:
         mode, task = name.split("_", 1)
         ids = configurations(task, mode, args.demos)
         bags = [bag_name(os.path.join(out_root, name), task, mode, i) for i in ids]
-        results = [lfd_bags.demo_outcome(b) for b in bags if os.path.exists(b)]
+        results = [outcomes(b) for b in bags if os.path.exists(b)]
         ok = sum(bool(r["success"]) for r in results)
         durations = [r["duration"] for r in results if "duration" in r]
         topics = sorted({t for r in results for t in r.get("topics", {})})
@@ -234,12 +238,12 @@ def main():
         for n in names:
             shutil.rmtree(os.path.join(out_root, n), ignore_errors=True)
     start = time.time()
-    crashes = []
+    crashes, outcomes = [], redo.Outcomes()
     with master_for_this_process():
-        generate(names, out_root, args, log_dir, crashes)
+        generate(names, out_root, args, log_dir, crashes, outcomes)
     total = time.time() - start
     print("[datasets] generation took %.1f s wall in total (logs in %s)" % (total, log_dir))
-    ok = summarize(out_root, names, args)
+    ok = summarize(out_root, names, args, outcomes)
     if crashes:
         print("[datasets] %d node crash(es) during generation: %s" % (len(crashes), ", ".join(
             "%s/%s signal %d" % c for c in crashes)))

@@ -20,7 +20,7 @@ import rostest
 import yaml
 from geometry_msgs.msg import PoseStamped
 from lfd_msgs.msg import DemoMetadata, Phase
-from lfd_tools import bags, config, judge, report, tasks
+from lfd_tools import bags, config, judge, redo, report, tasks
 
 GRASP = {"object": "stick", "distance": "xyz", "tolerance_m": 0.03, "min_lift_m": 0.10, "yaw_symmetry": 2}
 PUSH = {"object": "box", "distance": "xy", "tolerance_m": 0.03, "yaw_symmetry": 4}
@@ -278,24 +278,74 @@ class CriteriaFromTheTaskFiles(unittest.TestCase):
             tasks.success_criterion("wipes")
 
 
-class DemoBagJudged(unittest.TestCase):
-    """A hand-written demo bag: metadata scene, ground-truth phases and the stick's last pose."""
+def write_grasp_bag(path, final_z):
+    """A hand-written grasp demo bag: metadata scene, ground-truth phases and the stick's last pose
+    (final_z: where the stick ends, 0.95 = lifted to its goal)."""
+    goal = {"position": [0.5, -0.3, 0.95], "orientation": [1.0, 0.0, 0.0, 0.0]}
+    extra = {"task": "grasp", "scene": {"frame": "world", "objects": {}, "goal": goal, "joints": {}}}
+    with rosbag.Bag(path, "w") as b:
+        b.write("/lfd/metadata", DemoMetadata(task="grasp", mode="sim", configuration=0, speed=1.0,
+                                              extra_json=json.dumps(extra)), rospy.Time(10.0))
+        for t, name in ((10.0, "approach"), (12.0, "grasp"), (13.0, "move"), (13.5, "move"), (18.0, "done")):
+            b.write("/lfd/phase", Phase(task="grasp", name=name), rospy.Time(t))
+        for t, z in ((10.5, TABLE + 0.015), (18.5, final_z)):
+            p = PoseStamped()
+            p.pose.position.x, p.pose.position.y, p.pose.position.z = 0.5, -0.3, z
+            p.pose.orientation.w = 1.0
+            b.write("/objects/stick/pose", p, rospy.Time(t))
+    return path
 
+
+class RedoDemos(unittest.TestCase):
+    """generate_datasets' choice of the demos to record (again), lfd_tools.redo: a bag that is no
+    usable demonstration is set aside, never deleted nor overwritten, and recorded again."""
+
+    def setUp(self):
+        self.dir = tempfile.mkdtemp()
+
+    def tearDown(self):
+        shutil.rmtree(self.dir)
+
+    def path(self, name):
+        return os.path.join(self.dir, name)
+
+    def test_cut_off_failed_and_missing_demos_are_recorded_again(self):
+        good = write_grasp_bag(self.path("grasp_sim_00.bag"), 0.95)
+        dropped = write_grasp_bag(self.path("grasp_sim_01.bag"), TABLE + 0.015)
+        with open(self.path("grasp_sim_01.bag.failed"), "w") as f:
+            f.write("an earlier failure")
+        with open(self.path("grasp_sim_03.bag"), "wb") as f:  # cut off: half a bag header
+            f.write(b"#ROSBAG V2.0\n\x00\x01")
+        bag_of = {i: self.path("grasp_sim_%02d.bag" % i) for i in range(4)}
+        todo, aside = redo.demos_to_record(bag_of, bags.demo_outcome)
+        self.assertEqual(todo, [1, 2, 3])
+        self.assertEqual([(c, os.path.basename(p)) for c, p, _ in aside],
+                         [(1, "grasp_sim_01.bag.failed.2"), (3, "grasp_sim_03.bag.failed")])
+        self.assertIn("above the table 1.5 cm", aside[0][2])
+        self.assertIn("unreadable", aside[1][2])
+        self.assertTrue(os.path.exists(good))
+        self.assertFalse(os.path.exists(dropped))
+        with open(self.path("grasp_sim_01.bag.failed")) as f:
+            self.assertEqual(f.read(), "an earlier failure")
+        self.assertFalse(bags.demo_outcome(aside[0][1])["success"])  # the same bag, kept
+        self.assertEqual(bags.list_bags(self.dir), [good])
+
+    def test_each_version_of_a_bag_is_judged_once(self):
+        calls = []
+        outcomes = redo.Outcomes(lambda p: calls.append(p) or {"success": True})
+        bag = write_grasp_bag(self.path("grasp_sim_00.bag"), 0.95)
+        self.assertEqual(redo.demos_to_record({0: bag}, outcomes), ([], []))
+        outcomes(bag)
+        self.assertEqual(len(calls), 1)
+        write_grasp_bag(bag, 0.96)
+        os.utime(bag, ns=(1, 1))  # a new version, even within the file system's time resolution
+        outcomes(bag)
+        self.assertEqual(len(calls), 2)
+
+
+class DemoBagJudged(unittest.TestCase):
     def bag(self, final_z):
-        path = os.path.join(tempfile.mkdtemp(), "grasp_sim_00.bag")
-        goal = {"position": [0.5, -0.3, 0.95], "orientation": [1.0, 0.0, 0.0, 0.0]}
-        extra = {"task": "grasp", "scene": {"frame": "world", "objects": {}, "goal": goal, "joints": {}}}
-        with rosbag.Bag(path, "w") as b:
-            b.write("/lfd/metadata", DemoMetadata(task="grasp", mode="sim", configuration=0, speed=1.0,
-                                                  extra_json=json.dumps(extra)), rospy.Time(10.0))
-            for t, name in ((10.0, "approach"), (12.0, "grasp"), (13.0, "move"), (13.5, "move"), (18.0, "done")):
-                b.write("/lfd/phase", Phase(task="grasp", name=name), rospy.Time(t))
-            for t, z in ((10.5, TABLE + 0.015), (18.5, final_z)):
-                p = PoseStamped()
-                p.pose.position.x, p.pose.position.y, p.pose.position.z = 0.5, -0.3, z
-                p.pose.orientation.w = 1.0
-                b.write("/objects/stick/pose", p, rospy.Time(t))
-        return path
+        return write_grasp_bag(os.path.join(tempfile.mkdtemp(), "grasp_sim_00.bag"), final_z)
 
     def test_success_and_failure_from_the_bag(self):
         ok = bags.demo_outcome(self.bag(0.95))
@@ -356,7 +406,7 @@ class Records(unittest.TestCase):
 def all_tests():
     return unittest.TestSuite([unittest.defaultTestLoader.loadTestsFromTestCase(c) for c in (
         SegmentationRule, SegmentationFigures, PhysicalSuccess, Rules, CriteriaFromTheTaskFiles, DemoBagJudged,
-        Records)])
+        RedoDemos, Records)])
 
 
 if __name__ == "__main__":
