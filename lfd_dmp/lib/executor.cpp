@@ -346,6 +346,7 @@ ExecutionPlan TaskPlanner::plan(const SkillLibrary& library,
     // their mix keeps them: a wipe's three strokes stay three full strokes.
     lfd::GeneralizationResult gen = lfd::generalizeSegment(dmps, params, query, gen_options);
     if (heading) gen.dmp = gen.dmp.rotated(yawMatrix(heading->yaw));
+    if (gen_options.local_linear) planned.slope_ridge = gen.slope_ridge;
 
     lfd::SegmentRolloutOptions ro;
     ro.dt = options.dt;

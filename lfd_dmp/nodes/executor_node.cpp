@@ -120,6 +120,9 @@ class Executor {
     auto& gen = options_.generalization;
     gen.bandwidth = param(pnh, "generalization/bandwidth", 0.0);
     gen.local_linear = param(pnh, "generalization/local_linear", gen.local_linear);
+    gen.slope_ridge = param(pnh, "generalization/slope_ridge", gen.slope_ridge);
+    gen.slope_ridge_candidates =
+        param(pnh, "generalization/slope_ridge_candidates", gen.slope_ridge_candidates);
     gen.range_margin = param(pnh, "generalization/range_margin", gen.range_margin);
     options_.min_range_margin =
         param(pnh, "generalization/min_range_margin", options_.min_range_margin);
@@ -327,6 +330,7 @@ class Executor {
     for (const auto& s : plan.segments) {
       result->segment_names.push_back(s.name);
       result->segment_frames.push_back(s.frames);
+      result->segment_slope_ridges.push_back(s.slope_ridge);
       result->segment_durations.push_back(s.duration);
     }
     const ros::Time now = ros::Time::now();

@@ -94,7 +94,9 @@ TEST(SegmentCli, SeveralCsvRunThePipelineWithSensorValidation) {
   ASSERT_EQ(j["relevance"]["features"].size(), 3u);  // gripper, speed, noise
   for (const auto& f : j["relevance"]["features"]) {
     EXPECT_EQ(f["correlation"].size(), 3u);
-    if (f["name"] == "noise") EXPECT_FALSE(f["selected"].get<bool>());
+    if (f["name"] == "noise") {
+      EXPECT_FALSE(f["selected"].get<bool>());
+    }
   }
   ASSERT_EQ(j["demos"].size(), 3u);
   for (int d = 0; d < 3; ++d) {
@@ -334,7 +336,9 @@ TEST(SegmentCli, RandomExtremeCommandLinesGiveAResultOrAClearError) {
     }
     EXPECT_TRUE(status == 0 || status == 1) << args << " exit " << status;
     EXPECT_EQ(j["success"].get<bool>(), status == 0) << args;
-    if (status != 0) EXPECT_FALSE(j["error"].get<std::string>().empty()) << args;
+    if (status != 0) {
+      EXPECT_FALSE(j["error"].get<std::string>().empty()) << args;
+    }
     std::ifstream after_in(csv);
     ASSERT_EQ(std::string((std::istreambuf_iterator<char>(after_in)), {}), before) << args;
   }

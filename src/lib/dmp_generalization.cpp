@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <numeric>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -58,7 +60,102 @@ Eigen::Quaterniond weightedQuaternionMean(const std::vector<Eigen::Quaterniond>&
   return Eigen::Quaterniond(acc[3], acc[0], acc[1], acc[2]);
 }
 
+// Normalized Gaussian kernel weights of the columns of `points` at `query` (shifted in the exponent
+// so that far queries do not underflow to all zeros).
+Eigen::VectorXd kernelWeights(const Eigen::MatrixXd& points, const Eigen::VectorXd& query,
+                              double h) {
+  Eigen::VectorXd sq(points.cols());
+  for (Eigen::Index j = 0; j < points.cols(); ++j)
+    sq[j] = (points.col(j) - query).squaredNorm() / (h * h);
+  const Eigen::VectorXd k = (-0.5 * (sq.array() - sq.minCoeff())).exp().matrix();
+  return k / k.sum();
+}
+
+// Weighted least squares of y ~ b0 + b^T (p - q) / h with a ridge on b; the prediction is
+// b0 = sum_j c_j y_j with c = K X (X^T K X + L)^-1 e1: an affine combination (sums to 1).
+Eigen::VectorXd localLinearCoefficients(const Eigen::MatrixXd& points, const Eigen::VectorXd& query,
+                                        double h, const Eigen::VectorXd& k, double ridge) {
+  const Eigen::Index dim = query.size(), j_count = points.cols();
+  Eigen::MatrixXd x(j_count, dim + 1);
+  x.col(0).setOnes();
+  for (Eigen::Index j = 0; j < j_count; ++j)
+    x.block(j, 1, 1, dim) = ((points.col(j) - query) / h).transpose();
+  Eigen::MatrixXd m = x.transpose() * k.asDiagonal() * x;
+  const double lambda = std::max(ridge, 1e-12) * k.sum();
+  for (Eigen::Index i = 1; i <= dim; ++i) m(i, i) += lambda;
+  const Eigen::VectorXd sol = m.ldlt().solve(Eigen::VectorXd::Unit(dim + 1, 0));
+  Eigen::VectorXd c = k.asDiagonal() * (x * sol);
+  return c / c.sum();  // exact affine combination despite round-off
+}
+
+Eigen::MatrixXd parameterMatrix(const std::vector<Eigen::VectorXd>& params) {
+  Eigen::MatrixXd points(params.front().size(), static_cast<Eigen::Index>(params.size()));
+  for (size_t j = 0; j < params.size(); ++j) points.col(static_cast<Eigen::Index>(j)) = params[j];
+  return points;
+}
+
+// Samples of a leave-one-out rollout: enough for a segment's shape, cheap for a few demos.
+constexpr int kLooSamples = 200;
+
+// Position RMS between demo `held`'s own rollout and the rollout of the forcing weights mixed
+// from the other demos by `c` (indexed like `others`), both over the held demo's start, goal,
+// start velocity and duration.
+double heldOutRms(const PositionDmp& held, const std::vector<const PositionDmp*>& others,
+                  const Eigen::VectorXd& c) {
+  Eigen::MatrixXd w = Eigen::MatrixXd::Zero(held.weights().rows(), held.dims());
+  for (size_t i = 0; i < others.size(); ++i)
+    w += c[static_cast<Eigen::Index>(i)] * others[i]->weights();
+  const PositionDmp mixed(held.parameters(), held.tau(), w, held.start(), held.goal(),
+                          held.startVelocity());
+  const double dt = held.tau() / (kLooSamples - 1);
+  Eigen::MatrixXd own(kLooSamples, held.dims()), predicted(kLooSamples, held.dims());
+  const double* v = held.startVelocity().data();
+  held.rolloutInto(held.start().data(), held.goal().data(), v, held.tau(), dt, kLooSamples,
+                   own.data());
+  mixed.rolloutInto(held.start().data(), held.goal().data(), v, held.tau(), dt, kLooSamples,
+                    predicted.data());
+  return std::sqrt((own - predicted).rowwise().squaredNorm().mean());
+}
+
 }  // namespace
+
+namespace {
+// Each demo held out in turn: its position RMS (see leaveOneOutRms).
+std::vector<double> leaveOneOutErrors(const std::vector<SegmentDmp>& demos,
+                                      const std::vector<Eigen::VectorXd>& params, double bandwidth,
+                                      double slope_ridge) {
+  if (demos.size() < 3 || params.size() != demos.size() || !(bandwidth > 0.0))
+    throw std::invalid_argument(
+        "leaveOneOutRms: needs >= 3 demos, one parameter vector each, and "
+        "a bandwidth > 0");
+  std::vector<double> errors;
+  for (size_t held = 0; held < demos.size(); ++held) {
+    std::vector<Eigen::VectorXd> rest;
+    std::vector<const PositionDmp*> others;
+    for (size_t j = 0; j < demos.size(); ++j) {
+      if (j == held) continue;
+      if (!demos[j].position) throw std::invalid_argument("leaveOneOutRms: a demo has no position");
+      rest.push_back(params[j]);
+      others.push_back(&*demos[j].position);
+    }
+    if (!demos[held].position)
+      throw std::invalid_argument("leaveOneOutRms: a demo has no position");
+    const Eigen::MatrixXd points = parameterMatrix(rest);
+    const Eigen::VectorXd k = kernelWeights(points, params[held], bandwidth);
+    const Eigen::VectorXd c =
+        localLinearCoefficients(points, params[held], bandwidth, k, slope_ridge);
+    errors.push_back(heldOutRms(*demos[held].position, others, c));
+  }
+  return errors;
+}
+}  // namespace
+
+double leaveOneOutRms(const std::vector<SegmentDmp>& demos,
+                      const std::vector<Eigen::VectorXd>& params, double bandwidth,
+                      double slope_ridge) {
+  const std::vector<double> e = leaveOneOutErrors(demos, params, bandwidth, slope_ridge);
+  return std::accumulate(e.begin(), e.end(), 0.0) / static_cast<double>(e.size());
+}
 
 Eigen::VectorXd goalParameters(const SegmentDmp& dmp) {
   if (!dmp.position) throw std::invalid_argument("goalParameters: the segment has no position DMP");
@@ -92,6 +189,36 @@ double convexHullDistance(const Eigen::MatrixXd& points, const Eigen::VectorXd& 
   return (points * l - q).norm();
 }
 
+namespace {
+
+// options.slope_ridge, or by leave-one-out with the one-standard-error rule (Hastie, Tibshirani &
+// Friedman, ESL 7.10): the largest ridge (the smoothest fit, nearest the convex kernel average)
+// whose mean error is within one standard error of the best mean. With the 5-10 demos of a task
+// the errors are noisy, and the plain minimum followed the noise. Writes each mean to *loo.
+double chooseSlopeRidge(const std::vector<SegmentDmp>& demos,
+                        const std::vector<Eigen::VectorXd>& params, double h,
+                        const GeneralizationOptions& options, std::vector<double>* loo) {
+  if (options.slope_ridge_candidates.size() < 2 || demos.size() < 3 || !demos.front().position)
+    return options.slope_ridge;
+  double best_mean = std::numeric_limits<double>::infinity(), best_se = 0.0;
+  for (double ridge : options.slope_ridge_candidates) {
+    const std::vector<double> e = leaveOneOutErrors(demos, params, h, ridge);
+    const double n = static_cast<double>(e.size());
+    const double mean = std::accumulate(e.begin(), e.end(), 0.0) / n;
+    double var = 0.0;
+    for (double x : e) var += (x - mean) * (x - mean);
+    loo->push_back(mean);
+    if (mean < best_mean) best_mean = mean, best_se = std::sqrt(var / (n - 1.0) / n);
+  }
+  double chosen = -1.0;
+  for (size_t i = 0; i < loo->size(); ++i)
+    if ((*loo)[i] <= best_mean + best_se)
+      chosen = std::max(chosen, options.slope_ridge_candidates[i]);
+  return chosen;
+}
+
+}  // namespace
+
 GeneralizationResult generalizeSegment(const std::vector<SegmentDmp>& demos,
                                        const std::vector<Eigen::VectorXd>& params,
                                        const Eigen::VectorXd& query,
@@ -105,9 +232,12 @@ GeneralizationResult generalizeSegment(const std::vector<SegmentDmp>& demos,
   const Eigen::Index dim = query.size();
   if (dim == 0) throw std::invalid_argument("generalizeSegment: empty query");
   requireFinite(query, "generalizeSegment query");
-  if (!(options.bandwidth >= 0.0) || !(options.slope_ridge >= 0.0) ||
-      !(options.range_margin >= 0.0)) {
-    throw std::invalid_argument("generalizeSegment: bandwidth, slope_ridge, range_margin >= 0");
+  bool ridges_ok = options.slope_ridge >= 0.0;
+  for (double r : options.slope_ridge_candidates)
+    ridges_ok = ridges_ok && r >= 0.0 && std::isfinite(r);
+  if (!(options.bandwidth >= 0.0) || !ridges_ok || !(options.range_margin >= 0.0)) {
+    throw std::invalid_argument(
+        "generalizeSegment: bandwidth, slope_ridge (and its candidates), range_margin >= 0");
   }
   const size_t nd = demos.size();
   Eigen::MatrixXd points(dim, static_cast<Eigen::Index>(nd));
@@ -140,31 +270,11 @@ GeneralizationResult generalizeSegment(const std::vector<SegmentDmp>& demos,
   }
   result.bandwidth = h;
 
-  // Kernel weights (shifted in the exponent so far queries do not underflow to all zeros).
-  const Eigen::Index j_count = static_cast<Eigen::Index>(nd);
-  Eigen::VectorXd sq(j_count);
-  for (Eigen::Index j = 0; j < j_count; ++j)
-    sq[j] = (points.col(j) - query).squaredNorm() / (h * h);
-  const double min_sq = sq.minCoeff();
-  Eigen::VectorXd k = (-0.5 * (sq.array() - min_sq)).exp().matrix();
-  result.kernel_weights = k / k.sum();
-
+  result.kernel_weights = kernelWeights(points, query, h);
   if (options.local_linear && nd > 1) {
-    // Weighted least squares of y ~ b0 + b^T (p - q) / h with a ridge on b; the prediction is
-    // b0 = sum_j c_j y_j with c = K X (X^T K X + L)^-1 e1.
-    Eigen::MatrixXd x(j_count, dim + 1);
-    x.col(0).setOnes();
-    for (Eigen::Index j = 0; j < j_count; ++j) {
-      x.block(j, 1, 1, dim) = ((points.col(j) - query) / h).transpose();
-    }
-    Eigen::MatrixXd m = x.transpose() * k.asDiagonal() * x;
-    const double lambda = std::max(options.slope_ridge, 1e-12) * k.sum();
-    for (Eigen::Index i = 1; i <= dim; ++i) m(i, i) += lambda;
-    const Eigen::VectorXd e1 = Eigen::VectorXd::Unit(dim + 1, 0);
-    const Eigen::VectorXd sol = m.ldlt().solve(e1);
-    result.coefficients = k.asDiagonal() * (x * sol);
-    // Exact affine combination despite round-off.
-    result.coefficients /= result.coefficients.sum();
+    result.slope_ridge = chooseSlopeRidge(demos, params, h, options, &result.loo_rms);
+    result.coefficients =
+        localLinearCoefficients(points, query, h, result.kernel_weights, result.slope_ridge);
   } else {
     result.coefficients = result.kernel_weights;
   }

@@ -3,7 +3,10 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <numeric>
+#include <random>
 
 namespace {
 
@@ -141,6 +144,116 @@ TEST(DmpGeneralization, QueryOnADemoReproducesThatDemo) {
 // goes and is mixed as a convex average (the kernel weights). An affine (local linear) mix gave
 // that demo a negative coefficient at goals away from it and turned its closing into an opening
 // past the open/close threshold (teleop grasp: the stick dropped in 2 of 10 reproductions).
+const std::vector<double> kRidges = {1e-3, 1e-2, 0.1, 1.0, 10.0, 100.0};
+
+TEST(DmpGeneralization, LeaveOneOutKeepsTheLinearTrendOfCleanDemos) {
+  const Eigen::Vector3d start(0.3, 0.0, 0.9);
+  const DemoSet set = bracketingDemos(start);
+  lfd::GeneralizationOptions cv;
+  cv.slope_ridge_candidates = kRidges;
+  const Eigen::Vector3d new_goal(0.65, 0.1, 0.8);
+  const auto res = lfd::generalizeSegment(set.dmps, set.params, new_goal, cv);
+  ASSERT_EQ(res.loo_rms.size(), kRidges.size());
+  // The lift follows the goal: the held-out demos are predicted best by the local linear fit.
+  EXPECT_LE(res.slope_ridge, 0.1);
+  EXPECT_LT(res.loo_rms.front(), 0.5 * res.loo_rms.back());
+  lfd::SegmentRolloutOptions o;
+  o.dt = kDuration / 399.0;
+  o.start_position = start;
+  o.goal_position = new_goal;
+  o.start_velocity = Eigen::Vector3d::Zero();
+  const auto traj = res.dmp.rollout(o);
+  EXPECT_LT(rmse(traj.positions, reach(traj.times, start, new_goal)), 0.008);
+}
+
+// A stroke pressed into the table, the same 12 cm along x wherever it is made, to a depth that
+// varies from demo to demo, not with where, and with an operator's slow wobble (a few mm on each
+// axis, random phases): a teleoperated wipe's stroke.
+const Eigen::Vector3d kStroke(0.12, 0.0, 0.0);
+
+Eigen::MatrixXd press(const Eigen::VectorXd& t, const Eigen::Vector3d& start, double depth,
+                      std::mt19937& rng) {
+  std::uniform_real_distribution<double> amplitude(-0.003, 0.003), phase(0.0, 2.0 * M_PI);
+  Eigen::Matrix<double, 3, 2> a, p;
+  for (int k = 0; k < 6; ++k) a(k % 3, k / 3) = amplitude(rng), p(k % 3, k / 3) = phase(rng);
+  Eigen::MatrixXd y(t.size(), 3);
+  for (Eigen::Index i = 0; i < t.size(); ++i) {
+    const double s = t[i] / kDuration;
+    const double mj = 10 * std::pow(s, 3) - 15 * std::pow(s, 4) + 6 * std::pow(s, 5);
+    y.row(i) = (start + kStroke * mj).transpose();
+    y(i, 2) -= depth * std::pow(std::sin(M_PI * mj), 2);
+    for (int d = 0; d < 3; ++d)  // zero at both ends: the wobble leaves start and goal alone
+      for (int f = 0; f < 2; ++f)
+        y(i, d) += a(d, f) * std::sin(M_PI * s) * std::sin((f + 2) * M_PI * s + p(d, f));
+  }
+  return y;
+}
+
+double pressedDepth(const lfd::SegmentDmp& dmp, const Eigen::Vector3d& start) {
+  lfd::SegmentRolloutOptions o;
+  o.dt = 0.005;
+  o.start_position = start;
+  o.goal_position = Eigen::Vector3d(start + kStroke);
+  o.start_velocity = Eigen::Vector3d::Zero();
+  return start.z() - dmp.rollout(o).positions.col(2).minCoeff();
+}
+
+TEST(DmpGeneralization, LeaveOneOutDoesNotFitTheNoiseOfTheDemos) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> depth(0.038, 0.048), side(-0.06, 0.06);
+  lfd::GeneralizationOptions fixed, cv;
+  cv.slope_ridge_candidates = kRidges;
+  int fixed_outside = 0;
+  double fixed_error = 0.0, cv_error = 0.0;
+  for (int trial = 0; trial < 10; ++trial) {
+    DemoSet set;
+    std::vector<double> depths;
+    for (int j = 0; j < 6; ++j) {
+      const Eigen::Vector3d start(0.45 + side(rng), -0.3 + side(rng), 0.8);
+      depths.push_back(depth(rng));
+      lfd::SegmentDemo demo;
+      demo.times = Eigen::VectorXd::LinSpaced(400, 0.0, kDuration);
+      demo.positions = press(demo.times, start, depths.back(), rng);
+      set.dmps.push_back(lfd::SegmentDmp::learn(demo));
+      set.params.push_back(start + kStroke);
+    }
+    const auto [lo, hi] = std::minmax_element(depths.begin(), depths.end());
+    const double mean = std::accumulate(depths.begin(), depths.end(), 0.0) / depths.size();
+    for (const Eigen::Vector3d& start :
+         {Eigen::Vector3d(0.46, -0.27, 0.8), Eigen::Vector3d(0.43, -0.33, 0.8)}) {
+      const Eigen::Vector3d goal = start + kStroke;
+      const auto with_cv = lfd::generalizeSegment(set.dmps, set.params, goal, cv);
+      const double d_fixed =
+          pressedDepth(lfd::generalizeSegment(set.dmps, set.params, goal, fixed).dmp, start);
+      const double d_cv = pressedDepth(with_cv.dmp, start);
+      EXPECT_GE(with_cv.slope_ridge, 1.0) << "trial " << trial;
+      EXPECT_GE(d_cv, *lo - 1e-4) << "trial " << trial;
+      EXPECT_LE(d_cv, *hi + 1e-4) << "trial " << trial;
+      fixed_outside += d_fixed < *lo - 1e-4 || d_fixed > *hi + 1e-4;
+      fixed_error += std::abs(d_fixed - mean);
+      cv_error += std::abs(d_cv - mean);
+    }
+  }
+  // The nearly unregularized fit follows the noise of six demos, past their range at times.
+  EXPECT_GT(fixed_outside, 0);
+  EXPECT_LT(cv_error, 0.5 * fixed_error);
+}
+
+TEST(DmpGeneralization, LeaveOneOutNeedsThreeDemos) {
+  const DemoSet set = bracketingDemos(Eigen::Vector3d(0.3, 0.0, 0.9));
+  const std::vector<lfd::SegmentDmp> two(set.dmps.begin(), set.dmps.begin() + 2);
+  const std::vector<Eigen::VectorXd> params(set.params.begin(), set.params.begin() + 2);
+  lfd::GeneralizationOptions cv;
+  cv.slope_ridge_candidates = kRidges;
+  const auto res = lfd::generalizeSegment(two, params, Eigen::Vector3d(0.7, -0.2, 0.8), cv);
+  EXPECT_TRUE(res.loo_rms.empty());
+  EXPECT_EQ(res.slope_ridge, cv.slope_ridge);
+  EXPECT_THROW(lfd::leaveOneOutRms(two, params, 0.1, 1.0), std::invalid_argument);
+  cv.slope_ridge_candidates = {1.0, -1.0};
+  EXPECT_THROW(lfd::generalizeSegment(set.dmps, set.params, set.params[0], cv),
+               std::invalid_argument);
+}
+
 TEST(DmpGeneralization, NoMixOpensAGripperThatNoDemoOpens) {
   const Eigen::Vector3d start(0.3, 0.0, 0.9);
   DemoSet set;

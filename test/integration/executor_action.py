@@ -18,7 +18,7 @@ from actionlib_msgs.msg import GoalStatus
 from lfd_msgs.msg import DemoSegmentation, ExecuteTaskFeedback
 from lfd_msgs.srv import LearnSkills
 from lfd_tools import bags
-from lfd_tools import judge, lockstep, tasks
+from lfd_tools import config, judge, lockstep, tasks
 
 TASK = "grasp"
 FUZZ_GOALS = 150      # seeded random goals of test_7 (~10 s on the 2-core machine)
@@ -113,6 +113,11 @@ class ExecutorAction(unittest.TestCase):
         # which these 4 demos tell apart by millimetres), the move at the goal.
         self.assertIn(result.segment_frames[0].split(" / ")[0], ("object:stick", "heading:stick"))
         self.assertTrue(result.segment_frames[1].startswith("goal"), result.segment_frames)
+        # Each segment's local linear fit, its ridge chosen by leave-one-out among executor.yaml's.
+        candidates = config.load_yaml(config.config_path("executor.yaml"))["generalization"]["slope_ridge_candidates"]
+        self.assertEqual(len(result.segment_slope_ridges), 2)
+        for ridge in result.segment_slope_ridges:
+            self.assertIn(ridge, candidates)
         self.assertGreater(result.motion_start.to_sec(), 0.0)
         self.assertAlmostEqual(sum(result.segment_durations), result.planned_duration, places=6)
         self.assertGreater(result.execution_time, result.planned_duration)  # it reached the end

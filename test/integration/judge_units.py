@@ -373,6 +373,7 @@ class Response(object):
         self.final_position_error, self.final_orientation_error = 0.004, 0.02
         self.segment_durations = [4.0, 6.0]
         self.segment_frames = ["object:stick / object:stick", "goal / goal"]
+        self.segment_slope_ridges = [0.001, -1.0]
         self.extrapolation_distance, self.extrapolation_angle, self.outside_demo_range = 0.0, 0.0, False
 
 

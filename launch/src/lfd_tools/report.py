@@ -63,6 +63,7 @@ def goal_record(goal_id, response=None, outcome=None, error="", demo_duration=No
          "planning_time_s": response.planning_time if executed else None,
          "segment_durations_s": list(response.segment_durations) if executed else [],
          "segment_frames": list(response.segment_frames) if response is not None else [],
+         "segment_slope_ridges": list(response.segment_slope_ridges) if response is not None else [],
          "extrapolation_distance_m": response.extrapolation_distance if response is not None else None,
          "extrapolation_angle_rad": response.extrapolation_angle if response is not None else None,
          "outside_demo_range": bool(response.outside_demo_range) if response is not None else None,
