@@ -66,6 +66,17 @@ double rmse(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
   return std::sqrt((a - b).rowwise().squaredNorm().mean());
 }
 
+// A rollout from `start` at rest to `goal`, sampled every dt.
+lfd::SegmentTrajectory rolloutBetween(const lfd::SegmentDmp& dmp, const Eigen::Vector3d& start,
+                                      const Eigen::Vector3d& goal, double dt) {
+  lfd::SegmentRolloutOptions o;
+  o.dt = dt;
+  o.start_position = start;
+  o.goal_position = goal;
+  o.start_velocity = Eigen::Vector3d::Zero();
+  return dmp.rollout(o);
+}
+
 TEST(DmpGeneralization, NewBracketedGoalIsReachedWithTheDemosShape) {
   const Eigen::Vector3d start(0.3, 0.0, 0.9);
   const DemoSet set = bracketingDemos(start);
@@ -76,12 +87,7 @@ TEST(DmpGeneralization, NewBracketedGoalIsReachedWithTheDemosShape) {
   EXPECT_NEAR(res.kernel_weights.sum(), 1.0, 1e-12);
   EXPECT_GT(res.bandwidth, 0.0);
 
-  lfd::SegmentRolloutOptions o;
-  o.dt = kDuration / 399.0;
-  o.start_position = start;
-  o.goal_position = new_goal;
-  o.start_velocity = Eigen::Vector3d::Zero();
-  const auto traj = res.dmp.rollout(o);
+  const auto traj = rolloutBetween(res.dmp, start, new_goal, kDuration / 399.0);
   const Eigen::Vector3d end = traj.positions.bottomRows(1).transpose();
   EXPECT_LT((end - new_goal).norm(), 1e-3);
 
@@ -98,7 +104,7 @@ TEST(DmpGeneralization, NewBracketedGoalIsReachedWithTheDemosShape) {
   for (size_t j = 1; j < set.params.size(); ++j) {
     if ((set.params[j] - new_goal).norm() < (set.params[nearest] - new_goal).norm()) nearest = j;
   }
-  const auto naive = set.dmps[nearest].rollout(o);
+  const auto naive = rolloutBetween(set.dmps[nearest], start, new_goal, kDuration / 399.0);
   EXPECT_LT(err, 0.5 * rmse(naive.positions, truth));
 
   // Gripper and orientation come along on the same phase.
@@ -157,12 +163,7 @@ TEST(DmpGeneralization, LeaveOneOutKeepsTheLinearTrendOfCleanDemos) {
   // The lift follows the goal: the held-out demos are predicted best by the local linear fit.
   EXPECT_LE(res.slope_ridge, 0.1);
   EXPECT_LT(res.loo_rms.front(), 0.5 * res.loo_rms.back());
-  lfd::SegmentRolloutOptions o;
-  o.dt = kDuration / 399.0;
-  o.start_position = start;
-  o.goal_position = new_goal;
-  o.start_velocity = Eigen::Vector3d::Zero();
-  const auto traj = res.dmp.rollout(o);
+  const auto traj = rolloutBetween(res.dmp, start, new_goal, kDuration / 399.0);
   EXPECT_LT(rmse(traj.positions, reach(traj.times, start, new_goal)), 0.008);
 }
 
@@ -190,12 +191,7 @@ Eigen::MatrixXd press(const Eigen::VectorXd& t, const Eigen::Vector3d& start, do
 }
 
 double pressedDepth(const lfd::SegmentDmp& dmp, const Eigen::Vector3d& start) {
-  lfd::SegmentRolloutOptions o;
-  o.dt = 0.005;
-  o.start_position = start;
-  o.goal_position = Eigen::Vector3d(start + kStroke);
-  o.start_velocity = Eigen::Vector3d::Zero();
-  return start.z() - dmp.rollout(o).positions.col(2).minCoeff();
+  return start.z() - rolloutBetween(dmp, start, start + kStroke, 0.005).positions.col(2).minCoeff();
 }
 
 TEST(DmpGeneralization, LeaveOneOutDoesNotFitTheNoiseOfTheDemos) {
