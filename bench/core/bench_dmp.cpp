@@ -111,23 +111,27 @@ void BM_LearnSegmentPoseGripper(benchmark::State& state) {
 }
 BENCHMARK(BM_LearnSegmentPoseGripper)->Arg(300)->Arg(1000)->Unit(benchmark::kMicrosecond);
 
-void BM_Generalize5Demos(benchmark::State& state) {
+// range(0) demos; range(1) = 1: the ridge chosen by leave-one-out among executor.yaml's six
+// candidates (what the executor does per segment and goal), 0: the fixed ridge.
+void BM_Generalize(benchmark::State& state) {
   std::vector<lfd::SegmentDmp> dmps;
   std::vector<Eigen::VectorXd> params;
-  for (int j = 0; j < 5; ++j) {
+  for (int j = 0; j < state.range(0); ++j) {
     lfd::SegmentDemo demo = poseDemo(500);
     demo.positions.col(0) *= 1.0 + 0.1 * j;
     demo.positions.col(1).array() += 0.05 * (j % 2);
     dmps.push_back(lfd::SegmentDmp::learn(demo));
     params.push_back(lfd::goalParameters(dmps.back()));
   }
+  lfd::GeneralizationOptions options;
+  if (state.range(1)) options.slope_ridge_candidates = {1e-3, 1e-2, 0.1, 1.0, 10.0, 100.0};
   const Eigen::VectorXd query = 0.5 * (params[1] + params[2]);
   for (auto _ : state) {
-    const auto res = lfd::generalizeSegment(dmps, params, query);
+    const auto res = lfd::generalizeSegment(dmps, params, query, options);
     benchmark::DoNotOptimize(res.coefficients.data());
   }
 }
-BENCHMARK(BM_Generalize5Demos)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_Generalize)->Args({5, 0})->Args({5, 1})->Args({9, 1})->Unit(benchmark::kMicrosecond);
 
 }  // namespace
 
