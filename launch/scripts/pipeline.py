@@ -419,7 +419,7 @@ def write_report(out, report):
         for task, e in sorted(report[key].items()):
             if not e.get("goals"):
                 continue
-            lines += ["%s, per goal:" % task, "",
+            lines += ["%s, per goal%s:" % (task, records.ridges_note(e["goals"])), "",
                       "| goal | result | object error | yaw error | TCP error | time ratio | planning | wall |",
                       "| --- | --- | --- | --- | --- | --- | --- | --- |"]
             sec = lambda v: "-" if v is None else "%.2f s" % v  # noqa: E731

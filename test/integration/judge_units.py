@@ -396,6 +396,13 @@ class Records(unittest.TestCase):
         none = report.reproduction_record("lib.json", (8.0, 3, 2), [refused, crashed])
         self.assertEqual(none["error"], "reset failed; unreachable")
 
+    def test_ridges_per_segment(self):
+        goals = [{"segment_slope_ridges": [0.01, 100.0, 0.1]}, {"segment_slope_ridges": [0.01, 100.0, 0.1]},
+                 {"segment_slope_ridges": [0.01, -1.0, 0.1]}, {"segment_slope_ridges": []}]
+        self.assertEqual(report.ridges_note(goals), " (ridge per segment: 0.01, 100, 0.1 / 0.01, kernel, 0.1)")
+        self.assertEqual(report.ridges_note([{}]), "")
+        self.assertEqual(report.goal_record(100, Response())["segment_slope_ridges"], [0.001, -1.0])
+
     def test_segmentation_record(self):
         r = report.segmentation_record({"weighted_product": {"success_rate": 0.5, "selected_features": ["f"]},
                                         "average": {"error": "failed"}}, 0.5)

@@ -126,3 +126,14 @@ def run_client(main):
     except KeyboardInterrupt:
         print("interrupted: the results so far are written (\"complete\": false)", file=sys.stderr)
         return 130
+
+
+def ridges_note(goals):
+    """The ridge of each segment's local linear fit, as the executor chose it by leave-one-out
+    (-1: kernel average), over the goals: " (ridge per segment: 0.01, 100 / ...)" or ""."""
+    seen = []
+    for g in goals:
+        ridges = ", ".join("kernel" if r < 0 else "%g" % r for r in g.get("segment_slope_ridges") or [])
+        if ridges and ridges not in seen:
+            seen.append(ridges)
+    return " (ridge per segment: %s)" % " / ".join(seen) if seen else ""
