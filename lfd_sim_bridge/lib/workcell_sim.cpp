@@ -130,6 +130,10 @@ WorkcellSim::WorkcellSim(const std::string& mjcf_path, const WorkcellConfig& con
     this->log(LogLevel::kWarn, "no body '" + config_.base_body + "'; using body '" +
                                    mj_id2name(m_, mjOBJ_BODY, base_body_) + "' as base_link");
   }
+  // A joint belongs to the robot when its body hangs from the same world child as base_link;
+  // any other (the drawer's slide) is a scene object's.
+  for (int j : joint_ids_)
+    object_joint_.push_back(m_->body_rootid[m_->jnt_bodyid[j]] != m_->body_rootid[base_body_]);
   ee_site_ = mj_name2id(m_, mjOBJ_SITE, config_.ee_site.c_str());
   if (ee_site_ < 0) this->log(LogLevel::kWarn, "no site '" + config_.ee_site + "' in the model");
   gripper_ = actuatedIndex(config_.gripper_joint);
@@ -690,6 +694,7 @@ void WorkcellSim::readState(WorkcellState* s) {
   s->time = d_->time;
   const size_t nj = joint_ids_.size();
   s->joint_names = joint_names_;
+  s->object_joint = object_joint_;
   s->joint_positions.resize(nj);
   s->joint_velocities.resize(nj);
   s->joint_efforts.resize(nj);

@@ -249,6 +249,8 @@ class BridgeNode {
 
     clock_pub_ = nh.advertise<rosgraph_msgs::Clock>("/clock", 10);
     joint_state_pub_ = nh.advertise<sensor_msgs::JointState>("/joint_states", kSensorQueue);
+    object_joint_pub_ =
+        nh.advertise<sensor_msgs::JointState>("/objects/joint_states", kSensorQueue);
     gripper_state_pub_ = nh.advertise<sensor_msgs::JointState>("/gripper/state", kSensorQueue);
     wrench_pub_ = nh.advertise<geometry_msgs::WrenchStamped>("/wrist_ft", kSensorQueue);
     touch_pub_ = nh.advertise<lfd_msgs::Touch>("/touch", kSensorQueue);
@@ -373,14 +375,21 @@ class BridgeNode {
   void publishState() {
     sim_->readState(&state_);
     const ros::Time stamp(state_.time);
-    if (joint_state_pub_.getNumSubscribers() > 0) {
+    // The robot's joints on /joint_states (what a robot's driver publishes, and all that
+    // robot_state_publisher knows from the URDF); a scene object's (the drawer's slide) apart.
+    for (const bool objects : {false, true}) {
+      const ros::Publisher& pub = objects ? object_joint_pub_ : joint_state_pub_;
+      if (pub.getNumSubscribers() == 0) continue;
       sensor_msgs::JointState js;
       js.header.stamp = stamp;
-      js.name = state_.joint_names;
-      js.position = state_.joint_positions;
-      js.velocity = state_.joint_velocities;
-      js.effort = state_.joint_efforts;
-      joint_state_pub_.publish(js);
+      for (size_t i = 0; i < state_.joint_names.size(); ++i) {
+        if (state_.object_joint[i] != objects) continue;
+        js.name.push_back(state_.joint_names[i]);
+        js.position.push_back(state_.joint_positions[i]);
+        js.velocity.push_back(state_.joint_velocities[i]);
+        js.effort.push_back(state_.joint_efforts[i]);
+      }
+      if (!js.name.empty()) pub.publish(js);
     }
     if (gripper_state_pub_.getNumSubscribers() > 0) {
       sensor_msgs::JointState gs;
@@ -619,8 +628,8 @@ class BridgeNode {
   ThrottledErrors errors_;
   static constexpr size_t kMaxPendingGripper = 1000;
   std::deque<lfd_msgs::GripperCommand> pending_gripper_;  // stamped ahead, by stamp
-  ros::Publisher clock_pub_, joint_state_pub_, gripper_state_pub_, wrench_pub_, touch_pub_,
-      imu_pub_, ee_pose_pub_, ee_twist_pub_, tf_pub_;
+  ros::Publisher clock_pub_, joint_state_pub_, object_joint_pub_, gripper_state_pub_, wrench_pub_,
+      touch_pub_, imu_pub_, ee_pose_pub_, ee_twist_pub_, tf_pub_;
   std::vector<ros::Publisher> object_pubs_;
   tf2_ros::StaticTransformBroadcaster static_tf_;
   ros::Subscriber joint_command_sub_, trajectory_sub_, gripper_sub_;

@@ -6,11 +6,11 @@
 //            [--distance d] [--azimuth deg] [--elevation deg]
 //
 // For each time the scene is rebuilt from the bag, not simulated: the joints by name from
-// /joint_states (the robot's and the scene's, a drawer's slide), the free and the fixed objects
-// from /objects/<body>/pose (the latest message at or before the time), then mj_forward and one
-// offscreen render. Times are bag time (the recorded stamps, as
-// the `segment` CLI reports changepoint_times), or seconds from the bag's start with --relative.
-// Writes DIR/snapshot_<k>_<t>s.png and prints one "t file" line per picture.
+// /joint_states and /objects/joint_states (the robot's joints, a drawer's slide), the free and the
+// fixed objects from /objects/<body>/pose (the latest message at or before the time), then
+// mj_forward and one offscreen render. Times are bag time (the recorded stamps, as the `segment`
+// CLI reports changepoint_times), or seconds from the bag's start with --relative. Writes
+// DIR/snapshot_<k>_<t>s.png and prints one "t file" line per picture.
 //
 // Rendering needs no display: an OSMesa context (libOSMesa, loaded at run time so the package
 // does not link it; MuJoCo's GL loader then finds OSMesaGetProcAddress in the process).
@@ -145,6 +145,7 @@ struct Stamped {
 struct Recording {
   double start = 0, end = 0;
   std::vector<Stamped<sensor_msgs::JointState>> joints;
+  std::vector<Stamped<sensor_msgs::JointState>> object_joints;  // /objects/joint_states (a drawer)
   std::map<std::string, std::vector<Stamped<geometry_msgs::PoseStamped>>> objects;
   std::vector<double>
       segment_ends;  // last /lfd/phase message of each ground-truth phase but the last
@@ -166,6 +167,8 @@ Recording read_recording(const std::string& path) {
     double t = m.getTime().toSec();
     if (topic == "/joint_states") {
       if (auto js = m.instantiate<sensor_msgs::JointState>()) r.joints.push_back({t, *js});
+    } else if (topic == "/objects/joint_states") {
+      if (auto js = m.instantiate<sensor_msgs::JointState>()) r.object_joints.push_back({t, *js});
     } else if (topic.rfind("/objects/", 0) == 0 && topic.size() > 14 &&
                topic.compare(topic.size() - 5, 5, "/pose") == 0) {
       if (auto p = m.instantiate<geometry_msgs::PoseStamped>())
@@ -225,14 +228,19 @@ void setPose(const geometry_msgs::Pose& p, mjtNum* pos, mjtNum* quat) {
   mju_normalize4(quat);
 }
 
-void apply_state(const mjModel* m, mjData* d, const Recording& r, double t) {
-  const sensor_msgs::JointState& js = latest(r.joints, t);
+void apply_joints(const mjModel* m, mjData* d, const sensor_msgs::JointState& js) {
   for (std::size_t k = 0; k < js.name.size() && k < js.position.size(); ++k) {
     int id = mj_name2id(m, mjOBJ_JOINT, js.name[k].c_str());
     if (id < 0) continue;  // a joint of the robot's description unknown to the scene
     if (m->jnt_type[id] != mjJNT_HINGE && m->jnt_type[id] != mjJNT_SLIDE) continue;
     d->qpos[m->jnt_qposadr[id]] = js.position[k];
   }
+}
+
+void apply_state(const mjModel* m, mjData* d, const Recording& r, double t) {
+  apply_joints(m, d, latest(r.joints, t));
+  // Bags recorded before the split carry the drawer's slide on /joint_states (applied above).
+  if (!r.object_joints.empty()) apply_joints(m, d, latest(r.object_joints, t));
   for (const auto& [name, samples] : r.objects) {
     const geometry_msgs::Pose& p = latest(samples, t).pose;
     const int body = mj_name2id(m, mjOBJ_BODY, name.c_str());

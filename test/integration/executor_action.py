@@ -120,7 +120,7 @@ class ExecutorAction(unittest.TestCase):
             self.assertIn(ridge, candidates)
         self.assertGreater(result.motion_start.to_sec(), 0.0)
         self.assertAlmostEqual(sum(result.segment_durations), result.planned_duration, places=6)
-        self.assertGreater(result.execution_time, result.planned_duration)  # it reached the end
+        self.assertGreaterEqual(result.execution_time, result.planned_duration)  # it reached the end (the TCP may settle on the last sample: equal, as sampled)
         self.assertLess(result.execution_time, 1.05 * result.planned_duration + 0.1)
         self.assertLess(result.final_position_error, 0.005)
         self.assertLess(result.extrapolation_distance, 0.05)

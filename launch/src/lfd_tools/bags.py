@@ -103,7 +103,10 @@ def truth_from_labels(path, runs=None):
 
 # ---- a recording's physical outcome -------------------------------------------------------------
 
-TOUCH_TOPIC, EE_TOPIC, JOINTS_TOPIC = "/touch", "/ee_pose", "/joint_states"
+TOUCH_TOPIC, EE_TOPIC = "/touch", "/ee_pose"
+# A scene object's joint (the drawer's slide) is on /objects/joint_states; bags recorded before
+# the bridge split it from the robot's carry it on /joint_states.
+JOINT_TOPICS = ("/objects/joint_states", "/joint_states")
 
 
 def topics_for(criterion):
@@ -113,7 +116,7 @@ def topics_for(criterion):
         if "object" in rule:
             topics.add("/objects/%s/pose" % tasks.body_of(rule["object"]))
         if rule["rule"] == "joint":
-            topics.add(JOINTS_TOPIC)
+            topics.update(JOINT_TOPICS)
         if rule["rule"] == "contact_path":
             topics.update((TOUCH_TOPIC, EE_TOPIC))
     return sorted(topics)
@@ -133,7 +136,7 @@ def measure(bag, criterion, base_in_world):
         if topic in names:
             p, q = msg.pose.position, msg.pose.orientation
             out["objects"][names[topic]] = {"position": [p.x, p.y, p.z], "orientation": [q.w, q.x, q.y, q.z]}
-        elif topic == JOINTS_TOPIC:
+        elif topic in JOINT_TOPICS:
             for name, value in zip(msg.name, msg.position):
                 if name in joint_names:
                     out["joints"][name] = value

@@ -33,9 +33,9 @@ def message_type(topic):
     from geometry_msgs.msg import PoseStamped
     from lfd_msgs.msg import Touch
     from sensor_msgs.msg import JointState
-    if topic.startswith("/objects/") or topic == "/ee_pose":
+    types = {"/joint_states": JointState, "/objects/joint_states": JointState, "/touch": Touch}
+    if topic not in types and (topic.startswith("/objects/") or topic == "/ee_pose"):
         return PoseStamped
-    types = {"/joint_states": JointState, "/touch": Touch}
     if topic not in types:
         raise RuntimeError("no message type known for topic %s" % topic)
     return types[topic]

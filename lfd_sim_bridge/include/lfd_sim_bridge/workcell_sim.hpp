@@ -104,6 +104,9 @@ struct WorkcellState {
   double time = 0.0;
   std::vector<std::string> joint_names;  // every hinge/slide joint of the model (no free joints)
   std::vector<double> joint_positions, joint_velocities, joint_efforts;
+  // Parallel to joint_names: true for a joint of a scene object (a drawer's slide), whose body is
+  // not in the robot's tree. The bridge keeps these off the robot's /joint_states.
+  std::vector<bool> object_joint;
   std::array<double, 3> wrist_force{}, wrist_torque{};  // in the r_wrist_ft site frame
   std::vector<std::string> touch_names;
   std::vector<double> touch_values;
@@ -205,6 +208,7 @@ class WorkcellSim {
   std::map<std::string, int> actuated_index_;
   std::vector<std::string> joint_names_;
   std::vector<int> joint_ids_;
+  std::vector<bool> object_joint_;  // parallel to joint_ids_ (WorkcellState::object_joint)
   std::unique_ptr<TrajectoryInterpolator> trajectory_;
   std::vector<int> trajectory_to_actuated_;
   JointTrajectory last_trajectory_;
