@@ -83,7 +83,8 @@ def generate(names, out_root, args, log_dir, crashes, outcomes):
     them in turn); the demos that failed are tried once more in a second launch (a fresh scene),
     as a demonstrator redoes a botched demonstration."""
     for attempt in (1, 2):
-        jobs = [job for job in (missing_demos(n, out_root, args, attempt, outcomes) for n in names) if job]
+        jobs = [missing_demos(n, out_root, args, attempt, outcomes) for n in names]
+        jobs = [job for job in jobs if job]
         if not jobs:
             break
         record(jobs, args, log_dir, attempt, crashes)

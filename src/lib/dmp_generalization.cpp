@@ -117,29 +117,25 @@ double heldOutRms(const PositionDmp& held, const std::vector<const PositionDmp*>
   return std::sqrt((own - predicted).rowwise().squaredNorm().mean());
 }
 
-}  // namespace
-
-namespace {
 // Each demo held out in turn: its position RMS (see leaveOneOutRms).
 std::vector<double> leaveOneOutErrors(const std::vector<SegmentDmp>& demos,
                                       const std::vector<Eigen::VectorXd>& params, double bandwidth,
                                       double slope_ridge) {
-  if (demos.size() < 3 || params.size() != demos.size() || !(bandwidth > 0.0))
+  const bool positions =
+      std::all_of(demos.begin(), demos.end(), [](const SegmentDmp& d) { return d.position; });
+  if (demos.size() < 3 || params.size() != demos.size() || !(bandwidth > 0.0) || !positions)
     throw std::invalid_argument(
-        "leaveOneOutRms: needs >= 3 demos, one parameter vector each, and "
-        "a bandwidth > 0");
+        "leaveOneOutRms: needs >= 3 demos with a position DMP, one parameter vector each, and a "
+        "bandwidth > 0");
   std::vector<double> errors;
   for (size_t held = 0; held < demos.size(); ++held) {
     std::vector<Eigen::VectorXd> rest;
     std::vector<const PositionDmp*> others;
     for (size_t j = 0; j < demos.size(); ++j) {
       if (j == held) continue;
-      if (!demos[j].position) throw std::invalid_argument("leaveOneOutRms: a demo has no position");
       rest.push_back(params[j]);
       others.push_back(&*demos[j].position);
     }
-    if (!demos[held].position)
-      throw std::invalid_argument("leaveOneOutRms: a demo has no position");
     const Eigen::MatrixXd points = parameterMatrix(rest);
     const Eigen::VectorXd k = kernelWeights(points, params[held], bandwidth);
     const Eigen::VectorXd c =
@@ -205,10 +201,12 @@ double chooseSlopeRidge(const std::vector<SegmentDmp>& demos,
     const std::vector<double> e = leaveOneOutErrors(demos, params, h, ridge);
     const double n = static_cast<double>(e.size());
     const double mean = std::accumulate(e.begin(), e.end(), 0.0) / n;
+    loo->push_back(mean);
+    if (mean >= best_mean) continue;
     double var = 0.0;
     for (double x : e) var += (x - mean) * (x - mean);
-    loo->push_back(mean);
-    if (mean < best_mean) best_mean = mean, best_se = std::sqrt(var / (n - 1.0) / n);
+    best_mean = mean;
+    best_se = std::sqrt(var / (n - 1.0) / n);
   }
   double chosen = -1.0;
   for (size_t i = 0; i < loo->size(); ++i)
@@ -240,7 +238,6 @@ GeneralizationResult generalizeSegment(const std::vector<SegmentDmp>& demos,
         "generalizeSegment: bandwidth, slope_ridge (and its candidates), range_margin >= 0");
   }
   const size_t nd = demos.size();
-  Eigen::MatrixXd points(dim, static_cast<Eigen::Index>(nd));
   for (size_t j = 0; j < nd; ++j) {
     checkCompatible(demos[0], demos[j], j);
     if (params[j].size() != dim) {
@@ -249,8 +246,8 @@ GeneralizationResult generalizeSegment(const std::vector<SegmentDmp>& demos,
                                   std::to_string(dim));
     }
     requireFinite(params[j], "generalizeSegment demo parameters");
-    points.col(static_cast<Eigen::Index>(j)) = params[j];
   }
+  const Eigen::MatrixXd points = parameterMatrix(params);
 
   GeneralizationResult result;
   // Bandwidth and diameter from pairwise distances.

@@ -34,11 +34,11 @@ def message_type(topic):
     from lfd_msgs.msg import Touch
     from sensor_msgs.msg import JointState
     types = {"/joint_states": JointState, "/objects/joint_states": JointState, "/touch": Touch}
-    if topic not in types and (topic.startswith("/objects/") or topic == "/ee_pose"):
+    if topic in types:
+        return types[topic]
+    if topic.startswith("/objects/") or topic == "/ee_pose":  # /objects/<body>/pose
         return PoseStamped
-    if topic not in types:
-        raise RuntimeError("no message type known for topic %s" % topic)
-    return types[topic]
+    raise RuntimeError("no message type known for topic %s" % topic)
 
 
 class LiveRecording(object):

@@ -115,8 +115,8 @@ struct PlannedSegment {
   double duration = 0.0;      ///< s
   TcpPose goal;               ///< goal pose given to the DMP
   std::vector<std::string> demos;
-  double slope_ridge =
-      -1.0;  ///< of its local linear fit (GeneralizationResult); -1 = kernel average
+  /// The ridge of its local linear fit (GeneralizationResult::slope_ridge); -1 = kernel average.
+  double slope_ridge = -1.0;
 };
 
 struct ExecutionPlan {
