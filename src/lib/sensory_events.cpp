@@ -135,6 +135,10 @@ struct Channel {
   std::vector<double> y;  // median-smoothed signal
   double rest = 0.0;      // rest level
   double on = 0.0;        // activity threshold
+  // The threshold is the noise floor, above the ratio of the largest change: the channel's
+  // contact is within a few noise levels (a torque the press barely moves), so its drift can keep
+  // it off its rest level for good.
+  bool noise_limited = false;
   std::vector<PlacedEvent> events;
 };
 
@@ -151,9 +155,9 @@ std::vector<double> lagged_differences(const std::vector<double>& y, std::size_t
 
 // On-threshold of the activity: the paper's ratio of the largest difference (or the noise rule),
 // never below the noise floors.
-double activity_threshold(const Eigen::Ref<const Eigen::VectorXd>& signal,
-                          const std::vector<double>& mag, double peak,
-                          const SensoryEventConfig& config) {
+void set_activity_threshold(const Eigen::Ref<const Eigen::VectorXd>& signal,
+                            const std::vector<double>& mag, double peak,
+                            const SensoryEventConfig& config, Channel* c) {
   // The sigma floor is measured on the RAW first differences (nearly independent samples) and
   // scaled to the lagged differences of a median of w samples (white noise: x 1.2533 / sqrt(w)).
   double sigma = 0.0;
@@ -171,7 +175,8 @@ double activity_threshold(const Eigen::Ref<const Eigen::VectorXd>& signal,
       std::max(config.noise_floor_sigmas * sigma, config.noise_floor_excursions * excursion);
   const double ratio =
       config.threshold == EventThreshold::kNoise ? config.relative_floor : config.threshold_ratio;
-  return std::max(floor, ratio * peak);
+  c->on = std::max(floor, ratio * peak);
+  c->noise_limited = floor > ratio * peak;
 }
 
 std::vector<Burst> find_bursts(const std::vector<double>& mag, double on, double off,
@@ -310,7 +315,7 @@ Channel analyse_channel(const Eigen::Ref<const Eigen::VectorXd>& signal,
   const std::vector<double> mag = lagged_differences(c.y, config.difference_lag, edge);
   const double peak = *std::max_element(mag.begin(), mag.end());
   if (!(peak > 0.0)) return c;
-  c.on = activity_threshold(signal, mag, peak, config);
+  set_activity_threshold(signal, mag, peak, config, &c);
   const bool walk_back = config.placement != EventPlacement::kThreshold;
   const std::vector<Burst> bursts = merge_bursts(
       find_bursts(mag, c.on, config.hysteresis * c.on, walk_back), config.merge_gap, n);
@@ -344,6 +349,19 @@ bool at_rest(const Channel& c, std::size_t from, std::size_t to) {
   return median_of(d) < c.on;
 }
 
+// Whether channel c leaves its rest level (regains it) at a sample of [from, to).
+bool leaves_rest_within(const Channel& c, std::size_t from, std::size_t to) {
+  return std::any_of(c.events.begin(), c.events.end(), [&](const PlacedEvent& p) {
+    return p.from_rest && p.event.index >= from && p.event.index < to;
+  });
+}
+
+bool regains_rest_within(const Channel& c, std::size_t from, std::size_t to) {
+  return std::any_of(c.events.begin(), c.events.end(), [&](const PlacedEvent& p) {
+    return p.to_rest && p.event.index >= from && p.event.index < to;
+  });
+}
+
 // For every sample, the length of the run of samples around it where the whole group sits at
 // rest (0 where it does not).
 std::vector<std::size_t> rest_run_lengths(const std::vector<Channel>& channels,
@@ -373,13 +391,27 @@ std::vector<std::size_t> rest_run_lengths(const std::vector<Channel>& channels,
 }
 
 // A sensor of several channels (a touch pad per finger, a force vector) is at rest only when
-// all of them are: one pad letting go while the other takes over is not the contact's end. And
+// all of them are: one pad letting go while the other takes over is not the contact's end, and the
+// sensor leaves rest with its first channel and regains it with its last (a channel's edge is
+// none when another leaves rest up to a lag before it, or regains it up to a lag after it: the
+// friction of a wiping hand that flips one last time while the press force still fades). And
 // a rest shorter than `min_rest` samples (the merge gap: activity separated by less is one
 // activity) is a pause within the interaction, not its end: a teleoperator's hesitation, an arm
 // slowing between two strokes.
+// The channels that say when the sensor is at rest: those whose contact stands clear of their
+// noise, when it has any (else all of them).
+std::vector<std::size_t> deciding_channels(const std::vector<Channel>& channels,
+                                           const std::vector<std::size_t>& group) {
+  std::vector<std::size_t> clear;
+  for (std::size_t c : group)
+    if (!channels[c].events.empty() && !channels[c].noise_limited) clear.push_back(c);
+  return clear.empty() ? group : clear;
+}
+
 void flag_rest_edges_of_group(std::vector<Channel>* channels, const std::vector<std::size_t>& group,
                               std::size_t lag, std::size_t min_rest) {
-  const std::vector<std::size_t> run = rest_run_lengths(*channels, group);
+  const std::vector<std::size_t> deciding = deciding_channels(*channels, group);
+  const std::vector<std::size_t> run = rest_run_lengths(*channels, deciding);
   const auto longest = [&](std::size_t from, std::size_t to) {
     std::size_t best = 0;
     for (std::size_t t = from; t < std::min(to, run.size()); ++t) best = std::max(best, run[t]);
@@ -390,10 +422,12 @@ void flag_rest_edges_of_group(std::vector<Channel>* channels, const std::vector<
       const std::size_t e = p.event.index, lo = e > lag ? e - lag : 0;
       bool before = p.from_rest && longest(lo, e) >= min_rest;
       bool after = p.to_rest && longest(e, e + lag) >= min_rest;
-      for (std::size_t o : group) {
+      for (std::size_t o : deciding) {
         if (o == c) continue;
-        before = before && at_rest((*channels)[o], lo, e);
-        after = after && at_rest((*channels)[o], e, e + lag);
+        before =
+            before && at_rest((*channels)[o], lo, e) && !leaves_rest_within((*channels)[o], lo, e);
+        after = after && at_rest((*channels)[o], e, e + lag) &&
+                !regains_rest_within((*channels)[o], e + 1, e + lag + 1);
       }
       p.event.rest_edge = before || after;
     }

@@ -343,6 +343,45 @@ TEST(SensoryEvents, OnePadLettingGoWhileTheOtherHoldsIsNoRestEdge) {
   EXPECT_THROW(lfd::detect_sensor_events(pads, yaml_at_50hz(), {0}), std::invalid_argument);
 }
 
+// A wrist F/T pressing and wiping, at 50 Hz: the press force (10 N) from 2 s, the friction (4 N)
+// from 2.2 s. At the release the press force fades from 8 s to 8.6 s and the friction ends at 8.2
+// s, when the press force is below the activity threshold (0.4 x 10 N) for most of the next lag.
+// The sensor leaves rest with its first channel (2 s) and regains it with its last (8.6 s): the
+// friction's own edges are none. (Judged by the other channel's median level alone, the release
+// came 0.4 s early and the friction's onset made a second zone edge.)
+TEST(SensoryEvents, TheSensorLeavesRestWithItsFirstChannelAndRegainsItWithItsLast) {
+  Eigen::MatrixXd wrench = Eigen::MatrixXd::Zero(700, 2);
+  for (Eigen::Index t = 100; t < 430; ++t)
+    wrench(t, 0) = 10.0 * std::min(1.0, (430.0 - static_cast<double>(t)) / 30.0);
+  wrench.block(110, 1, 300, 1).setConstant(4.0);
+  const lfd::SensorEvents e = lfd::detect_sensor_events(wrench, yaml_at_50hz(), {0, 0});
+  EXPECT_EQ(e.zone_events, (Events{100, 430})) << ::testing::PrintToString(e.all);
+  const lfd::SensorEvents apart = lfd::detect_sensor_events(wrench, yaml_at_50hz(), {0, 1});
+  EXPECT_EQ(apart.zone_events, (Events{100, 110, 410, 430}));
+}
+
+// A wrist F/T at 50 Hz: the press force (10 N, noise 0.3 N) from 2 s to 9 s, and a torque axis the
+// press barely moves (0.06 Nm against 0.02 Nm of noise, so its threshold is its noise floor) whose
+// offset drifts by 0.07 Nm meanwhile: after the contact it hovers at the edge of its rest band.
+// Such a channel cannot say when the contact ends: the force does (9 s); the torque may add its own
+// release there. (Waiting for every channel, the sensor never came back to rest: no release.)
+TEST(SensoryEvents, AChannelWithinItsNoiseDoesNotKeepTheSensorFromRest) {
+  std::mt19937 rng(5);
+  std::normal_distribution<double> g(0.0, 1.0);
+  Eigen::MatrixXd wrench(800, 2);
+  for (Eigen::Index t = 0; t < wrench.rows(); ++t) {
+    const bool pressed = t >= 100 && t < 450;
+    const double drift = 0.07 * std::clamp((static_cast<double>(t) - 100.0) / 350.0, 0.0, 1.0);
+    wrench(t, 0) = (pressed ? 10.0 : 0.0) + 0.3 * g(rng);
+    wrench(t, 1) = (pressed ? 0.06 : 0.0) + drift + 0.02 * g(rng);
+  }
+  const lfd::SensorEvents e = lfd::detect_sensor_events(wrench, yaml_at_50hz(), {0, 0});
+  ASSERT_GE(e.zone_events.size(), 2u) << ::testing::PrintToString(e.all);
+  EXPECT_NEAR(static_cast<double>(e.zone_events.front()), 100.0, 3.0);
+  for (std::size_t i = 1; i < e.zone_events.size(); ++i)  // the force's, maybe the torque's too
+    EXPECT_NEAR(static_cast<double>(e.zone_events[i]), 450.0, 5.0);
+}
+
 // A rest shorter than the merge gap is a pause inside the interaction: pad A from 2 s to 4 s and
 // pad B of the same sensor from 4.6 s to 6 s leave the sensor at rest for 0.6 s only, less than
 // the 1 s merge gap, though each pad rests for longer. With a 2 s pause both ends are rest edges.

@@ -19,8 +19,10 @@
 //     at t0 keeps the lagged difference high from t0 - L/2 to t0 + L/2; `placement` says where in
 //     the burst the events go (where the thresholds are crossed, shifted back by L/2, or fitted
 //     where the level starts to change and where it settles);
-//   - rest edges: the events where a sensor (all channels of it) leaves its rest level or settles
-//     back at it for at least merge_gap (contact made or lost) can be the only ones that make
+//   - rest edges: the events where a sensor (all channels of it: it leaves rest with its first
+//     channel and is back with its last; a channel whose threshold is its noise floor cannot hold
+//     it off rest) leaves its rest level or settles back at it for at least merge_gap (contact
+//     made or lost) can be the only ones that make
 //     zones (zones_from_rest_edges), and are placed where the samples stop being consistent with
 //     rest when that is earlier (rest_edge_sigmas, a CUSUM change time);
 //   - threshold kNoise + noise_block: the threshold is a statistic of the noise measured where the
