@@ -253,9 +253,10 @@ void check_demos_fit(const SegmentationParams& params, const std::vector<lfd::Fe
     const std::size_t rows = static_cast<std::size_t>(m.rows());
     if (rows > lim.max_samples_per_demo) {
       throw std::invalid_argument("'" + source + "' has " + std::to_string(rows) +
-                                  " samples after resampling, over the limit of " +
+                                  " samples on its clock, over the limit of " +
                                   std::to_string(lim.max_samples_per_demo) +
-                                  " (limits/max_samples_per_demo)");
+                                  " (limits/max_samples_per_demo): put it on a slower clock "
+                                  "(bags: rate; the segment CLI's CSV: --resample HZ)");
     }
     total += rows;
     if (rows < 2) continue;

@@ -35,6 +35,8 @@ const char* kUsage = R"(usage: segment [options] FILE...
   --state-columns a,b,c     CSV columns considered for segmentation (default: all other columns)
   --time-column NAME        CSV time column (default: time, t, timestamp or stamp if present)
   --rate HZ                 bag resampling rate / CSV sample rate (overrides a CSV time column)
+  --resample HZ             CSV: average the rows onto a clock of HZ (a 1 kHz F/T: 100); the
+                            segmentation is in seconds, so only speed and the sample limits change
   --combination NAME[,NAME] average | product | weighted_average | weighted_product |
                             distance_average | weighted_distance_average, or 'all'. Several: the
                             features are selected once and the JSON holds one result per name
@@ -99,7 +101,7 @@ struct Options {
   bool list_fields = false;
   std::vector<std::string> files, sensors, states;
   std::string time_column, combination, output, procedure;
-  double rate = 0, threshold = 0, min_seconds = 0, window_seconds = 0;
+  double rate = 0, resample = 0, threshold = 0, min_seconds = 0, window_seconds = 0;
   long num_changepoints = 0, threads = -1;
   bool timing = false, feature_profiles = false, profiles = true, features = false;
 };
@@ -140,6 +142,10 @@ Options parse_args(int argc, char** argv) {
       o.time_column = value();
     } else if (arg == "--rate") {
       o.rate = number();
+    } else if (arg == "--resample") {
+      o.resample = number();
+      if (!(o.resample > 0) || !std::isfinite(o.resample))
+        throw std::invalid_argument("--resample must be a rate > 0 (Hz)");
     } else if (arg == "--combination") {
       o.combination = value();
     } else if (arg == "--procedure") {
@@ -213,6 +219,8 @@ nlohmann::json run(const Options& o) {
   for (const std::string& f : o.files) bags += ends_with(f, ".bag") ? 1 : 0;
   if (bags != 0 && bags != o.files.size())
     throw std::invalid_argument("do not mix bags and CSV files");
+  if (bags != 0 && o.resample > 0)
+    throw std::invalid_argument("--resample is for CSV files: a bag's clock is set by --rate");
   std::vector<lfd::FeatureMatrix> demos;
   std::vector<std::string> sensors = o.sensors, states = o.states;
   for (const std::string& f : o.files) {
@@ -229,6 +237,7 @@ nlohmann::json run(const Options& o) {
             "CSV file '" + f +
             "' has no time column (time, t, timestamp, stamp or --time-column): give its sample "
             "rate with --rate, the time parameters are in seconds");
+      if (o.resample > 0) demos.back() = lfd::resample(demos.back(), o.resample);
     }
   }
   lfd_segmentation::check_demos_fit(params, demos, o.files);

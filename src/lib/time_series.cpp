@@ -145,6 +145,19 @@ FeatureMatrix resample(const std::vector<Stream>& streams, double rate_hz) {
   return out;
 }
 
+FeatureMatrix resample(const FeatureMatrix& matrix, double rate_hz) {
+  matrix.validate_shape();
+  if (matrix.time.empty()) throw std::invalid_argument("resample: the matrix has no clock");
+  std::vector<Stream> streams(static_cast<std::size_t>(matrix.cols()));
+  for (Eigen::Index c = 0; c < matrix.cols(); ++c) {
+    Stream& s = streams[static_cast<std::size_t>(c)];
+    s.name = matrix.names[static_cast<std::size_t>(c)];
+    s.time = matrix.time;
+    s.values.assign(matrix.data.col(c).data(), matrix.data.col(c).data() + matrix.rows());
+  }
+  return resample(streams, rate_hz);
+}
+
 bool normalize_min_max(Eigen::Ref<Eigen::VectorXd> x, double eps) {
   if (x.size() == 0) return true;
   const double lo = x.minCoeff(), hi = x.maxCoeff();

@@ -70,4 +70,27 @@ TEST(Resample, DiscreteStreamsAreHeldNotAveraged) {
     EXPECT_TRUE(m.data(r, 0) == 0.0 || m.data(r, 0) == 1.0) << r;
 }
 
+// A matrix on its own clock (a CSV at 1 kHz) goes onto a 100 Hz clock column by column, each
+// averaged over the period: a line stays the line (within half an input sample: the period holds
+// ten of its samples), the names stay. No clock, no resampling.
+TEST(Resample, AMatrixOnItsOwnClockIsResampledColumnByColumn) {
+  lfd::FeatureMatrix m;
+  m.names = {"up", "down"};
+  m.data.resize(2001, 2);
+  for (Eigen::Index r = 0; r < m.rows(); ++r) {
+    m.time.push_back(0.001 * static_cast<double>(r));
+    m.data(r, 0) = m.time.back();
+    m.data(r, 1) = -2.0 * m.time.back();
+  }
+  const lfd::FeatureMatrix out = lfd::resample(m, 100.0);
+  ASSERT_EQ(out.rows(), 201);
+  EXPECT_EQ(out.names, m.names);
+  for (Eigen::Index r = 1; r + 1 < out.rows(); ++r) {
+    EXPECT_NEAR(out.data(r, 0), out.time[static_cast<std::size_t>(r)], 0.5e-3 + 1e-9) << r;
+    EXPECT_NEAR(out.data(r, 1), -2.0 * out.time[static_cast<std::size_t>(r)], 1e-3 + 1e-9) << r;
+  }
+  m.time.clear();
+  EXPECT_THROW(lfd::resample(m, 100.0), std::invalid_argument);
+}
+
 }  // namespace

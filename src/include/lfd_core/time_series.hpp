@@ -50,6 +50,11 @@ struct FeatureMatrix {
 /// or non-finite streams, decreasing timestamps, or streams that do not overlap in time.
 FeatureMatrix resample(const std::vector<Stream>& streams, double rate_hz);
 
+/// The same for the columns of a matrix on its own clock (every column continuous): a CSV
+/// recorded faster than the segmentation needs (a 1 kHz F/T) averaged onto `rate_hz`. Throws
+/// std::invalid_argument when the matrix has no clock.
+FeatureMatrix resample(const FeatureMatrix& matrix, double rate_hz);
+
 /// Evaluates one stream at the given query times (queries outside the stream are clamped).
 std::vector<double> interpolate(const Stream& stream, const std::vector<double>& query_times);
 
