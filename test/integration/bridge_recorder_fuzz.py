@@ -109,7 +109,8 @@ class BridgeRecorderFuzz(unittest.TestCase):
                 res = self.step(steps)
                 self.assertFalse(res.success)
                 self.assertIn("max_steps_per_call", res.message)
-                self.assertLess(time.time() - t0, 2.0)
+                # Refused before stepping (a million steps would take minutes); room for load.
+                self.assertLess(time.time() - t0, 5.0)
             # The largest allowed step: a concurrent pause is answered within its bounded time.
             thread = threading.Thread(target=lambda: self.step(10000), daemon=True)
             thread.start()

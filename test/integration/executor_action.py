@@ -155,7 +155,9 @@ class ExecutorAction(unittest.TestCase):
         self.assertEqual(state, GoalStatus.PREEMPTED, result.error)
         self.assertIn("preempted", result.error)
         self.assertIn("the arm holds there", result.error)
-        self.assertLess(time.time() - cancelled, 1.5)
+        # Served without sim time moving (the plan had ~10 s of it left); the bound leaves room
+        # for a loaded 2-core CI machine, a cancel that waits for the motion never comes.
+        self.assertLess(time.time() - cancelled, 5.0)
         self.assert_alive()
 
     def test_3_preempted_while_planning(self):
@@ -213,7 +215,7 @@ class ExecutorAction(unittest.TestCase):
             time.sleep(0.01)
         result, state = self.cell.result()
         self.assertEqual(state, GoalStatus.PREEMPTED, result.error)
-        self.assertLess(time.time() - cancelled, 1.5)
+        self.assertLess(time.time() - cancelled, 5.0)  # sim time stands still: else never
         self.assert_alive()  # and nothing is "busy"
 
     def test_6_bad_requests_are_clear_errors(self):
