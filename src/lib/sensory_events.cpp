@@ -390,14 +390,6 @@ std::vector<std::size_t> rest_run_lengths(const std::vector<Channel>& channels,
   return run;
 }
 
-// A sensor of several channels (a touch pad per finger, a force vector) is at rest only when
-// all of them are: one pad letting go while the other takes over is not the contact's end, and the
-// sensor leaves rest with its first channel and regains it with its last (a channel's edge is
-// none when another leaves rest up to a lag before it, or regains it up to a lag after it: the
-// friction of a wiping hand that flips one last time while the press force still fades). And
-// a rest shorter than `min_rest` samples (the merge gap: activity separated by less is one
-// activity) is a pause within the interaction, not its end: a teleoperator's hesitation, an arm
-// slowing between two strokes.
 // The channels that say when the sensor is at rest: those whose contact stands clear of their
 // noise, when it has any (else all of them).
 std::vector<std::size_t> deciding_channels(const std::vector<Channel>& channels,
@@ -408,6 +400,14 @@ std::vector<std::size_t> deciding_channels(const std::vector<Channel>& channels,
   return clear.empty() ? group : clear;
 }
 
+// A sensor of several channels (a touch pad per finger, a force vector) is at rest only when
+// all of them are: one pad letting go while the other takes over is not the contact's end, and the
+// sensor leaves rest with its first channel and regains it with its last (a channel's edge is
+// none when another leaves rest up to a lag before it, or regains it up to a lag after it: the
+// friction of a wiping hand that flips one last time while the press force still fades). And
+// a rest shorter than `min_rest` samples (the merge gap: activity separated by less is one
+// activity) is a pause within the interaction, not its end: a teleoperator's hesitation, an arm
+// slowing between two strokes. Only the deciding channels (above) can hold the sensor off rest.
 void flag_rest_edges_of_group(std::vector<Channel>* channels, const std::vector<std::size_t>& group,
                               std::size_t lag, std::size_t min_rest) {
   const std::vector<std::size_t> deciding = deciding_channels(*channels, group);
