@@ -2,6 +2,7 @@
 
 #include "lfd_core/safe_paths.hpp"
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
@@ -139,6 +140,25 @@ lfd::FeatureMatrix read_csv_features(const std::string& path, const std::string&
     m.time = std::move(time);
   }
   return m;
+}
+
+std::string clock_gap_warning(const lfd::FeatureMatrix& matrix, const std::string& path,
+                              double max_missing) {
+  if (matrix.time.size() < 3) return "";
+  std::vector<double> steps(matrix.time.size() - 1);
+  for (std::size_t r = 1; r < matrix.time.size(); ++r)
+    steps[r - 1] = matrix.time[r] - matrix.time[r - 1];
+  const auto largest = std::max_element(steps.begin(), steps.end());
+  const std::size_t row = static_cast<std::size_t>(largest - steps.begin()) + 1;
+  const double gap = *largest;
+  std::nth_element(steps.begin(), steps.begin() + steps.size() / 2, steps.end());
+  const double median = steps[steps.size() / 2];
+  if (!(median > 0.0) || !(gap > max_missing * median)) return "";
+  std::ostringstream text;
+  text << "'" << path << "': the clock jumps " << gap << " s at row " << row << " (median step "
+       << median << " s); the rows are taken as evenly spaced, so put them on a uniform clock with "
+       << "--resample HZ";
+  return text.str();
 }
 
 }  // namespace lfd_segmentation

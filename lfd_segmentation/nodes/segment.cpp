@@ -223,6 +223,7 @@ nlohmann::json run(const Options& o) {
     throw std::invalid_argument("--resample is for CSV files: a bag's clock is set by --rate");
   std::vector<lfd::FeatureMatrix> demos;
   std::vector<std::string> sensors = o.sensors, states = o.states;
+  std::vector<std::string> clock_warnings;
   for (const std::string& f : o.files) {
     if (bags) {
       lfd_segmentation::DemoFeatures demo =
@@ -238,6 +239,8 @@ nlohmann::json run(const Options& o) {
             "' has no time column (time, t, timestamp, stamp or --time-column): give its sample "
             "rate with --rate, the time parameters are in seconds");
       if (o.resample > 0) demos.back() = lfd::resample(demos.back(), o.resample);
+      const std::string gap = lfd_segmentation::clock_gap_warning(demos.back(), f);
+      if (!gap.empty()) clock_warnings.push_back(gap);
     }
   }
   lfd_segmentation::check_demos_fit(params, demos, o.files);
@@ -300,6 +303,10 @@ nlohmann::json run(const Options& o) {
     std::cerr << "segment: " << demos.size() << " demo(s), " << demos[0].cols() << " features, "
               << samples << " samples: load " << load_time << " s, segmentation " << compute_time
               << " s, total " << seconds_since(start) << " s\n";
+  }
+  for (const std::string& w : clock_warnings) {
+    out["warnings"].push_back(w);
+    std::cerr << "segment: warning: " << w << "\n";
   }
   out["success"] = true;
   return out;

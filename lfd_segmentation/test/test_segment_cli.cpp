@@ -209,6 +209,44 @@ TEST(SegmentCli, ResampleAveragesAFastCsvOntoASlowerClock) {
   EXPECT_NE(j["error"].get<std::string>().find("--resample"), std::string::npos);
 }
 
+// A logger that stalled for a second: the rows across the gap are not evenly spaced, which the
+// segmentation assumes (its windows are counted in samples). The result says so, and the same demos
+// put on a uniform clock (--resample) carry no such warning.
+TEST(SegmentCli, AClockWithAGapIsWarnedAbout) {
+  std::string files;
+  for (unsigned d = 0; d < 3; ++d) {
+    const std::string f = (temp_dir() / ("gap" + std::to_string(d) + ".csv")).string();
+    write_demo_csv(f, 650, 60 + d);
+    if (d == 0) {  // one second missing after row 300
+      std::ifstream in(f);
+      std::vector<std::string> lines;
+      for (std::string line; std::getline(in, line);) lines.push_back(line);
+      std::ofstream out(f);
+      for (std::size_t r = 0; r < lines.size(); ++r) {
+        if (r <= 300) {
+          out << lines[r] << "\n";
+          continue;
+        }
+        const std::size_t comma = lines[r].find(',');
+        out << std::stod(lines[r].substr(0, comma)) + 1.0 << lines[r].substr(comma) << "\n";
+      }
+    }
+    files += " " + f;
+  }
+  const auto warned = [](const nlohmann::json& j) {
+    for (const auto& w : j["warnings"])
+      if (w.get<std::string>().find("clock jumps") != std::string::npos) return true;
+    return false;
+  };
+  int status = 0;
+  const auto j = run_cli("--sensor-columns touch" + files, &status);
+  ASSERT_EQ(status, 0) << j.dump();
+  EXPECT_TRUE(warned(j)) << j["warnings"];
+  const auto uniform = run_cli("--sensor-columns touch --resample 50" + files, &status);
+  ASSERT_EQ(status, 0) << uniform.dump();
+  EXPECT_FALSE(warned(uniform)) << uniform["warnings"];
+}
+
 TEST(SegmentCli, FeaturesAreTheMatrixTheBagReaderGave) {
   std::vector<std::string> bags;
   std::string files;

@@ -20,4 +20,10 @@ lfd::FeatureMatrix read_csv_features(const std::string& path, const std::string&
                                      double rate = 0.0,
                                      const RequestLimits& limits = RequestLimits());
 
+/// "" for a clock without gaps; else a warning naming the largest gap: the segmentation takes the
+/// rows as evenly spaced (its windows and lags are counted in samples of the median step), so a
+/// gap of more than `max_missing` median steps shifts every time parameter across it.
+std::string clock_gap_warning(const lfd::FeatureMatrix& matrix, const std::string& path,
+                              double max_missing = 10.0);
+
 }  // namespace lfd_segmentation
