@@ -184,6 +184,26 @@ Options parse_args(int argc, char** argv) {
   return o;
 }
 
+// --resample: the clock's span is checked against the per-demo sample limit before anything is
+// allocated (a time column in milliseconds read as seconds would ask for 1000 times the rows).
+lfd::FeatureMatrix resample_within_limits(const lfd::FeatureMatrix& m, double rate,
+                                          const std::string& path,
+                                          const lfd_segmentation::SegmentationParams& params) {
+  const double span = m.time.empty() ? 0.0 : m.time.back() - m.time.front();
+  const double rows = span * rate + 1.0;
+  if (!(rows <= static_cast<double>(params.limits.max_samples_per_demo)))
+    throw std::invalid_argument("'" + path + "' spans " + std::to_string(span) +
+                                " s: at --resample " + std::to_string(rate) +
+                                " Hz that is over the limit of " +
+                                std::to_string(params.limits.max_samples_per_demo) +
+                                " samples (limits/max_samples_per_demo)");
+  try {
+    return lfd::resample(m, rate);
+  } catch (const std::invalid_argument& e) {
+    throw std::invalid_argument("'" + path + "': " + e.what());
+  }
+}
+
 nlohmann::json run(const Options& o) {
   const auto start = std::chrono::steady_clock::now();
   lfd_segmentation::SegmentationParams params = lfd_segmentation::load_params_file(o.config);
@@ -238,7 +258,8 @@ nlohmann::json run(const Options& o) {
             "CSV file '" + f +
             "' has no time column (time, t, timestamp, stamp or --time-column): give its sample "
             "rate with --rate, the time parameters are in seconds");
-      if (o.resample > 0) demos.back() = lfd::resample(demos.back(), o.resample);
+      if (o.resample > 0)
+        demos.back() = resample_within_limits(demos.back(), o.resample, f, params);
       const std::string gap = lfd_segmentation::clock_gap_warning(demos.back(), f);
       if (!gap.empty()) clock_warnings.push_back(gap);
     }

@@ -207,6 +207,14 @@ TEST(SegmentCli, ResampleAveragesAFastCsvOntoASlowerClock) {
   j = run_cli("--resample 0 --sensor-columns touch" + fast, &status);
   EXPECT_EQ(status, 1);
   EXPECT_NE(j["error"].get<std::string>().find("--resample"), std::string::npos);
+  // A time column in milliseconds read as seconds: 13,000 s at 50 Hz is refused before anything
+  // is allocated.
+  const std::string ms = (temp_dir() / "milliseconds.csv").string();
+  write_demo_csv(ms, 13000, 7, 1.0);
+  j = run_cli("--sensor-columns touch --resample 50 " + ms + fast, &status);
+  EXPECT_EQ(status, 1);
+  EXPECT_NE(j["error"].get<std::string>().find("max_samples_per_demo"), std::string::npos)
+      << j["error"];
 }
 
 // A logger that stalled for a second: the rows across the gap are not evenly spaced, which the
