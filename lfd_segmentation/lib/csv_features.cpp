@@ -1,8 +1,8 @@
 #include "lfd_segmentation/csv_features.hpp"
 
 #include "lfd_core/safe_paths.hpp"
+#include "lfd_core/segmentation_pipeline.hpp"
 
-#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
@@ -145,15 +145,17 @@ lfd::FeatureMatrix read_csv_features(const std::string& path, const std::string&
 std::string clock_gap_warning(const lfd::FeatureMatrix& matrix, const std::string& path,
                               double max_missing) {
   if (matrix.time.size() < 3) return "";
-  std::vector<double> steps(matrix.time.size() - 1);
-  for (std::size_t r = 1; r < matrix.time.size(); ++r)
-    steps[r - 1] = matrix.time[r] - matrix.time[r - 1];
-  const auto largest = std::max_element(steps.begin(), steps.end());
-  const std::size_t row = static_cast<std::size_t>(largest - steps.begin()) + 1;
-  const double gap = *largest;
-  std::nth_element(steps.begin(), steps.begin() + steps.size() / 2, steps.end());
-  const double median = steps[steps.size() / 2];
-  if (!(median > 0.0) || !(gap > max_missing * median)) return "";
+  std::size_t row = 1;  // the row after the largest step
+  for (std::size_t r = 2; r < matrix.time.size(); ++r)
+    if (matrix.time[r] - matrix.time[r - 1] > matrix.time[row] - matrix.time[row - 1]) row = r;
+  const double gap = matrix.time[row] - matrix.time[row - 1];
+  double median = 0.0;  // the pipeline's own step
+  try {
+    median = 1.0 / lfd::sample_rate_of(matrix);
+  } catch (const std::invalid_argument&) {
+    return "";  // a clock that does not increase: the pipeline refuses it, naming the demo
+  }
+  if (!(gap > max_missing * median)) return "";
   std::ostringstream text;
   text << "'" << path << "': the clock jumps " << gap << " s at row " << row << " (median step "
        << median << " s); the rows are taken as evenly spaced, so put them on a uniform clock with "

@@ -349,16 +349,10 @@ bool at_rest(const Channel& c, std::size_t from, std::size_t to) {
   return median_of(d) < c.on;
 }
 
-// Whether channel c leaves its rest level (regains it) at a sample of [from, to).
-bool leaves_rest_within(const Channel& c, std::size_t from, std::size_t to) {
+// Whether channel c leaves its rest level (`leaving`) or regains it at a sample of [from, to).
+bool rest_edge_within(const Channel& c, bool leaving, std::size_t from, std::size_t to) {
   return std::any_of(c.events.begin(), c.events.end(), [&](const PlacedEvent& p) {
-    return p.from_rest && p.event.index >= from && p.event.index < to;
-  });
-}
-
-bool regains_rest_within(const Channel& c, std::size_t from, std::size_t to) {
-  return std::any_of(c.events.begin(), c.events.end(), [&](const PlacedEvent& p) {
-    return p.to_rest && p.event.index >= from && p.event.index < to;
+    return (leaving ? p.from_rest : p.to_rest) && p.event.index >= from && p.event.index < to;
   });
 }
 
@@ -424,10 +418,10 @@ void flag_rest_edges_of_group(std::vector<Channel>* channels, const std::vector<
       bool after = p.to_rest && longest(e, e + lag) >= min_rest;
       for (std::size_t o : deciding) {
         if (o == c) continue;
-        before =
-            before && at_rest((*channels)[o], lo, e) && !leaves_rest_within((*channels)[o], lo, e);
-        after = after && at_rest((*channels)[o], e, e + lag) &&
-                !regains_rest_within((*channels)[o], e + 1, e + lag + 1);
+        const Channel& other = (*channels)[o];
+        before = before && at_rest(other, lo, e) && !rest_edge_within(other, true, lo, e);
+        after = after && at_rest(other, e, e + lag) &&
+                !rest_edge_within(other, false, e + 1, e + lag + 1);
       }
       p.event.rest_edge = before || after;
     }
