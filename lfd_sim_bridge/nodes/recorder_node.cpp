@@ -25,6 +25,7 @@
 #include <topic_tools/shape_shifter.h>
 
 #include "lfd_sim_bridge/bag_recorder.hpp"
+#include "lfd_sim_bridge/topic_connections.hpp"
 
 namespace {
 
@@ -128,6 +129,7 @@ class Recorder {
       std::lock_guard<std::mutex> lock(mutex_);
       if (latched) latched_[topic] = event;
       last_stamp_[topic] = stamp;
+      heard_from_[topic].insert(event.getPublisherName());
       if (bag_ && (stop_time_.isZero() || stamp <= stop_time_)) {
         try {
           bag_->write(topic, stamp, event);
@@ -139,22 +141,18 @@ class Recorder {
     settled_.notify_all();
   }
 
-  // A subscription may still be connecting when the first demo starts (seen on a loaded CI
-  // machine: /wrist_ft joined 4 s of sim time late). Wait, in wall time and bounded, until every
-  // topic that the master knows a publisher of is connected. Topics nobody publishes yet (e.g.
-  // the demonstrator's /lfd/phase when the recorder starts first) are not waited for.
-  // paused_only: give up as soon as sim time moves (a running sim would lose data meanwhile);
-  // the lockstep demonstrator keeps the sim paused while it starts a recording.
-  void waitForConnections(double timeout, bool paused_only = false) {
+  // At start-up, wait (in wall time, bounded) until every topic that the master knows a publisher
+  // of has one. Topics nobody publishes yet (e.g. the demonstrator's /lfd/phase when the recorder
+  // starts first) are not waited for. A counted publisher may not be sending yet: see
+  // waitForPublisherLinks.
+  void waitForConnections(double timeout) {
     ros::master::V_TopicInfo advertised;
     if (!ros::master::getTopics(advertised)) return;
     std::set<std::string> published;
     for (const ros::master::TopicInfo& t : advertised) published.insert(t.name);
     const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(timeout);
-    const ros::Time sim_start = ros::Time::now();
     std::vector<std::string> missing;
     do {
-      if (paused_only && ros::Time::now() != sim_start) return;
       missing.clear();
       for (std::size_t i = 0; i < subscribers_.size(); ++i)
         if (published.count(subscribers_[i].getTopic()) && subscribers_[i].getNumPublishers() == 0)
@@ -162,11 +160,70 @@ class Recorder {
       if (missing.empty()) return;
       ros::WallDuration(0.01).sleep();
     } while (ros::WallTime::now() < deadline && ros::ok());
-    std::string names;
-    for (const std::string& m : missing) names += " " + m;
-    if (!paused_only)
-      ROS_WARN("recorder: no publisher connected after %.1f s on:%s (going on)", timeout,
-               names.c_str());
+    ROS_WARN("recorder: no publisher connected after %.1f s on:%s (going on)", timeout,
+             joined(missing).c_str());
+  }
+
+  // Before a bag opens, every periodic topic is connected to each of its publishers but the node
+  // asking for the recording (topic_connections.hpp: a counted publisher may not be sending yet).
+  // Seen on a loaded CI machine: four sensor topics joined a bag 7.5 s of sim time late. A topic
+  // is connected once a message came from the publisher, or once the publisher lists the link.
+  // Waits only while the sim is paused (a running sim would lose data meanwhile; the lockstep
+  // demonstrator keeps it paused while it starts a recording), at most connect_timeout.
+  void waitForPublisherLinks(const std::string& caller) {
+    lfd_sim_bridge::PublishersByTopic publishers;
+    if (!lfd_sim_bridge::publishersFromMaster(&publishers)) return;
+    std::vector<std::string> periodic;
+    for (const TopicSpec& spec : topics_)
+      if (spec.rate > 0.0) periodic.push_back(spec.name);
+    const ros::Time sim_start = ros::Time::now();
+    const ros::WallTime wait_start = ros::WallTime::now();
+    const ros::WallTime deadline = wait_start + ros::WallDuration(connect_timeout_);
+    std::map<std::string, std::set<std::string>> linked;  // topic -> publishers known connected
+    std::vector<std::string> awaiting, first_awaiting;
+    while (ros::ok()) {
+      {
+        std::lock_guard<std::mutex> lock(mutex_);
+        for (const auto& [topic, nodes] : heard_from_)
+          linked[topic].insert(nodes.begin(), nodes.end());
+      }
+      awaiting = lfd_sim_bridge::topicsAwaitingData(periodic, publishers, linked, caller);
+      if (awaiting.empty() || ros::Time::now() != sim_start) {
+        if (!first_awaiting.empty())
+          ROS_INFO("recorder: waited %.2f s for the links of:%s",
+                   (ros::WallTime::now() - wait_start).toSec(), joined(first_awaiting).c_str());
+        return;
+      }
+      if (first_awaiting.empty()) first_awaiting = awaiting;
+      const double left = (deadline - ros::WallTime::now()).toSec();
+      if (left <= 0.0) break;
+      askPublishersForLinks(awaiting, publishers, left, &linked);
+      ros::WallDuration(0.01).sleep();
+    }
+    ROS_WARN("recorder: after %.1f s, still not connected to a publisher of:%s (recording anyway)",
+             connect_timeout_, joined(awaiting).c_str());
+  }
+
+  static void askPublishersForLinks(const std::vector<std::string>& topics,
+                                    const lfd_sim_bridge::PublishersByTopic& publishers,
+                                    double timeout,
+                                    std::map<std::string, std::set<std::string>>* linked) {
+    std::set<std::string> nodes;
+    for (const std::string& topic : topics)
+      for (const std::string& node : publishers.at(topic)) nodes.insert(node);
+    for (const std::string& node : nodes) {
+      std::set<std::string> topics_of_node;
+      if (!lfd_sim_bridge::topicsLinkedTo(node, ros::this_node::getName(), timeout,
+                                          &topics_of_node))
+        continue;
+      for (const std::string& topic : topics_of_node) (*linked)[topic].insert(node);
+    }
+  }
+
+  static std::string joined(const std::vector<std::string>& names) {
+    std::string text;
+    for (const std::string& name : names) text += " " + name;
+    return text;
   }
 
   // Logs each recovered crash and returns it as text for the service answer ("" if none).
@@ -182,9 +239,12 @@ class Recorder {
     return text;
   }
 
-  bool onStart(lfd_msgs::StartRecording::Request& req, lfd_msgs::StartRecording::Response& res) {
-    // Publishers that appeared after start-up (e.g. the bridge started after the recorder).
-    waitForConnections(2.0, true);
+  bool onStart(ros::ServiceEvent<lfd_msgs::StartRecording::Request,
+                                 lfd_msgs::StartRecording::Response>& event) {
+    const lfd_msgs::StartRecording::Request& req = event.getRequest();
+    lfd_msgs::StartRecording::Response& res = event.getResponse();
+    // Also covers publishers that appeared after start-up (e.g. a bridge started after us).
+    waitForPublisherLinks(event.getCallerName());
     std::lock_guard<std::mutex> lock(mutex_);
     if (bag_) {
       res.success = false;
@@ -295,7 +355,7 @@ class Recorder {
   std::vector<TopicSpec> topics_;
   double settle_timeout_ = 1.0;
   std::vector<ros::Subscriber> subscribers_;
-  double connect_timeout_ = 5.0;  // s of wall time, at start-up
+  double connect_timeout_ = 5.0;  // s of wall time: at start-up, and at a start (sim paused)
   double max_unflushed_ = 0.1;    // s of bag time a kill -9 may lose (chunk closed this often)
   ros::NodeHandle service_nh_;
   ros::CallbackQueue service_queue_;
@@ -308,6 +368,7 @@ class Recorder {
   ros::Time stop_time_, latest_clock_;
   ros::Subscriber clock_sub_;
   std::map<std::string, ros::Time> last_stamp_;
+  std::map<std::string, std::set<std::string>> heard_from_;  // topic -> publisher nodes
   std::map<std::string, ros::MessageEvent<const topic_tools::ShapeShifter>> latched_;
 };
 
