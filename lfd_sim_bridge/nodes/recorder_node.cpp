@@ -132,7 +132,7 @@ class Recorder {
       heard_from_[topic].insert(event.getPublisherName());
       if (bag_ && (stop_time_.isZero() || stamp <= stop_time_)) {
         try {
-          bag_->write(topic, stamp, event);
+          if (bag_->write(topic, stamp, event)) first_written_.emplace(topic, stamp);
         } catch (const std::exception& e) {
           ROS_ERROR_THROTTLE(1.0, "recorder: writing %s failed: %s", topic.c_str(), e.what());
         }
@@ -164,19 +164,17 @@ class Recorder {
              joined(missing).c_str());
   }
 
-  // Before a bag opens, every periodic topic is connected to each of its publishers but the node
-  // asking for the recording (topic_connections.hpp: a counted publisher may not be sending yet).
-  // Seen on a loaded CI machine: four sensor topics joined a bag 7.5 s of sim time late. A topic
-  // is connected once a message came from the publisher, or once the publisher lists the link.
-  // Waits only while the sim is paused (a running sim would lose data meanwhile; the lockstep
-  // demonstrator keeps it paused while it starts a recording), at most connect_timeout.
+  // A new bag's periodic topics are each linked to each of their publishers but the node asking
+  // for the recording (topic_connections.hpp: roscpp counts a publisher before the publisher has
+  // taken the connection, and what it sends in between is lost). Seen on a loaded CI machine:
+  // four sensor topics joined a bag 7.5 s of sim time late. A topic is linked once a message came
+  // from the publisher, or once the publisher lists the link. Waits at most connect_timeout.
   void waitForPublisherLinks(const std::string& caller) {
     lfd_sim_bridge::PublishersByTopic publishers;
     if (!lfd_sim_bridge::publishersFromMaster(&publishers)) return;
     std::vector<std::string> periodic;
     for (const TopicSpec& spec : topics_)
       if (spec.rate > 0.0) periodic.push_back(spec.name);
-    const ros::Time sim_start = ros::Time::now();
     const ros::WallTime wait_start = ros::WallTime::now();
     const ros::WallTime deadline = wait_start + ros::WallDuration(connect_timeout_);
     std::map<std::string, std::set<std::string>> linked;  // topic -> publishers known connected
@@ -188,7 +186,7 @@ class Recorder {
           linked[topic].insert(nodes.begin(), nodes.end());
       }
       awaiting = lfd_sim_bridge::topicsAwaitingData(periodic, publishers, linked, caller);
-      if (awaiting.empty() || ros::Time::now() != sim_start) {
+      if (awaiting.empty()) {
         if (!first_awaiting.empty())
           ROS_INFO("recorder: waited %.2f s for the links of:%s",
                    (ros::WallTime::now() - wait_start).toSec(), joined(first_awaiting).c_str());
@@ -241,15 +239,20 @@ class Recorder {
 
   bool onStart(ros::ServiceEvent<lfd_msgs::StartRecording::Request,
                                  lfd_msgs::StartRecording::Response>& event) {
-    const lfd_msgs::StartRecording::Request& req = event.getRequest();
-    lfd_msgs::StartRecording::Response& res = event.getResponse();
-    // Also covers publishers that appeared after start-up (e.g. a bridge started after us).
+    if (!openBag(event.getRequest(), &event.getResponse())) return true;
+    // The bag is open: topics already linked record from its start while the others connect.
+    // The caller waits for this answer (a lockstep demonstrator does not step the sim meanwhile).
     waitForPublisherLinks(event.getCallerName());
+    return true;
+  }
+
+  bool openBag(const lfd_msgs::StartRecording::Request& req,
+               lfd_msgs::StartRecording::Response* res) {
     std::lock_guard<std::mutex> lock(mutex_);
     if (bag_) {
-      res.success = false;
-      res.message = "already recording to " + bag_->path();
-      return true;
+      res->success = false;
+      res->message = "already recording to " + bag_->path();
+      return false;
     }
     const ros::Time start =
         req.metadata.header.stamp.isZero() ? ros::Time::now() : req.metadata.header.stamp;
@@ -260,16 +263,17 @@ class Recorder {
       bag_ = std::make_unique<lfd_sim_bridge::DemoBag>(req.bag_path, req.metadata, start,
                                                        ros::Duration(max_unflushed_));
     } catch (const std::exception& e) {
-      res.success = false;
-      res.message = e.what() + recovered;
+      res->success = false;
+      res->message = e.what() + recovered;
       ROS_ERROR("recorder: %s", e.what());
-      return true;
+      return false;
     }
     stop_time_ = ros::Time();
+    first_written_.clear();
     // Latched topics (e.g. /tf_static) were sent once, before this demo: repeat them at its start.
     for (const auto& [topic, event] : latched_) bag_->write(topic, start, event);
-    res.success = true;
-    res.message = "recording " + req.bag_path + recovered;
+    res->success = true;
+    res->message = "recording " + req.bag_path + recovered;
     ROS_INFO("recorder: start %s at t=%.3f", req.bag_path.c_str(), start.toSec());
     return true;
   }
@@ -338,6 +342,12 @@ class Recorder {
     const double duration = (stop_time_ - bag_->start()).toSec();
     if (duration <= 0.5) return;
     for (const TopicSpec& spec : topics_) {
+      // A late first message is data lost upstream (e.g. a publisher queue shorter than our lag).
+      const auto first = first_written_.find(spec.name);
+      if (spec.rate > 0.0 && first != first_written_.end() &&
+          (first->second - bag_->start()).toSec() > 2.0 / spec.rate)
+        ROS_WARN("recorder: %s began %.3f s after the bag's start: its first messages were lost",
+                 spec.name.c_str(), (first->second - bag_->start()).toSec());
       const auto it = bag_->perTopic().find(spec.name);
       const double count = it == bag_->perTopic().end() ? 0.0 : static_cast<double>(it->second);
       if (spec.rate > 0.0 && count < 0.5 * spec.rate * duration)
@@ -355,7 +365,7 @@ class Recorder {
   std::vector<TopicSpec> topics_;
   double settle_timeout_ = 1.0;
   std::vector<ros::Subscriber> subscribers_;
-  double connect_timeout_ = 5.0;  // s of wall time: at start-up, and at a start (sim paused)
+  double connect_timeout_ = 5.0;  // s of wall time: at start-up, and at each start
   double max_unflushed_ = 0.1;    // s of bag time a kill -9 may lose (chunk closed this often)
   ros::NodeHandle service_nh_;
   ros::CallbackQueue service_queue_;
@@ -368,6 +378,7 @@ class Recorder {
   ros::Time stop_time_, latest_clock_;
   ros::Subscriber clock_sub_;
   std::map<std::string, ros::Time> last_stamp_;
+  std::map<std::string, ros::Time> first_written_;           // per topic, in the open bag
   std::map<std::string, std::set<std::string>> heard_from_;  // topic -> publisher nodes
   std::map<std::string, ros::MessageEvent<const topic_tools::ShapeShifter>> latched_;
 };
