@@ -1,7 +1,8 @@
 // recorder_node: one bag per demonstration. Subscribes generically (ShapeShifter) to the topics of
 // config/recorder.yaml from startup, so no subscription latency is paid when a demo starts, and
 // writes them while a recording is active, stamped with their header time (sim time).
-//   /recorder/start (lfd_msgs/StartRecording): open <bag_path>.active, write metadata first
+//   /recorder/start (lfd_msgs/StartRecording): open <bag_path>.active, write metadata first,
+//                   answer once every topic is linked to each of its publishers
 //   /recorder/stop  (lfd_msgs/StopRecording):  wait for in-flight messages, close, rename
 // SIGINT/SIGTERM close the open bag cleanly before the node exits.
 #include <atomic>
