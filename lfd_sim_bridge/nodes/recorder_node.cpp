@@ -133,7 +133,7 @@ class Recorder {
       heard_from_[topic].insert(event.getPublisherName());
       if (bag_ && (stop_time_.isZero() || stamp <= stop_time_)) {
         try {
-          if (bag_->write(topic, stamp, event)) first_written_.emplace(topic, stamp);
+          if (bag_->write(topic, stamp, event)) first_written_.try_emplace(topic, stamp);
         } catch (const std::exception& e) {
           ROS_ERROR_THROTTLE(1.0, "recorder: writing %s failed: %s", topic.c_str(), e.what());
         }

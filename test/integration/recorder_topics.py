@@ -35,6 +35,15 @@ class RecorderTopics(unittest.TestCase):
             self.assertLess(time.time(), deadline, "%s did not appear in %.0f s" % (path, timeout))
             time.sleep(0.2)
 
+    def spawn_recorder(self, name, **params):
+        """A second recorder node, `name`, with the shipped topics and services under /<name>/."""
+        rospy.set_param("/%s/topics" % name, self.config["topics"])
+        for key, value in params.items():
+            rospy.set_param("/%s/%s" % (name, key), value)
+        return subprocess.Popen(["rosrun", "lfd_sim_bridge", "recorder_node", "__name:=" + name,
+                                 "/recorder/start:=/%s/start" % name,
+                                 "/recorder/stop:=/%s/stop" % name])
+
     def test_1_demo_bag_has_every_topic_at_its_rate(self):
         bag_path = os.path.join(self.output_dir, "push_sim_00.bag")
         self.wait_for_file(bag_path, 180.0)
@@ -66,11 +75,7 @@ class RecorderTopics(unittest.TestCase):
                 self.assertLessEqual(end - stamps[-1], 2.0 * period + 1e-6, name)
 
     def test_2_sigint_closes_the_bag(self):
-        rospy.set_param("/recorder_sigint/topics", self.config["topics"])
-        proc = subprocess.Popen(["rosrun", "lfd_sim_bridge", "recorder_node",
-                                 "__name:=recorder_sigint",
-                                 "/recorder/start:=/recorder_sigint/start",
-                                 "/recorder/stop:=/recorder_sigint/stop"])
+        proc = self.spawn_recorder("recorder_sigint")
         try:
             rospy.wait_for_service("/recorder_sigint/start", timeout=30.0)
             time.sleep(0.5)  # subscriptions connect
@@ -120,11 +125,7 @@ class RecorderTopics(unittest.TestCase):
         rospy.wait_for_service("/bridge/pause", timeout=10.0)
         pause = rospy.ServiceProxy("/bridge/pause", SetBool)
         self.assertTrue(pause(True).success)
-        rospy.set_param("/recorder_paused/topics", self.config["topics"])
-        rospy.set_param("/recorder_paused/connect_timeout", 30.0)
-        proc = subprocess.Popen(["rosrun", "lfd_sim_bridge", "recorder_node", "__name:=recorder_paused",
-                                 "/recorder/start:=/recorder_paused/start",
-                                 "/recorder/stop:=/recorder_paused/stop"])
+        proc = self.spawn_recorder("recorder_paused", connect_timeout=30.0)
         bag_path = os.path.join(self.output_dir, "paused", "paused.bag")
         try:
             rospy.wait_for_service("/recorder_paused/start", timeout=60.0)
