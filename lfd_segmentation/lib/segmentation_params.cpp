@@ -80,6 +80,52 @@ TopicConfig parse_topic(const YAML::Node& node, std::size_t index) {
   return topic;
 }
 
+double fraction(double value, const std::string& key) {
+  if (!(value >= 0 && value <= 1))
+    throw std::invalid_argument("segmentation parameter '" + key + "' must be in [0, 1]");
+  return value;
+}
+
+// joint: the joint segmentation's evidence weights, pauses, alignment and agreement.
+void parse_joint(const YAML::Node& node, lfd::JointSegmentationConfig* joint) {
+  const YAML::Node w = node ? node["weights"] : YAML::Node();
+  auto& weights = joint->weights;
+  weights.contact = fraction(get<double>(w, "contact", weights.contact), "joint/weights/contact");
+  weights.sensor_level = fraction(get<double>(w, "sensor_level", weights.sensor_level),
+                                  "joint/weights/sensor_level");
+  weights.motion_onset = fraction(get<double>(w, "motion_onset", weights.motion_onset),
+                                  "joint/weights/motion_onset");
+  weights.clasp = fraction(get<double>(w, "clasp", weights.clasp), "joint/weights/clasp");
+  const YAML::Node pause = node ? node["pauses"] : YAML::Node();
+  auto& pc = joint->pauses;
+  pc.smoothing = non_negative(get<double>(pause, "smoothing_seconds", pc.smoothing),
+                              "joint/pauses/smoothing_seconds");
+  pc.rest_fraction = fraction(get<double>(pause, "rest_fraction", pc.rest_fraction),
+                              "joint/pauses/rest_fraction");
+  pc.min_pause = non_negative(get<double>(pause, "min_pause_seconds", pc.min_pause),
+                              "joint/pauses/min_pause_seconds");
+  pc.pause_scale = positive(get<double>(pause, "pause_scale_seconds", pc.pause_scale),
+                            "joint/pauses/pause_scale_seconds");
+  pc.motion_window = positive(get<double>(pause, "motion_window_seconds", pc.motion_window),
+                              "joint/pauses/motion_window_seconds");
+  joint->grid_step = positive(get<double>(node, "grid_step_seconds", joint->grid_step),
+                              "joint/grid_step_seconds");
+  joint->spread = positive(get<double>(node, "spread_seconds", joint->spread),
+                           "joint/spread_seconds");
+  joint->min_support =
+      fraction(get<double>(node, "min_support", joint->min_support), "joint/min_support");
+  joint->short_phase_support = fraction(
+      get<double>(node, "short_phase_support", joint->short_phase_support),
+      "joint/short_phase_support");
+  joint->match_window = positive(get<double>(node, "match_window_seconds", joint->match_window),
+                                 "joint/match_window_seconds");
+  joint->colocation = non_negative(get<double>(node, "colocation_seconds", joint->colocation),
+                                   "joint/colocation_seconds");
+  joint->extra_event_weight = fraction(
+      get<double>(node, "extra_event_weight", joint->extra_event_weight),
+      "joint/extra_event_weight");
+}
+
 }  // namespace
 
 lfd::SegmentationPipelineConfig SegmentationParams::pipeline_config() const {
@@ -144,6 +190,7 @@ SegmentationParams params_from_yaml(const YAML::Node& root) {
     throw std::invalid_argument(
         "segmentation parameter 'consensus_fill_p_value' must be in [0, 1)");
   p.pipeline.threads = get<int>(root, "threads", p.pipeline.threads);
+  parse_joint(root["joint"], &p.pipeline.joint);
 
   const YAML::Node clasp = root["clasp"];
   auto& cc = seg.clasp;

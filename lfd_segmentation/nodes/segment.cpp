@@ -42,7 +42,8 @@ const char* kUsage = R"(usage: segment [options] FILE...
                             features are selected once and the JSON holds one result per name
                             under "methods" (the selection does not depend on the combination)
   --procedure NAME          zone_search (default: zones first, changepoints on their events) |
-                            paper (the paper's: paper_candidates anywhere, then the zone filter)
+                            paper (the paper's: paper_candidates anywhere, then the zone filter) |
+                            joint (all demos together: every kind of evidence, agreed by DTW)
   --threshold T             relevance threshold in (0,1]
   --min-segment-seconds S   min segment length min_s (s)
   --window-seconds S        fixed ClaSP window (s)

@@ -20,31 +20,27 @@ POSE = ["x", "y", "z", "qx", "qy", "qz", "qw"]
 WRENCH = ["fx", "fy", "fz", "tx", "ty", "tz"]
 
 
-def min_jerk(a, b, n):
-    s = np.linspace(0.0, 1.0, n)
-    return a + (b - a) * (10 * s ** 3 - 15 * s ** 4 + 6 * s ** 5)[:, None]
-
-
 def demo(rng, rate):
     reach, wipe, retract = rng.uniform(2.0, 3.5), rng.uniform(6.0, 10.0), rng.uniform(2.0, 3.0)
     start = np.array([0.3, -0.2, 0.35]) + rng.uniform(-0.05, 0.05, 3)
     touch = np.array([0.55, 0.0, 0.10]) + rng.uniform(-0.05, 0.05, 3)
     n_reach, n_wipe, n_retract = (int(round(d * rate)) for d in (reach, wipe, retract))
     above = touch + [0, 0, 0.04]
-    path = [min_jerk(start, above, n_reach - n_reach // 4), min_jerk(above, touch, n_reach // 4)]
+    path = [synthetic.min_jerk(start, above, n_reach - n_reach // 4),
+            synthetic.min_jerk(above, touch, n_reach // 4)]
     period, amp = rng.uniform(1.0, 1.8), rng.uniform(0.04, 0.08)
     tw = np.arange(n_wipe) / rate
     ramp = np.clip(tw / 0.5, 0, 1)  # the stroke builds up over half a second
     wiping = np.tile(touch, (n_wipe, 1))
     wiping[:, 1] += ramp * amp * np.sin(2 * np.pi * tw / period)
     wiping[:, 2] -= 0.002 * ramp  # the surface gives a little under the pressure
-    path += [wiping, min_jerk(wiping[-1], start + [0, 0, 0.05], n_retract)]
+    path += [wiping, synthetic.min_jerk(wiping[-1], start + [0, 0, 0.05], n_retract)]
     pos = np.vstack(path)
     n = len(pos)
     t = np.arange(n) / rate
     # The hand points down (half a turn about x) and turns slowly about the vertical.
     yaw = rng.uniform(-0.2, 0.2) + 0.2 * np.sin(2 * np.pi * t / (1.3 * t[-1]))
-    quat = np.column_stack([np.cos(yaw / 2), np.sin(yaw / 2), np.zeros(n), np.zeros(n)])
+    quat = synthetic.hand_down_quaternion(yaw)
     pos += 2e-4 * rng.standard_normal(pos.shape)
     # Wrench: press force during contact (ramping in and out over 0.15-0.4 s), friction along the
     # stroke, rest offset, white noise and drift.
@@ -61,10 +57,7 @@ def demo(rng, rate):
     fy = -0.4 * press * np.tanh(vel / 0.02)
     fx = 0.1 * press * stroke
     wrench = np.column_stack([fx, fy, fz, -0.1 * fy, 0.1 * fx, 0.01 * fy])
-    offset = rng.uniform(-2, 2, 6) * [1, 1, 1, 0.1, 0.1, 0.1]
-    drift = np.cumsum(rng.standard_normal((n, 6)), axis=0) * 0.01 / np.sqrt(rate)
-    noise = rng.standard_normal((n, 6)) * [0.5, 0.5, 0.7, 0.03, 0.03, 0.02]
-    wrench += offset + drift + noise
+    wrench += synthetic.ft_disturbance(rng, n, rate)
     return t, np.column_stack([pos, quat]), wrench, on / rate, off / rate
 
 

@@ -1,17 +1,16 @@
 #include "lfd_core/segmentation_pipeline.hpp"
 
+#include "lfd_core/joint_segmentation.hpp"
+#include "lfd_core/parallel_for.hpp"
 #include "lfd_core/segmentation_consensus.hpp"
 
 #include <algorithm>
-#include <atomic>
 #include <chrono>
 #include <cmath>
-#include <exception>
 #include <map>
 #include <set>
 #include <sstream>
 #include <stdexcept>
-#include <thread>
 
 namespace lfd {
 
@@ -56,9 +55,9 @@ bool is_constant(const FeatureMatrix& demo, int col) {
   return !(hi - lo > 1e-12 * (1.0 + std::max(std::abs(hi), std::abs(lo))));
 }
 
-// The channels of one sensor share their name up to the last '/' (a topic's array or vector:
-// /touch/values/0 and /touch/values/1); names without '/' (CSV columns) are one sensor.
-std::vector<std::size_t> sensor_groups(const std::vector<std::string>& names) {
+}  // namespace
+
+std::vector<std::size_t> sensor_channel_groups(const std::vector<std::string>& names) {
   std::map<std::string, std::size_t> ids;
   std::vector<std::size_t> groups;
   for (const std::string& name : names) {
@@ -69,40 +68,21 @@ std::vector<std::size_t> sensor_groups(const std::vector<std::string>& names) {
   return groups;
 }
 
-// Runs job(d) for every demonstration on up to `threads` threads; rethrows the first failure (by
+namespace {
+
+// Runs job(d) for every demonstration (parallel_for); rethrows the first failure (by
 // demonstration index) with the demonstration named.
 template <typename Job>
 void for_each_demo(std::size_t count, int threads, Job job) {
-  std::vector<std::exception_ptr> errors(count);
-  std::atomic<std::size_t> next{0};
-  auto worker = [&]() {
-    for (std::size_t d = next++; d < count; d = next++) {
-      try {
-        job(d);
-      } catch (...) {
-        errors[d] = std::current_exception();
-      }
-    }
-  };
-  if (threads <= 0) threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
-  threads = static_cast<int>(std::min<std::size_t>(threads, count));
-  if (threads <= 1) {
-    worker();
-  } else {
-    std::vector<std::thread> pool;
-    for (int t = 0; t < threads; ++t) pool.emplace_back(worker);
-    for (std::thread& t : pool) t.join();
-  }
-  for (std::size_t d = 0; d < count; ++d) {
-    if (!errors[d]) continue;
+  parallel_for(count, threads, [&](std::size_t d) {
     try {
-      std::rethrow_exception(errors[d]);
+      job(d);
     } catch (const std::invalid_argument& e) {
       throw std::invalid_argument(demo_context(d) + ": " + e.what());
     } catch (const std::exception& e) {
       throw std::runtime_error(demo_context(d) + ": " + e.what());
     }
-  }
+  });
 }
 
 // The sample-count settings of one demonstration: the config's own counts, or its seconds
@@ -199,11 +179,21 @@ std::size_t samples(double seconds, double rate, std::size_t at_least) {
 SegmentationProcedure parse_segmentation_procedure(const std::string& name) {
   if (name == "zone_search") return SegmentationProcedure::kZoneSearch;
   if (name == "paper") return SegmentationProcedure::kPaper;
-  throw std::invalid_argument("unknown segmentation procedure '" + name + "' (zone_search, paper)");
+  if (name == "joint") return SegmentationProcedure::kJoint;
+  throw std::invalid_argument("unknown segmentation procedure '" + name +
+                              "' (zone_search, paper, joint)");
 }
 
 std::string to_string(SegmentationProcedure procedure) {
-  return procedure == SegmentationProcedure::kPaper ? "paper" : "zone_search";
+  switch (procedure) {
+    case SegmentationProcedure::kPaper:
+      return "paper";
+    case SegmentationProcedure::kJoint:
+      return "joint";
+    case SegmentationProcedure::kZoneSearch:
+      break;
+  }
+  return "zone_search";
 }
 
 SegmentationPipelineConfig in_samples(const SegmentationPipelineConfig& config, double rate) {
@@ -340,6 +330,8 @@ PreparedSegmentation prepare_segmentation(const std::vector<FeatureMatrix>& demo
 SegmentationPipelineResult segment_prepared(const PreparedSegmentation& prepared,
                                             const std::vector<FeatureMatrix>& demos,
                                             const SegmentationPipelineConfig& config) {
+  if (config.procedure == SegmentationProcedure::kJoint)
+    return segment_jointly(prepared, demos, config);
   const auto segmentation_start = std::chrono::steady_clock::now();
   SegmentationPipelineResult result = prepared.base;
   const std::vector<std::string>& sensor_features = result.sensor_features;
@@ -350,7 +342,7 @@ SegmentationPipelineResult segment_prepared(const PreparedSegmentation& prepared
                                   ? "no sensor features: ClaSP changepoints are not validated"
                                   : "sensor validation disabled: ClaSP changepoints are accepted");
   }
-  const std::vector<std::size_t> groups = sensor_groups(sensor_features);
+  const std::vector<std::size_t> groups = sensor_channel_groups(sensor_features);
   result.demos.resize(demos.size());
   for_each_demo(demos.size(), config.threads, [&](std::size_t d) {
     result.demos[d] = segment_demo(demos[d], settings[d], result, validate, groups);
@@ -359,17 +351,21 @@ SegmentationPipelineResult segment_prepared(const PreparedSegmentation& prepared
     agree_on_changepoint_count(demos, validate, config.consensus_fill_p_value, &result);
   result.segmentation_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - segmentation_start).count();
-  for (std::size_t d = 0; d < demos.size() && validate; ++d) {
-    for (const std::string& sensor : sensor_features) {
-      if (is_constant(demos[d], demos[d].require(sensor)))
-        result.warnings.push_back(demo_context(d) + ": sensor '" + sensor +
-                                  "' is constant (dead or disconnected?): no zone from it");
-    }
-    if (result.demos[d].events.empty())
-      result.warnings.push_back(demo_context(d) +
-                                ": no sensory event detected, so no changepoint can be validated");
-  }
+  add_sensor_warnings(demos, validate, &result);
   return result;
+}
+
+void add_sensor_warnings(const std::vector<FeatureMatrix>& demos, bool validated,
+                         SegmentationPipelineResult* result) {
+  for (std::size_t d = 0; d < demos.size() && validated; ++d) {
+    for (const std::string& sensor : result->sensor_features) {
+      if (is_constant(demos[d], demos[d].require(sensor)))
+        result->warnings.push_back(demo_context(d) + ": sensor '" + sensor +
+                                   "' is constant (dead or disconnected?): no event from it");
+    }
+    if (result->demos[d].events.empty())
+      result->warnings.push_back(demo_context(d) + ": no sensory event detected");
+  }
 }
 
 SegmentationPipelineResult run_segmentation_pipeline(

@@ -15,6 +15,7 @@
 
 #include "lfd_core/clasp.hpp"
 #include "lfd_core/feature_relevance.hpp"
+#include "lfd_core/joint_segmentation_config.hpp"
 #include "lfd_core/multivariate_segmentation.hpp"
 #include "lfd_core/sensory_events.hpp"
 #include "lfd_core/time_series.hpp"
@@ -47,9 +48,12 @@ enum class SegmentationProcedure {
   /// Kaiser-penalized combined profile, then the zone filter (eq. 1): those inside a zone are
   /// the changepoints.
   kPaper,
+  /// All demos together (joint_segmentation.hpp): evidence of every kind (contact, sensor level
+  /// steps, motion after a pause, ClaSP) agreed across the demos aligned by DTW.
+  kJoint,
 };
 
-/// "zone_search" or "paper" (throws std::invalid_argument otherwise).
+/// "zone_search", "paper" or "joint" (throws std::invalid_argument otherwise).
 SegmentationProcedure parse_segmentation_procedure(const std::string& name);
 std::string to_string(SegmentationProcedure procedure);
 
@@ -87,9 +91,16 @@ struct SegmentationPipelineConfig {
   /// best in-zone candidates down to this p-value (0 = never), one per free zone: the agreement
   /// of the other demos is evidence that a skill boundary is there.
   double consensus_fill_p_value = 0.0;
+  /// kJoint: evidence weights, pauses, alignment and agreement.
+  JointSegmentationConfig joint;
   /// Worker threads for DTW and the per-demonstration segmentations (<= 0 = all cores).
   int threads = 0;
 };
+
+/// Each sensor column's sensor: the channels of one sensor share their name up to the last '/'
+/// (a topic's array or vector: /touch/values/0 and /touch/values/1); names without '/' (CSV
+/// columns) are one sensor.
+std::vector<std::size_t> sensor_channel_groups(const std::vector<std::string>& names);
 
 /// The configuration with its seconds (if any) converted to sample counts at `rate` (Hz) and
 /// `seconds` cleared; unchanged without seconds. Throws std::invalid_argument for rate <= 0.
@@ -102,6 +113,8 @@ double sample_rate_of(const FeatureMatrix& demo);
 struct DemoSegmentationResult {
   std::vector<std::size_t> changepoints;  ///< validated changepoints (row indices, sorted)
   std::vector<double> changepoint_times;  ///< their times (s, or index without a clock)
+  /// kJoint: the kinds of evidence of each changepoint in this demo ("contact+clasp", ...).
+  std::vector<std::string> changepoint_evidence;
   std::vector<std::size_t> rejected;      ///< ClaSP changepoints outside every zone
   std::vector<double> rejected_times;
   std::vector<std::size_t> pruned;  ///< validated, dropped to the consensus count (consensus_count)
@@ -151,6 +164,11 @@ PreparedSegmentation prepare_segmentation(const std::vector<FeatureMatrix>& demo
 SegmentationPipelineResult segment_prepared(const PreparedSegmentation& prepared,
                                             const std::vector<FeatureMatrix>& demos,
                                             const SegmentationPipelineConfig& config = {});
+
+/// Warns, per demo, of each constant (dead) sensor and of a demo without a sensory event
+/// (nothing when the sensors were not used).
+void add_sensor_warnings(const std::vector<FeatureMatrix>& demos, bool validated,
+                         SegmentationPipelineResult* result);
 
 /// Runs the pipeline (prepare_segmentation, then segment_prepared). `sensor_features` name the
 /// sensor columns; `state_features` name the candidates for segmentation (empty = every column that

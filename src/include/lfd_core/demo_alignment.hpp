@@ -1,0 +1,49 @@
+// Demonstrations of one task aligned on a common time axis, that of one reference demonstration
+// (the medoid: the least DTW cost to all others), by multivariate DTW of their state features on
+// a coarse uniform grid. The joint segmentation (joint_segmentation.hpp) carries each demo's
+// boundary evidence onto the reference's axis this way, and each agreed boundary back.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstddef>
+#include <vector>
+
+namespace lfd {
+
+/// One demonstration's features (rows = samples, already scaled alike across demos) on a grid of
+/// `step` seconds from its first sample: row k holds the features at time[0] + k * step
+/// (linear interpolation). Throws std::invalid_argument on a size mismatch or step <= 0.
+Eigen::MatrixXd on_uniform_grid(const Eigen::MatrixXd& features, const std::vector<double>& time,
+                                double step);
+
+/// Summed squared Euclidean distance along the best monotone warping path (no band).
+double multivariate_dtw_cost(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b);
+
+/// For every row of `a`, the mean row of `b` it is warped to by multivariate DTW (fractional).
+std::vector<double> multivariate_dtw_map(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b);
+
+struct DemoAlignment {
+  std::size_t reference = 0;  ///< the medoid demonstration
+  /// Per demo, per grid row: the reference grid row it aligns to (the reference maps to itself).
+  std::vector<std::vector<double>> to_reference;
+  /// Per demo, per reference grid row: the demo's grid row aligned to it.
+  std::vector<std::vector<double>> from_reference;
+  std::vector<double> mean_cost;  ///< per demo, DTW cost to the reference per aligned row
+};
+
+/// Aligns gridded demos (on_uniform_grid) to their medoid; `threads` <= 0 = all cores.
+/// Throws std::invalid_argument on no demos, an empty one or differing feature counts.
+DemoAlignment align_to_medoid(const std::vector<Eigen::MatrixXd>& gridded, int threads);
+
+/// The same map, with the alignment held at anchor pairs: row a_anchors[k] of `a` is matched to
+/// row b_anchors[k] of `b` and DTW runs between consecutive anchors only (both increasing, inside
+/// the series). Agreed boundaries hold a long alignment on track where the features alone are
+/// ambiguous (a pause matches any other pause).
+std::vector<double> anchored_dtw_map(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b,
+                                     const std::vector<std::size_t>& a_anchors,
+                                     const std::vector<std::size_t>& b_anchors);
+
+/// Linear interpolation of a per-row map at a fractional row (clamped to its ends).
+double map_row(const std::vector<double>& map, double row);
+
+}  // namespace lfd

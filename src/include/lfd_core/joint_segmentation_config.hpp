@@ -1,0 +1,34 @@
+// Settings of the joint segmentation (joint_segmentation.hpp), in seconds or as statistics.
+#pragma once
+
+#include "lfd_core/boundary_evidence.hpp"
+
+namespace lfd {
+
+struct JointSegmentationConfig {
+  EvidenceWeights weights;
+  PauseConfig pauses;
+  /// Step of the grid the demos are aligned on (s): alignment needs the phases' order, not the
+  /// samples; each boundary is then placed on its own demo's evidence at the full rate.
+  double grid_step = 0.1;
+  /// Spread of a piece of evidence on the reference's axis (s, Gaussian sigma): the DTW
+  /// alignment's error between demos that move at different speeds.
+  double spread = 0.5;
+  /// A boundary of the task needs this support: the mean over the demos of each demo's evidence
+  /// near it (noisy-OR of its pieces). 0.5 = as if half the demos were sure of it.
+  double min_support = 0.5;
+  /// A boundary closer than min_segment (s) to a better supported one needs this support: short
+  /// phases exist, but two pieces of evidence of one change (a touch and the force settling)
+  /// usually lie that close.
+  double short_phase_support = 0.8;
+  /// A demo's own evidence must lie within this of an agreed boundary (s, on the reference's
+  /// axis); a demo with none there is reported as lacking that boundary, never forced.
+  double match_window = 1.5;
+  /// Pieces of one demo's evidence closer than this (s) mark one instant: they reinforce each
+  /// other when a boundary is placed, and are claimed by it together.
+  double colocation = 0.25;
+  /// A demo's unmatched evidence at least this heavy is reported as an event its siblings lack.
+  double extra_event_weight = 0.85;
+};
+
+}  // namespace lfd

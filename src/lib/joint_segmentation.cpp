@@ -1,0 +1,439 @@
+#include "lfd_core/joint_segmentation.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+
+#include "lfd_core/demo_alignment.hpp"
+#include "lfd_core/parallel_for.hpp"
+
+namespace lfd {
+
+namespace {
+
+// One demo's evidence: its pieces, where each falls on the reference's grid, whether an agreed
+// boundary has claimed it, and the demo's own rows on its grid.
+struct DemoEvidence {
+  std::vector<BoundaryEvidence> pieces;
+  std::vector<double> reference_rows;
+  std::vector<bool> claimed;
+  std::vector<double> grid_rows;  ///< per piece, on the demo's own grid
+};
+
+// One agreed boundary: where on the reference, how well supported, and per demo the piece that
+// places it (-1: the demo shows no evidence of it) and the demo's grid row that anchors the
+// alignment (the piece's, else where the alignment expects it).
+struct Anchor {
+  double reference_row = 0.0;
+  double support = 0.0;
+  std::vector<long> piece;
+  std::vector<std::size_t> demo_row;
+};
+
+std::string describe(const std::string& what, std::size_t d) {
+  return "demonstration " + std::to_string(d) + ": " + what;
+}
+
+// State features that move in at least one demo.
+std::vector<std::string> moving_states(const std::vector<FeatureMatrix>& demos,
+                                       const std::vector<std::string>& states) {
+  std::vector<std::string> out;
+  for (const std::string& name : states) {
+    for (const FeatureMatrix& demo : demos) {
+      const auto col = demo.data.col(demo.require(name));
+      if (col.maxCoeff() - col.minCoeff() > 1e-12 * (1.0 + col.cwiseAbs().maxCoeff())) {
+        out.push_back(name);
+        break;
+      }
+    }
+  }
+  return out;
+}
+
+// The moving state features of every demo, each divided by its largest range over the task, so
+// that DTW and the speed weigh a joint angle and a position alike.
+std::vector<Eigen::MatrixXd> scaled_states(const std::vector<FeatureMatrix>& demos,
+                                           const std::vector<std::string>& names) {
+  std::vector<Eigen::MatrixXd> out;
+  for (const FeatureMatrix& demo : demos) out.push_back(demo.select(names).data);
+  for (Eigen::Index c = 0; c < static_cast<Eigen::Index>(names.size()); ++c) {
+    double range = 0.0;
+    for (const Eigen::MatrixXd& m : out)
+      range = std::max(range, m.col(c).maxCoeff() - m.col(c).minCoeff());
+    if (!(range > 0)) range = 1.0;
+    for (Eigen::MatrixXd& m : out) m.col(c) = (m.col(c).array() - m.col(c).minCoeff()) / range;
+  }
+  return out;
+}
+
+double percentile95(const Eigen::VectorXd& values) {
+  std::vector<double> v(values.data(), values.data() + values.size());
+  if (v.empty()) return 0.0;
+  const std::size_t k = (v.size() - 1) * 95 / 100;
+  std::nth_element(v.begin(), v.begin() + static_cast<long>(k), v.end());
+  return v[k];
+}
+
+// The speed as one more feature for the alignment, in units of the demo's typical speed and
+// weighing as much as all the state features together: they stand still through a pause, and
+// only the speed says where motion resumes; a phase is a motion between pauses more than a
+// place.
+Eigen::MatrixXd with_speed(const Eigen::MatrixXd& states, const Eigen::VectorXd& speed) {
+  Eigen::MatrixXd out(states.rows(), states.cols() + 1);
+  out.leftCols(states.cols()) = states;
+  const double typical = percentile95(speed);
+  const double weight = std::sqrt(static_cast<double>(std::max<Eigen::Index>(1, states.cols())));
+  out.col(states.cols()) = typical > 0 ? Eigen::VectorXd(weight * (speed / typical).cwiseMin(1.5))
+                                       : Eigen::VectorXd::Zero(speed.size());
+  return out;
+}
+
+std::vector<double> clock_of(const FeatureMatrix& demo) {
+  std::vector<double> t(static_cast<std::size_t>(demo.rows()));
+  for (Eigen::Index i = 0; i < demo.rows(); ++i) t[static_cast<std::size_t>(i)] = demo.time_at(i);
+  return t;
+}
+
+std::size_t sample_at(const FeatureMatrix& demo, double grid_row, double step) {
+  const double t = demo.time_at(0) + grid_row * step;
+  std::size_t i = 0;
+  while (i + 1 < static_cast<std::size_t>(demo.rows()) &&
+         demo.time_at(static_cast<Eigen::Index>(i + 1)) <= t)
+    ++i;
+  return i;
+}
+
+// A demo's evidence of every kind, and its features and speed on the alignment grid.
+void gather_evidence(const FeatureMatrix& demo, const Eigen::MatrixXd& scaled,
+                     const SegmentationPipelineResult& base, const std::vector<std::size_t>& groups,
+                     bool sensors, const SegmentationPipelineConfig& config,
+                     DemoSegmentationResult* out, DemoEvidence* evidence, Eigen::MatrixXd* grid) {
+  const JointSegmentationConfig& joint = config.joint;
+  const double rate = sample_rate_of(demo);
+  const SegmentationPipelineConfig own = in_samples(config, rate);
+  out->num_samples = static_cast<std::size_t>(demo.rows());
+  out->sample_rate = rate;
+  out->clasp = segment_multivariate(demo.select(base.selected_features).data,
+                                    base.feature_weights, own.segmentation);
+  out->min_segment_length = out->clasp.min_segment_length;
+  std::vector<BoundaryEvidence>& pieces = evidence->pieces;
+  pieces = clasp_evidence(out->clasp, joint.weights.clasp);
+  if (sensors) {
+    const SensorEvents events =
+        detect_sensor_events(demo.select(base.sensor_features).data, own.events, groups);
+    out->events = events.all;
+    out->event_details = events.details;
+    const auto s = sensory_evidence(events, joint.weights);
+    pieces.insert(pieces.end(), s.begin(), s.end());
+  }
+  const std::vector<double> clock = clock_of(demo);
+  const Eigen::VectorXd speed = state_speed(scaled, clock, joint.pauses.smoothing);
+  const std::vector<Pause> pauses = find_pauses(speed, clock, joint.pauses);
+  const auto m = motion_onset_evidence(speed, clock, pauses, joint.pauses, joint.weights.motion_onset);
+  pieces.insert(pieces.end(), m.begin(), m.end());
+  gather_into_pauses(pauses, out->num_samples, &pieces);
+  for (const BoundaryEvidence& p : pieces)
+    evidence->grid_rows.push_back((clock[p.index] - clock.front()) / joint.grid_step);
+  evidence->claimed.assign(pieces.size(), false);
+  *grid = on_uniform_grid(with_speed(scaled, speed), clock, joint.grid_step);
+}
+
+// Noisy-OR of a demo's unclaimed evidence around each reference row: how sure this demo is that
+// a boundary lies there.
+Eigen::VectorXd demo_support(const DemoEvidence& e, Eigen::Index rows, double spread_rows) {
+  Eigen::VectorXd none = Eigen::VectorXd::Ones(rows);
+  const Eigen::Index reach = static_cast<Eigen::Index>(std::ceil(4 * spread_rows));
+  for (std::size_t p = 0; p < e.pieces.size(); ++p) {
+    if (e.claimed[p]) continue;
+    const double u = e.reference_rows[p];
+    const Eigen::Index lo = std::max<Eigen::Index>(0, static_cast<Eigen::Index>(u) - reach);
+    const Eigen::Index hi = std::min<Eigen::Index>(rows - 1, static_cast<Eigen::Index>(u) + reach);
+    for (Eigen::Index r = lo; r <= hi; ++r) {
+      const double z = (static_cast<double>(r) - u) / spread_rows;
+      none[r] *= 1.0 - e.pieces[p].weight * std::exp(-0.5 * z * z);
+    }
+  }
+  return Eigen::VectorXd::Ones(rows) - none;
+}
+
+// The best supported peak that may join the anchors: at least min_support, and
+// short_phase_support when closer than min_segment_rows to an anchor. -1 when none.
+double next_boundary(const Eigen::VectorXd& support, const std::vector<Anchor>& anchors,
+                     const JointSegmentationConfig& config, double min_segment_rows) {
+  double best_row = -1.0, best = 0.0;
+  for (Eigen::Index r = 1; r + 1 < support.size(); ++r) {
+    const double s = support[r];
+    if (s < config.min_support || s < support[r - 1] || s <= support[r + 1] || s <= best) continue;
+    bool near_anchor = false;
+    for (const Anchor& a : anchors)
+      near_anchor = near_anchor || std::abs(a.reference_row - static_cast<double>(r)) < min_segment_rows;
+    if (near_anchor && s < config.short_phase_support) continue;
+    best = s;
+    best_row = static_cast<double>(r);
+  }
+  return best_row;
+}
+
+// The demo's piece for a boundary expected at reference row u: the unclaimed piece within the
+// match window and strictly between the demo's neighbouring anchors that scores best, its score
+// being the noisy-OR of the unclaimed pieces at its place (a contact and a ClaSP changepoint at
+// one instant reinforce each other) times its closeness to u. -1 when there is none.
+long best_piece(const DemoEvidence& e, double u, double window_rows, double spread_rows,
+                double colocation_rows, double after_row, double before_row) {
+  long best = -1;
+  double best_score = 0.0;
+  for (std::size_t p = 0; p < e.pieces.size(); ++p) {
+    const double distance = std::abs(e.reference_rows[p] - u);
+    if (e.claimed[p] || distance > window_rows || e.grid_rows[p] <= after_row ||
+        e.grid_rows[p] >= before_row)
+      continue;
+    double none = 1.0;
+    for (std::size_t q = 0; q < e.pieces.size(); ++q)
+      if (!e.claimed[q] && std::abs(e.grid_rows[q] - e.grid_rows[p]) <= colocation_rows)
+        none *= 1.0 - e.pieces[q].weight;
+    const double z = distance / spread_rows;
+    const double score = (1.0 - none) * std::exp(-0.5 * z * z);
+    if (score > best_score) {
+      best_score = score;
+      best = static_cast<long>(p);
+    }
+  }
+  return best;
+}
+
+// The demo's grid rows of the anchors before and after reference row u (or its ends).
+std::pair<double, double> neighbouring_rows(const std::vector<Anchor>& anchors, std::size_t d,
+                                            double u, double demo_rows) {
+  double after = -1.0, before = demo_rows;
+  for (const Anchor& a : anchors) {
+    if (a.piece[d] < 0) continue;
+    const double row = static_cast<double>(a.demo_row[d]);
+    if (a.reference_row < u) after = std::max(after, row);
+    if (a.reference_row > u) before = std::min(before, row);
+  }
+  return {after, before};
+}
+
+// "contact+clasp": the kinds of the demo's pieces at the chosen piece's place.
+std::string evidence_kinds(const DemoEvidence& e, std::size_t chosen, double colocation_rows) {
+  std::vector<std::string> kinds;
+  for (std::size_t p = 0; p < e.pieces.size(); ++p) {
+    if (std::abs(e.grid_rows[p] - e.grid_rows[chosen]) > colocation_rows) continue;
+    const std::string k = to_string(e.pieces[p].kind);
+    if (std::find(kinds.begin(), kinds.end(), k) == kinds.end()) kinds.push_back(k);
+  }
+  std::string out;
+  for (const std::string& k : kinds) out += (out.empty() ? "" : "+") + k;
+  return out;
+}
+
+// The agreement, boundary by boundary.
+class JointAgreement {
+ public:
+  JointAgreement(std::vector<DemoEvidence> evidence, std::vector<Eigen::MatrixXd> grids,
+                 const JointSegmentationConfig& config, double min_segment_seconds, int threads)
+      : evidence_(std::move(evidence)),
+        grids_(std::move(grids)),
+        config_(config),
+        min_segment_rows_(min_segment_seconds / config.grid_step),
+        spread_rows_(config.spread / config.grid_step),
+        window_rows_(config.match_window / config.grid_step),
+        colocation_rows_(config.colocation / config.grid_step),
+        threads_(threads) {
+    const DemoAlignment alignment = align_to_medoid(grids_, threads_);
+    reference_ = alignment.reference;
+    to_reference_ = alignment.to_reference;
+    from_reference_ = alignment.from_reference;
+  }
+
+  // Adds agreed boundaries, best supported first, re-aligning between them after each.
+  void run(std::size_t max_boundaries) {
+    while (anchors_.size() < max_boundaries) {
+      map_evidence();
+      const double u = next_boundary(support(), anchors_, config_, min_segment_rows_);
+      if (u < 0) break;
+      if (!add_anchor(u)) break;
+      realign();
+    }
+    map_evidence();
+  }
+
+  const std::vector<Anchor>& anchors() const { return anchors_; }
+  const DemoEvidence& evidence(std::size_t d) const { return evidence_[d]; }
+  double expected_row(std::size_t d, double reference_row) const {
+    return map_row(from_reference_[d], reference_row);
+  }
+  double colocation_rows() const { return colocation_rows_; }
+  double window_rows() const { return window_rows_; }
+
+ private:
+  void map_evidence() {
+    for (DemoEvidence& e : evidence_) e.reference_rows.clear();
+    for (std::size_t d = 0; d < evidence_.size(); ++d)
+      for (double row : evidence_[d].grid_rows)
+        evidence_[d].reference_rows.push_back(map_row(to_reference_[d], row));
+  }
+
+  Eigen::VectorXd support() const {
+    const Eigen::Index rows = grids_[reference_].rows();
+    Eigen::VectorXd s = Eigen::VectorXd::Zero(rows);
+    for (const DemoEvidence& e : evidence_)
+      s += demo_support(e, rows, spread_rows_) / static_cast<double>(evidence_.size());
+    return s;
+  }
+
+  // Places the boundary in every demo; false when no demo has a piece for it (the support came
+  // from pieces the order forbids), so the search stops rather than loop.
+  bool add_anchor(double u) {
+    Anchor a;
+    a.reference_row = u;
+    bool any = false;
+    for (std::size_t d = 0; d < evidence_.size(); ++d) {
+      const double rows = static_cast<double>(grids_[d].rows());
+      const auto [after, before] = neighbouring_rows(anchors_, d, u, rows);
+      const long p = best_piece(evidence_[d], u, window_rows_, spread_rows_, colocation_rows_,
+                                after, before);
+      a.piece.push_back(p);
+      const double row = p >= 0 ? evidence_[d].grid_rows[static_cast<std::size_t>(p)]
+                                : expected_row(d, u);
+      a.demo_row.push_back(static_cast<std::size_t>(std::clamp(std::lround(row), 0L,
+                                                               static_cast<long>(rows) - 1)));
+      if (p >= 0) claim(d, static_cast<std::size_t>(p));
+      any = any || p >= 0;
+    }
+    if (!any) return false;
+    a.support = 0.0;
+    anchors_.insert(std::upper_bound(anchors_.begin(), anchors_.end(), a,
+                                     [](const Anchor& x, const Anchor& y) {
+                                       return x.reference_row < y.reference_row;
+                                     }),
+                    a);
+    return true;
+  }
+
+  // The chosen piece and those at its place belong to this boundary.
+  void claim(std::size_t d, std::size_t p) {
+    DemoEvidence& e = evidence_[d];
+    for (std::size_t q = 0; q < e.pieces.size(); ++q)
+      if (std::abs(e.grid_rows[q] - e.grid_rows[p]) <= colocation_rows_) e.claimed[q] = true;
+  }
+
+  void realign() {
+    std::vector<std::size_t> reference_rows;
+    for (const Anchor& a : anchors_)
+      reference_rows.push_back(static_cast<std::size_t>(std::lround(a.reference_row)));
+    parallel_for(evidence_.size(), threads_, [&](std::size_t d) {
+      if (d == reference_) return;
+      std::vector<std::size_t> own;
+      for (const Anchor& a : anchors_) own.push_back(a.demo_row[d]);
+      to_reference_[d] = anchored_dtw_map(grids_[d], grids_[reference_], own, reference_rows);
+      from_reference_[d] = anchored_dtw_map(grids_[reference_], grids_[d], reference_rows, own);
+    });
+  }
+
+  std::vector<DemoEvidence> evidence_;
+  std::vector<Eigen::MatrixXd> grids_;
+  const JointSegmentationConfig& config_;
+  double min_segment_rows_, spread_rows_, window_rows_, colocation_rows_;
+  int threads_;
+  std::size_t reference_ = 0;
+  std::vector<std::vector<double>> to_reference_, from_reference_;
+  std::vector<Anchor> anchors_;
+};
+
+std::string seconds_after_start(const FeatureMatrix& demo, std::size_t index) {
+  std::ostringstream out;
+  out.precision(3);
+  out << demo.time_at(static_cast<Eigen::Index>(index)) - demo.time_at(0) << " s";
+  return out.str();
+}
+
+// The demo's changepoints, zones (the match windows), and what it lacks or has in excess.
+void report_demo(const JointAgreement& agreement, const FeatureMatrix& demo, std::size_t d,
+                 const JointSegmentationConfig& config, DemoSegmentationResult* out,
+                 std::vector<std::string>* warnings) {
+  const DemoEvidence& e = agreement.evidence(d);
+  const std::size_t half = static_cast<std::size_t>(config.match_window * out->sample_rate);
+  const auto& anchors = agreement.anchors();
+  for (std::size_t k = 0; k < anchors.size(); ++k) {
+    const std::size_t expected =
+        sample_at(demo, agreement.expected_row(d, anchors[k].reference_row), config.grid_step);
+    out->zones.push_back({expected > half ? expected - half : 0,
+                          std::min(expected + half, out->num_samples - 1)});
+    const long p = anchors[k].piece[d];
+    if (p < 0) {
+      warnings->push_back(describe("no evidence of boundary " + std::to_string(k + 1) + " of " +
+                                       std::to_string(anchors.size()) +
+                                       " (the others agree on it near " +
+                                       seconds_after_start(demo, expected) +
+                                       "): this demonstration may lack that phase",
+                                   d));
+      continue;
+    }
+    out->changepoints.push_back(e.pieces[static_cast<std::size_t>(p)].index);
+    out->changepoint_evidence.push_back(
+        evidence_kinds(e, static_cast<std::size_t>(p), agreement.colocation_rows()));
+  }
+  std::vector<std::string> extra;
+  for (std::size_t p = 0; p < e.pieces.size(); ++p) {
+    if (e.claimed[p]) continue;
+    out->rejected.push_back(e.pieces[p].index);
+    if (e.pieces[p].weight >= config.extra_event_weight)
+      extra.push_back(to_string(e.pieces[p].kind) + " at " + seconds_after_start(demo, e.pieces[p].index));
+  }
+  if (!extra.empty()) {
+    std::string list;
+    for (const std::string& x : extra) list += (list.empty() ? "" : ", ") + x;
+    warnings->push_back(describe("strong evidence the other demonstrations do not share (an extra "
+                                 "phase?): " + list,
+                                 d));
+  }
+  std::sort(out->rejected.begin(), out->rejected.end());
+  out->rejected.erase(std::unique(out->rejected.begin(), out->rejected.end()), out->rejected.end());
+  for (std::size_t cp : out->changepoints)
+    out->changepoint_times.push_back(demo.time_at(static_cast<Eigen::Index>(cp)));
+  for (std::size_t cp : out->rejected)
+    out->rejected_times.push_back(demo.time_at(static_cast<Eigen::Index>(cp)));
+}
+
+}  // namespace
+
+SegmentationPipelineResult segment_jointly(const PreparedSegmentation& prepared,
+                                           const std::vector<FeatureMatrix>& demos,
+                                           const SegmentationPipelineConfig& config) {
+  if (!config.seconds)
+    throw std::invalid_argument(
+        "the joint segmentation needs its time parameters in seconds (demos with a clock)");
+  const auto start = std::chrono::steady_clock::now();
+  SegmentationPipelineResult result = prepared.base;
+  const std::size_t n = demos.size();
+  result.demos.resize(n);
+  const std::vector<Eigen::MatrixXd> scaled =
+      scaled_states(demos, moving_states(demos, result.state_features));
+  const std::vector<std::size_t> groups = sensor_channel_groups(result.sensor_features);
+  const bool sensors = !result.sensor_features.empty() && config.validate_with_sensors;
+
+  std::vector<DemoEvidence> evidence(n);
+  std::vector<Eigen::MatrixXd> grids(n);
+  parallel_for(n, config.threads, [&](std::size_t d) {
+    try {
+      gather_evidence(demos[d], scaled[d], result, groups, sensors, config, &result.demos[d],
+                      &evidence[d], &grids[d]);
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument(describe(e.what(), d));
+    }
+  });
+  JointAgreement agreement(std::move(evidence), std::move(grids), config.joint,
+                           config.seconds->min_segment, config.threads);
+  agreement.run(config.segmentation.max_changepoints);
+  for (std::size_t d = 0; d < n; ++d)
+    report_demo(agreement, demos[d], d, config.joint, &result.demos[d], &result.warnings);
+  add_sensor_warnings(demos, sensors, &result);
+  result.segmentation_seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return result;
+}
+
+}  // namespace lfd
