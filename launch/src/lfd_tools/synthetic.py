@@ -1,6 +1,8 @@
-"""What the synthetic demonstration writers (lfd_segmentation/scripts/make_*_demos.py) share: their
-command line (an output folder, how many demos, the rate, a seed) and one CSV per demo, a time
-column first, as the `segment` CLI reads it."""
+"""What the synthetic demonstration writers (lfd_segmentation/scripts/make_*.py, and
+lfd_tools.signal_classes) share: their command line (an output folder, how many demos, the rate, a
+seed), one CSV per demo, a time column first, as the `segment` CLI reads it, and the pieces of a
+kinesthetic recording: minimum-jerk motions, a hand pointing down, a wrist F/T's offset, noise and
+drift."""
 import argparse
 import os
 
@@ -28,3 +30,31 @@ def write_demo_csv(out, index, t, names, columns):
     np.savetxt(path, np.column_stack([t] + list(columns)), delimiter=",",
                header=",".join(["time"] + list(names)), comments="", fmt="%.6g")
     return path
+
+
+def s_curve(n):
+    """n samples of the minimum-jerk profile from 0 to 1 (10 s^3 - 15 s^4 + 6 s^5)."""
+    s = np.linspace(0.0, 1.0, n)
+    return 10 * s ** 3 - 15 * s ** 4 + 6 * s ** 5
+
+
+def min_jerk(a, b, n):
+    """n samples of the minimum-jerk motion from point a to point b (rows: samples)."""
+    return a + (b - a) * s_curve(n)[:, None]
+
+
+def hand_down_quaternion(yaw):
+    """(qx, qy, qz, qw) columns of a hand pointing down (half a turn about a horizontal axis) turned
+    by `yaw` (rad, one per sample) about the vertical."""
+    zero = np.zeros(len(yaw))
+    return np.column_stack([np.cos(yaw / 2), np.sin(yaw / 2), zero, zero])
+
+
+def ft_disturbance(rng, n, rate, drift=0.01):
+    """What a wrist F/T adds to the true wrench (n x 6: fx fy fz tx ty tz): a rest offset (up to
+    2 N, 0.2 N m), a random-walk drift (`drift` per square root of a second) and white noise (0.5-0.7
+    N, 0.02-0.03 N m, a small industrial F/T)."""
+    offset = rng.uniform(-2, 2, 6) * [1, 1, 1, 0.1, 0.1, 0.1]
+    walk = np.cumsum(rng.standard_normal((n, 6)), axis=0) * drift / np.sqrt(rate)
+    noise = rng.standard_normal((n, 6)) * [0.5, 0.5, 0.7, 0.03, 0.03, 0.02]
+    return offset + walk + noise
