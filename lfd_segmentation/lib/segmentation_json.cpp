@@ -175,6 +175,7 @@ json to_json(const lfd::SegmentationPipelineResult& r, const std::vector<lfd::Fe
     demo["num_samples"] = s.num_samples;
     demo["changepoints"] = s.changepoints;
     demo["changepoint_times"] = s.changepoint_times;
+    demo["changepoint_evidence"] = s.changepoint_evidence;
     demo["rejected"] = s.rejected;
     demo["rejected_times"] = s.rejected_times;
     demo["pruned"] = s.pruned;

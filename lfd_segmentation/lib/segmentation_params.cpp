@@ -95,6 +95,8 @@ void parse_joint(const YAML::Node& node, lfd::JointSegmentationConfig* joint) {
                                   "joint/weights/sensor_level");
   weights.motion_onset = fraction(get<double>(w, "motion_onset", weights.motion_onset),
                                   "joint/weights/motion_onset");
+  weights.motion_stop = fraction(get<double>(w, "motion_stop", weights.motion_stop),
+                                 "joint/weights/motion_stop");
   weights.clasp = fraction(get<double>(w, "clasp", weights.clasp), "joint/weights/clasp");
   const YAML::Node pause = node ? node["pauses"] : YAML::Node();
   auto& pc = joint->pauses;

@@ -47,6 +47,31 @@ double peak_speed_after(const Eigen::VectorXd& speed, const std::vector<double>&
   return peak;
 }
 
+// Every rest run [begin, end) of the speed, the demo's first and last included.
+std::vector<Pause> rest_runs(const Eigen::VectorXd& speed, const std::vector<double>& time,
+                             const PauseConfig& config) {
+  std::vector<Pause> runs;
+  const double typical = percentile(speed, 0.95);
+  if (!(typical > 0) || time.size() != static_cast<std::size_t>(speed.size())) return runs;
+  const std::vector<bool> moving = moving_samples(speed, config.rest_fraction * typical,
+                                                  config.small_motion_fraction * typical);
+  for (std::size_t i = 0; i < moving.size();) {
+    std::size_t j = i;
+    while (j < moving.size() && !moving[j]) ++j;
+    if (j > i) runs.push_back({i, j});
+    i = std::max(j, i + 1);
+  }
+  return runs;
+}
+
+double duration(const Pause& run, const std::vector<double>& time) {
+  return (run.end < time.size() ? time[run.end] : time.back()) - time[run.begin];
+}
+
+bool at_an_end(const Pause& run, std::size_t samples) {
+  return run.begin == 0 || run.end >= samples;
+}
+
 }  // namespace
 
 std::string to_string(EvidenceKind kind) {
@@ -57,6 +82,8 @@ std::string to_string(EvidenceKind kind) {
       return "sensor_level";
     case EvidenceKind::kMotionOnset:
       return "motion_onset";
+    case EvidenceKind::kMotionStop:
+      return "motion_stop";
     case EvidenceKind::kClasp:
       return "clasp";
   }
@@ -83,24 +110,24 @@ Eigen::VectorXd state_speed(const Eigen::MatrixXd& scaled_states, const std::vec
 std::vector<Pause> find_pauses(const Eigen::VectorXd& speed, const std::vector<double>& time,
                                const PauseConfig& config) {
   std::vector<Pause> pauses;
-  const double typical = percentile(speed, 0.95);
-  if (!(typical > 0) || time.size() != static_cast<std::size_t>(speed.size())) return pauses;
-  const std::vector<bool> moving = moving_samples(speed, config.rest_fraction * typical,
-                                                  config.small_motion_fraction * typical);
-  for (std::size_t i = 0; i < moving.size();) {
-    if (moving[i]) {
-      ++i;
-      continue;
-    }
-    std::size_t j = i;
-    while (j < moving.size() && !moving[j]) ++j;
-    const double last = j < time.size() ? time[j] : time.back();
-    // Pauses shorter than min_pause are a reversal's velocity zero, kept at the demo's ends.
-    if (last - time[i] >= config.min_pause || i == 0 || j == moving.size())
-      pauses.push_back({i, j});
-    i = j;
-  }
+  for (const Pause& run : rest_runs(speed, time, config))
+    if (duration(run, time) >= config.min_pause || at_an_end(run, time.size()))
+      pauses.push_back(run);
   return pauses;
+}
+
+std::vector<BoundaryEvidence> motion_stop_evidence(const Eigen::VectorXd& speed,
+                                                   const std::vector<double>& time,
+                                                   const PauseConfig& config, double weight) {
+  std::vector<BoundaryEvidence> out;
+  for (const Pause& run : rest_runs(speed, time, config)) {
+    if (duration(run, time) >= config.min_pause || at_an_end(run, time.size())) continue;
+    Eigen::Index slowest = 0;
+    speed.segment(static_cast<Eigen::Index>(run.begin), static_cast<Eigen::Index>(run.end - run.begin))
+        .minCoeff(&slowest);
+    out.push_back({run.begin + static_cast<std::size_t>(slowest), weight, EvidenceKind::kMotionStop});
+  }
+  return out;
 }
 
 std::vector<BoundaryEvidence> motion_onset_evidence(const Eigen::VectorXd& speed,
@@ -133,13 +160,23 @@ void gather_into_pauses(const std::vector<Pause>& pauses, std::size_t samples,
 }
 
 std::vector<BoundaryEvidence> sensory_evidence(const SensorEvents& events,
-                                               const EvidenceWeights& weights) {
+                                               const EvidenceWeights& weights,
+                                               std::size_t fold_samples) {
   std::vector<BoundaryEvidence> out;
   for (const SensoryEvent& e : events.details) {
-    if (e.rest_edge)
+    if (e.rest_edge) {
       out.push_back({e.index, weights.contact, EvidenceKind::kContact});
-    else
-      out.push_back({e.index, weights.sensor_level, EvidenceKind::kSensorLevel});
+      continue;
+    }
+    std::size_t index = e.index, nearest = fold_samples + 1;
+    for (const SensoryEvent& edge : events.details) {
+      const std::size_t distance = edge.index > e.index ? edge.index - e.index : e.index - edge.index;
+      if (edge.rest_edge && distance <= fold_samples && distance < nearest) {
+        nearest = distance;
+        index = edge.index;
+      }
+    }
+    out.push_back({index, weights.sensor_level, EvidenceKind::kSensorLevel});
   }
   return out;
 }

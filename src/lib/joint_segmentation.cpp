@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <sstream>
 #include <stdexcept>
 
@@ -125,7 +127,7 @@ void gather_evidence(const FeatureMatrix& demo, const Eigen::MatrixXd& scaled,
         detect_sensor_events(demo.select(base.sensor_features).data, own.events, groups);
     out->events = events.all;
     out->event_details = events.details;
-    const auto s = sensory_evidence(events, joint.weights);
+    const auto s = sensory_evidence(events, joint.weights, own.events.merge_gap);
     pieces.insert(pieces.end(), s.begin(), s.end());
   }
   const std::vector<double> clock = clock_of(demo);
@@ -133,6 +135,8 @@ void gather_evidence(const FeatureMatrix& demo, const Eigen::MatrixXd& scaled,
   const std::vector<Pause> pauses = find_pauses(speed, clock, joint.pauses);
   const auto m = motion_onset_evidence(speed, clock, pauses, joint.pauses, joint.weights.motion_onset);
   pieces.insert(pieces.end(), m.begin(), m.end());
+  const auto stops = motion_stop_evidence(speed, clock, joint.pauses, joint.weights.motion_stop);
+  pieces.insert(pieces.end(), stops.begin(), stops.end());
   gather_into_pauses(pauses, out->num_samples, &pieces);
   for (const BoundaryEvidence& p : pieces)
     evidence->grid_rows.push_back((clock[p.index] - clock.front()) / joint.grid_step);
@@ -176,6 +180,24 @@ double next_boundary(const Eigen::VectorXd& support, const std::vector<Anchor>& 
   return best_row;
 }
 
+// How sharply a kind of evidence times a change: a sensor's rest edge to a sample, a pause's
+// end closely, ClaSP only to within its window.
+int timing_precision(EvidenceKind kind) {
+  switch (kind) {
+    case EvidenceKind::kContact:
+      return 4;
+    case EvidenceKind::kSensorLevel:
+      return 3;
+    case EvidenceKind::kMotionOnset:
+      return 2;
+    case EvidenceKind::kMotionStop:
+      return 1;
+    case EvidenceKind::kClasp:
+      return 0;
+  }
+  return 0;
+}
+
 // The demo's piece for a boundary expected at reference row u: the unclaimed piece within the
 // match window and strictly between the demo's neighbouring anchors that scores best, its score
 // being the noisy-OR of the unclaimed pieces at its place (a contact and a ClaSP changepoint at
@@ -194,7 +216,9 @@ long best_piece(const DemoEvidence& e, double u, double window_rows, double spre
       if (!e.claimed[q] && std::abs(e.grid_rows[q] - e.grid_rows[p]) <= colocation_rows)
         none *= 1.0 - e.pieces[q].weight;
     const double z = distance / spread_rows;
-    const double score = (1.0 - none) * std::exp(-0.5 * z * z);
+    // Among pieces of equal support, the one whose kind times a change best places it.
+    const double score =
+        (1.0 - none) * std::exp(-0.5 * z * z) + 1e-3 * timing_precision(e.pieces[p].kind);
     if (score > best_score) {
       best_score = score;
       best = static_cast<long>(p);
@@ -252,6 +276,7 @@ class JointAgreement {
   void run(std::size_t max_boundaries) {
     while (anchors_.size() < max_boundaries) {
       map_evidence();
+      if (std::getenv("LFD_JOINT_DEBUG")) debug_dump();
       const double u = next_boundary(support(), anchors_, config_, min_segment_rows_);
       if (u < 0) break;
       if (!add_anchor(u)) break;
@@ -269,6 +294,21 @@ class JointAgreement {
   double window_rows() const { return window_rows_; }
 
  private:
+  void debug_dump() const {
+    for (std::size_t d = 0; d < evidence_.size(); ++d) {
+      std::fprintf(stderr, "demo %zu:", d);
+      const DemoEvidence& e = evidence_[d];
+      for (std::size_t p = 0; p < e.pieces.size(); ++p)
+        std::fprintf(stderr, " %s%s@%.1f(r%.1f)=%.2f", e.claimed[p] ? "*" : "", to_string(e.pieces[p].kind).c_str(),
+                     e.grid_rows[p] * config_.grid_step, e.reference_rows[p] * config_.grid_step, e.pieces[p].weight);
+      std::fprintf(stderr, "\n");
+    }
+    const Eigen::VectorXd s = support();
+    std::fprintf(stderr, "support:");
+    for (Eigen::Index r = 0; r < s.size(); r += 2) std::fprintf(stderr, "%c", " .:-=+*#%@"[std::min(9, int(s[r] * 10))]);
+    std::fprintf(stderr, "\n");
+  }
+
   void map_evidence() {
     for (DemoEvidence& e : evidence_) e.reference_rows.clear();
     for (std::size_t d = 0; d < evidence_.size(); ++d)

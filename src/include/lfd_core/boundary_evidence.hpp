@@ -19,6 +19,7 @@ enum class EvidenceKind {
   kContact,      ///< a sensor leaves its rest level or regains it (contact made or lost)
   kSensorLevel,  ///< a sensor's level steps while away from rest (a snap, a press that deepens)
   kMotionOnset,  ///< the state features move again after a pause
+  kMotionStop,   ///< the state features stop for an instant (one motion ends, the next begins)
   kClasp,        ///< a changepoint of ClaSP's recursive segmentation (shape change)
 };
 
@@ -37,6 +38,9 @@ struct EvidenceWeights {
   double contact = 0.9;        ///< rest edges: the sensors say an interaction starts or ends
   double sensor_level = 0.6;   ///< a level step in contact
   double motion_onset = 0.8;   ///< motion after a long pause, scaled by pause and motion below
+  /// An instant of rest between two motions: weak alone (every reversal of a periodic motion is
+  /// one), it marks where a shape change ClaSP finds nearby begins.
+  double motion_stop = 0.3;
   double clasp = 0.5;          ///< a ClaSP changepoint (significant by ClaSP's own test)
 };
 
@@ -46,7 +50,7 @@ struct PauseConfig {
   /// range over the task, smoothed by a Gaussian of this sigma (s).
   double smoothing = 0.1;
   /// At rest below this fraction of the demo's 95th percentile speed.
-  double rest_fraction = 0.1;
+  double rest_fraction = 0.05;
   /// Pauses shorter than this are velocity zero crossings of a reversal, not pauses (s).
   double min_pause = 0.25;
   /// A pause of duration p weighs 1 - exp(-p / pause_scale): a hesitation of 0.3 s little, a
@@ -86,15 +90,24 @@ std::vector<BoundaryEvidence> motion_onset_evidence(const Eigen::VectorXd& speed
                                                     const std::vector<Pause>& pauses,
                                                     const PauseConfig& config, double weight);
 
+/// Evidence of the instants of rest shorter than a pause between two motions (at the speed's
+/// minimum).
+std::vector<BoundaryEvidence> motion_stop_evidence(const Eigen::VectorXd& speed,
+                                                   const std::vector<double>& time,
+                                                   const PauseConfig& config, double weight);
+
 /// A pause between two motions is one transition: evidence inside it (the gripper closing while
 /// the arm waits) moves to the pause's end, where the next motion starts. Evidence in the first
 /// rest or the last one stays where it is.
 void gather_into_pauses(const std::vector<Pause>& pauses, std::size_t samples,
                         std::vector<BoundaryEvidence>* evidence);
 
-/// Evidence of the sensory events: rest edges as contact, the others as level steps.
+/// Evidence of the sensory events: rest edges as contact, the others as level steps. A level
+/// event within `fold_samples` of a rest edge is that contact's own force building up or fading
+/// (the ramp reaching its plateau), so it joins the rest edge instead of standing alone.
 std::vector<BoundaryEvidence> sensory_evidence(const SensorEvents& events,
-                                               const EvidenceWeights& weights);
+                                               const EvidenceWeights& weights,
+                                               std::size_t fold_samples);
 
 /// Evidence of ClaSP's accepted changepoints.
 std::vector<BoundaryEvidence> clasp_evidence(const MultivariateSegmentation& clasp,
