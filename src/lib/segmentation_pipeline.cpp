@@ -1,8 +1,7 @@
 #include "lfd_core/segmentation_pipeline.hpp"
 
-#include "lfd_core/joint_segmentation.hpp"
-#include "lfd_core/parallel_for.hpp"
-#include "lfd_core/segmentation_consensus.hpp"
+#include "lfd_core/segmentation_method.hpp"
+#include "lfd_core/segmentation_steps.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -22,20 +21,16 @@ std::string join(const std::vector<std::string>& names) {
   return out;
 }
 
-std::string demo_context(std::size_t d) {
-  return "demonstration " + std::to_string(d);
-}
-
 // Every demonstration must carry the same feature names (in any order).
 void check_same_features(const std::vector<FeatureMatrix>& demos) {
   const std::set<std::string> reference(demos[0].names.begin(), demos[0].names.end());
   if (reference.size() != demos[0].names.size()) {
-    throw std::invalid_argument(demo_context(0) + " has duplicate feature names");
+    throw std::invalid_argument(demo_label(0) + " has duplicate feature names");
   }
   for (std::size_t d = 1; d < demos.size(); ++d) {
     const std::set<std::string> names(demos[d].names.begin(), demos[d].names.end());
     if (names.size() != demos[d].names.size()) {
-      throw std::invalid_argument(demo_context(d) + " has duplicate feature names");
+      throw std::invalid_argument(demo_label(d) + " has duplicate feature names");
     }
     if (names == reference) continue;
     std::vector<std::string> missing, extra;
@@ -43,10 +38,10 @@ void check_same_features(const std::vector<FeatureMatrix>& demos) {
                         std::back_inserter(missing));
     std::set_difference(names.begin(), names.end(), reference.begin(), reference.end(),
                         std::back_inserter(extra));
-    std::string msg = "features differ between demonstrations: " + demo_context(d);
+    std::string msg = "features differ between demonstrations: " + demo_label(d);
     if (!missing.empty()) msg += " lacks " + join(missing);
     if (!extra.empty()) msg += (missing.empty() ? " has extra " : " and has extra ") + join(extra);
-    throw std::invalid_argument(msg + " (compared with " + demo_context(0) + ")");
+    throw std::invalid_argument(msg + " (compared with " + demo_label(0) + ")");
   }
 }
 
@@ -67,108 +62,6 @@ std::vector<std::size_t> sensor_channel_groups(const std::vector<std::string>& n
   }
   return groups;
 }
-
-namespace {
-
-// Runs job(d) for every demonstration (parallel_for); rethrows the first failure (by
-// demonstration index) with the demonstration named.
-template <typename Job>
-void for_each_demo(std::size_t count, int threads, Job job) {
-  parallel_for(count, threads, [&](std::size_t d) {
-    try {
-      job(d);
-    } catch (const std::invalid_argument& e) {
-      throw std::invalid_argument(demo_context(d) + ": " + e.what());
-    } catch (const std::exception& e) {
-      throw std::runtime_error(demo_context(d) + ": " + e.what());
-    }
-  });
-}
-
-// The sample-count settings of one demonstration: the config's own counts, or its seconds
-// converted at the demonstration's rate.
-struct DemoSettings {
-  SegmentationPipelineConfig config;
-  double rate = 0.0;
-};
-
-DemoSettings settings_for(const FeatureMatrix& demo, const SegmentationPipelineConfig& config) {
-  if (!config.seconds) return {config, 0.0};
-  const double rate = sample_rate_of(demo);
-  return {in_samples(config, rate), rate};
-}
-
-// Every demo's sample-count settings; checks its clock and that it holds 2 min_s.
-std::vector<DemoSettings> demo_settings(const std::vector<FeatureMatrix>& demos,
-                                        const SegmentationPipelineConfig& config) {
-  std::vector<DemoSettings> settings;
-  for (std::size_t d = 0; d < demos.size(); ++d) {
-    try {
-      settings.push_back(settings_for(demos[d], config));
-    } catch (const std::invalid_argument& e) {
-      throw std::invalid_argument(demo_context(d) + ": " + e.what());
-    }
-    const std::size_t min_s = settings.back().config.segmentation.min_segment_length;
-    if (min_s > 0 && static_cast<std::size_t>(demos[d].rows()) < 2 * min_s) {
-      throw std::invalid_argument(demo_context(d) + " has " + std::to_string(demos[d].rows()) +
-                                  " samples, fewer than 2 * min_s = " + std::to_string(2 * min_s));
-    }
-  }
-  return settings;
-}
-
-// II-C for one demonstration: ClaSP on the selected features and the sensory zones, met as the
-// procedure says.
-DemoSegmentationResult segment_demo(const FeatureMatrix& demo, const DemoSettings& settings,
-                                    const SegmentationPipelineResult& prepared, bool validate,
-                                    const std::vector<std::size_t>& groups) {
-  const SegmentationPipelineConfig& own = settings.config;
-  DemoSegmentationResult out;
-  out.num_samples = static_cast<std::size_t>(demo.rows());
-  out.sample_rate = settings.rate;
-  MultivariateSegmentationConfig seg = own.segmentation;
-  if (own.window_size > 0)
-    seg.window_sizes.assign(prepared.selected_features.size(), own.window_size);
-  // Events do not depend on min_s: detected once, for the zone-guided search and validation.
-  const SensorEvents events =
-      validate
-          ? detect_sensor_events(demo.select(prepared.sensor_features).data, own.events, groups)
-          : SensorEvents{};
-  const std::vector<std::size_t>& zone_events =
-      own.events.zones_from_rest_edges ? events.zone_events : events.all;
-  const auto zones = [&](std::size_t min_s) {
-    return confidence_zones(zone_events, min_s, static_cast<std::size_t>(demo.rows()));
-  };
-  if (validate && own.procedure == SegmentationProcedure::kZoneSearch) {
-    seg.candidate_zones_for = zones;
-    for (const SensoryEvent& e :
-         own.anchor_to_events ? events.details : std::vector<SensoryEvent>{}) {
-      seg.zone_anchors.push_back(e.index);
-      seg.preferred_anchors.push_back(e.rest_edge);
-    }
-  } else if (validate) {
-    seg.num_changepoints = static_cast<int>(own.paper_candidates);
-  }
-  out.clasp = segment_multivariate(demo.select(prepared.selected_features).data,
-                                   prepared.feature_weights, seg);
-  out.min_segment_length = out.clasp.min_segment_length;
-  if (validate) {
-    const ChangepointValidation v =
-        validate_with_zones(out.clasp.changepoints, zones(out.min_segment_length));
-    out.changepoints = v.accepted;
-    out.rejected = v.rejected;
-    out.zones = v.zones;
-    out.events = events.all;
-    out.event_details = events.details;
-  } else {
-    out.changepoints = out.clasp.changepoints;
-  }
-  for (std::size_t cp : out.changepoints) out.changepoint_times.push_back(demo.time_at(cp));
-  for (std::size_t cp : out.rejected) out.rejected_times.push_back(demo.time_at(cp));
-  return out;
-}
-
-}  // namespace
 
 namespace {
 std::size_t samples(double seconds, double rate, std::size_t at_least) {
@@ -242,10 +135,10 @@ PreparedSegmentation prepare_segmentation(const std::vector<FeatureMatrix>& demo
     try {
       demos[d].validate_shape();
     } catch (const std::invalid_argument& e) {
-      throw std::invalid_argument(demo_context(d) + ": " + e.what());
+      throw std::invalid_argument(demo_label(d) + ": " + e.what());
     }
     if (demos[d].rows() < 2) {
-      throw std::invalid_argument(demo_context(d) + " has " + std::to_string(demos[d].rows()) +
+      throw std::invalid_argument(demo_label(d) + " has " + std::to_string(demos[d].rows()) +
                                   " samples; at least 2 are needed");
     }
   }
@@ -275,8 +168,7 @@ PreparedSegmentation prepare_segmentation(const std::vector<FeatureMatrix>& demo
   }
   std::vector<std::string> used = result.state_features;
   used.insert(used.end(), sensor_features.begin(), sensor_features.end());
-  for (std::size_t d = 0; d < demos.size(); ++d)
-    check_finite(demos[d].select(used), demo_context(d));
+  for (std::size_t d = 0; d < demos.size(); ++d) check_finite(demos[d].select(used), demo_label(d));
 
   demo_settings(demos, config);  // checks every demo's clock and length
 
@@ -330,29 +222,7 @@ PreparedSegmentation prepare_segmentation(const std::vector<FeatureMatrix>& demo
 SegmentationPipelineResult segment_prepared(const PreparedSegmentation& prepared,
                                             const std::vector<FeatureMatrix>& demos,
                                             const SegmentationPipelineConfig& config) {
-  if (config.procedure == SegmentationProcedure::kJoint)
-    return segment_jointly(prepared, demos, config);
-  const auto segmentation_start = std::chrono::steady_clock::now();
-  SegmentationPipelineResult result = prepared.base;
-  const std::vector<std::string>& sensor_features = result.sensor_features;
-  const std::vector<DemoSettings> settings = demo_settings(demos, config);
-  const bool validate = config.validate_with_sensors && !sensor_features.empty();
-  if (!validate) {
-    result.warnings.push_back(sensor_features.empty()
-                                  ? "no sensor features: ClaSP changepoints are not validated"
-                                  : "sensor validation disabled: ClaSP changepoints are accepted");
-  }
-  const std::vector<std::size_t> groups = sensor_channel_groups(sensor_features);
-  result.demos.resize(demos.size());
-  for_each_demo(demos.size(), config.threads, [&](std::size_t d) {
-    result.demos[d] = segment_demo(demos[d], settings[d], result, validate, groups);
-  });
-  if (config.consensus_count && config.procedure == SegmentationProcedure::kZoneSearch)
-    agree_on_changepoint_count(demos, validate, config.consensus_fill_p_value, &result);
-  result.segmentation_seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - segmentation_start).count();
-  add_sensor_warnings(demos, validate, &result);
-  return result;
+  return make_segmentation_method(to_string(config.procedure))->segment(prepared, demos, config);
 }
 
 void add_sensor_warnings(const std::vector<FeatureMatrix>& demos, bool validated,
@@ -360,11 +230,11 @@ void add_sensor_warnings(const std::vector<FeatureMatrix>& demos, bool validated
   for (std::size_t d = 0; d < demos.size() && validated; ++d) {
     for (const std::string& sensor : result->sensor_features) {
       if (is_constant(demos[d], demos[d].require(sensor)))
-        result->warnings.push_back(demo_context(d) + ": sensor '" + sensor +
+        result->warnings.push_back(demo_label(d) + ": sensor '" + sensor +
                                    "' is constant (dead or disconnected?): no event from it");
     }
     if (result->demos[d].events.empty())
-      result->warnings.push_back(demo_context(d) + ": no sensory event detected");
+      result->warnings.push_back(demo_label(d) + ": no sensory event detected");
   }
 }
 

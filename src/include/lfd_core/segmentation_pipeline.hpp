@@ -38,7 +38,8 @@ struct TimeParameters {
   double event_noise_block = 1.0;     ///< block length of the local noise estimate (s)
 };
 
-/// How ClaSP's candidates meet the sensory zones.
+/// How ClaSP's candidates meet the sensory zones: the name of the SegmentationMethod that
+/// segment_prepared runs (segmentation_method.hpp; to_string gives the registry name).
 enum class SegmentationProcedure {
   /// Ours: the zones first, each recursion step takes its argmax inside them, the changepoint
   /// sits on a sensory event of its zone (anchor_to_events), the demos agree on their count
@@ -158,9 +159,10 @@ PreparedSegmentation prepare_segmentation(const std::vector<FeatureMatrix>& demo
                                           const SegmentationPipelineConfig& config = {},
                                           const std::vector<std::string>& state_features = {});
 
-/// II-C on prepared demos: `config` may differ from the one prepared with in its II-C settings
-/// only (combination, ClaSP, events, procedure), e.g. to compare the combinations on one feature
-/// selection. `demos` must be the prepared ones.
+/// II-C on prepared demos by the method config.procedure names (make_segmentation_method):
+/// `config` may differ from the one prepared with in its II-C settings only (combination, ClaSP,
+/// events, procedure), e.g. to compare the combinations on one feature selection. `demos` must be
+/// the prepared ones.
 SegmentationPipelineResult segment_prepared(const PreparedSegmentation& prepared,
                                             const std::vector<FeatureMatrix>& demos,
                                             const SegmentationPipelineConfig& config = {});
