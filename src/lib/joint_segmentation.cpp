@@ -162,18 +162,28 @@ Eigen::VectorXd demo_support(const DemoEvidence& e, Eigen::Index rows, double sp
   return Eigen::VectorXd::Ones(rows) - none;
 }
 
-// The best supported peak that may join the anchors: at least min_support, and
-// short_phase_support when closer than min_segment_rows to an anchor. -1 when none.
+// The support a boundary needs at `distance` rows from its nearest anchor: min_support beyond
+// min_segment, rising linearly to short_phase_support as it comes closer (a prior on the
+// length of a phase, not a wall).
+double needed_support(double distance, const JointSegmentationConfig& config,
+                      double min_segment_rows) {
+  if (distance >= min_segment_rows) return config.min_support;
+  return config.min_support + (config.short_phase_support - config.min_support) *
+                                  (1.0 - distance / min_segment_rows);
+}
+
+// The best supported peak that may join the anchors (it reaches the support its distance to
+// them needs); -1 when none.
 double next_boundary(const Eigen::VectorXd& support, const std::vector<Anchor>& anchors,
                      const JointSegmentationConfig& config, double min_segment_rows) {
   double best_row = -1.0, best = 0.0;
   for (Eigen::Index r = 1; r + 1 < support.size(); ++r) {
     const double s = support[r];
-    if (s < config.min_support || s < support[r - 1] || s <= support[r + 1] || s <= best) continue;
-    bool near_anchor = false;
+    if (s < support[r - 1] || s <= support[r + 1] || s <= best) continue;
+    double distance = min_segment_rows;
     for (const Anchor& a : anchors)
-      near_anchor = near_anchor || std::abs(a.reference_row - static_cast<double>(r)) < min_segment_rows;
-    if (near_anchor && s < config.short_phase_support) continue;
+      distance = std::min(distance, std::abs(a.reference_row - static_cast<double>(r)));
+    if (s < needed_support(distance, config, min_segment_rows)) continue;
     best = s;
     best_row = static_cast<double>(r);
   }
@@ -321,7 +331,11 @@ class JointAgreement {
     Eigen::VectorXd s = Eigen::VectorXd::Zero(rows);
     for (const DemoEvidence& e : evidence_)
       s += demo_support(e, rows, spread_rows_) / static_cast<double>(evidence_.size());
-    return s;
+    // Support above the background: evidence that is everywhere (a contact force varying all
+    // along a wipe, in every demo at other times) supports every instant alike and so none.
+    const double background = s.mean();
+    return background < 1.0 ? Eigen::VectorXd((s.array() - background).max(0.0) / (1.0 - background))
+                            : Eigen::VectorXd::Zero(rows);
   }
 
   // Places the boundary in every demo; false when no demo has a piece for it (the support came
