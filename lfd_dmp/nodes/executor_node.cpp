@@ -26,6 +26,8 @@
 #include <tf2_ros/transform_listener.h>
 
 #include <chrono>
+#include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <map>
 #include <memory>
@@ -209,6 +211,7 @@ class Executor {
                                     "' on tf: " + why);
       ros::WallDuration(0.01).sleep();
     }
+    loadLibraryLimits(pnh);
     const geometry_msgs::Transform t =
         tf_buffer_.lookupTransform(target, source, ros::Time(0)).transform;
     Eigen::Isometry3d iso = Eigen::Isometry3d::Identity();
@@ -217,6 +220,24 @@ class Executor {
                        .normalized()
                        .toRotationMatrix();
     return iso;
+  void loadLibraryLimits(ros::NodeHandle& pnh) {
+    lfd_dmp::LibraryLimits& l = library_limits_;
+    auto count = [&](const char* key, std::size_t fallback) {
+      return static_cast<std::size_t>(std::max(
+          0, param(pnh, std::string("library_limits/") + key, static_cast<int>(fallback))));
+    };
+    l.min_tau = param(pnh, "library_limits/min_tau", l.min_tau);
+    l.max_tau = param(pnh, "library_limits/max_tau", l.max_tau);
+    l.max_tau_ratio = param(pnh, "library_limits/max_tau_ratio", l.max_tau_ratio);
+    l.max_segments = count("max_segments", l.max_segments);
+    l.max_demos = count("max_demos", l.max_demos);
+    l.max_num_basis = static_cast<int>(count("max_num_basis", l.max_num_basis));
+    l.max_list_length = count("max_list_length", l.max_list_length);
+    l.max_string_length = count("max_string_length", l.max_string_length);
+    l.max_file_bytes = count("max_file_megabytes", l.max_file_bytes >> 20) << 20;
+    lfd_dmp::checkLibraryLimits(l);
+  }
+
   }
 
   lfd::Scene scene(const lfd_msgs::ExecuteTaskGoal& goal) {
@@ -267,7 +288,7 @@ class Executor {
       opt.duration_scale = lfd_dmp::checkedDurationScale(goal.duration_scale, limits_);
       opt.allow_extrapolation = goal.allow_extrapolation;
       const std::string path = libraryPath(goal.library);
-      const lfd_dmp::SkillLibrary library = lfd_dmp::loadSkillLibrary(path);
+      const lfd_dmp::SkillLibrary library = lfd_dmp::loadSkillLibrary(path, library_limits_);
       if (library.cartesian_frame != cartesianFrame())
         throw std::invalid_argument("the library's poses are in '" + library.cartesian_frame +
                                     "', the robot's Cartesian frame is '" + cartesianFrame() + "'");
@@ -540,3 +561,4 @@ int main(int argc, char** argv) {
   }
   return 0;
 }
+  lfd_dmp::LibraryLimits library_limits_;
