@@ -119,6 +119,14 @@ std::string checkOutputFile(const std::string& path, const PathPolicy& policy, b
   return resolved.string();
 }
 
+std::string checkPathInRoots(const std::string& path, const PathPolicy& policy) {
+  if (path.empty()) throw std::invalid_argument("empty path");
+  checkParentReferences(path, policy);
+  const fs::path resolved = fs::weakly_canonical(fs::absolute(path));
+  checkRoots(path, resolved, policy);
+  return resolved.string();
+}
+
 void writeFileAtomically(const std::string& path, bool overwrite,
                          const std::function<void(const std::string& temp_path)>& write) {
   const fs::path target = fs::absolute(path);
