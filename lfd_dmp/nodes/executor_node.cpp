@@ -21,10 +21,13 @@
 
 #include <actionlib/server/simple_action_server.h>
 #include <ros/ros.h>
+#include <rosgraph_msgs/Clock.h>
 #include <sensor_msgs/JointState.h>
 #include <tf2_ros/buffer.h>
 #include <tf2_ros/transform_listener.h>
 
+#include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <map>
@@ -83,6 +86,23 @@ class ClockWatch {
   Clock::time_point since_ = Clock::now();
 };
 
+template <class M>
+void ignore(const boost::shared_ptr<const M>&) {}
+
+// Handles on the action's topics (the names and types ActionServer uses) while its server is
+// replaced: roscpp keeps a topic and its connections as long as one handle on it lives, so the
+// clients stay connected to the new server.
+struct ActionTopics {
+  explicit ActionTopics(ros::NodeHandle& pnh)
+      : goal(pnh.subscribe("execute/goal", 1, &ignore<lfd_msgs::ExecuteTaskActionGoal>)),
+        cancel(pnh.subscribe("execute/cancel", 1, &ignore<actionlib_msgs::GoalID>)),
+        status(pnh.advertise<actionlib_msgs::GoalStatusArray>("execute/status", 1, true)),
+        feedback(pnh.advertise<lfd_msgs::ExecuteTaskActionFeedback>("execute/feedback", 1)),
+        result(pnh.advertise<lfd_msgs::ExecuteTaskActionResult>("execute/result", 1)) {}
+  ros::Subscriber goal, cancel;
+  ros::Publisher status, feedback, result;
+};
+
 class Executor {
  public:
   Executor(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh), tf_listener_(tf_buffer_) {
@@ -96,14 +116,56 @@ class Executor {
     const auto hints = ros::TransportHints().tcpNoDelay();
     joint_sub_ = nh.subscribe("/joint_states", 5, &Executor::onJoints, this, hints);
     gripper_sub_ = nh.subscribe("/gripper/state", 5, &Executor::onGripper, this, hints);
-    server_ = std::make_unique<ActionServer>(
-        pnh, "execute", [this](const lfd_msgs::ExecuteTaskGoalConstPtr& g) { execute(*g); }, false);
-    server_->start();
+    pnh_ = pnh;
+    startServer();
+    // A simulator restart takes sim time back to 0: the action server would drop every goal
+    // stamped before its last one (RECALLED, no error text) until sim time caught up.
+    if (ros::Time::isSimTime())
+      clock_sub_ = nh.subscribe("/clock", 10, &Executor::onClock, this, hints);
     ROS_INFO("executor: ready (action %s/execute, dt %.4f s)", pnh.getNamespace().c_str(),
              options_.dt);
   }
 
  private:
+  // ---- the action server and sim time going back -----------------------------------------------
+  // The goal thread calls execute() with the server that owns it: while a restart destroys that
+  // server (joining its goal thread), server_ already holds nothing.
+  void startServer() {
+    auto slot = std::make_shared<ActionServer*>(nullptr);
+    server_ = std::make_unique<ActionServer>(
+        pnh_, "execute",
+        [this, slot](const lfd_msgs::ExecuteTaskGoalConstPtr& g) { execute(**slot, *g); }, false);
+    *slot = server_.get();
+    server_->start();
+  }
+
+  void onClock(const rosgraph_msgs::Clock::ConstPtr& msg) {
+    const ros::Time before = last_clock_;
+    last_clock_ = msg->clock;
+    if (msg->clock >= before) return;
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      clock_reset_text_ = "sim time went back from " + std::to_string(before.toSec()) + " to " +
+                          std::to_string(msg->clock.toSec()) +
+                          " s (the simulator restarted): the goal is aborted, send it again";
+    }
+    ROS_WARN(
+        "executor: sim time went back from %.3f to %.3f s (the simulator restarted): "
+        "aborting the active goal and restarting the action server, so that new goals "
+        "stamped on the new clock are taken at once",
+        before.toSec(), msg->clock.toSec());
+    const ActionTopics keep(pnh_);
+    clock_reset_ = true;  // the active goal (if any) aborts at its next check
+    server_.reset();      // joins the goal thread
+    clock_reset_ = false;
+    startServer();
+  }
+
+  std::string clockResetText() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return clock_reset_text_;
+  }
+
   // ---- configuration ---------------------------------------------------------------------------
   void loadParameters(ros::NodeHandle& pnh) {
     library_dir_ = param<std::string>(pnh, "library_dir", "");
@@ -149,12 +211,31 @@ class Executor {
     limits_.max_name_length =
         param(pnh, "limits/max_name_length", static_cast<int>(limits_.max_name_length));
     lfd_dmp::checkLimits(limits_);
+    loadLibraryLimits(pnh);
     if (!(options_.dt > 0.0) || !(settle_time_ >= 0.0) || !(clock_timeout_ > 0.0) ||
         !(motion_lead_ >= 0.0) || !(trajectory_period_ > 0.0))
       throw std::runtime_error(
           "executor: dt, clock_timeout, trajectory_period must be > 0 and "
           "settle_time, motion_lead >= 0");
     options_.max_samples = static_cast<size_t>(limits_.max_plan_seconds / options_.dt);
+  }
+
+  void loadLibraryLimits(ros::NodeHandle& pnh) {
+    lfd_dmp::LibraryLimits& l = library_limits_;
+    auto count = [&](const char* key, std::size_t fallback) {
+      return static_cast<std::size_t>(std::max(
+          0, param(pnh, std::string("library_limits/") + key, static_cast<int>(fallback))));
+    };
+    l.min_tau = param(pnh, "library_limits/min_tau", l.min_tau);
+    l.max_tau = param(pnh, "library_limits/max_tau", l.max_tau);
+    l.max_tau_ratio = param(pnh, "library_limits/max_tau_ratio", l.max_tau_ratio);
+    l.max_segments = count("max_segments", l.max_segments);
+    l.max_demos = count("max_demos", l.max_demos);
+    l.max_num_basis = static_cast<int>(count("max_num_basis", l.max_num_basis));
+    l.max_list_length = count("max_list_length", l.max_list_length);
+    l.max_string_length = count("max_string_length", l.max_string_length);
+    l.max_file_bytes = count("max_file_megabytes", l.max_file_bytes >> 20) << 20;
+    lfd_dmp::checkLibraryLimits(l);
   }
 
   // The IK chain on the robot model, built once (the URDF is on the parameter server).
@@ -256,18 +337,19 @@ class Executor {
   }
 
   // ---- the action ------------------------------------------------------------------------------
-  void execute(const lfd_msgs::ExecuteTaskGoal& goal) {
+  void execute(ActionServer& server, const lfd_msgs::ExecuteTaskGoal& goal) {
+    goal_server_ = &server;
     const auto wall0 = Clock::now();
     lfd_msgs::ExecuteTaskResult result;
     try {
       feedback_ = lfd_msgs::ExecuteTaskFeedback();
       feedback_.state = lfd_msgs::ExecuteTaskFeedback::PLANNING;
-      server_->publishFeedback(feedback_);
+      goal_server_->publishFeedback(feedback_);
       lfd_dmp::ExecutorOptions opt = options_;
       opt.duration_scale = lfd_dmp::checkedDurationScale(goal.duration_scale, limits_);
       opt.allow_extrapolation = goal.allow_extrapolation;
       const std::string path = libraryPath(goal.library);
-      const lfd_dmp::SkillLibrary library = lfd_dmp::loadSkillLibrary(path);
+      const lfd_dmp::SkillLibrary library = lfd_dmp::loadSkillLibrary(path, library_limits_);
       if (library.cartesian_frame != cartesianFrame())
         throw std::invalid_argument("the library's poses are in '" + library.cartesian_frame +
                                     "', the robot's Cartesian frame is '" + cartesianFrame() + "'");
@@ -282,7 +364,7 @@ class Executor {
         result.extrapolation_angle = std::max(result.extrapolation_angle, t.range.angle);
       }
       lfd_dmp::ExecutionPlan plan = planner().plan(library, targets, q, gripper, opt, [this] {
-        return server_->isPreemptRequested() || !ros::ok();
+        return goal_server_->isPreemptRequested() || !ros::ok() || clock_reset_;
       });
       plan.warnings.insert(plan.warnings.begin(), warnings.begin(), warnings.end());
       describePlan(plan, wall0, &result);
@@ -291,9 +373,9 @@ class Executor {
                plan.max_ik_position_error * 1e3, result.planning_time);
       if (!goal.dry_run) run(plan, &result);
       result.success = true;
-      server_->setSucceeded(result);
+      goal_server_->setSucceeded(result);
     } catch (const lfd_dmp::PlanningCancelled& e) {
-      finish(&result, e.what(), true);
+      finish(&result, clock_reset_ ? clockResetText() : e.what(), !clock_reset_);
     } catch (const Preempted& e) {
       finish(&result, e.what(), true);
     } catch (const lfd_dmp::OutsideDemoRange& e) {
@@ -311,10 +393,10 @@ class Executor {
     result->error = error;
     if (preempted) {
       ROS_WARN("executor: %s", error.c_str());
-      server_->setPreempted(*result, error);
+      goal_server_->setPreempted(*result, error);
     } else {
       ROS_ERROR("executor: %s", error.c_str());
-      server_->setAborted(*result, error);
+      goal_server_->setAborted(*result, error);
     }
   }
 
@@ -369,7 +451,8 @@ class Executor {
     ros::Time reached;
     for (;;) {
       const ros::Time now = ros::Time::now();
-      if (server_->isPreemptRequested() || !ros::ok()) stop(plan, t0, now);
+      if (clock_reset_) throw std::runtime_error(clockResetText());
+      if (goal_server_->isPreemptRequested() || !ros::ok()) stop(plan, t0, now);
       watch.check(now);
       const ros::Time measured = track(plan, t0);
       if (now >= t_end) {
@@ -467,7 +550,7 @@ class Executor {
   }
 
   void publishFeedback() {
-    server_->publishFeedback(feedback_);
+    goal_server_->publishFeedback(feedback_);
     last_feedback_ = Clock::now();
   }
 
@@ -503,6 +586,7 @@ class Executor {
   lfd::PathPolicy paths_;
   lfd_dmp::ExecutorOptions options_;
   lfd_dmp::RequestLimits limits_;
+  lfd_dmp::LibraryLimits library_limits_;
   double settle_time_ = 0.5, clock_timeout_ = 5.0, motion_lead_ = 0.1, connect_timeout_ = 5.0;
   double tf_timeout_ = 1.0;
   double trajectory_period_ = 0.01, feedback_period_ = 0.05;
@@ -511,7 +595,13 @@ class Executor {
   tf2_ros::TransformListener tf_listener_;
   ros::Publisher trajectory_pub_, gripper_pub_, planned_pub_, executed_pub_, marker_pub_;
   ros::Subscriber joint_sub_, gripper_sub_;
+  ros::NodeHandle pnh_;
   std::unique_ptr<ActionServer> server_;
+  ActionServer* goal_server_ = nullptr;  // the server whose goal thread runs execute()
+  ros::Subscriber clock_sub_;
+  ros::Time last_clock_;  // the newest /clock (its callbacks never overlap)
+  std::atomic<bool> clock_reset_{false};
+  std::string clock_reset_text_;
   lfd_msgs::ExecuteTaskFeedback feedback_;
   Clock::time_point last_feedback_;
   ros::Time tracked_stamp_;

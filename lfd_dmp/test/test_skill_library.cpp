@@ -250,6 +250,73 @@ TEST(SkillLibrary, ValidationNamesTheProblem) {
 
 // catkin_add_gtest links gtest without gtest_main (and the static gtest_main archive is then simply
 // not pulled in by the standalone build).
+// Issue 23 row 8: a library whose tau is 1e-6 s (or 0.05 s where its demos took 9.8 s)
+// "succeeded" in 0.1 s without moving. Durations, sizes and strings are checked on load; each
+// refusal names the segment, the field and the limit's key. The valid library still loads.
+TEST(SkillLibrary, ImplausibleDurationsAndSizesAreRefusedOnLoad) {
+  const nlohmann::json good = lfd_dmp::toJson(makeLibrary());
+  EXPECT_EQ(loadError(good), "");
+
+  nlohmann::json j = good;
+  j["segments"][1]["demos"][0]["dmp"]["tau"] = 1e-6;
+  std::string error = loadError(j);
+  EXPECT_NE(error.find("segments[1] 'move', demos[0] 'demo_0.bag'.dmp.tau: 1e-06 s outside"),
+            std::string::npos)
+      << error;
+  EXPECT_NE(error.find("library_limits/min_tau"), std::string::npos) << error;
+
+  j = good;  // a 9.8 s demonstration played in 0.5 s
+  j["segments"][0]["demos"][1]["end_time"] = 9.8;
+  j["segments"][0]["demos"][1]["start_time"] = 0.0;
+  j["segments"][0]["demos"][1]["dmp"]["tau"] = 0.5;
+  error = loadError(j);
+  EXPECT_NE(error.find("segments[0] 'approach', demos[1] 'demo_1.bag'.dmp.tau: 0.5 s for a "
+                       "demonstrated segment of 9.8 s"),
+            std::string::npos)
+      << error;
+  EXPECT_NE(error.find("library_limits/max_tau_ratio"), std::string::npos) << error;
+
+  j = good;
+  j["segments"][0]["demos"][0]["dmp"]["tau"] = 1e6;
+  EXPECT_NE(loadError(j).find("library_limits/min_tau, max_tau"), std::string::npos);
+
+  j = good;  // sizes: segments, basis functions, strings
+  for (int k = 0; k < 70; ++k) j["segments"].push_back(good["segments"][0]);
+  EXPECT_NE(loadError(j).find("segments: 72 is over the limit of 64 (library_limits/max_segments)"),
+            std::string::npos)
+      << loadError(j);
+  j = good;
+  j["dmp_parameters"]["num_basis"] = 5000;
+  EXPECT_NE(loadError(j).find("dmp_parameters.num_basis: over the limit of 1000"),
+            std::string::npos)
+      << loadError(j);
+  j = good;
+  j["segments"][0]["demos"][0]["demo_id"] = std::string(100000, 'x');
+  error = loadError(j);
+  EXPECT_NE(error.find("skill library.segments[0].demos[0].demo_id: a string of 100000 is over "
+                       "the limit of 1024 (library_limits/max_string_length)"),
+            std::string::npos)
+      << error;
+  EXPECT_LT(error.size(), 400u);
+  j = good;
+  j["features"] = nlohmann::json::array();
+  for (int k = 0; k < 2000; ++k) j["features"].push_back("f");
+  EXPECT_NE(loadError(j).find("library_limits/max_list_length"), std::string::npos);
+
+  lfd_dmp::LibraryLimits tight;  // the file's size, before it is parsed
+  tight.max_file_bytes = 1000;
+  const std::string path = tempPath("big.json");
+  std::ofstream(path) << good.dump();
+  try {
+    lfd_dmp::loadSkillLibrary(path, tight);
+    ADD_FAILURE() << "a library over max_file_bytes loaded";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("library_limits/max_file_bytes"), std::string::npos)
+        << e.what();
+  }
+  std::remove(path.c_str());
+}
+
 int main(int argc, char** argv) {
   ::testing::InitGoogleTest(&argc, argv);
   return RUN_ALL_TESTS();

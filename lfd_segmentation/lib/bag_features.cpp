@@ -15,6 +15,7 @@
 
 #include "lfd_core/ros_message_reader.hpp"
 #include "lfd_core/safe_paths.hpp"
+#include "lfd_core/user_text.hpp"
 
 namespace lfd_segmentation {
 
@@ -145,7 +146,7 @@ void open_bag(rosbag::Bag& bag, const std::string& path) {
     lfd::checkInputFile(path);  // a FIFO or device would block bag.open forever
     bag.open(path, rosbag::bagmode::Read);
   } catch (const std::exception& e) {
-    throw std::runtime_error("cannot open bag '" + path + "': " + e.what());
+    throw std::runtime_error("cannot open bag " + lfd::quoted(path) + ": " + e.what());
   }
 }
 
@@ -181,9 +182,10 @@ void read_part(const std::string& path, const std::vector<TopicConfig>& topics,
       }
     }
   } catch (const std::invalid_argument& e) {
-    throw std::invalid_argument("bag '" + path + "': " + e.what());
+    throw std::invalid_argument("bag " + lfd::quoted(path) + ": " + e.what());
   } catch (const std::exception& e) {
-    throw std::runtime_error("cannot read bag '" + path + "' (truncated or corrupt?): " + e.what());
+    throw std::runtime_error("cannot read bag " + lfd::quoted(path) +
+                             " (truncated or corrupt?): " + e.what());
   }
 }
 
@@ -208,7 +210,7 @@ std::vector<std::string> demo_parts(const std::string& path) {
   std::stringstream in(path);
   std::string part;
   while (std::getline(in, part, ',')) {
-    if (part.empty()) throw std::invalid_argument("empty bag name in '" + path + "'");
+    if (part.empty()) throw std::invalid_argument("empty bag name in " + lfd::quoted(path));
     parts.push_back(part);
   }
   return parts;
@@ -220,7 +222,7 @@ std::vector<lfd::Stream> read_bag_streams(const std::string& path,
   if (topics.empty()) throw std::invalid_argument("no topics configured for the features");
   for (const TopicConfig& cfg : topics) {
     if (cfg.topic == kGroundTruthTopic) {
-      throw std::invalid_argument("bag '" + path + "': " + kGroundTruthTopic +
+      throw std::invalid_argument("bag " + lfd::quoted(path) + ": " + kGroundTruthTopic +
                                   " is ground truth and is never read by the segmenter");
     }
   }
@@ -235,7 +237,7 @@ std::vector<lfd::Stream> read_bag_streams(const std::string& path,
     try {
       topic_streams = readers[k].take_streams();
     } catch (const std::invalid_argument& e) {
-      throw std::invalid_argument("bag '" + path + "': " + e.what());
+      throw std::invalid_argument("bag " + lfd::quoted(path) + ": " + e.what());
     }
     if (roles) roles->insert(roles->end(), topic_streams.size(), topics[k].role);
     for (lfd::Stream& s : topic_streams) streams.push_back(std::move(s));
@@ -256,8 +258,8 @@ DemoFeatures read_bag_features(const std::string& path, const std::vector<TopicC
     end = std::min(end, s.time.back());
   }
   if (end > start && (end - start) * rate + 1 > static_cast<double>(limits.max_samples_per_demo)) {
-    throw std::invalid_argument("bag '" + path + "': " + std::to_string(end - start) + " s at " +
-                                std::to_string(rate) + " Hz is over the limit of " +
+    throw std::invalid_argument("bag " + lfd::quoted(path) + ": " + std::to_string(end - start) +
+                                " s at " + std::to_string(rate) + " Hz is over the limit of " +
                                 std::to_string(limits.max_samples_per_demo) +
                                 " samples per demo (limits/max_samples_per_demo)");
   }
@@ -266,7 +268,7 @@ DemoFeatures read_bag_features(const std::string& path, const std::vector<TopicC
   try {
     demo.matrix = lfd::resample(streams, rate);
   } catch (const std::invalid_argument& e) {
-    throw std::invalid_argument("bag '" + path + "': " + e.what());
+    throw std::invalid_argument("bag " + lfd::quoted(path) + ": " + e.what());
   }
   for (std::size_t k = 0; k < streams.size(); ++k) {
     if (roles[k] == FeatureRole::kSensor) demo.sensor_features.push_back(streams[k].name);
@@ -300,7 +302,7 @@ std::string describe_bag(const std::string& path) {
         out << field_list(schema, sample) << "\n";
       }
     } catch (const std::exception& e) {
-      throw std::runtime_error("cannot read bag '" + part + "': " + e.what());
+      throw std::runtime_error("cannot read bag " + lfd::quoted(part) + ": " + e.what());
     }
   }
   return out.str();

@@ -2,6 +2,7 @@
 
 #include "lfd_core/safe_paths.hpp"
 #include "lfd_core/segmentation_pipeline.hpp"
+#include "lfd_core/user_text.hpp"
 
 #include <cerrno>
 #include <cmath>
@@ -44,20 +45,21 @@ lfd::FeatureMatrix read_csv_features(const std::string& path, const std::string&
     throw std::invalid_argument(std::string("cannot open CSV file: ") + e.what());
   }
   std::ifstream in(path);
-  if (!in) throw std::invalid_argument("cannot open CSV file '" + path + "'");
+  if (!in) throw std::invalid_argument("cannot open CSV file " + lfd::quoted(path));
   std::string line;
   std::size_t line_number = 0;
   while (std::getline(in, line)) {
     ++line_number;
     if (!trim(line).empty()) break;
   }
-  if (trim(line).empty()) throw std::invalid_argument("CSV file '" + path + "' is empty");
+  if (trim(line).empty())
+    throw std::invalid_argument("CSV file " + lfd::quoted(path) + " is empty");
   const std::vector<std::string> header = split(line);
   int time_index = -1;
   for (std::size_t c = 0; c < header.size(); ++c) {
     if (header[c].empty()) {
-      throw std::invalid_argument("CSV file '" + path + "': column " + std::to_string(c + 1) +
-                                  " of the header has no name");
+      throw std::invalid_argument("CSV file " + lfd::quoted(path) + ": column " +
+                                  std::to_string(c + 1) + " of the header has no name");
     }
     const bool is_time = time_column.empty() ? (header[c] == "time" || header[c] == "t" ||
                                                 header[c] == "timestamp" || header[c] == "stamp")
@@ -65,13 +67,15 @@ lfd::FeatureMatrix read_csv_features(const std::string& path, const std::string&
     if (is_time && time_index < 0) time_index = static_cast<int>(c);
   }
   if (!time_column.empty() && time_index < 0) {
-    throw std::invalid_argument("CSV file '" + path + "' has no time column '" + time_column + "'");
+    throw std::invalid_argument("CSV file " + lfd::quoted(path) + " has no time column " +
+                                lfd::quoted(time_column));
   }
   lfd::FeatureMatrix m;
   for (std::size_t c = 0; c < header.size(); ++c) {
     if (static_cast<int>(c) != time_index) m.names.push_back(header[c]);
   }
-  if (m.names.empty()) throw std::invalid_argument("CSV file '" + path + "' has no feature column");
+  if (m.names.empty())
+    throw std::invalid_argument("CSV file " + lfd::quoted(path) + " has no feature column");
 
   std::vector<double> values;  // row-major while reading
   std::vector<double> time;
@@ -80,7 +84,7 @@ lfd::FeatureMatrix read_csv_features(const std::string& path, const std::string&
     ++line_number;
     if (trim(line).empty()) continue;
     if (++rows_read > limits.max_csv_rows) {
-      throw std::invalid_argument("CSV file '" + path + "' has more than " +
+      throw std::invalid_argument("CSV file " + lfd::quoted(path) + " has more than " +
                                   std::to_string(limits.max_csv_rows) +
                                   " data rows (limits/max_csv_rows)");
     }
@@ -92,22 +96,23 @@ lfd::FeatureMatrix read_csv_features(const std::string& path, const std::string&
       errno = 0;
       const double v = std::strtod(p, &end);
       if (end == p) {
-        throw std::invalid_argument("CSV file '" + path + "' line " + std::to_string(line_number) +
-                                    ": column " + std::to_string(column + 1) + " ('" +
-                                    (column < header.size() ? header[column] : "?") +
-                                    "') is not a number");
+        throw std::invalid_argument(
+            "CSV file " + lfd::quoted(path) + " line " + std::to_string(line_number) + ": column " +
+            std::to_string(column + 1) + " (" +
+            lfd::quoted(column < header.size() ? header[column] : "?") + ") is not a number");
       }
       if (column >= header.size()) {
-        throw std::invalid_argument("CSV file '" + path + "' line " + std::to_string(line_number) +
-                                    " has more than " + std::to_string(header.size()) + " columns");
+        throw std::invalid_argument("CSV file " + lfd::quoted(path) + " line " +
+                                    std::to_string(line_number) + " has more than " +
+                                    std::to_string(header.size()) + " columns");
       }
       if (std::isfinite(v) && std::abs(v) > limits.max_abs_value) {
         std::ostringstream text;
         text << v << " is beyond +-" << limits.max_abs_value;
-        throw std::invalid_argument("CSV file '" + path + "' line " + std::to_string(line_number) +
-                                    ", column " + std::to_string(column + 1) + " ('" +
-                                    header[column] + "'): " + text.str() +
-                                    " (limits/max_abs_value): distances would overflow");
+        throw std::invalid_argument(
+            "CSV file " + lfd::quoted(path) + " line " + std::to_string(line_number) + ", column " +
+            std::to_string(column + 1) + " (" + lfd::quoted(header[column]) + "): " + text.str() +
+            " (limits/max_abs_value): distances would overflow");
       }
       (static_cast<int>(column) == time_index ? time : values).push_back(v);
       ++column;
@@ -118,19 +123,20 @@ lfd::FeatureMatrix read_csv_features(const std::string& path, const std::string&
         continue;
       }
       if (*p != '\0') {
-        throw std::invalid_argument("CSV file '" + path + "' line " + std::to_string(line_number) +
-                                    ": unexpected '" + std::string(1, *p) + "'");
+        throw std::invalid_argument("CSV file " + lfd::quoted(path) + " line " +
+                                    std::to_string(line_number) + ": unexpected '" +
+                                    std::string(1, *p) + "'");
       }
       break;
     }
     if (column != header.size()) {
-      throw std::invalid_argument("CSV file '" + path + "' line " + std::to_string(line_number) +
-                                  " has " + std::to_string(column) + " columns, the header " +
-                                  std::to_string(header.size()));
+      throw std::invalid_argument("CSV file " + lfd::quoted(path) + " line " +
+                                  std::to_string(line_number) + " has " + std::to_string(column) +
+                                  " columns, the header " + std::to_string(header.size()));
     }
   }
   const std::size_t rows = values.size() / m.names.size();
-  if (rows == 0) throw std::invalid_argument("CSV file '" + path + "' has no data rows");
+  if (rows == 0) throw std::invalid_argument("CSV file " + lfd::quoted(path) + " has no data rows");
   m.data = Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(
       values.data(), rows, m.names.size());
   if (rate > 0) {  // an explicit rate overrides the time column (e.g. stamps of a bad clock)

@@ -57,6 +57,12 @@ const char* role_of(const std::string& name, const std::vector<std::string>& sta
   return in(states) ? "state" : in(sensors) ? "sensor" : "context";
 }
 
+// Feature names, file names and errors come from the user's files and may hold any bytes: invalid
+// UTF-8 is written as U+FFFD instead of throwing (nlohmann's type_error 316 aborted the CLI).
+std::string dump_text(const json& j) {
+  return j.dump(-1, ' ', false, json::error_handler_t::replace);
+}
+
 bool is_flat(const json& j) {
   return !j.is_structured() || j.empty() ||
          (j.is_array() &&
@@ -65,14 +71,14 @@ bool is_flat(const json& j) {
 
 void dump_indented(const json& j, int depth, std::string& out) {
   if (is_flat(j)) {
-    out += j.dump();
+    out += dump_text(j);
     return;
   }
   const std::string pad(static_cast<std::size_t>(depth) + 1, ' ');
   out += j.is_object() ? '{' : '[';
   for (auto it = j.begin(); it != j.end(); ++it) {
     out += (it == j.begin() ? "\n" : ",\n") + pad;
-    if (j.is_object()) out += json(it.key()).dump() + ": ";
+    if (j.is_object()) out += dump_text(json(it.key())) + ": ";
     dump_indented(*it, depth + 1, out);
   }
   out += "\n" + std::string(static_cast<std::size_t>(depth), ' ') + (j.is_object() ? '}' : ']');

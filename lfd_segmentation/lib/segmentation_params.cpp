@@ -1,5 +1,7 @@
 #include "lfd_segmentation/segmentation_params.hpp"
 
+#include "lfd_core/user_text.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <sstream>
@@ -22,15 +24,16 @@ T get(const YAML::Node& node, const std::string& key, T fallback) {
 
 double non_negative(double value, const std::string& key) {
   if (!(value >= 0) || !std::isfinite(value)) {
-    throw std::invalid_argument("segmentation parameter '" + key + "' must be >= 0, got " +
-                                std::to_string(value));
+    throw std::invalid_argument("segmentation parameter " + lfd::quoted(key) +
+                                " must be >= 0, got " + std::to_string(value));
   }
   return value;
 }
 
 double positive(double value, const std::string& key) {
   if (!(value > 0) || !std::isfinite(value)) {
-    throw std::invalid_argument("segmentation parameter '" + key + "' must be > 0 and finite");
+    throw std::invalid_argument("segmentation parameter " + lfd::quoted(key) +
+                                " must be > 0 and finite");
   }
   return value;
 }
@@ -63,8 +66,8 @@ TopicConfig parse_topic(const YAML::Node& node, std::size_t index) {
   } else if (role == "context") {
     topic.role = FeatureRole::kContext;
   } else {
-    throw std::invalid_argument(where + ": role must be 'state', 'sensor' or 'context', got '" +
-                                role + "'");
+    throw std::invalid_argument(where + ": role must be 'state', 'sensor' or 'context', got " +
+                                lfd::quoted(role));
   }
   const std::string interpolation = get<std::string>(node, "interpolation", "linear");
   if (interpolation == "linear") {
@@ -278,7 +281,8 @@ SegmentationParams load_params_file(const std::string& path) {
   try {
     root = YAML::LoadFile(path);
   } catch (const YAML::Exception& e) {
-    throw std::invalid_argument("cannot read segmentation parameters '" + path + "': " + e.what());
+    throw std::invalid_argument("cannot read segmentation parameters " + lfd::quoted(path) + ": " +
+                                e.what());
   }
   return params_from_yaml(root);
 }
@@ -301,7 +305,7 @@ void check_demos_fit(const SegmentationParams& params, const std::vector<lfd::Fe
     const std::string& source = d < sources.size() ? sources[d] : "demo " + std::to_string(d);
     const std::size_t rows = static_cast<std::size_t>(m.rows());
     if (rows > lim.max_samples_per_demo) {
-      throw std::invalid_argument("'" + source + "' has " + std::to_string(rows) +
+      throw std::invalid_argument(lfd::quoted(source) + " has " + std::to_string(rows) +
                                   " samples on its clock, over the limit of " +
                                   std::to_string(lim.max_samples_per_demo) +
                                   " (limits/max_samples_per_demo): put it on a slower clock "
@@ -331,7 +335,7 @@ void check_streams(const std::vector<lfd::Stream>& streams, const std::string& s
     if (!s.time.empty()) {
       const auto [first, last] = std::minmax_element(s.time.begin(), s.time.end());
       if (*last - *first > limits.max_demo_seconds) {
-        throw std::invalid_argument("'" + source + "': " + s.name + " has stamps " +
+        throw std::invalid_argument(lfd::quoted(source) + ": " + s.name + " has stamps " +
                                     seconds(*last - *first) + " apart (first " + seconds(*first) +
                                     ", last " + seconds(*last) + "), over the limit of " +
                                     seconds(limits.max_demo_seconds) +
@@ -340,10 +344,10 @@ void check_streams(const std::vector<lfd::Stream>& streams, const std::string& s
     }
     for (std::size_t k = 0; k < s.values.size(); ++k) {
       if (std::abs(s.values[k]) > limits.max_abs_value) {
-        throw std::invalid_argument("'" + source + "': " + s.name + " = " + number(s.values[k]) +
-                                    " at t = " + seconds(k < s.time.size() ? s.time[k] : 0.0) +
-                                    " is beyond +-" + number(limits.max_abs_value) +
-                                    " (limits/max_abs_value): distances would overflow");
+        throw std::invalid_argument(
+            lfd::quoted(source) + ": " + s.name + " = " + number(s.values[k]) +
+            " at t = " + seconds(k < s.time.size() ? s.time[k] : 0.0) + " is beyond +-" +
+            number(limits.max_abs_value) + " (limits/max_abs_value): distances would overflow");
       }
     }
   }

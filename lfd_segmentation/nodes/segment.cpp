@@ -13,6 +13,7 @@
 #include <stdexcept>
 
 #include "lfd_core/safe_paths.hpp"
+#include "lfd_core/user_text.hpp"
 #include "lfd_segmentation/bag_features.hpp"
 #include "lfd_segmentation/csv_features.hpp"
 #include "lfd_segmentation/segmentation_json.hpp"
@@ -86,7 +87,7 @@ std::vector<lfd::ProfileCombination> parse_combinations(const std::string& list)
   for (const std::string& name : split_list(list)) {
     const lfd::ProfileCombination c = lfd::parse_profile_combination(name);
     if (std::find(out.begin(), out.end(), c) != out.end())
-      throw std::invalid_argument("--combination names '" + name + "' twice");
+      throw std::invalid_argument("--combination names " + lfd::quoted(name) + " twice");
     out.push_back(c);
   }
   return out;
@@ -123,7 +124,7 @@ Options parse_args(int argc, char** argv) {
         if (used != v.size()) throw std::invalid_argument("");
         return x;
       } catch (const std::exception&) {
-        throw std::invalid_argument(arg + " expects a number, got '" + v + "'");
+        throw std::invalid_argument(arg + " expects a number, got " + lfd::quoted(v));
       }
     };
     if (arg == "-h" || arg == "--help") {
@@ -193,7 +194,7 @@ lfd::FeatureMatrix resample_within_limits(const lfd::FeatureMatrix& m, double ra
   const double span = m.time.empty() ? 0.0 : m.time.back() - m.time.front();
   const double rows = span * rate + 1.0;
   if (!(rows <= static_cast<double>(params.limits.max_samples_per_demo)))
-    throw std::invalid_argument("'" + path + "' spans " + std::to_string(span) +
+    throw std::invalid_argument(lfd::quoted(path) + " spans " + std::to_string(span) +
                                 " s: at --resample " + std::to_string(rate) +
                                 " Hz that is over the limit of " +
                                 std::to_string(params.limits.max_samples_per_demo) +
@@ -201,7 +202,7 @@ lfd::FeatureMatrix resample_within_limits(const lfd::FeatureMatrix& m, double ra
   try {
     return lfd::resample(m, rate);
   } catch (const std::invalid_argument& e) {
-    throw std::invalid_argument("'" + path + "': " + e.what());
+    throw std::invalid_argument(lfd::quoted(path) + ": " + e.what());
   }
 }
 
@@ -256,8 +257,8 @@ nlohmann::json run(const Options& o) {
       demos.push_back(lfd_segmentation::read_csv_features(f, o.time_column, o.rate, params.limits));
       if (demos.back().time.empty())
         throw std::invalid_argument(
-            "CSV file '" + f +
-            "' has no time column (time, t, timestamp, stamp or --time-column): give its sample "
+            "CSV file " + lfd::quoted(f) +
+            " has no time column (time, t, timestamp, stamp or --time-column): give its sample "
             "rate with --rate, the time parameters are in seconds");
       if (o.resample > 0)
         demos.back() = resample_within_limits(demos.back(), o.resample, f, params);

@@ -162,6 +162,42 @@ TEST(SegmentCli, BadInputFailsWithAnErrorInTheJson) {
   EXPECT_EQ(status, 1);
 }
 
+// Issue 23 row 7: a column name or a file name with bytes that are not UTF-8 made the JSON writer
+// throw (nlohmann type_error 316) and the CLI abort (exit 134). Now the JSON is valid (U+FFFD for
+// the bad bytes), an error quotes the name printably, and never more than ~200 characters of it.
+TEST(SegmentCli, NonUtf8NamesGiveValidJsonAndLongInputIsQuotedShort) {
+  const std::string csv = (temp_dir() / "bad_header.csv").string();
+  write_demo_csv(csv, 300, 7);
+  {  // the header's second column becomes "gr\xffipper"
+    std::ifstream in(csv);
+    std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    text.replace(text.find("gripper"), 7, "gr\xff\xfeipper");
+    std::ofstream(csv) << text;
+  }
+  int status = -1;
+  auto j = run_cli(csv, &status);
+  ASSERT_EQ(status, 0) << j.dump();
+  EXPECT_EQ(j["selected_features"][0].get<std::string>(), "gr\xef\xbf\xbd\xef\xbf\xbdipper")
+      << j["selected_features"].dump();
+
+  const std::string named = (temp_dir() / "demo_\xff\xc3.csv").string();
+  fs::copy_file(csv, named, fs::copy_options::overwrite_existing);
+  j = run_cli(named, &status);
+  ASSERT_EQ(status, 0) << j.dump();
+  EXPECT_NE(j["demos"][0]["source"].get<std::string>().find("demo_\xef\xbf\xbd"),
+            std::string::npos);
+
+  j = run_cli((temp_dir() / "missing_\xff.csv").string(), &status);
+  EXPECT_EQ(status, 1);
+  EXPECT_NE(j["error"].get<std::string>().find("missing_\\xff.csv"), std::string::npos) << j.dump();
+
+  const std::string long_name = "/nonexistent/" + std::string(5000, 'a') + ".csv";
+  j = run_cli(long_name, &status);
+  EXPECT_EQ(status, 1);
+  EXPECT_LT(j["error"].get<std::string>().size(), 400u) << j["error"].get<std::string>().size();
+  EXPECT_NE(j["error"].get<std::string>().find("(5017 bytes)"), std::string::npos);
+}
+
 // Each feature's role as the bag reader gave it.
 std::map<std::string, std::string> roles_of(const lfd_segmentation::DemoFeatures& demo) {
   std::map<std::string, std::string> roles;

@@ -1,8 +1,9 @@
 // recorder_node: one bag per demonstration. Subscribes generically (ShapeShifter) to the topics of
 // config/recorder.yaml from startup, so no subscription latency is paid when a demo starts, and
 // writes them while a recording is active, stamped with their header time (sim time).
-//   /recorder/start (lfd_msgs/StartRecording): open <bag_path>.active, write metadata first,
-//                   answer once every topic is linked to each of its publishers
+//   /recorder/start (lfd_msgs/StartRecording): open <bag_path>.active (inside ~allowed_roots, no
+//                   ".."), write metadata first, answer once every topic is linked to each of
+//                   its publishers
 //   /recorder/stop  (lfd_msgs/StopRecording):  wait for in-flight messages, close, rename
 // SIGINT/SIGTERM close the open bag cleanly before the node exits.
 #include <atomic>
@@ -24,6 +25,8 @@
 #include <ros/ros.h>
 #include <rosgraph_msgs/Clock.h>
 #include <topic_tools/shape_shifter.h>
+
+#include <lfd_core/safe_paths.hpp>
 
 #include "lfd_sim_bridge/bag_recorder.hpp"
 #include "lfd_sim_bridge/topic_connections.hpp"
@@ -73,6 +76,7 @@ class Recorder {
     settle_timeout_ = pnh.param("settle_timeout", 1.0);
     connect_timeout_ = pnh.param("connect_timeout", 5.0);
     max_unflushed_ = pnh.param("max_unflushed_seconds", max_unflushed_);
+    paths_.allowed_roots = pnh.param("allowed_roots", paths_.allowed_roots);
     for (const std::string& folder : pnh.param("recovery_folders", std::vector<std::string>{}))
       reportRecovered(lfd_sim_bridge::recoverCrashedBags(folder));
     for (const TopicSpec& spec : topics_) {
@@ -257,10 +261,13 @@ class Recorder {
     }
     const ros::Time start =
         req.metadata.header.stamp.isZero() ? ros::Time::now() : req.metadata.header.stamp;
-    // A crash of an earlier recorder left `.active` bags in this folder: keep and reindex them.
-    const std::string recovered = reportRecovered(lfd_sim_bridge::recoverCrashedBags(
-        std::filesystem::path(req.bag_path).parent_path().string()));
+    std::string recovered;
     try {
+      lfd::checkPathInRoots(req.bag_path, paths_);
+      // A crash may have left this very bag's `.active`: keep and reindex it. Only this path, and
+      // only when no live recorder holds it (another recorder may be recording next to it).
+      if (const auto r = lfd_sim_bridge::recoverCrashedBag(req.bag_path))
+        recovered = reportRecovered({*r});
       bag_ = std::make_unique<lfd_sim_bridge::DemoBag>(req.bag_path, req.metadata, start,
                                                        ros::Duration(max_unflushed_));
     } catch (const std::exception& e) {
@@ -368,6 +375,7 @@ class Recorder {
   std::vector<ros::Subscriber> subscribers_;
   double connect_timeout_ = 5.0;  // s of wall time: at start-up, and at each start
   double max_unflushed_ = 0.1;    // s of bag time a kill -9 may lose (chunk closed this often)
+  lfd::PathPolicy paths_;         // ~allowed_roots of a start's bag_path
   ros::NodeHandle service_nh_;
   ros::CallbackQueue service_queue_;
   std::unique_ptr<ros::AsyncSpinner> service_spinner_;

@@ -1,6 +1,8 @@
 #include "lfd_sim_bridge/bag_recorder.hpp"
 
 #include <fcntl.h>
+#include <sys/file.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -13,6 +15,7 @@
 #include <vector>
 
 #include <ros/serialization.h>
+#include <lfd_core/user_text.hpp>
 
 namespace lfd_sim_bridge {
 namespace {
@@ -31,6 +34,41 @@ std::string firstFieldLine(const std::string& definition) {
     return line.substr(begin);
   }
   return "";
+}
+
+// True when a live recorder holds `active`'s lock (it dies with the process, so a crashed
+// recording is never live). Opened without following a link and without blocking.
+bool isLive(const std::string& active) {
+  const int fd = ::open(active.c_str(), O_RDONLY | O_NOFOLLOW | O_NONBLOCK | O_CLOEXEC);
+  if (fd < 0) return false;
+  const bool live = ::flock(fd, LOCK_EX | LOCK_NB) != 0 && errno == EWOULDBLOCK;
+  ::close(fd);
+  return live;
+}
+
+// Creates `active` already locked (flock, exclusive): the file is made and locked under a temporary
+// name, then linked to its name, which fails if it exists (a crashed recording, maybe the only
+// copy of a demo, or another recorder's live one: rosbag's Write mode would truncate either).
+// Nobody ever sees `active` unlocked while it is being recorded. Returns the locked descriptor.
+int createLocked(const std::string& active) {
+  std::string temp = active + ".lock.XXXXXX";
+  const int fd = ::mkostemp(temp.data(), O_CLOEXEC);  // a child (rosbag reindex) gets no lock
+  if (fd < 0)
+    throw std::runtime_error("cannot create " + lfd::quoted(active) + ": " + std::strerror(errno));
+  ::fchmod(fd, 0644);
+  const bool locked = ::flock(fd, LOCK_EX | LOCK_NB) == 0;
+  const bool linked = locked && ::link(temp.c_str(), active.c_str()) == 0;
+  const int link_errno = errno;
+  ::unlink(temp.c_str());
+  if (linked) return fd;
+  ::close(fd);
+  if (locked && link_errno == EEXIST)
+    throw std::runtime_error(
+        lfd::quoted(active) + " exists (" +
+        (isLive(active) ? "another recorder is recording it" : "a crashed recording") +
+        "); it is kept: choose another bag_path");
+  throw std::runtime_error("cannot create " + lfd::quoted(active) + ": " +
+                           std::strerror(link_errno));
 }
 
 bool startsWithHeader(const std::string& definition) {
@@ -60,28 +98,23 @@ DemoBag::DemoBag(const std::string& bag_path, lfd_msgs::DemoMetadata metadata,
     : path_(bag_path), start_(start), max_unflushed_(max_unflushed), chunk_start_(start) {
   namespace fs = std::filesystem;
   if (bag_path.empty() || fs::path(bag_path).is_relative())
-    throw std::runtime_error("bag path must be absolute, got '" + bag_path + "'");
+    throw std::runtime_error("bag path must be absolute, got " + lfd::quoted(bag_path));
   if (fs::path(bag_path).extension() != ".bag")
-    throw std::runtime_error("bag path must end in .bag, got '" + bag_path + "'");
+    throw std::runtime_error("bag path must end in .bag, got " + lfd::quoted(bag_path));
   std::error_code ec;
   fs::create_directories(fs::path(bag_path).parent_path(), ec);
-  if (ec) throw std::runtime_error("cannot create folder for '" + bag_path + "': " + ec.message());
-  if (fs::exists(bag_path)) throw std::runtime_error("bag '" + bag_path + "' already exists");
-  // O_EXCL: rosbag's Write mode truncates, and an existing .active is a crashed recording.
-  const std::string active = bag_path + ".active";
-  const int fd = ::open(active.c_str(), O_CREAT | O_EXCL | O_WRONLY, 0644);
-  if (fd < 0) {
-    throw std::runtime_error(errno == EEXIST
-                                 ? "'" + active +
-                                       "' exists (a crashed recording?); it is kept: "
-                                       "choose another bag_path"
-                                 : "cannot create '" + active + "': " + std::strerror(errno));
-  }
-  ::close(fd);
+  if (ec)
+    throw std::runtime_error("cannot create folder for " + lfd::quoted(bag_path) + ": " +
+                             ec.message());
+  if (fs::exists(bag_path))
+    throw std::runtime_error("bag " + lfd::quoted(bag_path) + " already exists");
+  lock_fd_ = createLocked(bag_path + ".active");
   try {
     bag_.open(bag_path + ".active", rosbag::bagmode::Write);
   } catch (const rosbag::BagException& e) {
-    throw std::runtime_error("cannot open '" + bag_path + ".active': " + e.what());
+    ::unlink((bag_path + ".active").c_str());  // empty, and ours: no crash to keep
+    releaseLock();
+    throw std::runtime_error("cannot open " + lfd::quoted(bag_path + ".active") + ": " + e.what());
   }
   open_ = true;
   if (metadata.header.stamp.isZero()) metadata.header.stamp = start;
@@ -99,6 +132,7 @@ DemoBag::~DemoBag() {
   } catch (const std::exception& e) {
     std::fprintf(stderr, "[recorder] closing %s failed: %s\n", path_.c_str(), e.what());
   }
+  releaseLock();
 }
 
 bool DemoBag::write(const std::string& topic, const ros::Time& stamp,
@@ -122,8 +156,16 @@ void DemoBag::close() {
   if (!open_) return;
   open_ = false;
   bag_.close();
-  if (std::rename((path_ + ".active").c_str(), path_.c_str()) != 0)
-    throw std::runtime_error("cannot rename '" + path_ + ".active' to '" + path_ + "'");
+  const bool renamed = std::rename((path_ + ".active").c_str(), path_.c_str()) == 0;
+  releaseLock();  // after the rename: `.active` is never seen unlocked while it is live
+  if (!renamed)
+    throw std::runtime_error("cannot rename " + lfd::quoted(path_ + ".active") + " to " +
+                             lfd::quoted(path_));
+}
+
+void DemoBag::releaseLock() {
+  if (lock_fd_ >= 0) ::close(lock_fd_);
+  lock_fd_ = -1;
 }
 
 namespace {
@@ -134,43 +176,65 @@ std::string shellQuoted(const std::string& s) {
   return out + "'";
 }
 
+// `rosbag reindex` of `r->active` (the .crashed file) into `<bag_path>.recovered`; it rewrites a
+// copy in --output-dir and leaves the crashed file as it is.
+void reindex(const std::string& bag_path, RecoveredBag* r) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  const fs::path folder = fs::path(bag_path).parent_path();
+  const fs::path work = folder / (".reindex_" + std::to_string(::getpid()));
+  fs::create_directories(work, ec);
+  const std::string copy = (work / fs::path(r->active).filename()).string();
+  const std::string cmd = "rosbag reindex --quiet --output-dir " + shellQuoted(work.string()) +
+                          " " + shellQuoted(r->active) + " >/dev/null 2>&1";
+  if (std::system(cmd.c_str()) == 0 && fs::exists(copy)) {
+    r->recovered = bag_path + ".recovered";
+    fs::rename(copy, r->recovered, ec);
+    if (ec) r->error = "reindexed but cannot move it: " + ec.message(), r->recovered.clear();
+  } else {
+    r->error = "rosbag reindex failed (is python3-rosbag installed?)";
+  }
+  fs::remove_all(work, ec);
+}
+
 }  // namespace
 
-std::vector<RecoveredBag> recoverCrashedBags(const std::string& folder, const std::string& skip) {
+std::optional<RecoveredBag> recoverCrashedBag(const std::string& bag_path) {
+  namespace fs = std::filesystem;
+  const std::string active = bag_path + ".active";
+  // The lock is taken on the file itself and held while it is renamed: a recorder that starts
+  // the same path meanwhile cannot take it (its link() finds the name taken, or it is gone).
+  const int fd = ::open(active.c_str(), O_RDONLY | O_NOFOLLOW | O_NONBLOCK | O_CLOEXEC);
+  if (fd < 0) return std::nullopt;
+  struct stat st {};
+  if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode) || ::flock(fd, LOCK_EX | LOCK_NB) != 0) {
+    ::close(fd);  // not a file, or live: another recorder's, left alone
+    return std::nullopt;
+  }
+  RecoveredBag r;
+  r.active = bag_path + ".crashed";
+  if (fs::exists(r.active) || std::rename(active.c_str(), r.active.c_str()) != 0) {
+    ::close(fd);
+    r.active = active;
+    r.error = "cannot rename it to .crashed; left in place";
+    return r;
+  }
+  ::close(fd);
+  reindex(bag_path, &r);
+  return r;
+}
+
+std::vector<RecoveredBag> recoverCrashedBags(const std::string& folder) {
   namespace fs = std::filesystem;
   std::vector<RecoveredBag> found;
   std::error_code ec;
+  const std::string suffix = ".bag.active";
   for (const fs::directory_entry& e : fs::directory_iterator(folder, ec)) {
-    const std::string name = e.path().filename().string();
-    const std::string suffix = ".bag.active";
-    if (name.size() <= suffix.size() ||
-        name.compare(name.size() - suffix.size(), suffix.size(), suffix) != 0)
+    const std::string path = e.path().string();
+    if (path.size() <= suffix.size() ||
+        path.compare(path.size() - suffix.size(), suffix.size(), suffix) != 0)
       continue;
-    if (!e.is_regular_file() || e.path().string() == skip) continue;
-    RecoveredBag r;
-    const std::string bag = e.path().string().substr(0, e.path().string().size() - 7);
-    r.active = bag + ".crashed";
-    if (fs::exists(r.active) || std::rename(e.path().c_str(), r.active.c_str()) != 0) {
-      r.active = e.path().string();
-      r.error = "cannot rename it to .crashed; left in place";
-      found.push_back(r);
-      continue;
-    }
-    // rosbag reindex rewrites a copy in --output-dir and leaves the crashed file as it is.
-    const fs::path work = fs::path(folder) / (".reindex_" + std::to_string(::getpid()));
-    fs::create_directories(work, ec);
-    const std::string copy = (work / fs::path(r.active).filename()).string();
-    const std::string cmd = "rosbag reindex --quiet --output-dir " + shellQuoted(work.string()) +
-                            " " + shellQuoted(r.active) + " >/dev/null 2>&1";
-    if (std::system(cmd.c_str()) == 0 && fs::exists(copy)) {
-      r.recovered = bag + ".recovered";
-      fs::rename(copy, r.recovered, ec);
-      if (ec) r.error = "reindexed but cannot move it: " + ec.message(), r.recovered.clear();
-    } else {
-      r.error = "rosbag reindex failed (is python3-rosbag installed?)";
-    }
-    fs::remove_all(work, ec);
-    found.push_back(r);
+    if (auto r = recoverCrashedBag(path.substr(0, path.size() - 7))) found.push_back(*r);
   }
   return found;
 }

@@ -119,8 +119,11 @@ def record(jobs, args, log_dir, attempt, crashes):
     """One demonstrate.launch for every job; its output goes to the log of the dataset being
     recorded (split_output), so each log, its wall time and its crashes are the dataset's."""
     names = ["%s_%s" % (j["mode"], j["task"]) for j in jobs]
+    # The recorder writes only inside allowed roots: these datasets' folders, wherever they are.
+    roots = [f(j["output_dir"]) for j in jobs for f in (os.path.abspath, os.path.realpath)]
     cmd = ["roslaunch", "lfd_launch", "demonstrate.launch", "mode:=" + jobs[0]["mode"],
-           "seed:=%d" % args.seed, "datasets:=" + json.dumps(jobs)]
+           "seed:=%d" % args.seed, "datasets:=" + json.dumps(jobs),
+           "allowed_roots:=" + json.dumps(list(dict.fromkeys(roots)))]
     timeout = args.timeout * len(jobs)
     # Line-buffered: a log shows how far its dataset is (tail -f) while the launch runs.
     logs = {n: open(os.path.join(log_dir, n + ".log"), "w" if attempt == 1 else "a", buffering=1)

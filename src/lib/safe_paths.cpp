@@ -11,19 +11,22 @@
 #include <filesystem>
 #include <stdexcept>
 
+#include "lfd_core/user_text.hpp"
+
 namespace lfd {
 namespace {
 
 namespace fs = std::filesystem;
 
 [[noreturn]] void refuse(const std::string& path, const std::string& why) {
-  throw std::invalid_argument("path '" + path + "': " + why);
+  throw std::invalid_argument("path " + lfd::quoted(path) + ": " + why);
 }
 
 std::string expandHome(const std::string& root) {
   if (root.empty() || root[0] != '~') return root;
   const char* home = std::getenv("HOME");
-  if (!home || !*home) throw std::invalid_argument("allowed root '" + root + "' needs $HOME");
+  if (!home || !*home)
+    throw std::invalid_argument("allowed root " + lfd::quoted(root) + " needs $HOME");
   return std::string(home) + root.substr(1);
 }
 
@@ -113,6 +116,14 @@ std::string checkOutputFile(const std::string& path, const PathPolicy& policy, b
   if (exists && !S_ISREG(out.st_mode))
     refuse(path, std::string("exists and is ") + typeName(out.st_mode));
   if (exists && !overwrite) refuse(path, "exists; set overwrite to replace it");
+  return resolved.string();
+}
+
+std::string checkPathInRoots(const std::string& path, const PathPolicy& policy) {
+  if (path.empty()) throw std::invalid_argument("empty path");
+  checkParentReferences(path, policy);
+  const fs::path resolved = fs::weakly_canonical(fs::absolute(path));
+  checkRoots(path, resolved, policy);
   return resolved.string();
 }
 

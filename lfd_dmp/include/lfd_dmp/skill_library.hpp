@@ -44,6 +44,8 @@
 #include <lfd_core/task_frames.hpp>
 #include <lfd_core/time_alignment.hpp>
 
+#include "lfd_dmp/library_limits.hpp"
+
 #include <nlohmann/json.hpp>
 
 #include <map>
@@ -110,8 +112,9 @@ SkillLibrary skillLibraryFromJson(const nlohmann::json& j);
 /// Writes pretty-printed JSON atomically (lfd::writeFileAtomically). An existing file is kept
 /// (std::invalid_argument) unless `overwrite`. Throws std::runtime_error on I/O errors.
 void saveSkillLibrary(const SkillLibrary& library, const std::string& path, bool overwrite);
-/// Only regular files are read (a FIFO is refused, never opened). Throws std::runtime_error with
-/// the file name and the JSON location of the problem, std::invalid_argument for a bad path.
-SkillLibrary loadSkillLibrary(const std::string& path);
+/// Only regular files are read (a FIFO is refused, never opened), within `limits` (file size,
+/// sizes, durations: library_limits.hpp). Throws std::runtime_error with the file name and the
+/// JSON location of the problem.
+SkillLibrary loadSkillLibrary(const std::string& path, const LibraryLimits& limits = {});
 
 }  // namespace lfd_dmp

@@ -3,12 +3,15 @@
 // under its final name is always complete. Crash safety: an existing `.active` (a crashed
 // recording, maybe the only copy of a demo) is never opened for writing, and the open chunk is
 // closed every `max_unflushed` of bag time, so a kill -9 loses at most about that much data;
-// recoverCrashedBags() reindexes what a crash left behind.
+// recoverCrashedBag() reindexes what a crash left behind. A live recording holds an exclusive
+// flock on its `.active` from before the name appears until after the rename: the lock dies with
+// its process, so recovery tells a crashed recording (unlocked) from another recorder's live one.
 #pragma once
 
 #include <cstdint>
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -49,12 +52,15 @@ class DemoBag {
   const std::map<std::string, uint64_t>& perTopic() const { return per_topic_; }
 
  private:
+  void releaseLock();
+
   std::string path_;
   ros::Time start_;
   rosbag::Bag bag_;
   ros::Duration max_unflushed_;
   ros::Time chunk_start_;
   bool open_ = false;
+  int lock_fd_ = -1;  // holds the flock on `<path>.active` while it is being recorded
   uint64_t written_ = 0;
   std::map<std::string, uint64_t> per_topic_;
 };
@@ -66,10 +72,14 @@ struct RecoveredBag {
   std::string error;      // why the reindex failed
 };
 
-// Every `*.bag.active` in `folder` except `skip`: each is kept (renamed `.crashed`, so it is
-// found once) and reindexed with `rosbag reindex` into `<name>.bag.recovered`. Neither name ends
-// in .bag, so datasets never count a partial demonstration as a complete one.
-std::vector<RecoveredBag> recoverCrashedBags(const std::string& folder,
-                                             const std::string& skip = "");
+// `<bag_path>.active` when a crashed recording left it (no live recorder holds its lock): kept
+// (renamed `.crashed`, so it is found once) and reindexed with `rosbag reindex` into
+// `<bag_path>.recovered`. Neither name ends in .bag, so datasets never count a partial
+// demonstration as a complete one. Nothing (no file, or a live recording): std::nullopt.
+std::optional<RecoveredBag> recoverCrashedBag(const std::string& bag_path);
+
+// recoverCrashedBag() for every `*.bag.active` in `folder` (the recorder's start-up
+// `recovery_folders`); live recordings are left alone.
+std::vector<RecoveredBag> recoverCrashedBags(const std::string& folder);
 
 }  // namespace lfd_sim_bridge

@@ -27,6 +27,11 @@ std::string checkInputFile(const std::string& path, const PathPolicy& policy = {
 std::string checkOutputFile(const std::string& path, const PathPolicy& policy, bool overwrite,
                             const std::vector<std::string>& inputs = {});
 
+/// Checks a path a request names for a file that may not exist yet (nor its folder: e.g. a bag the
+/// recorder creates with its folders): under roots, no ".." and inside a root once the part that
+/// exists is resolved (links followed). Returns the absolute, resolved path.
+std::string checkPathInRoots(const std::string& path, const PathPolicy& policy);
+
 /// Writes `path` atomically: `write` fills a temporary file in the same folder, which is then
 /// renamed over `path` (readers see the old file or the whole new one, never half of one). Without
 /// `overwrite` an existing `path` is kept and the call throws. The temporary is removed on error.
