@@ -109,7 +109,7 @@ std::size_t sample_at(const FeatureMatrix& demo, double grid_row, double step) {
 
 // A demo's evidence of every kind, and its features and speed on the alignment grid.
 void gather_evidence(const FeatureMatrix& demo, const Eigen::MatrixXd& scaled,
-                     const SegmentationPipelineResult& base, const std::vector<std::size_t>& groups,
+                     const Eigen::MatrixXd& scaled_sensors, const SegmentationPipelineResult& base, const std::vector<std::size_t>& groups,
                      bool sensors, const SegmentationPipelineConfig& config,
                      DemoSegmentationResult* out, DemoEvidence* evidence, Eigen::MatrixXd* grid) {
   const JointSegmentationConfig& joint = config.joint;
@@ -141,7 +141,10 @@ void gather_evidence(const FeatureMatrix& demo, const Eigen::MatrixXd& scaled,
   for (const BoundaryEvidence& p : pieces)
     evidence->grid_rows.push_back((clock[p.index] - clock.front()) / joint.grid_step);
   evidence->claimed.assign(pieces.size(), false);
-  *grid = on_uniform_grid(with_speed(scaled, speed), clock, joint.grid_step);
+  // The sensors align the demos too: contact begins and ends in the same order in each.
+  Eigen::MatrixXd aligned(scaled.rows(), scaled.cols() + 1 + scaled_sensors.cols());
+  aligned << with_speed(scaled, speed), scaled_sensors;
+  *grid = on_uniform_grid(aligned, clock, joint.grid_step);
 }
 
 // Noisy-OR of a demo's unclaimed evidence around each reference row: how sure this demo is that
@@ -291,6 +294,8 @@ class JointAgreement {
       if (u < 0) break;
       if (!add_anchor(u)) break;
       realign();
+      map_evidence();
+      retry_missing();
     }
     map_evidence();
   }
@@ -338,33 +343,45 @@ class JointAgreement {
                             : Eigen::VectorXd::Zero(rows);
   }
 
-  // Places the boundary in every demo; false when no demo has a piece for it (the support came
-  // from pieces the order forbids), so the search stops rather than loop.
+  // Adds the boundary and places it in every demo; false (and nothing added) when no demo has
+  // a piece for it (the support came from pieces the order forbids), so the search stops rather
+  // than loop.
   bool add_anchor(double u) {
     Anchor a;
     a.reference_row = u;
+    a.piece.assign(evidence_.size(), -1);
+    a.demo_row.assign(evidence_.size(), 0);
+    const auto at = anchors_.insert(
+        std::upper_bound(anchors_.begin(), anchors_.end(), a,
+                         [](const Anchor& x, const Anchor& y) { return x.reference_row < y.reference_row; }),
+        a);
     bool any = false;
-    for (std::size_t d = 0; d < evidence_.size(); ++d) {
-      const double rows = static_cast<double>(grids_[d].rows());
-      const auto [after, before] = neighbouring_rows(anchors_, d, u, rows);
-      const long p = best_piece(evidence_[d], u, window_rows_, spread_rows_, colocation_rows_,
-                                after, before);
-      a.piece.push_back(p);
-      const double row = p >= 0 ? evidence_[d].grid_rows[static_cast<std::size_t>(p)]
-                                : expected_row(d, u);
-      a.demo_row.push_back(static_cast<std::size_t>(std::clamp(std::lround(row), 0L,
-                                                               static_cast<long>(rows) - 1)));
-      if (p >= 0) claim(d, static_cast<std::size_t>(p));
-      any = any || p >= 0;
-    }
-    if (!any) return false;
-    a.support = 0.0;
-    anchors_.insert(std::upper_bound(anchors_.begin(), anchors_.end(), a,
-                                     [](const Anchor& x, const Anchor& y) {
-                                       return x.reference_row < y.reference_row;
-                                     }),
-                    a);
+    for (std::size_t d = 0; d < evidence_.size(); ++d) any = place(&*at, d) || any;
+    if (!any) anchors_.erase(at);
+    return any;
+  }
+
+  // Places anchor `a` in demo d on its best piece between the demo's neighbouring anchors.
+  bool place(Anchor* a, std::size_t d) {
+    const double rows = static_cast<double>(grids_[d].rows());
+    const auto [after, before] = neighbouring_rows(anchors_, d, a->reference_row, rows);
+    const long p = best_piece(evidence_[d], a->reference_row, window_rows_, spread_rows_,
+                              colocation_rows_, after, before);
+    if (p < 0) return false;
+    a->piece[d] = p;
+    a->demo_row[d] = static_cast<std::size_t>(std::clamp(
+        std::lround(evidence_[d].grid_rows[static_cast<std::size_t>(p)]), 0L,
+        static_cast<long>(rows) - 1));
+    claim(d, static_cast<std::size_t>(p));
     return true;
+  }
+
+  // A demo that had no piece for a boundary may have one once the alignment holds at the other
+  // boundaries.
+  void retry_missing() {
+    for (Anchor& a : anchors_)
+      for (std::size_t d = 0; d < evidence_.size(); ++d)
+        if (a.piece[d] < 0) place(&a, d);
   }
 
   // The chosen piece and those at its place belong to this boundary.
@@ -374,14 +391,17 @@ class JointAgreement {
       if (std::abs(e.grid_rows[q] - e.grid_rows[p]) <= colocation_rows_) e.claimed[q] = true;
   }
 
+  // The alignment of every demo, held at the boundaries placed in it (a boundary the demo lacks
+  // says nothing of where it would be).
   void realign() {
-    std::vector<std::size_t> reference_rows;
-    for (const Anchor& a : anchors_)
-      reference_rows.push_back(static_cast<std::size_t>(std::lround(a.reference_row)));
     parallel_for(evidence_.size(), threads_, [&](std::size_t d) {
       if (d == reference_) return;
-      std::vector<std::size_t> own;
-      for (const Anchor& a : anchors_) own.push_back(a.demo_row[d]);
+      std::vector<std::size_t> own, reference_rows;
+      for (const Anchor& a : anchors_) {
+        if (a.piece[d] < 0) continue;
+        own.push_back(a.demo_row[d]);
+        reference_rows.push_back(static_cast<std::size_t>(std::lround(a.reference_row)));
+      }
       to_reference_[d] = anchored_dtw_map(grids_[d], grids_[reference_], own, reference_rows);
       from_reference_[d] = anchored_dtw_map(grids_[reference_], grids_[d], reference_rows, own);
     });
@@ -468,12 +488,14 @@ SegmentationPipelineResult segment_jointly(const PreparedSegmentation& prepared,
       scaled_states(demos, moving_states(demos, result.state_features));
   const std::vector<std::size_t> groups = sensor_channel_groups(result.sensor_features);
   const bool sensors = !result.sensor_features.empty() && config.validate_with_sensors;
+  const std::vector<Eigen::MatrixXd> scaled_sensors = scaled_states(
+      demos, sensors ? moving_states(demos, result.sensor_features) : std::vector<std::string>{});
 
   std::vector<DemoEvidence> evidence(n);
   std::vector<Eigen::MatrixXd> grids(n);
   parallel_for(n, config.threads, [&](std::size_t d) {
     try {
-      gather_evidence(demos[d], scaled[d], result, groups, sensors, config, &result.demos[d],
+      gather_evidence(demos[d], scaled[d], scaled_sensors[d], result, groups, sensors, config, &result.demos[d],
                       &evidence[d], &grids[d]);
     } catch (const std::invalid_argument& e) {
       throw std::invalid_argument(describe(e.what(), d));
