@@ -70,6 +70,33 @@ std::vector<Eigen::MatrixXd> scaled_states(const std::vector<FeatureMatrix>& dem
   return out;
 }
 
+// Per sensor, how far its channels are from their level at the demo's start (the norm over the
+// channels), divided by the largest such distance over the task: which pad or which axis feels a
+// contact may differ between demos, that a contact is felt does not.
+std::vector<Eigen::MatrixXd> sensor_magnitudes(const std::vector<FeatureMatrix>& demos,
+                                               const std::vector<std::string>& names,
+                                               const std::vector<std::size_t>& groups) {
+  const std::size_t sensors =
+      groups.empty() ? 0 : *std::max_element(groups.begin(), groups.end()) + 1;
+  std::vector<Eigen::MatrixXd> out;
+  for (const FeatureMatrix& demo : demos) {
+    const Eigen::MatrixXd raw = demo.select(names).data;
+    Eigen::MatrixXd m = Eigen::MatrixXd::Zero(raw.rows(), static_cast<Eigen::Index>(sensors));
+    for (Eigen::Index c = 0; c < raw.cols(); ++c) {
+      const auto g = static_cast<Eigen::Index>(groups[static_cast<std::size_t>(c)]);
+      m.col(g) += (raw.col(c).array() - raw(0, c)).square().matrix();
+    }
+    out.push_back(m.cwiseSqrt());
+  }
+  for (Eigen::Index g = 0; g < static_cast<Eigen::Index>(sensors); ++g) {
+    double top = 0.0;
+    for (const Eigen::MatrixXd& m : out) top = std::max(top, m.col(g).maxCoeff());
+    if (top > 0)
+      for (Eigen::MatrixXd& m : out) m.col(g) /= top;
+  }
+  return out;
+}
+
 double percentile95(const Eigen::VectorXd& values) {
   std::vector<double> v(values.data(), values.data() + values.size());
   if (v.empty()) return 0.0;
@@ -488,8 +515,9 @@ SegmentationPipelineResult segment_jointly(const PreparedSegmentation& prepared,
       scaled_states(demos, moving_states(demos, result.state_features));
   const std::vector<std::size_t> groups = sensor_channel_groups(result.sensor_features);
   const bool sensors = !result.sensor_features.empty() && config.validate_with_sensors;
-  const std::vector<Eigen::MatrixXd> scaled_sensors = scaled_states(
-      demos, sensors ? moving_states(demos, result.sensor_features) : std::vector<std::string>{});
+  const std::vector<Eigen::MatrixXd> scaled_sensors =
+      sensors ? sensor_magnitudes(demos, result.sensor_features, groups)
+              : std::vector<Eigen::MatrixXd>(n, Eigen::MatrixXd(0, 0));
 
   std::vector<DemoEvidence> evidence(n);
   std::vector<Eigen::MatrixXd> grids(n);
