@@ -97,6 +97,18 @@ std::vector<Eigen::MatrixXd> sensor_magnitudes(const std::vector<FeatureMatrix>&
   return out;
 }
 
+// Each feature over its own range in this demo (at least half its range over the task, so that
+// a feature this demo barely moves is not blown up to noise): demos toward other goals move to
+// other places, and the alignment should follow the shape of the motion, as II-B's DTW does.
+Eigen::MatrixXd own_shape(const Eigen::MatrixXd& scaled) {
+  Eigen::MatrixXd out = scaled;
+  for (Eigen::Index c = 0; c < out.cols(); ++c) {
+    const double lo = out.col(c).minCoeff(), range = out.col(c).maxCoeff() - lo;
+    out.col(c) = (out.col(c).array() - lo) / std::max(range, 0.5);
+  }
+  return out;
+}
+
 double percentile95(const Eigen::VectorXd& values) {
   std::vector<double> v(values.data(), values.data() + values.size());
   if (v.empty()) return 0.0;
@@ -170,7 +182,10 @@ void gather_evidence(const FeatureMatrix& demo, const Eigen::MatrixXd& scaled,
   evidence->claimed.assign(pieces.size(), false);
   // The sensors align the demos too: contact begins and ends in the same order in each.
   Eigen::MatrixXd aligned(scaled.rows(), scaled.cols() + 1 + scaled_sensors.cols());
-  aligned << with_speed(scaled, speed), scaled_sensors;
+  // A sensor weighs as much as the state features together, as the speed does: where contact
+  // begins and ends is the surest landmark two demos share.
+  const double weight = std::sqrt(static_cast<double>(std::max<Eigen::Index>(1, scaled.cols())));
+  aligned << with_speed(own_shape(scaled), speed), weight * scaled_sensors;
   *grid = on_uniform_grid(aligned, clock, joint.grid_step);
 }
 
