@@ -126,6 +126,8 @@ void parse_joint(const YAML::Node& node, lfd::JointSegmentationConfig* joint) {
                                  "joint/match_window_seconds");
   joint->colocation = non_negative(get<double>(node, "colocation_seconds", joint->colocation),
                                    "joint/colocation_seconds");
+  joint->max_speed_correlation =
+      get<double>(node, "max_speed_correlation", joint->max_speed_correlation);
   joint->extra_event_weight = fraction(
       get<double>(node, "extra_event_weight", joint->extra_event_weight),
       "joint/extra_event_weight");

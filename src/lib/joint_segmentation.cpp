@@ -146,11 +146,70 @@ std::size_t sample_at(const FeatureMatrix& demo, double grid_row, double step) {
   return i;
 }
 
+// The sensor channels whose events count as contact, with each channel's sensor.
+struct SensorSelection {
+  std::vector<std::string> names;
+  std::vector<std::size_t> groups;
+};
+
+// Pearson correlation of two equally long series (0 when either is constant).
+double correlation(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
+  const Eigen::ArrayXd x = a.array() - a.mean(), y = b.array() - b.mean();
+  const double den = std::sqrt((x * x).sum() * (y * y).sum());
+  return den > 0 ? (x * y).sum() / den : 0.0;
+}
+
+// The sensors whose magnitude is not explained by the robot's own speed. A loosely controlled
+// arm's tracking error, or a wrist F/T feeling the hand's inertia, rises and falls with every
+// motion: its "contacts" are the motion's starts and stops, which the motion evidence already
+// holds. Pooled over the demos, per sensor.
+SensorSelection contact_sensors(const std::vector<std::string>& names,
+                                const std::vector<std::size_t>& groups,
+                                const std::vector<Eigen::MatrixXd>& magnitudes,
+                                const std::vector<Eigen::VectorXd>& speeds, double max_correlation,
+                                std::vector<std::string>* warnings) {
+  SensorSelection out;
+  std::vector<bool> keep;
+  for (Eigen::Index g = 0; g < (magnitudes.empty() ? 0 : magnitudes[0].cols()); ++g) {
+    Eigen::Index rows = 0;
+    for (const Eigen::VectorXd& v : speeds) rows += v.size();
+    Eigen::VectorXd m(rows), v(rows);
+    Eigen::Index at = 0;
+    for (std::size_t d = 0; d < speeds.size(); ++d) {
+      m.segment(at, speeds[d].size()) = magnitudes[d].col(g);
+      v.segment(at, speeds[d].size()) = speeds[d];
+      at += speeds[d].size();
+    }
+    const double r = correlation(m, v);
+    keep.push_back(!(r > max_correlation));
+    if (!keep.back()) {
+      std::ostringstream msg;
+      msg.precision(2);
+      std::string sensor;
+      for (std::size_t c = 0; c < names.size(); ++c)
+        if (groups[c] == static_cast<std::size_t>(g)) sensor += (sensor.empty() ? "" : ", ") + names[c];
+      msg << "sensor " << sensor << " follows the robot's own speed (correlation " << r
+          << "): its events are motion, not contact, and are not used as contacts";
+      warnings->push_back(msg.str());
+    }
+  }
+  std::vector<std::size_t> renumber(keep.size(), 0);
+  std::size_t next = 0;
+  for (std::size_t g = 0; g < keep.size(); ++g) renumber[g] = keep[g] ? next++ : 0;
+  for (std::size_t c = 0; c < names.size(); ++c) {
+    if (!keep[groups[c]]) continue;
+    out.names.push_back(names[c]);
+    out.groups.push_back(renumber[groups[c]]);
+  }
+  return out;
+}
+
 // A demo's evidence of every kind, and its features and speed on the alignment grid.
 void gather_evidence(const FeatureMatrix& demo, const Eigen::MatrixXd& scaled,
-                     const Eigen::MatrixXd& scaled_sensors, const SegmentationPipelineResult& base, const std::vector<std::size_t>& groups,
-                     bool sensors, const SegmentationPipelineConfig& config,
-                     DemoSegmentationResult* out, DemoEvidence* evidence, Eigen::MatrixXd* grid) {
+                     const Eigen::VectorXd& speed, const Eigen::MatrixXd& scaled_sensors,
+                     const SegmentationPipelineResult& base, const SensorSelection& contact,
+                     const SegmentationPipelineConfig& config, DemoSegmentationResult* out,
+                     DemoEvidence* evidence, Eigen::MatrixXd* grid) {
   const JointSegmentationConfig& joint = config.joint;
   const double rate = sample_rate_of(demo);
   const SegmentationPipelineConfig own = in_samples(config, rate);
@@ -161,16 +220,15 @@ void gather_evidence(const FeatureMatrix& demo, const Eigen::MatrixXd& scaled,
   out->min_segment_length = out->clasp.min_segment_length;
   std::vector<BoundaryEvidence>& pieces = evidence->pieces;
   pieces = clasp_evidence(out->clasp, joint.weights.clasp);
-  if (sensors) {
+  if (!contact.names.empty()) {
     const SensorEvents events =
-        detect_sensor_events(demo.select(base.sensor_features).data, own.events, groups);
+        detect_sensor_events(demo.select(contact.names).data, own.events, contact.groups);
     out->events = events.all;
     out->event_details = events.details;
     const auto s = sensory_evidence(events, joint.weights, own.events.merge_gap);
     pieces.insert(pieces.end(), s.begin(), s.end());
   }
   const std::vector<double> clock = clock_of(demo);
-  const Eigen::VectorXd speed = state_speed(scaled, clock, joint.pauses.smoothing);
   const std::vector<Pause> pauses = find_pauses(speed, clock, joint.pauses);
   const auto m = motion_onset_evidence(speed, clock, pauses, joint.pauses, joint.weights.motion_onset);
   pieces.insert(pieces.end(), m.begin(), m.end());
@@ -534,12 +592,21 @@ SegmentationPipelineResult segment_jointly(const PreparedSegmentation& prepared,
       sensors ? sensor_magnitudes(demos, result.sensor_features, groups)
               : std::vector<Eigen::MatrixXd>(n, Eigen::MatrixXd(0, 0));
 
+  std::vector<Eigen::VectorXd> speeds(n);
+  parallel_for(n, config.threads, [&](std::size_t d) {
+    speeds[d] = state_speed(scaled[d], clock_of(demos[d]), config.joint.pauses.smoothing);
+  });
+  const SensorSelection contact =
+      sensors ? contact_sensors(result.sensor_features, groups, scaled_sensors, speeds,
+                                config.joint.max_speed_correlation, &result.warnings)
+              : SensorSelection{};
+
   std::vector<DemoEvidence> evidence(n);
   std::vector<Eigen::MatrixXd> grids(n);
   parallel_for(n, config.threads, [&](std::size_t d) {
     try {
-      gather_evidence(demos[d], scaled[d], scaled_sensors[d], result, groups, sensors, config, &result.demos[d],
-                      &evidence[d], &grids[d]);
+      gather_evidence(demos[d], scaled[d], speeds[d], scaled_sensors[d], result, contact, config,
+                      &result.demos[d], &evidence[d], &grids[d]);
     } catch (const std::invalid_argument& e) {
       throw std::invalid_argument(describe(e.what(), d));
     }

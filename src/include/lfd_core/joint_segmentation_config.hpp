@@ -27,6 +27,10 @@ struct JointSegmentationConfig {
   /// Pieces of one demo's evidence closer than this (s) mark one instant: they reinforce each
   /// other when a boundary is placed, and are claimed by it together.
   double colocation = 0.25;
+  /// A sensor whose magnitude correlates with the robot's speed above this (pooled over the
+  /// demos) reports the robot's own motion (a tracking error, inertia), not contact: its events
+  /// are left out.
+  double max_speed_correlation = 0.4;
   /// A demo's unmatched evidence at least this heavy is reported as an event its siblings lack.
   double extra_event_weight = 0.85;
 };
