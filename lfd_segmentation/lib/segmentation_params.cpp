@@ -115,6 +115,8 @@ void parse_joint(const YAML::Node& node, lfd::JointSegmentationConfig* joint) {
                               "joint/pauses/motion_window_seconds");
   joint->grid_step = positive(get<double>(node, "grid_step_seconds", joint->grid_step),
                               "joint/grid_step_seconds");
+  joint->alignment_band =
+      positive(get<double>(node, "alignment_band", joint->alignment_band), "joint/alignment_band");
   joint->spread = positive(get<double>(node, "spread_seconds", joint->spread),
                            "joint/spread_seconds");
   joint->min_support =
@@ -124,6 +126,8 @@ void parse_joint(const YAML::Node& node, lfd::JointSegmentationConfig* joint) {
       "joint/short_phase_support");
   joint->match_window = positive(get<double>(node, "match_window_seconds", joint->match_window),
                                  "joint/match_window_seconds");
+  joint->min_piece_weight = fraction(get<double>(node, "min_piece_weight", joint->min_piece_weight),
+                                     "joint/min_piece_weight");
   joint->colocation = non_negative(get<double>(node, "colocation_seconds", joint->colocation),
                                    "joint/colocation_seconds");
   joint->max_speed_correlation =

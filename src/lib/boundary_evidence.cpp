@@ -151,11 +151,11 @@ std::vector<BoundaryEvidence> motion_onset_evidence(const Eigen::VectorXd& speed
 }
 
 void gather_into_pauses(const std::vector<Pause>& pauses, std::size_t samples,
-                        std::vector<BoundaryEvidence>* evidence) {
+                        std::size_t start_samples, std::vector<BoundaryEvidence>* evidence) {
   for (const Pause& p : pauses) {
     if (p.begin == 0 || p.end >= samples) continue;
     for (BoundaryEvidence& e : *evidence)
-      if (e.index >= p.begin && e.index <= p.end) e.index = p.end;
+      if (e.index > p.begin + start_samples && e.index <= p.end) e.index = p.end;
   }
 }
 

@@ -13,13 +13,30 @@ namespace {
 
 constexpr float kInf = std::numeric_limits<float>::infinity();
 
+// Whether cell (i, j) lies farther than band x the longer length from the diagonal joining the
+// two series' corners (a slanted Sakoe-Chiba band, at least one cell wide so the corner stays
+// reachable).
+bool outside_band(Eigen::Index i, Eigen::Index j, Eigen::Index n, Eigen::Index m, double band) {
+  if (band >= 1.0) return false;
+  const double centre = n > 1 ? static_cast<double>(i) * static_cast<double>(m - 1) /
+                                    static_cast<double>(n - 1)
+                              : 0.0;
+  const double radius = std::max(1.0, band * static_cast<double>(std::max(n, m)));
+  return std::abs(static_cast<double>(j) - centre) > radius;
+}
+
 // Accumulated cost matrix (row-major, n x m) of the DTW recursion; float is plenty for features
 // scaled to about [0, 1] and halves the memory of a long pair.
-std::vector<float> accumulated_cost(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
+std::vector<float> accumulated_cost(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b,
+                                    double band) {
   const Eigen::Index n = a.rows(), m = b.rows();
   std::vector<float> d(static_cast<std::size_t>(n * m));
   for (Eigen::Index i = 0; i < n; ++i) {
     for (Eigen::Index j = 0; j < m; ++j) {
+      if (outside_band(i, j, n, m, band)) {
+        d[i * m + j] = kInf;
+        continue;
+      }
       const float local = static_cast<float>((a.row(i) - b.row(j)).squaredNorm());
       float best = 0.0f;
       if (i > 0 || j > 0) {
@@ -64,12 +81,16 @@ Eigen::MatrixXd on_uniform_grid(const Eigen::MatrixXd& features, const std::vect
   return out;
 }
 
-double multivariate_dtw_cost(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
+double multivariate_dtw_cost(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b, double band) {
   check_pair(a, b);
   const Eigen::Index m = b.rows();
   std::vector<double> prev(static_cast<std::size_t>(m)), row(static_cast<std::size_t>(m));
   for (Eigen::Index i = 0; i < a.rows(); ++i) {
     for (Eigen::Index j = 0; j < m; ++j) {
+      if (outside_band(i, j, a.rows(), m, band)) {
+        row[j] = std::numeric_limits<double>::infinity();
+        continue;
+      }
       const double local = (a.row(i) - b.row(j)).squaredNorm();
       double best = 0.0;
       if (i > 0 || j > 0) {
@@ -85,10 +106,11 @@ double multivariate_dtw_cost(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b)
   return prev[m - 1];
 }
 
-std::vector<double> multivariate_dtw_map(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
+std::vector<double> multivariate_dtw_map(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b,
+                                         double band) {
   check_pair(a, b);
   const Eigen::Index n = a.rows(), m = b.rows();
-  const std::vector<float> d = accumulated_cost(a, b);
+  const std::vector<float> d = accumulated_cost(a, b, band);
   std::vector<double> sum(static_cast<std::size_t>(n), 0.0), count(static_cast<std::size_t>(n), 0.0);
   Eigen::Index i = n - 1, j = m - 1;
   while (true) {
@@ -114,7 +136,7 @@ std::vector<double> multivariate_dtw_map(const Eigen::MatrixXd& a, const Eigen::
 
 std::vector<double> anchored_dtw_map(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b,
                                      const std::vector<std::size_t>& a_anchors,
-                                     const std::vector<std::size_t>& b_anchors) {
+                                     const std::vector<std::size_t>& b_anchors, double band) {
   check_pair(a, b);
   if (a_anchors.size() != b_anchors.size())
     throw std::invalid_argument("anchored DTW needs as many anchors in both series");
@@ -136,7 +158,7 @@ std::vector<double> anchored_dtw_map(const Eigen::MatrixXd& a, const Eigen::Matr
     const auto rows_b = static_cast<Eigen::Index>(b_cuts[k + 1] - b_cuts[k]);
     const std::vector<double> part = multivariate_dtw_map(
         a.middleRows(static_cast<Eigen::Index>(a_cuts[k]), rows_a),
-        b.middleRows(static_cast<Eigen::Index>(b_cuts[k]), rows_b));
+        b.middleRows(static_cast<Eigen::Index>(b_cuts[k]), rows_b), band);
     for (double row : part) map.push_back(row + static_cast<double>(b_cuts[k]));
   }
   return map;
@@ -152,7 +174,8 @@ double map_row(const std::vector<double>& map, double row) {
   return (1.0 - w) * map[k] + w * map[k + 1];
 }
 
-DemoAlignment align_to_medoid(const std::vector<Eigen::MatrixXd>& gridded, int threads) {
+DemoAlignment align_to_medoid(const std::vector<Eigen::MatrixXd>& gridded, int threads,
+                              double band) {
   const std::size_t n = gridded.size();
   if (n == 0) throw std::invalid_argument("no demonstrations to align");
   for (const Eigen::MatrixXd& g : gridded) check_pair(g, gridded.front());
@@ -162,7 +185,7 @@ DemoAlignment align_to_medoid(const std::vector<Eigen::MatrixXd>& gridded, int t
   std::vector<double> cost(pairs.size());
   parallel_for(pairs.size(), threads, [&](std::size_t p) {
     const auto [a, b] = pairs[p];
-    cost[p] = multivariate_dtw_cost(gridded[a], gridded[b]) /
+    cost[p] = multivariate_dtw_cost(gridded[a], gridded[b], band) /
               static_cast<double>(gridded[a].rows() + gridded[b].rows());
   });
   std::vector<double> total(n, 0.0);
@@ -177,8 +200,8 @@ DemoAlignment align_to_medoid(const std::vector<Eigen::MatrixXd>& gridded, int t
   out.mean_cost.assign(n, 0.0);
   const Eigen::MatrixXd& ref = gridded[out.reference];
   parallel_for(n, threads, [&](std::size_t d) {
-    out.to_reference[d] = multivariate_dtw_map(gridded[d], ref);
-    out.from_reference[d] = multivariate_dtw_map(ref, gridded[d]);
+    out.to_reference[d] = multivariate_dtw_map(gridded[d], ref, band);
+    out.from_reference[d] = multivariate_dtw_map(ref, gridded[d], band);
   });
   for (std::size_t p = 0; p < pairs.size(); ++p) {
     if (pairs[p].first == out.reference) out.mean_cost[pairs[p].second] = cost[p];

@@ -3,8 +3,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <cstdio>
-#include <cstdlib>
 #include <sstream>
 #include <stdexcept>
 
@@ -146,6 +144,21 @@ std::size_t sample_at(const FeatureMatrix& demo, double grid_row, double step) {
   return i;
 }
 
+// Each state feature weighed by how consistently the demos move it (II-B's mean correlation
+// after DTW, clipped to [0, 1]): a wrist that turns a little at random in each demo would
+// otherwise hide the pauses from the speed and mislead the alignment. All 1 without II-B (one
+// demo).
+Eigen::VectorXd consistency_weights(const SegmentationPipelineResult& result,
+                                    const std::vector<std::string>& states) {
+  Eigen::VectorXd weights = Eigen::VectorXd::Ones(static_cast<Eigen::Index>(states.size()));
+  if (!result.relevance_computed) return weights;
+  for (std::size_t c = 0; c < states.size(); ++c)
+    for (const FeatureRelevance& f : result.relevance.features)
+      if (f.name == states[c])
+        weights[static_cast<Eigen::Index>(c)] = std::clamp(f.mean_correlation, 0.0, 1.0);
+  return weights;
+}
+
 // The sensor channels whose events count as contact, with each channel's sensor.
 struct SensorSelection {
   std::vector<std::string> names;
@@ -206,7 +219,7 @@ SensorSelection contact_sensors(const std::vector<std::string>& names,
 
 // A demo's evidence of every kind, and its features and speed on the alignment grid.
 void gather_evidence(const FeatureMatrix& demo, const Eigen::MatrixXd& scaled,
-                     const Eigen::VectorXd& speed, const Eigen::MatrixXd& scaled_sensors,
+                     const Eigen::VectorXd& consistency, const Eigen::VectorXd& speed, const Eigen::MatrixXd& scaled_sensors,
                      const SegmentationPipelineResult& base, const SensorSelection& contact,
                      const SegmentationPipelineConfig& config, DemoSegmentationResult* out,
                      DemoEvidence* evidence, Eigen::MatrixXd* grid) {
@@ -234,7 +247,8 @@ void gather_evidence(const FeatureMatrix& demo, const Eigen::MatrixXd& scaled,
   pieces.insert(pieces.end(), m.begin(), m.end());
   const auto stops = motion_stop_evidence(speed, clock, joint.pauses, joint.weights.motion_stop);
   pieces.insert(pieces.end(), stops.begin(), stops.end());
-  gather_into_pauses(pauses, out->num_samples, &pieces);
+  gather_into_pauses(pauses, out->num_samples,
+                     static_cast<std::size_t>(std::lround(joint.colocation * rate)), &pieces);
   for (const BoundaryEvidence& p : pieces)
     evidence->grid_rows.push_back((clock[p.index] - clock.front()) / joint.grid_step);
   evidence->claimed.assign(pieces.size(), false);
@@ -243,7 +257,8 @@ void gather_evidence(const FeatureMatrix& demo, const Eigen::MatrixXd& scaled,
   // A sensor weighs as much as the state features together, as the speed does: where contact
   // begins and ends is the surest landmark two demos share.
   const double weight = std::sqrt(static_cast<double>(std::max<Eigen::Index>(1, scaled.cols())));
-  aligned << with_speed(own_shape(scaled), speed), weight * scaled_sensors;
+  aligned << with_speed(own_shape(scaled) * consistency.asDiagonal(), speed),
+      weight * scaled_sensors;
   *grid = on_uniform_grid(aligned, clock, joint.grid_step);
 }
 
@@ -293,6 +308,14 @@ double next_boundary(const Eigen::VectorXd& support, const std::vector<Anchor>& 
   return best_row;
 }
 
+// The placement's distances on the grid, and the least support a demo's own evidence needs.
+struct PlacementRows {
+  double window = 0.0;
+  double spread = 0.0;
+  double colocation = 0.0;
+  double min_weight = 0.0;
+};
+
 // How sharply a kind of evidence times a change: a sensor's rest edge to a sample, a pause's
 // end closely, ClaSP only to within its window.
 int timing_precision(EvidenceKind kind) {
@@ -315,20 +338,50 @@ int timing_precision(EvidenceKind kind) {
 // match window and strictly between the demo's neighbouring anchors that scores best, its score
 // being the noisy-OR of the unclaimed pieces at its place (a contact and a ClaSP changepoint at
 // one instant reinforce each other) times its closeness to u. -1 when there is none.
-long best_piece(const DemoEvidence& e, double u, double window_rows, double spread_rows,
-                double colocation_rows, double after_row, double before_row) {
+// Noisy-OR of the unclaimed pieces of a demo within colocation_rows of piece p.
+double colocated_strength(const DemoEvidence& e, std::size_t p, double colocation_rows) {
+  double none = 1.0;
+  for (std::size_t q = 0; q < e.pieces.size(); ++q)
+    if (!e.claimed[q] && std::abs(e.grid_rows[q] - e.grid_rows[p]) <= colocation_rows)
+      none *= 1.0 - e.pieces[q].weight;
+  return 1.0 - none;
+}
+
+// ClaSP times a change only to within its subsequence window: a chosen ClaSP piece gives way to
+// the nearest sensory or kinematic piece of the demo within `spread_rows` of it (a contact, a
+// pause's end), which times the same change to a sample.
+long sharpen(const DemoEvidence& e, long chosen, double spread_rows, double min_weight,
+             double after_row, double before_row) {
+  if (chosen < 0 || e.pieces[static_cast<std::size_t>(chosen)].kind != EvidenceKind::kClasp)
+    return chosen;
+  const double row = e.grid_rows[static_cast<std::size_t>(chosen)];
+  long best = chosen;
+  double nearest = spread_rows;
+  for (std::size_t p = 0; p < e.pieces.size(); ++p) {
+    const double distance = std::abs(e.grid_rows[p] - row);
+    if (e.claimed[p] || e.pieces[p].kind == EvidenceKind::kClasp ||
+        e.pieces[p].weight < min_weight || distance > nearest || e.grid_rows[p] <= after_row ||
+        e.grid_rows[p] >= before_row)
+      continue;
+    nearest = distance;
+    best = static_cast<long>(p);
+  }
+  return best;
+}
+
+long best_piece(const DemoEvidence& e, double u, const PlacementRows& rows, double after_row,
+                double before_row) {
   long best = -1;
   double best_score = 0.0;
   for (std::size_t p = 0; p < e.pieces.size(); ++p) {
     const double distance = std::abs(e.reference_rows[p] - u);
-    if (e.claimed[p] || distance > window_rows || e.grid_rows[p] <= after_row ||
+    if (e.claimed[p] || distance > rows.window || e.grid_rows[p] <= after_row ||
         e.grid_rows[p] >= before_row)
       continue;
-    double none = 1.0;
-    for (std::size_t q = 0; q < e.pieces.size(); ++q)
-      if (!e.claimed[q] && std::abs(e.grid_rows[q] - e.grid_rows[p]) <= colocation_rows)
-        none *= 1.0 - e.pieces[q].weight;
-    const double z = distance / spread_rows;
+    const double strength = colocated_strength(e, p, rows.colocation);
+    if (strength < rows.min_weight) continue;
+    const double none = 1.0 - strength;
+    const double z = distance / rows.spread;
     // Among pieces of equal support, the one whose kind times a change best places it.
     const double score =
         (1.0 - none) * std::exp(-0.5 * z * z) + 1e-3 * timing_precision(e.pieces[p].kind);
@@ -337,7 +390,7 @@ long best_piece(const DemoEvidence& e, double u, double window_rows, double spre
       best = static_cast<long>(p);
     }
   }
-  return best;
+  return sharpen(e, best, rows.spread, rows.min_weight, after_row, before_row);
 }
 
 // The demo's grid rows of the anchors before and after reference row u (or its ends).
@@ -379,7 +432,7 @@ class JointAgreement {
         window_rows_(config.match_window / config.grid_step),
         colocation_rows_(config.colocation / config.grid_step),
         threads_(threads) {
-    const DemoAlignment alignment = align_to_medoid(grids_, threads_);
+    const DemoAlignment alignment = align_to_medoid(grids_, threads_, config_.alignment_band);
     reference_ = alignment.reference;
     to_reference_ = alignment.to_reference;
     from_reference_ = alignment.from_reference;
@@ -389,7 +442,6 @@ class JointAgreement {
   void run(std::size_t max_boundaries) {
     while (anchors_.size() < max_boundaries) {
       map_evidence();
-      if (std::getenv("LFD_JOINT_DEBUG")) debug_dump();
       const double u = next_boundary(support(), anchors_, config_, min_segment_rows_);
       if (u < 0) break;
       if (!add_anchor(u)) break;
@@ -409,21 +461,6 @@ class JointAgreement {
   double window_rows() const { return window_rows_; }
 
  private:
-  void debug_dump() const {
-    for (std::size_t d = 0; d < evidence_.size(); ++d) {
-      std::fprintf(stderr, "demo %zu:", d);
-      const DemoEvidence& e = evidence_[d];
-      for (std::size_t p = 0; p < e.pieces.size(); ++p)
-        std::fprintf(stderr, " %s%s@%.1f(r%.1f)=%.2f", e.claimed[p] ? "*" : "", to_string(e.pieces[p].kind).c_str(),
-                     e.grid_rows[p] * config_.grid_step, e.reference_rows[p] * config_.grid_step, e.pieces[p].weight);
-      std::fprintf(stderr, "\n");
-    }
-    const Eigen::VectorXd s = support();
-    std::fprintf(stderr, "support:");
-    for (Eigen::Index r = 0; r < s.size(); r += 2) std::fprintf(stderr, "%c", " .:-=+*#%@"[std::min(9, int(s[r] * 10))]);
-    std::fprintf(stderr, "\n");
-  }
-
   void map_evidence() {
     for (DemoEvidence& e : evidence_) e.reference_rows.clear();
     for (std::size_t d = 0; d < evidence_.size(); ++d)
@@ -465,8 +502,9 @@ class JointAgreement {
   bool place(Anchor* a, std::size_t d) {
     const double rows = static_cast<double>(grids_[d].rows());
     const auto [after, before] = neighbouring_rows(anchors_, d, a->reference_row, rows);
-    const long p = best_piece(evidence_[d], a->reference_row, window_rows_, spread_rows_,
-                              colocation_rows_, after, before);
+    const long p = best_piece(evidence_[d], a->reference_row,
+                              {window_rows_, spread_rows_, colocation_rows_, config_.min_piece_weight},
+                              after, before);
     if (p < 0) return false;
     a->piece[d] = p;
     a->demo_row[d] = static_cast<std::size_t>(std::clamp(
@@ -502,8 +540,10 @@ class JointAgreement {
         own.push_back(a.demo_row[d]);
         reference_rows.push_back(static_cast<std::size_t>(std::lround(a.reference_row)));
       }
-      to_reference_[d] = anchored_dtw_map(grids_[d], grids_[reference_], own, reference_rows);
-      from_reference_[d] = anchored_dtw_map(grids_[reference_], grids_[d], reference_rows, own);
+      to_reference_[d] = anchored_dtw_map(grids_[d], grids_[reference_], own, reference_rows,
+                                        config_.alignment_band);
+      from_reference_[d] = anchored_dtw_map(grids_[reference_], grids_[d], reference_rows, own,
+                                          config_.alignment_band);
     });
   }
 
@@ -584,8 +624,9 @@ SegmentationPipelineResult segment_jointly(const PreparedSegmentation& prepared,
   SegmentationPipelineResult result = prepared.base;
   const std::size_t n = demos.size();
   result.demos.resize(n);
-  const std::vector<Eigen::MatrixXd> scaled =
-      scaled_states(demos, moving_states(demos, result.state_features));
+  const std::vector<std::string> states = moving_states(demos, result.state_features);
+  const std::vector<Eigen::MatrixXd> scaled = scaled_states(demos, states);
+  const Eigen::VectorXd consistency = consistency_weights(result, states);
   const std::vector<std::size_t> groups = sensor_channel_groups(result.sensor_features);
   const bool sensors = !result.sensor_features.empty() && config.validate_with_sensors;
   const std::vector<Eigen::MatrixXd> scaled_sensors =
@@ -594,7 +635,8 @@ SegmentationPipelineResult segment_jointly(const PreparedSegmentation& prepared,
 
   std::vector<Eigen::VectorXd> speeds(n);
   parallel_for(n, config.threads, [&](std::size_t d) {
-    speeds[d] = state_speed(scaled[d], clock_of(demos[d]), config.joint.pauses.smoothing);
+    speeds[d] = state_speed(scaled[d] * consistency.asDiagonal(), clock_of(demos[d]),
+                            config.joint.pauses.smoothing);
   });
   const SensorSelection contact =
       sensors ? contact_sensors(result.sensor_features, groups, scaled_sensors, speeds,
@@ -605,7 +647,7 @@ SegmentationPipelineResult segment_jointly(const PreparedSegmentation& prepared,
   std::vector<Eigen::MatrixXd> grids(n);
   parallel_for(n, config.threads, [&](std::size_t d) {
     try {
-      gather_evidence(demos[d], scaled[d], speeds[d], scaled_sensors[d], result, contact, config,
+      gather_evidence(demos[d], scaled[d], consistency, speeds[d], scaled_sensors[d], result, contact, config,
                       &result.demos[d], &evidence[d], &grids[d]);
     } catch (const std::invalid_argument& e) {
       throw std::invalid_argument(describe(e.what(), d));

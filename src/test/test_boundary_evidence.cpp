@@ -212,7 +212,7 @@ TEST(GatherIntoPauses, EvidenceInsideAnInteriorPauseMovesToItsEnd) {
       {200, 0.6, lfd::EvidenceKind::kSensorLevel},  // at the pause's first sample
       {420, 0.9, lfd::EvidenceKind::kContact},      // in the last rest
   };
-  lfd::gather_into_pauses(pauses, 450, &evidence);
+  lfd::gather_into_pauses(pauses, 450, 0, &evidence);
   EXPECT_EQ(evidence[0].index, 20u) << "the first rest keeps its evidence";
   EXPECT_EQ(evidence[1].index, 100u);
   EXPECT_EQ(evidence[2].index, 300u);

@@ -97,10 +97,11 @@ std::vector<BoundaryEvidence> motion_stop_evidence(const Eigen::VectorXd& speed,
                                                    const PauseConfig& config, double weight);
 
 /// A pause between two motions is one transition: evidence inside it (the gripper closing while
-/// the arm waits) moves to the pause's end, where the next motion starts. Evidence in the first
-/// rest or the last one stays where it is.
+/// the arm waits) moves to the pause's end, where the next motion starts. Evidence within
+/// `start_samples` of the pause's beginning stays: a contact made as the hand stops (a press
+/// held still) begins a phase. Evidence in the first rest or the last one stays where it is.
 void gather_into_pauses(const std::vector<Pause>& pauses, std::size_t samples,
-                        std::vector<BoundaryEvidence>* evidence);
+                        std::size_t start_samples, std::vector<BoundaryEvidence>* evidence);
 
 /// Evidence of the sensory events: rest edges as contact, the others as level steps. A level
 /// event within `fold_samples` of a rest edge is that contact's own force building up or fading

@@ -11,6 +11,10 @@ struct JointSegmentationConfig {
   /// Step of the grid the demos are aligned on (s): alignment needs the phases' order, not the
   /// samples; each boundary is then placed on its own demo's evidence at the full rate.
   double grid_step = 0.1;
+  /// The alignment's warp stays within this fraction of the longer demo of the straight line
+  /// from start to end (>= 1: unconstrained): a periodic phase with a different number of
+  /// strokes otherwise lets DTW fold whole phases onto one stroke.
+  double alignment_band = 0.2;
   /// Spread of a piece of evidence on the reference's axis (s, Gaussian sigma): the DTW
   /// alignment's error between demos that move at different speeds.
   double spread = 0.5;
@@ -24,6 +28,9 @@ struct JointSegmentationConfig {
   /// A demo's own evidence must lie within this of an agreed boundary (s, on the reference's
   /// axis); a demo with none there is reported as lacking that boundary, never forced.
   double match_window = 1.5;
+  /// A demo's own evidence for a boundary must be at least this sure (as an instant of rest): a
+  /// hesitation is no boundary, even where the other demos have one.
+  double min_piece_weight = 0.3;
   /// Pieces of one demo's evidence closer than this (s) mark one instant: they reinforce each
   /// other when a boundary is placed, and are claimed by it together.
   double colocation = 0.25;
