@@ -216,10 +216,23 @@ TEST(GatherIntoPauses, EvidenceInsideAnInteriorPauseMovesToItsEnd) {
   EXPECT_EQ(evidence[0].index, 20u) << "the first rest keeps its evidence";
   EXPECT_EQ(evidence[1].index, 100u);
   EXPECT_EQ(evidence[2].index, 300u);
-  EXPECT_EQ(evidence[3].index, 300u);
+  EXPECT_EQ(evidence[3].index, 200u) << "evidence as the hand stops begins the pause's phase";
   EXPECT_EQ(evidence[4].index, 420u) << "the last rest keeps its evidence";
   EXPECT_EQ(evidence[2].kind, lfd::EvidenceKind::kContact);
   EXPECT_DOUBLE_EQ(evidence[2].weight, 0.9);
+}
+
+// A press held still: the contact made within start_samples of the hand stopping stays there;
+// one made later in the pause (a gripper closing while the arm waits) moves to its end.
+TEST(GatherIntoPauses, EvidenceAsTheHandStopsStaysWhereItIs) {
+  const std::vector<lfd::Pause> pauses = {{0, 50}, {200, 300}, {400, 450}};
+  std::vector<lfd::BoundaryEvidence> evidence = {
+      {208, 0.9, lfd::EvidenceKind::kContact},
+      {230, 0.9, lfd::EvidenceKind::kContact},
+  };
+  lfd::gather_into_pauses(pauses, 450, 10, &evidence);
+  EXPECT_EQ(evidence[0].index, 208u);
+  EXPECT_EQ(evidence[1].index, 300u);
 }
 
 // ---- sensory_evidence
