@@ -94,36 +94,36 @@ void parse_joint(const YAML::Node& node, lfd::JointSegmentationConfig* joint) {
   const YAML::Node w = node ? node["weights"] : YAML::Node();
   auto& weights = joint->weights;
   weights.contact = fraction(get<double>(w, "contact", weights.contact), "joint/weights/contact");
-  weights.sensor_level = fraction(get<double>(w, "sensor_level", weights.sensor_level),
-                                  "joint/weights/sensor_level");
-  weights.motion_onset = fraction(get<double>(w, "motion_onset", weights.motion_onset),
-                                  "joint/weights/motion_onset");
-  weights.motion_stop = fraction(get<double>(w, "motion_stop", weights.motion_stop),
-                                 "joint/weights/motion_stop");
+  weights.sensor_level =
+      fraction(get<double>(w, "sensor_level", weights.sensor_level), "joint/weights/sensor_level");
+  weights.motion_onset =
+      fraction(get<double>(w, "motion_onset", weights.motion_onset), "joint/weights/motion_onset");
+  weights.motion_stop =
+      fraction(get<double>(w, "motion_stop", weights.motion_stop), "joint/weights/motion_stop");
   weights.clasp = fraction(get<double>(w, "clasp", weights.clasp), "joint/weights/clasp");
   const YAML::Node pause = node ? node["pauses"] : YAML::Node();
   auto& pc = joint->pauses;
   pc.smoothing = non_negative(get<double>(pause, "smoothing_seconds", pc.smoothing),
                               "joint/pauses/smoothing_seconds");
-  pc.rest_fraction = fraction(get<double>(pause, "rest_fraction", pc.rest_fraction),
-                              "joint/pauses/rest_fraction");
+  pc.rest_fraction =
+      fraction(get<double>(pause, "rest_fraction", pc.rest_fraction), "joint/pauses/rest_fraction");
   pc.min_pause = non_negative(get<double>(pause, "min_pause_seconds", pc.min_pause),
                               "joint/pauses/min_pause_seconds");
   pc.pause_scale = positive(get<double>(pause, "pause_scale_seconds", pc.pause_scale),
                             "joint/pauses/pause_scale_seconds");
   pc.motion_window = positive(get<double>(pause, "motion_window_seconds", pc.motion_window),
                               "joint/pauses/motion_window_seconds");
-  joint->grid_step = positive(get<double>(node, "grid_step_seconds", joint->grid_step),
-                              "joint/grid_step_seconds");
+  joint->grid_step =
+      positive(get<double>(node, "grid_step_seconds", joint->grid_step), "joint/grid_step_seconds");
   joint->alignment_band =
       positive(get<double>(node, "alignment_band", joint->alignment_band), "joint/alignment_band");
-  joint->spread = positive(get<double>(node, "spread_seconds", joint->spread),
-                           "joint/spread_seconds");
+  joint->spread =
+      positive(get<double>(node, "spread_seconds", joint->spread), "joint/spread_seconds");
   joint->min_support =
       fraction(get<double>(node, "min_support", joint->min_support), "joint/min_support");
-  joint->short_phase_support = fraction(
-      get<double>(node, "short_phase_support", joint->short_phase_support),
-      "joint/short_phase_support");
+  joint->short_phase_support =
+      fraction(get<double>(node, "short_phase_support", joint->short_phase_support),
+               "joint/short_phase_support");
   joint->match_window = positive(get<double>(node, "match_window_seconds", joint->match_window),
                                  "joint/match_window_seconds");
   joint->min_piece_weight = fraction(get<double>(node, "min_piece_weight", joint->min_piece_weight),
@@ -132,9 +132,9 @@ void parse_joint(const YAML::Node& node, lfd::JointSegmentationConfig* joint) {
                                    "joint/colocation_seconds");
   joint->max_speed_correlation =
       get<double>(node, "max_speed_correlation", joint->max_speed_correlation);
-  joint->extra_event_weight = fraction(
-      get<double>(node, "extra_event_weight", joint->extra_event_weight),
-      "joint/extra_event_weight");
+  joint->extra_event_weight =
+      fraction(get<double>(node, "extra_event_weight", joint->extra_event_weight),
+               "joint/extra_event_weight");
 }
 
 }  // namespace

@@ -32,7 +32,8 @@ std::vector<bool> moving_samples(const Eigen::VectorXd& speed, double rest, doub
     double peak = 0.0;
     for (; j < n && speed[static_cast<Eigen::Index>(j)] >= rest; ++j)
       peak = std::max(peak, speed[static_cast<Eigen::Index>(j)]);
-    if (peak >= small) std::fill(moving.begin() + static_cast<long>(i), moving.begin() + static_cast<long>(j), true);
+    if (peak >= small)
+      std::fill(moving.begin() + static_cast<long>(i), moving.begin() + static_cast<long>(j), true);
     i = j;
   }
   return moving;
@@ -53,8 +54,8 @@ std::vector<Pause> rest_runs(const Eigen::VectorXd& speed, const std::vector<dou
   std::vector<Pause> runs;
   const double typical = percentile(speed, 0.95);
   if (!(typical > 0) || time.size() != static_cast<std::size_t>(speed.size())) return runs;
-  const std::vector<bool> moving = moving_samples(speed, config.rest_fraction * typical,
-                                                  config.small_motion_fraction * typical);
+  const std::vector<bool> moving =
+      moving_samples(speed, config.rest_fraction * typical, config.small_motion_fraction * typical);
   for (std::size_t i = 0; i < moving.size();) {
     std::size_t j = i;
     while (j < moving.size() && !moving[j]) ++j;
@@ -123,9 +124,12 @@ std::vector<BoundaryEvidence> motion_stop_evidence(const Eigen::VectorXd& speed,
   for (const Pause& run : rest_runs(speed, time, config)) {
     if (duration(run, time) >= config.min_pause || at_an_end(run, time.size())) continue;
     Eigen::Index slowest = 0;
-    speed.segment(static_cast<Eigen::Index>(run.begin), static_cast<Eigen::Index>(run.end - run.begin))
+    speed
+        .segment(static_cast<Eigen::Index>(run.begin),
+                 static_cast<Eigen::Index>(run.end - run.begin))
         .minCoeff(&slowest);
-    out.push_back({run.begin + static_cast<std::size_t>(slowest), weight, EvidenceKind::kMotionStop});
+    out.push_back(
+        {run.begin + static_cast<std::size_t>(slowest), weight, EvidenceKind::kMotionStop});
   }
   return out;
 }
@@ -141,9 +145,8 @@ std::vector<BoundaryEvidence> motion_onset_evidence(const Eigen::VectorXd& speed
     // The demo starts and ends at rest: neither is a boundary between skills.
     if (p.begin == 0 || p.end >= time.size()) continue;
     const double pause = time[p.end] - time[p.begin];
-    const double motion = std::min(
-        1.0, peak_speed_after(speed, time, p.end, config.motion_window) /
-                 (config.full_motion_fraction * typical));
+    const double motion = std::min(1.0, peak_speed_after(speed, time, p.end, config.motion_window) /
+                                            (config.full_motion_fraction * typical));
     out.push_back({p.end, weight * (1.0 - std::exp(-pause / config.pause_scale)) * motion,
                    EvidenceKind::kMotionOnset});
   }
@@ -170,7 +173,8 @@ std::vector<BoundaryEvidence> sensory_evidence(const SensorEvents& events,
     }
     std::size_t index = e.index, nearest = fold_samples + 1;
     for (const SensoryEvent& edge : events.details) {
-      const std::size_t distance = edge.index > e.index ? edge.index - e.index : e.index - edge.index;
+      const std::size_t distance =
+          edge.index > e.index ? edge.index - e.index : e.index - edge.index;
       if (edge.rest_edge && distance <= fold_samples && distance < nearest) {
         nearest = distance;
         index = edge.index;
@@ -181,8 +185,7 @@ std::vector<BoundaryEvidence> sensory_evidence(const SensorEvents& events,
   return out;
 }
 
-std::vector<BoundaryEvidence> clasp_evidence(const MultivariateSegmentation& clasp,
-                                             double weight) {
+std::vector<BoundaryEvidence> clasp_evidence(const MultivariateSegmentation& clasp, double weight) {
   std::vector<BoundaryEvidence> out;
   for (std::size_t cp : clasp.changepoints) out.push_back({cp, weight, EvidenceKind::kClasp});
   return out;

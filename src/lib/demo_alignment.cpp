@@ -18,9 +18,9 @@ constexpr float kInf = std::numeric_limits<float>::infinity();
 // reachable).
 bool outside_band(Eigen::Index i, Eigen::Index j, Eigen::Index n, Eigen::Index m, double band) {
   if (band >= 1.0) return false;
-  const double centre = n > 1 ? static_cast<double>(i) * static_cast<double>(m - 1) /
-                                    static_cast<double>(n - 1)
-                              : 0.0;
+  const double centre =
+      n > 1 ? static_cast<double>(i) * static_cast<double>(m - 1) / static_cast<double>(n - 1)
+            : 0.0;
   const double radius = std::max(1.0, band * static_cast<double>(std::max(n, m)));
   return std::abs(static_cast<double>(j) - centre) > radius;
 }
@@ -111,7 +111,8 @@ std::vector<double> multivariate_dtw_map(const Eigen::MatrixXd& a, const Eigen::
   check_pair(a, b);
   const Eigen::Index n = a.rows(), m = b.rows();
   const std::vector<float> d = accumulated_cost(a, b, band);
-  std::vector<double> sum(static_cast<std::size_t>(n), 0.0), count(static_cast<std::size_t>(n), 0.0);
+  std::vector<double> sum(static_cast<std::size_t>(n), 0.0),
+      count(static_cast<std::size_t>(n), 0.0);
   Eigen::Index i = n - 1, j = m - 1;
   while (true) {
     sum[i] += static_cast<double>(j);
@@ -156,9 +157,9 @@ std::vector<double> anchored_dtw_map(const Eigen::MatrixXd& a, const Eigen::Matr
   for (std::size_t k = 0; k + 1 < a_cuts.size(); ++k) {
     const auto rows_a = static_cast<Eigen::Index>(a_cuts[k + 1] - a_cuts[k]);
     const auto rows_b = static_cast<Eigen::Index>(b_cuts[k + 1] - b_cuts[k]);
-    const std::vector<double> part = multivariate_dtw_map(
-        a.middleRows(static_cast<Eigen::Index>(a_cuts[k]), rows_a),
-        b.middleRows(static_cast<Eigen::Index>(b_cuts[k]), rows_b), band);
+    const std::vector<double> part =
+        multivariate_dtw_map(a.middleRows(static_cast<Eigen::Index>(a_cuts[k]), rows_a),
+                             b.middleRows(static_cast<Eigen::Index>(b_cuts[k]), rows_b), band);
     for (double row : part) map.push_back(row + static_cast<double>(b_cuts[k]));
   }
   return map;
@@ -194,7 +195,8 @@ DemoAlignment align_to_medoid(const std::vector<Eigen::MatrixXd>& gridded, int t
     total[pairs[p].second] += cost[p];
   }
   DemoAlignment out;
-  out.reference = static_cast<std::size_t>(std::min_element(total.begin(), total.end()) - total.begin());
+  out.reference =
+      static_cast<std::size_t>(std::min_element(total.begin(), total.end()) - total.begin());
   out.to_reference.resize(n);
   out.from_reference.resize(n);
   out.mean_cost.assign(n, 0.0);

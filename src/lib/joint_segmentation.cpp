@@ -200,7 +200,8 @@ SensorSelection contact_sensors(const std::vector<std::string>& names,
       msg.precision(2);
       std::string sensor;
       for (std::size_t c = 0; c < names.size(); ++c)
-        if (groups[c] == static_cast<std::size_t>(g)) sensor += (sensor.empty() ? "" : ", ") + names[c];
+        if (groups[c] == static_cast<std::size_t>(g))
+          sensor += (sensor.empty() ? "" : ", ") + names[c];
       msg << "sensor " << sensor << " follows the robot's own speed (correlation " << r
           << "): its events are motion, not contact, and are not used as contacts";
       warnings->push_back(msg.str());
@@ -219,17 +220,17 @@ SensorSelection contact_sensors(const std::vector<std::string>& names,
 
 // A demo's evidence of every kind, and its features and speed on the alignment grid.
 void gather_evidence(const FeatureMatrix& demo, const Eigen::MatrixXd& scaled,
-                     const Eigen::VectorXd& consistency, const Eigen::VectorXd& speed, const Eigen::MatrixXd& scaled_sensors,
-                     const SegmentationPipelineResult& base, const SensorSelection& contact,
-                     const SegmentationPipelineConfig& config, DemoSegmentationResult* out,
-                     DemoEvidence* evidence, Eigen::MatrixXd* grid) {
+                     const Eigen::VectorXd& consistency, const Eigen::VectorXd& speed,
+                     const Eigen::MatrixXd& scaled_sensors, const SegmentationPipelineResult& base,
+                     const SensorSelection& contact, const SegmentationPipelineConfig& config,
+                     DemoSegmentationResult* out, DemoEvidence* evidence, Eigen::MatrixXd* grid) {
   const JointSegmentationConfig& joint = config.joint;
   const double rate = sample_rate_of(demo);
   const SegmentationPipelineConfig own = in_samples(config, rate);
   out->num_samples = static_cast<std::size_t>(demo.rows());
   out->sample_rate = rate;
-  out->clasp = segment_multivariate(demo.select(base.selected_features).data,
-                                    base.feature_weights, own.segmentation);
+  out->clasp = segment_multivariate(demo.select(base.selected_features).data, base.feature_weights,
+                                    own.segmentation);
   out->min_segment_length = out->clasp.min_segment_length;
   std::vector<BoundaryEvidence>& pieces = evidence->pieces;
   pieces = clasp_evidence(out->clasp, joint.weights.clasp);
@@ -243,7 +244,8 @@ void gather_evidence(const FeatureMatrix& demo, const Eigen::MatrixXd& scaled,
   }
   const std::vector<double> clock = clock_of(demo);
   const std::vector<Pause> pauses = find_pauses(speed, clock, joint.pauses);
-  const auto m = motion_onset_evidence(speed, clock, pauses, joint.pauses, joint.weights.motion_onset);
+  const auto m =
+      motion_onset_evidence(speed, clock, pauses, joint.pauses, joint.weights.motion_onset);
   pieces.insert(pieces.end(), m.begin(), m.end());
   const auto stops = motion_stop_evidence(speed, clock, joint.pauses, joint.weights.motion_stop);
   pieces.insert(pieces.end(), stops.begin(), stops.end());
@@ -286,8 +288,8 @@ Eigen::VectorXd demo_support(const DemoEvidence& e, Eigen::Index rows, double sp
 double needed_support(double distance, const JointSegmentationConfig& config,
                       double min_segment_rows) {
   if (distance >= min_segment_rows) return config.min_support;
-  return config.min_support + (config.short_phase_support - config.min_support) *
-                                  (1.0 - distance / min_segment_rows);
+  return config.min_support +
+         (config.short_phase_support - config.min_support) * (1.0 - distance / min_segment_rows);
 }
 
 // The best supported peak that may join the anchors (it reaches the support its distance to
@@ -476,8 +478,9 @@ class JointAgreement {
     // Support above the background: evidence that is everywhere (a contact force varying all
     // along a wipe, in every demo at other times) supports every instant alike and so none.
     const double background = s.mean();
-    return background < 1.0 ? Eigen::VectorXd((s.array() - background).max(0.0) / (1.0 - background))
-                            : Eigen::VectorXd::Zero(rows);
+    return background < 1.0
+               ? Eigen::VectorXd((s.array() - background).max(0.0) / (1.0 - background))
+               : Eigen::VectorXd::Zero(rows);
   }
 
   // Adds the boundary and places it in every demo; false (and nothing added) when no demo has
@@ -488,10 +491,11 @@ class JointAgreement {
     a.reference_row = u;
     a.piece.assign(evidence_.size(), -1);
     a.demo_row.assign(evidence_.size(), 0);
-    const auto at = anchors_.insert(
-        std::upper_bound(anchors_.begin(), anchors_.end(), a,
-                         [](const Anchor& x, const Anchor& y) { return x.reference_row < y.reference_row; }),
-        a);
+    const auto at = anchors_.insert(std::upper_bound(anchors_.begin(), anchors_.end(), a,
+                                                     [](const Anchor& x, const Anchor& y) {
+                                                       return x.reference_row < y.reference_row;
+                                                     }),
+                                    a);
     bool any = false;
     for (std::size_t d = 0; d < evidence_.size(); ++d) any = place(&*at, d) || any;
     if (!any) anchors_.erase(at);
@@ -502,14 +506,14 @@ class JointAgreement {
   bool place(Anchor* a, std::size_t d) {
     const double rows = static_cast<double>(grids_[d].rows());
     const auto [after, before] = neighbouring_rows(anchors_, d, a->reference_row, rows);
-    const long p = best_piece(evidence_[d], a->reference_row,
-                              {window_rows_, spread_rows_, colocation_rows_, config_.min_piece_weight},
-                              after, before);
+    const long p = best_piece(
+        evidence_[d], a->reference_row,
+        {window_rows_, spread_rows_, colocation_rows_, config_.min_piece_weight}, after, before);
     if (p < 0) return false;
     a->piece[d] = p;
-    a->demo_row[d] = static_cast<std::size_t>(std::clamp(
-        std::lround(evidence_[d].grid_rows[static_cast<std::size_t>(p)]), 0L,
-        static_cast<long>(rows) - 1));
+    a->demo_row[d] = static_cast<std::size_t>(
+        std::clamp(std::lround(evidence_[d].grid_rows[static_cast<std::size_t>(p)]), 0L,
+                   static_cast<long>(rows) - 1));
     claim(d, static_cast<std::size_t>(p));
     return true;
   }
@@ -541,9 +545,9 @@ class JointAgreement {
         reference_rows.push_back(static_cast<std::size_t>(std::lround(a.reference_row)));
       }
       to_reference_[d] = anchored_dtw_map(grids_[d], grids_[reference_], own, reference_rows,
-                                        config_.alignment_band);
-      from_reference_[d] = anchored_dtw_map(grids_[reference_], grids_[d], reference_rows, own,
                                           config_.alignment_band);
+      from_reference_[d] = anchored_dtw_map(grids_[reference_], grids_[d], reference_rows, own,
+                                            config_.alignment_band);
     });
   }
 
@@ -574,16 +578,15 @@ void report_demo(const JointAgreement& agreement, const FeatureMatrix& demo, std
   for (std::size_t k = 0; k < anchors.size(); ++k) {
     const std::size_t expected =
         sample_at(demo, agreement.expected_row(d, anchors[k].reference_row), config.grid_step);
-    out->zones.push_back({expected > half ? expected - half : 0,
-                          std::min(expected + half, out->num_samples - 1)});
+    out->zones.push_back(
+        {expected > half ? expected - half : 0, std::min(expected + half, out->num_samples - 1)});
     const long p = anchors[k].piece[d];
     if (p < 0) {
-      warnings->push_back(describe("no evidence of boundary " + std::to_string(k + 1) + " of " +
-                                       std::to_string(anchors.size()) +
-                                       " (the others agree on it near " +
-                                       seconds_after_start(demo, expected) +
-                                       "): this demonstration may lack that phase",
-                                   d));
+      warnings->push_back(describe(
+          "no evidence of boundary " + std::to_string(k + 1) + " of " +
+              std::to_string(anchors.size()) + " (the others agree on it near " +
+              seconds_after_start(demo, expected) + "): this demonstration may lack that phase",
+          d));
       continue;
     }
     out->changepoints.push_back(e.pieces[static_cast<std::size_t>(p)].index);
@@ -595,14 +598,17 @@ void report_demo(const JointAgreement& agreement, const FeatureMatrix& demo, std
     if (e.claimed[p]) continue;
     out->rejected.push_back(e.pieces[p].index);
     if (e.pieces[p].weight >= config.extra_event_weight)
-      extra.push_back(to_string(e.pieces[p].kind) + " at " + seconds_after_start(demo, e.pieces[p].index));
+      extra.push_back(to_string(e.pieces[p].kind) + " at " +
+                      seconds_after_start(demo, e.pieces[p].index));
   }
   if (!extra.empty()) {
     std::string list;
     for (const std::string& x : extra) list += (list.empty() ? "" : ", ") + x;
-    warnings->push_back(describe("strong evidence the other demonstrations do not share (an extra "
-                                 "phase?): " + list,
-                                 d));
+    warnings->push_back(
+        describe("strong evidence the other demonstrations do not share (an extra "
+                 "phase?): " +
+                     list,
+                 d));
   }
   std::sort(out->rejected.begin(), out->rejected.end());
   out->rejected.erase(std::unique(out->rejected.begin(), out->rejected.end()), out->rejected.end());
@@ -647,8 +653,8 @@ SegmentationPipelineResult segment_jointly(const PreparedSegmentation& prepared,
   std::vector<Eigen::MatrixXd> grids(n);
   parallel_for(n, config.threads, [&](std::size_t d) {
     try {
-      gather_evidence(demos[d], scaled[d], consistency, speeds[d], scaled_sensors[d], result, contact, config,
-                      &result.demos[d], &evidence[d], &grids[d]);
+      gather_evidence(demos[d], scaled[d], consistency, speeds[d], scaled_sensors[d], result,
+                      contact, config, &result.demos[d], &evidence[d], &grids[d]);
     } catch (const std::invalid_argument& e) {
       throw std::invalid_argument(describe(e.what(), d));
     }

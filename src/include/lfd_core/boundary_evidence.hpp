@@ -35,13 +35,13 @@ struct BoundaryEvidence {
 /// support it alone gives a boundary; the consensus accepts a boundary whose support, averaged
 /// over the demos, reaches JointSegmentationConfig::min_support.
 struct EvidenceWeights {
-  double contact = 0.9;        ///< rest edges: the sensors say an interaction starts or ends
-  double sensor_level = 0.7;   ///< a level step in contact
-  double motion_onset = 0.8;   ///< motion after a long pause, scaled by pause and motion below
+  double contact = 0.9;       ///< rest edges: the sensors say an interaction starts or ends
+  double sensor_level = 0.7;  ///< a level step in contact
+  double motion_onset = 0.8;  ///< motion after a long pause, scaled by pause and motion below
   /// An instant of rest between two motions: weak alone (every reversal of a periodic motion is
   /// one), it marks where a shape change ClaSP finds nearby begins.
   double motion_stop = 0.3;
-  double clasp = 0.5;          ///< a ClaSP changepoint (significant by ClaSP's own test)
+  double clasp = 0.5;  ///< a ClaSP changepoint (significant by ClaSP's own test)
 };
 
 /// How pauses of the state features are found (all in seconds or as statistics).
@@ -111,7 +111,6 @@ std::vector<BoundaryEvidence> sensory_evidence(const SensorEvents& events,
                                                std::size_t fold_samples);
 
 /// Evidence of ClaSP's accepted changepoints.
-std::vector<BoundaryEvidence> clasp_evidence(const MultivariateSegmentation& clasp,
-                                             double weight);
+std::vector<BoundaryEvidence> clasp_evidence(const MultivariateSegmentation& clasp, double weight);
 
 }  // namespace lfd

@@ -19,8 +19,7 @@ Eigen::MatrixXd on_uniform_grid(const Eigen::MatrixXd& features, const std::vect
 /// Summed squared Euclidean distance along the best monotone warping path. `band` (< 1): the
 /// path stays within band x the longer length of the diagonal joining the corners (a slanted
 /// Sakoe-Chiba band); >= 1 = unconstrained.
-double multivariate_dtw_cost(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b,
-                             double band = 1.0);
+double multivariate_dtw_cost(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b, double band = 1.0);
 
 /// For every row of `a`, the mean row of `b` it is warped to by multivariate DTW (fractional).
 std::vector<double> multivariate_dtw_map(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b,
@@ -47,8 +46,7 @@ DemoAlignment align_to_medoid(const std::vector<Eigen::MatrixXd>& gridded, int t
 /// ambiguous (a pause matches any other pause).
 std::vector<double> anchored_dtw_map(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b,
                                      const std::vector<std::size_t>& a_anchors,
-                                     const std::vector<std::size_t>& b_anchors,
-                                     double band = 1.0);
+                                     const std::vector<std::size_t>& b_anchors, double band = 1.0);
 
 /// Linear interpolation of a per-row map at a fractional row (clamped to its ends).
 double map_row(const std::vector<double>& map, double row);

@@ -116,7 +116,7 @@ struct DemoSegmentationResult {
   std::vector<double> changepoint_times;  ///< their times (s, or index without a clock)
   /// kJoint: the kinds of evidence of each changepoint in this demo ("contact+clasp", ...).
   std::vector<std::string> changepoint_evidence;
-  std::vector<std::size_t> rejected;      ///< ClaSP changepoints outside every zone
+  std::vector<std::size_t> rejected;  ///< ClaSP changepoints outside every zone
   std::vector<double> rejected_times;
   std::vector<std::size_t> pruned;  ///< validated, dropped to the consensus count (consensus_count)
   std::vector<double> pruned_times;
