@@ -2,54 +2,14 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 #include <stdexcept>
 
 #include "lfd_core/parallel_for.hpp"
+#include "lfd_core/time_alignment.hpp"
 
 namespace lfd {
 
 namespace {
-
-constexpr float kInf = std::numeric_limits<float>::infinity();
-
-// Whether cell (i, j) lies farther than band x the longer length from the diagonal joining the
-// two series' corners (a slanted Sakoe-Chiba band, at least one cell wide so the corner stays
-// reachable).
-bool outside_band(Eigen::Index i, Eigen::Index j, Eigen::Index n, Eigen::Index m, double band) {
-  if (band >= 1.0) return false;
-  const double centre =
-      n > 1 ? static_cast<double>(i) * static_cast<double>(m - 1) / static_cast<double>(n - 1)
-            : 0.0;
-  const double radius = std::max(1.0, band * static_cast<double>(std::max(n, m)));
-  return std::abs(static_cast<double>(j) - centre) > radius;
-}
-
-// Accumulated cost matrix (row-major, n x m) of the DTW recursion; float is plenty for features
-// scaled to about [0, 1] and halves the memory of a long pair.
-std::vector<float> accumulated_cost(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b,
-                                    double band) {
-  const Eigen::Index n = a.rows(), m = b.rows();
-  std::vector<float> d(static_cast<std::size_t>(n * m));
-  for (Eigen::Index i = 0; i < n; ++i) {
-    for (Eigen::Index j = 0; j < m; ++j) {
-      if (outside_band(i, j, n, m, band)) {
-        d[i * m + j] = kInf;
-        continue;
-      }
-      const float local = static_cast<float>((a.row(i) - b.row(j)).squaredNorm());
-      float best = 0.0f;
-      if (i > 0 || j > 0) {
-        const float diag = i > 0 && j > 0 ? d[(i - 1) * m + j - 1] : kInf;
-        const float up = i > 0 ? d[(i - 1) * m + j] : kInf;
-        const float left = j > 0 ? d[i * m + j - 1] : kInf;
-        best = std::min(diag, std::min(up, left));
-      }
-      d[i * m + j] = local + best;
-    }
-  }
-  return d;
-}
 
 void check_pair(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
   if (a.rows() == 0 || b.rows() == 0 || a.cols() != b.cols())
@@ -83,53 +43,19 @@ Eigen::MatrixXd on_uniform_grid(const Eigen::MatrixXd& features, const std::vect
 
 double multivariate_dtw_cost(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b, double band) {
   check_pair(a, b);
-  const Eigen::Index m = b.rows();
-  std::vector<double> prev(static_cast<std::size_t>(m)), row(static_cast<std::size_t>(m));
-  for (Eigen::Index i = 0; i < a.rows(); ++i) {
-    for (Eigen::Index j = 0; j < m; ++j) {
-      if (outside_band(i, j, a.rows(), m, band)) {
-        row[j] = std::numeric_limits<double>::infinity();
-        continue;
-      }
-      const double local = (a.row(i) - b.row(j)).squaredNorm();
-      double best = 0.0;
-      if (i > 0 || j > 0) {
-        best = std::numeric_limits<double>::infinity();
-        if (i > 0) best = std::min(best, prev[j]);
-        if (j > 0) best = std::min(best, row[j - 1]);
-        if (i > 0 && j > 0) best = std::min(best, prev[j - 1]);
-      }
-      row[j] = local + best;
-    }
-    std::swap(prev, row);
-  }
-  return prev[m - 1];
+  return dtwRows(a, b, nullptr, band);
 }
 
 std::vector<double> multivariate_dtw_map(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b,
                                          double band) {
   check_pair(a, b);
-  const Eigen::Index n = a.rows(), m = b.rows();
-  const std::vector<float> d = accumulated_cost(a, b, band);
-  std::vector<double> sum(static_cast<std::size_t>(n), 0.0),
-      count(static_cast<std::size_t>(n), 0.0);
-  Eigen::Index i = n - 1, j = m - 1;
-  while (true) {
-    sum[i] += static_cast<double>(j);
-    count[i] += 1.0;
-    if (i == 0 && j == 0) break;
-    // Ties prefer the diagonal, as lfd's univariate DTW does.
-    const float diag = i > 0 && j > 0 ? d[(i - 1) * m + j - 1] : kInf;
-    const float up = i > 0 ? d[(i - 1) * m + j] : kInf;
-    const float left = j > 0 ? d[i * m + j - 1] : kInf;
-    if (diag <= up && diag <= left) {
-      --i;
-      --j;
-    } else if (up <= left) {
-      --i;
-    } else {
-      --j;
-    }
+  std::vector<std::pair<int, int>> path;
+  dtwRows(a, b, &path, band);
+  std::vector<double> sum(static_cast<std::size_t>(a.rows()), 0.0);
+  std::vector<double> count(static_cast<std::size_t>(a.rows()), 0.0);
+  for (const auto& [i, j] : path) {
+    sum[static_cast<std::size_t>(i)] += static_cast<double>(j);
+    count[static_cast<std::size_t>(i)] += 1.0;
   }
   for (std::size_t k = 0; k < sum.size(); ++k) sum[k] /= count[k];
   return sum;

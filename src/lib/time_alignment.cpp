@@ -204,7 +204,7 @@ void checkInput(const std::vector<SegmentDemo>& demos, const TimeAlignmentOption
 }  // namespace
 
 double dtwRows(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b,
-               std::vector<std::pair<int, int>>* path) {
+               std::vector<std::pair<int, int>>* path, double band) {
   const Eigen::Index n = a.rows(), m = b.rows();
   if (n == 0 || m == 0 || a.cols() != b.cols())
     throw std::invalid_argument("dtwRows: empty series or different dimensions");
@@ -215,8 +215,14 @@ double dtwRows(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b,
     return acc[static_cast<std::size_t>(i * (m + 1) + j)];
   };
   at(0, 0) = 0.0;
+  // The slanted band: cell (i, j) within `radius` of the line joining the corners (at least one
+  // cell, so the corner stays reachable).
+  const double slope = n > 1 ? static_cast<double>(m - 1) / static_cast<double>(n - 1) : 0.0;
+  const double radius = std::max(1.0, band * static_cast<double>(std::max(n, m)));
   for (Eigen::Index i = 0; i < n; ++i)
     for (Eigen::Index j = 0; j < m; ++j) {
+      if (band < 1.0 && std::abs(static_cast<double>(j) - slope * static_cast<double>(i)) > radius)
+        continue;
       const double c = (a.row(i) - b.row(j)).squaredNorm();
       at(i + 1, j + 1) = c + std::min({at(i, j), at(i, j + 1), at(i + 1, j)});
     }

@@ -46,9 +46,11 @@ struct TimeAlignment {
 
 /// Multivariate DTW path between the rows of a (n x D) and b (m x D), squared Euclidean local
 /// cost, steps as lfd::dtw (ties: diagonal). Returns the summed cost; `path` gets (i, j) pairs
-/// from (0, 0) to (n - 1, m - 1) when not null.
+/// from (0, 0) to (n - 1, m - 1) when not null. `band` < 1: the path stays within band x the
+/// longer length of the straight line joining the corners (a slanted Sakoe-Chiba band); >= 1:
+/// unconstrained.
 double dtwRows(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b,
-               std::vector<std::pair<int, int>>* path = nullptr);
+               std::vector<std::pair<int, int>>* path = nullptr, double band = 1.0);
 
 /// Throws std::invalid_argument, its message starting with `where`, unless sample_seconds is finite
 /// and > 0 and warp_sigma finite and >= 0: the one rule for options from a config or a library.
