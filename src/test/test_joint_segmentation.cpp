@@ -208,28 +208,32 @@ TEST(JointSegmentation, FindsTheContactOnsetAndReleaseOfEveryDemo) {
   }
 }
 
-// A dead touch sensor in one demo (constant): the header promises that demo still has its motion
-// and ClaSP evidence, and that a boundary it shows no evidence of is reported as lacking, never
-// forced. So every agreed boundary is either placed near the truth or named in a warning.
-TEST(JointSegmentation, ADemoWithADeadSensorIsSegmentedFromItsMotionOrWarned) {
-  auto demos = reach_press_retract(6, 11);
-  const std::size_t dead = 2;
+// Kills demo `dead`'s touch sensor and segments: every other demo finds its boundaries, and the
+// dead one places each boundary on its own motion near the truth or reports it as lacking.
+lfd::SegmentationPipelineResult segment_with_a_dead_sensor(std::vector<Demo> demos,
+                                                           std::size_t dead) {
   demos[dead].matrix.data.col(3).setConstant(0.0);
   const auto result = lfd::run_segmentation_pipeline(matrices(demos), {"touch"}, joint_config());
   for (std::size_t d = 0; d < demos.size(); ++d)
     if (d != dead) expect_boundaries(result, demos[d], d, 0.2);
-  EXPECT_EQ(warnings_about(result, dead, "sensor 'touch' is constant"), 1u) << all_warnings(result);
   const auto& r = result.demos[dead];
-  const std::size_t lacking = warnings_about(result, dead, "lack");
-  EXPECT_EQ(r.changepoints.size() + lacking, 2u)
+  EXPECT_EQ(r.changepoints.size() + warnings_about(result, dead, "lack"), 2u)
       << "each of the 2 boundaries is placed or reported: got " << listed(r.changepoint_times)
       << all_warnings(result);
-  // What it places, it places on its own motion near a true boundary.
   for (double t : r.changepoint_times) {
     const auto& truth = demos[dead].truth;
     const double off = std::min(std::abs(t - truth[0]), std::abs(t - truth[1]));
     EXPECT_LT(off, 0.5) << "changepoint at " << t << " s, truth " << listed(truth);
   }
+  return result;
+}
+
+// A dead touch sensor in one demo (constant): the header promises that demo still has its motion
+// and ClaSP evidence, and that a boundary it shows no evidence of is reported as lacking, never
+// forced. So every agreed boundary is either placed near the truth or named in a warning.
+TEST(JointSegmentation, ADemoWithADeadSensorIsSegmentedFromItsMotionOrWarned) {
+  const auto result = segment_with_a_dead_sensor(reach_press_retract(6, 11), 2);
+  EXPECT_EQ(warnings_about(result, 2, "sensor 'touch' is constant"), 1u) << all_warnings(result);
 }
 
 // The same task with the hand sliding 25 cm along the surface while in contact (a wipe): the
@@ -246,21 +250,7 @@ TEST(JointSegmentation, AWipeWithADeadSensorIsSegmentedFromItsMotionOrWarned) {
   // the slide starting after a 0.3 s stop (weight 0.22, below min_piece_weight 0.3), so its
   // onset goes to a ClaSP changepoint mid-slide, 1.9 s off (issue 22, left open).
   GTEST_SKIP() << "the dead demo's onset has no evidence as sure as min_piece_weight";
-  auto demos = reach_press_retract(6, 11, 0.25);
-  const std::size_t dead = 2;
-  demos[dead].matrix.data.col(3).setConstant(0.0);
-  const auto result = lfd::run_segmentation_pipeline(matrices(demos), {"touch"}, joint_config());
-  for (std::size_t d = 0; d < demos.size(); ++d)
-    if (d != dead) expect_boundaries(result, demos[d], d, 0.2);
-  const auto& r = result.demos[dead];
-  EXPECT_EQ(r.changepoints.size() + warnings_about(result, dead, "lack"), 2u)
-      << "each of the 2 boundaries is placed or reported: got " << listed(r.changepoint_times)
-      << all_warnings(result);
-  for (double t : r.changepoint_times) {
-    const auto& truth = demos[dead].truth;
-    const double off = std::min(std::abs(t - truth[0]), std::abs(t - truth[1]));
-    EXPECT_LT(off, 0.5) << "changepoint at " << t << " s, truth " << listed(truth);
-  }
+  segment_with_a_dead_sensor(reach_press_retract(6, 11, 0.25), 2);
 }
 
 // Pose only: the long pauses end where a new skill starts; a 0.3 s hesitation inside a move is
