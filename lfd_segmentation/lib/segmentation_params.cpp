@@ -126,6 +126,11 @@ void parse_joint(const YAML::Node& node, lfd::JointSegmentationConfig* joint) {
                "joint/short_phase_support");
   joint->match_window = positive(get<double>(node, "match_window_seconds", joint->match_window),
                                  "joint/match_window_seconds");
+  joint->event_merge_gap =
+      non_negative(get<double>(node, "event_merge_gap_seconds", joint->event_merge_gap),
+                   "joint/event_merge_gap_seconds");
+  joint->ramp_fold = non_negative(get<double>(node, "ramp_fold_seconds", joint->ramp_fold),
+                                  "joint/ramp_fold_seconds");
   joint->min_piece_weight = fraction(get<double>(node, "min_piece_weight", joint->min_piece_weight),
                                      "joint/min_piece_weight");
   joint->colocation = non_negative(get<double>(node, "colocation_seconds", joint->colocation),

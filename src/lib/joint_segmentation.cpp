@@ -226,7 +226,9 @@ void gather_evidence(const FeatureMatrix& demo, const Eigen::MatrixXd& scaled,
                      DemoSegmentationResult* out, DemoEvidence* evidence, Eigen::MatrixXd* grid) {
   const JointSegmentationConfig& joint = config.joint;
   const double rate = sample_rate_of(demo);
-  const SegmentationPipelineConfig own = in_samples(config, rate);
+  SegmentationPipelineConfig own = in_samples(config, rate);
+  if (joint.event_merge_gap > 0)
+    own.events.merge_gap = static_cast<std::size_t>(std::lround(joint.event_merge_gap * rate));
   out->num_samples = static_cast<std::size_t>(demo.rows());
   out->sample_rate = rate;
   out->clasp = segment_multivariate(demo.select(base.selected_features).data, base.feature_weights,
@@ -239,7 +241,8 @@ void gather_evidence(const FeatureMatrix& demo, const Eigen::MatrixXd& scaled,
         detect_sensor_events(demo.select(contact.names).data, own.events, contact.groups);
     out->events = events.all;
     out->event_details = events.details;
-    const auto s = sensory_evidence(events, joint.weights, own.events.merge_gap);
+    const auto s = sensory_evidence(events, joint.weights,
+                                    static_cast<std::size_t>(std::lround(joint.ramp_fold * rate)));
     pieces.insert(pieces.end(), s.begin(), s.end());
   }
   const std::vector<double> clock = clock_of(demo);

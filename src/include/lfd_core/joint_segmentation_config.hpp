@@ -28,6 +28,13 @@ struct JointSegmentationConfig {
   /// A demo's own evidence must lie within this of an agreed boundary (s, on the reference's
   /// axis); a demo with none there is reported as lacking that boundary, never forced.
   double match_window = 1.5;
+  /// The sensory events' merge gap for this procedure (s; 0 = events/merge_gap_seconds): the
+  /// agreement across demos, not a second of rest, tells a contact from chatter, so a stroke that
+  /// lifts off for 0.8 s is a contact of its own.
+  double event_merge_gap = 0.5;
+  /// A sensor level step within this of a rest edge (s) is that contact's own force building up
+  /// or fading, and joins the rest edge.
+  double ramp_fold = 1.0;
   /// A demo's own evidence for a boundary must be at least this sure (as an instant of rest): a
   /// hesitation is no boundary, even where the other demos have one.
   double min_piece_weight = 0.3;
