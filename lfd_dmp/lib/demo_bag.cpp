@@ -63,8 +63,9 @@ DemoRecording readDemoBag(const std::string& path, const DemoBagTopics& topics,
                           const TransformLookup& fallback) {
   rosbag::Bag bag;
   try {
-    lfd::checkInputFile(path);  // a FIFO would block bag.open forever
-    bag.open(path, rosbag::bagmode::Read);
+    // Opened once through the file-access layer: a link swapped to a FIFO cannot hang open().
+    const lfd::InputFile file = lfd::openInputFile(path);
+    bag.open(file.readPath(), rosbag::bagmode::Read);
   } catch (const std::exception& e) {
     throw std::runtime_error("cannot open bag " + path + ": " + e.what());
   }

@@ -11,10 +11,13 @@
 
 #include <gtest/gtest.h>
 
+#include "link_swap_race.hpp"
+
 #include <unistd.h>
 
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 
 namespace {
 
@@ -301,6 +304,21 @@ TEST(DemoBag, ReadsPosesAndInterpolatesTheGripper) {
   EXPECT_FALSE(back.scene.has_value());  // no metadata: no scene (and no error)
   std::remove(path.c_str());
   EXPECT_THROW(lfd_dmp::readDemoBag(path), std::runtime_error);
+}
+
+// Issue 23 row 1: a link swapped between a demo bag and a FIFO while the learner reads it never
+// hangs it in open() (it checked the path, then opened it again by name).
+TEST(DemoBag, LinkSwappedToFifoNeverHangsTheReader) {
+  const std::string dir = ::testing::TempDir() + "/lfd_dmp_race_" + std::to_string(::getpid());
+  std::filesystem::create_directories(dir);
+  const std::string bag = dir + "/real.bag";
+  writeBag(bag, recording(bag, 0.6, 50.0), "", false);
+  const lfd_test::LinkSwapRaceResult r =
+      lfd_test::raceLinkSwap(dir + "/link.bag", bag, dir + "/pipe.bag",
+                             [](const std::string& link) { lfd_dmp::readDemoBag(link); });
+  EXPECT_EQ(r.hung_calls, 0) << "of " << r.calls << " calls";
+  EXPECT_GT(r.read_calls, 0);
+  std::filesystem::remove_all(dir);
 }
 
 // The scene of the metadata (the "scene" block, or the older object/object_start/goal fields) is

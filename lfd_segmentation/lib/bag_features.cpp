@@ -141,10 +141,12 @@ class TopicReader {
   rosmsg::FieldReader* last_reader_ = nullptr;
 };
 
+// Opens the bag through the file-access layer: rosbag reads the file that was checked, never what
+// the path names by then (a link swapped to a FIFO hung open()).
 void open_bag(rosbag::Bag& bag, const std::string& path) {
   try {
-    lfd::checkInputFile(path);  // a FIFO or device would block bag.open forever
-    bag.open(path, rosbag::bagmode::Read);
+    const lfd::InputFile file = lfd::openInputFile(path);
+    bag.open(file.readPath(), rosbag::bagmode::Read);
   } catch (const std::exception& e) {
     throw std::runtime_error("cannot open bag " + lfd::quoted(path) + ": " + e.what());
   }

@@ -1,5 +1,6 @@
 #include "lfd_segmentation/segmentation_params.hpp"
 
+#include "lfd_core/safe_paths.hpp"
 #include "lfd_core/user_text.hpp"
 
 #include <algorithm>
@@ -285,7 +286,9 @@ SegmentationParams params_from_yaml(const YAML::Node& root) {
 SegmentationParams load_params_file(const std::string& path) {
   YAML::Node root;
   try {
-    root = YAML::LoadFile(path);
+    root = YAML::LoadFile(lfd::openInputFile(path).readPath());  // no FIFO swapped in
+  } catch (const std::invalid_argument& e) {
+    throw std::invalid_argument("cannot read segmentation parameters: " + std::string(e.what()));
   } catch (const YAML::Exception& e) {
     throw std::invalid_argument("cannot read segmentation parameters " + lfd::quoted(path) + ": " +
                                 e.what());

@@ -6,6 +6,7 @@
 
 #include "demo_bag_writer.hpp"
 #include "lfd_segmentation/bag_features.hpp"
+#include "link_swap_race.hpp"
 
 namespace {
 
@@ -114,6 +115,22 @@ TEST(BagFeatures, UnreadableOrTruncatedBagIsARuntimeError) {
   std::ofstream(garbage) << "this is not a bag";
   EXPECT_THROW(lfd_segmentation::read_bag_features(garbage, default_topics(), 50),
                std::runtime_error);
+}
+
+// Issue 23 row 1: a link swapped between a bag and a FIFO while the reader runs never hangs it
+// (the path was checked, then opened again by name: open() blocked on the FIFO forever).
+TEST(BagFeatures, LinkSwappedToFifoNeverHangsTheReader) {
+  const fs::path dir = temp_dir();
+  const std::string bag = (dir / "real.bag").string();
+  lfd_segmentation_test::DemoBagOptions o;
+  o.duration = 1.0;
+  lfd_segmentation_test::write_demo_bag(bag, o);
+  const std::vector<TopicConfig> topics = default_topics();
+  const lfd_test::LinkSwapRaceResult r = lfd_test::raceLinkSwap(
+      (dir / "link.bag").string(), bag, (dir / "pipe.bag").string(),
+      [&](const std::string& link) { lfd_segmentation::read_bag_streams(link, topics); });
+  EXPECT_EQ(r.hung_calls, 0) << "of " << r.calls << " calls";
+  EXPECT_GT(r.read_calls, 0);  // the bag itself is still read when the link points at it
 }
 
 TEST(SegmentationParams, LoadsTheShippedConfigAndRejectsBadValues) {
