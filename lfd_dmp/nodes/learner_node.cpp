@@ -96,6 +96,9 @@ class Learner {
             }));
         checkDemoSize(demos.back(), b);
       }
+      std::vector<std::string> read_warnings;  // stamps the readers put in order, per demo
+      for (const auto& d : demos)
+        read_warnings.insert(read_warnings.end(), d.warnings.begin(), d.warnings.end());
       lfd_dmp::LearnOptions opt;
       opt.task = req.task;
       opt.features = req.selected_features;
@@ -107,11 +110,12 @@ class Learner {
       const lfd_dmp::LearnOutcome out = lfd_dmp::learnSkillLibrary(demos, cps, opt);
       lfd_dmp::saveSkillLibrary(out.library, output, req.overwrite);
       res.success = true;
-      res.warnings = out.warnings;
+      res.warnings = read_warnings;
+      res.warnings.insert(res.warnings.end(), out.warnings.begin(), out.warnings.end());
       res.library_path = output;
       res.num_segments = static_cast<uint32_t>(out.library.segments.size());
       res.num_demos = static_cast<uint32_t>(out.demos_used);
-      for (const auto& w : out.warnings) ROS_WARN("learner: %s", w.c_str());
+      for (const auto& w : res.warnings) ROS_WARN("learner: %s", w.c_str());
       ROS_INFO("learner: %u segments x %u demos -> %s", res.num_segments, res.num_demos,
                req.output_path.c_str());
     } catch (const std::exception& e) {

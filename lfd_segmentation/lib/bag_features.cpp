@@ -15,6 +15,7 @@
 
 #include "lfd_core/ros_message_reader.hpp"
 #include "lfd_core/safe_paths.hpp"
+#include "lfd_core/stamp_order.hpp"
 #include "lfd_core/user_text.hpp"
 
 namespace lfd_segmentation {
@@ -191,17 +192,30 @@ void read_part(const std::string& path, const std::vector<TopicConfig>& topics,
   }
 }
 
-// Messages are stored in receive order; sort each stream by stamp so resampling sees a clock.
-void sort_by_time(lfd::Stream& s) {
-  if (std::is_sorted(s.time.begin(), s.time.end())) return;
-  std::vector<std::size_t> order(s.time.size());
-  std::iota(order.begin(), order.end(), 0);
-  std::stable_sort(order.begin(), order.end(),
-                   [&](std::size_t a, std::size_t b) { return s.time[a] < s.time[b]; });
+// Messages are stored in receive order; the shared timestamp policy puts each stream in stamp
+// order (duplicates kept: resampling averages them) and reports what it found.
+lfd::StampReport order_by_stamp(lfd::Stream& s) {
+  lfd::StampReport report;
+  const std::vector<std::size_t> order =
+      lfd::orderByStamp(s.time, lfd::DuplicateStamps::kKeepAll, &report);
   std::vector<double> t, v;
+  t.reserve(order.size());
+  v.reserve(order.size());
   for (std::size_t k : order) t.push_back(s.time[k]), v.push_back(s.values[k]);
   s.time = std::move(t);
   s.values = std::move(v);
+  return report;
+}
+
+// Orders a topic's streams; one warning per topic (its fields share the messages' stamps).
+void order_topic(const std::string& topic, std::vector<lfd::Stream>& streams,
+                 std::vector<std::string>* warnings) {
+  std::string warning;
+  for (lfd::Stream& s : streams) {
+    const std::string w = lfd::stampWarning(topic, order_by_stamp(s));
+    if (warning.empty()) warning = w;
+  }
+  if (warnings && !warning.empty()) warnings->push_back(warning);
 }
 
 }  // namespace
@@ -220,7 +234,8 @@ std::vector<std::string> demo_parts(const std::string& path) {
 
 std::vector<lfd::Stream> read_bag_streams(const std::string& path,
                                           const std::vector<TopicConfig>& topics,
-                                          std::vector<FeatureRole>* roles) {
+                                          std::vector<FeatureRole>* roles,
+                                          std::vector<std::string>* warnings) {
   if (topics.empty()) throw std::invalid_argument("no topics configured for the features");
   for (const TopicConfig& cfg : topics) {
     if (cfg.topic == kGroundTruthTopic) {
@@ -241,17 +256,18 @@ std::vector<lfd::Stream> read_bag_streams(const std::string& path,
     } catch (const std::invalid_argument& e) {
       throw std::invalid_argument("bag " + lfd::quoted(path) + ": " + e.what());
     }
+    order_topic(topics[k].topic, topic_streams, warnings);
     if (roles) roles->insert(roles->end(), topic_streams.size(), topics[k].role);
     for (lfd::Stream& s : topic_streams) streams.push_back(std::move(s));
   }
-  for (lfd::Stream& s : streams) sort_by_time(s);
   return streams;
 }
 
 DemoFeatures read_bag_features(const std::string& path, const std::vector<TopicConfig>& topics,
                                double rate, const RequestLimits& limits) {
   std::vector<FeatureRole> roles;
-  const std::vector<lfd::Stream> streams = read_bag_streams(path, topics, &roles);
+  std::vector<std::string> warnings;
+  const std::vector<lfd::Stream> streams = read_bag_streams(path, topics, &roles, &warnings);
   check_streams(streams, path, limits);
   double start = -INFINITY, end = INFINITY;  // the span resample() keeps: where all streams overlap
   for (const lfd::Stream& s : streams) {
@@ -267,6 +283,8 @@ DemoFeatures read_bag_features(const std::string& path, const std::vector<TopicC
   }
   DemoFeatures demo;
   demo.source = path;
+  for (const std::string& w : warnings)
+    demo.warnings.push_back("bag " + lfd::quoted(path) + ": " + w);
   try {
     demo.matrix = lfd::resample(streams, rate);
   } catch (const std::invalid_argument& e) {

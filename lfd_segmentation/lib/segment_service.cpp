@@ -137,7 +137,11 @@ void handle_segment_request(const SegmentationParams& params,
     check_demos_fit(p, used.matrices, request.bag_paths);  // this request's window_seconds
     const lfd::SegmentationPipelineResult result =
         lfd::segment_prepared(used.prepared, used.matrices, config);
-    response.warnings = result.warnings;
+    response.warnings.clear();
+    for (const DemoFeatures& demo : used.demos)  // the stamps each bag's reader put in order
+      response.warnings.insert(response.warnings.end(), demo.warnings.begin(), demo.warnings.end());
+    response.warnings.insert(response.warnings.end(), result.warnings.begin(),
+                             result.warnings.end());
     response.selected_features = result.selected_features;
     response.selected_weights = result.feature_weights;
     response.sensor_features = result.sensor_features;

@@ -252,6 +252,7 @@ nlohmann::json run(const Options& o) {
           lfd_segmentation::read_bag_features(f, params.topics, params.rate, params.limits);
       if (demos.empty() && o.sensors.empty()) sensors = demo.sensor_features;
       if (demos.empty() && o.states.empty()) states = demo.state_features;
+      clock_warnings.insert(clock_warnings.end(), demo.warnings.begin(), demo.warnings.end());
       demos.push_back(std::move(demo.matrix));
     } else {
       demos.push_back(lfd_segmentation::read_csv_features(f, o.time_column, o.rate, params.limits));

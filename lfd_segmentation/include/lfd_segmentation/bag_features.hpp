@@ -22,6 +22,7 @@ struct DemoFeatures {
   std::vector<std::string> state_features;
   std::vector<std::string> sensor_features;
   std::vector<std::string> context_features;  ///< role context: in the matrix, used by neither
+  std::vector<std::string> warnings;  ///< stamps out of order, duplicated, with gaps (per topic)
 };
 
 /// The bag files of one demonstration: `path` itself, or its comma-separated parts (unless a file
@@ -31,10 +32,13 @@ std::vector<std::string> demo_parts(const std::string& path);
 /// Raw (not resampled) streams of the configured fields of one bag. Throws std::runtime_error for
 /// unreadable/truncated bags or messages that do not match their definition, and
 /// std::invalid_argument for a missing topic, a field that does not exist (listing the topic's
-/// numeric fields), a field no message carries, or the ground-truth topic.
+/// numeric fields), a field no message carries, or the ground-truth topic. Each stream is in stamp
+/// order (lfd_core/stamp_order.hpp); `warnings` gets one line per topic whose stamps were out of
+/// order, duplicated or had a gap.
 std::vector<lfd::Stream> read_bag_streams(const std::string& path,
                                           const std::vector<TopicConfig>& topics,
-                                          std::vector<FeatureRole>* roles = nullptr);
+                                          std::vector<FeatureRole>* roles = nullptr,
+                                          std::vector<std::string>* warnings = nullptr);
 
 /// read_bag_streams + resampling at `rate` Hz (errors name the bag). Streams over `limits`
 /// (time span, |value|) are refused before resampling (check_streams).
