@@ -13,6 +13,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "lfd_core/input_budget.hpp"
 #include "lfd_core/ros_message_reader.hpp"
 #include "lfd_core/safe_paths.hpp"
 #include "lfd_core/stamp_order.hpp"
@@ -230,6 +231,33 @@ std::vector<std::string> demo_parts(const std::string& path) {
     parts.push_back(part);
   }
   return parts;
+}
+
+void check_request_budget(const std::vector<std::string>& entries, const RequestLimits& limits,
+                          const lfd::PathPolicy& paths, const std::string& kind) {
+  if (entries.size() > limits.max_bags) {
+    throw std::invalid_argument(std::to_string(entries.size()) + " " + kind +
+                                " paths, over the limit of " + std::to_string(limits.max_bags) +
+                                " (limits/max_bags)");
+  }
+  std::vector<std::string> files;
+  for (const std::string& entry : entries) {
+    for (std::string& part : demo_parts(entry)) files.push_back(std::move(part));
+  }
+  lfd::InputBudget budget;
+  budget.what = kind + " files";
+  budget.max_files = limits.max_bag_files;
+  budget.max_files_key = "limits/max_bag_files";
+  budget.max_total_bytes = limits.max_total_bytes;
+  budget.max_total_bytes_key = "limits/max_total_bytes";
+  try {
+    lfd::checkInputBudget(files, budget, paths);
+  } catch (const std::invalid_argument& e) {
+    const std::string what = e.what();
+    // A file's own refusal (missing, FIFO, outside the roots) reads as before: "cannot open bag".
+    throw std::invalid_argument(what.rfind("path ", 0) == 0 ? "cannot open " + kind + ": " + what
+                                                            : what);
+  }
 }
 
 std::vector<lfd::Stream> read_bag_streams(const std::string& path,

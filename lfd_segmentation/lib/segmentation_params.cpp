@@ -264,6 +264,8 @@ SegmentationParams params_from_yaml(const YAML::Node& root) {
   const YAML::Node limits = root["limits"];
   auto& lim = p.limits;
   lim.max_bags = get<std::size_t>(limits, "max_bags", lim.max_bags);
+  lim.max_bag_files = get<std::size_t>(limits, "max_bag_files", lim.max_bag_files);
+  lim.max_total_bytes = get<std::uint64_t>(limits, "max_total_bytes", lim.max_total_bytes);
   lim.max_demo_seconds = positive(get<double>(limits, "max_demo_seconds", lim.max_demo_seconds),
                                   "limits/max_demo_seconds");
   lim.max_samples_per_demo =

@@ -29,6 +29,14 @@ struct DemoFeatures {
 /// of that very name exists).
 std::vector<std::string> demo_parts(const std::string& path);
 
+/// The request budget of the segmentation (service and CLI), checked before anything is read:
+/// `entries` (bag paths or CSV files) within limits/max_bags, the files they expand to (demo
+/// parts) within limits/max_bag_files, their total size within limits/max_total_bytes, and each
+/// one a regular file inside `paths`' roots. Throws std::invalid_argument naming the key, or for
+/// a file "cannot open <kind>: ..." and why.
+void check_request_budget(const std::vector<std::string>& entries, const RequestLimits& limits,
+                          const lfd::PathPolicy& paths, const std::string& kind = "bag");
+
 /// Raw (not resampled) streams of the configured fields of one bag. Throws std::runtime_error for
 /// unreadable/truncated bags or messages that do not match their definition, and
 /// std::invalid_argument for a missing topic, a field that does not exist (listing the topic's
