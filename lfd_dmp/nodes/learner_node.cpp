@@ -15,6 +15,7 @@
 #include <tf2_ros/buffer.h>
 #include <tf2_ros/transform_listener.h>
 
+#include <lfd_core/heap_trim.hpp>
 #include <lfd_core/input_budget.hpp>
 #include <lfd_core/safe_paths.hpp>
 #include <lfd_core/time_alignment.hpp>
@@ -53,6 +54,7 @@ class Learner {
   }
 
   bool learn(lfd_msgs::LearnSkills::Request& req, lfd_msgs::LearnSkills::Response& res) {
+    const lfd::TrimHeapOnExit trim;  // the demos read go back to the system once answered
     const auto t0 = std::chrono::steady_clock::now();
     try {
       if (req.output_path.empty()) throw std::invalid_argument("output_path is empty");
