@@ -2,6 +2,7 @@
 #include "lfd_dmp/demo_scene.hpp"
 
 #include <lfd_core/safe_paths.hpp>
+#include <lfd_core/stamp_order.hpp>
 
 #include <geometry_msgs/PoseStamped.h>
 #include <lfd_msgs/DemoMetadata.h>
@@ -57,14 +58,34 @@ std::optional<lfd::Scene> sceneOf(const std::string& path, const std::string& ex
                            "tf: learn.launch runs robot_state_publisher)");
 }
 
+// Samples of one topic in the shared timestamp policy's order: by stamp, the first of each stamp
+// kept (a DMP needs strictly increasing times), whatever was found reported in `warnings`.
+template <typename Row>
+void orderByStamp(const std::string& topic, std::vector<double>& stamps, std::vector<Row>& rows,
+                  std::vector<std::string>* warnings) {
+  lfd::StampReport report;
+  const std::vector<size_t> order =
+      lfd::orderByStamp(stamps, lfd::DuplicateStamps::kKeepFirst, &report);
+  std::vector<double> t;
+  std::vector<Row> r;
+  t.reserve(order.size());
+  r.reserve(order.size());
+  for (size_t i : order) t.push_back(stamps[i]), r.push_back(rows[i]);
+  stamps = std::move(t);
+  rows = std::move(r);
+  const std::string warning = lfd::stampWarning(topic, report);
+  if (!warning.empty()) warnings->push_back(warning);
+}
+
 }  // namespace
 
 DemoRecording readDemoBag(const std::string& path, const DemoBagTopics& topics,
                           const TransformLookup& fallback) {
   rosbag::Bag bag;
   try {
-    lfd::checkInputFile(path);  // a FIFO would block bag.open forever
-    bag.open(path, rosbag::bagmode::Read);
+    // Opened once through the file-access layer: a link swapped to a FIFO cannot hang open().
+    const lfd::InputFile file = lfd::openInputFile(path);
+    bag.open(file.readPath(), rosbag::bagmode::Read);
   } catch (const std::exception& e) {
     throw std::runtime_error("cannot open bag " + path + ": " + e.what());
   }
@@ -100,7 +121,6 @@ DemoRecording readDemoBag(const std::string& path, const DemoBagTopics& topics,
                                    " at t = " + std::to_string(stamp));
         }
       }
-      if (!t.empty() && stamp <= t.back()) continue;  // duplicate / out-of-order stamp
       if (t.empty()) frame = msg->header.frame_id;
       t.push_back(stamp);
       poses.push_back(row);
@@ -111,18 +131,19 @@ DemoRecording readDemoBag(const std::string& path, const DemoBagTopics& topics,
       if (it == msg->name.end()) continue;
       const size_t i = static_cast<size_t>(it - msg->name.begin());
       if (i >= msg->position.size() || !std::isfinite(msg->position[i])) continue;
-      const double stamp = msg->header.stamp.toSec();
-      if (!grip_t.empty() && stamp <= grip_t.back()) continue;
-      grip_t.push_back(stamp);
+      grip_t.push_back(msg->header.stamp.toSec());
       grip_v.push_back(msg->position[i]);
     }
   }
   bag.close();
+  DemoRecording rec;
+  orderByStamp(topics.pose, t, poses, &rec.warnings);
+  orderByStamp(topics.gripper, grip_t, grip_v, &rec.warnings);
+  for (std::string& w : rec.warnings) w = path + ": " + w;
   if (t.size() < static_cast<size_t>(lfd::kMinDmpSamples)) {
     throw std::runtime_error(path + ": only " + std::to_string(t.size()) + " messages on " +
                              topics.pose);
   }
-  DemoRecording rec;
   rec.id = path;
   rec.frame = frame;
   if (!extra_json.empty()) {

@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 
@@ -473,19 +474,19 @@ void saveSkillLibrary(const SkillLibrary& library, const std::string& path, bool
 
 SkillLibrary loadSkillLibrary(const std::string& path, const LibraryLimits& limits) {
   const std::string name = lfd::quoted(path);
-  std::string resolved;
+  std::optional<lfd::InputFile> file;  // opened once: the size checked is the file parsed
   try {
-    resolved = lfd::checkInputFile(path);  // a FIFO would block the read forever
+    file.emplace(lfd::openInputFile(path));
   } catch (const std::invalid_argument& e) {
     throw std::runtime_error(std::string("cannot open skill library: ") + e.what());
   }
   // Bounded before parsing: the parse costs ~11x the file in memory (300 MB took 3.3 GB).
-  const std::uintmax_t bytes = std::filesystem::file_size(resolved);
+  const std::uintmax_t bytes = file->size();
   if (bytes > limits.max_file_bytes)
     throw std::runtime_error(name + ": " + std::to_string(bytes) + " bytes, over the limit of " +
                              std::to_string(limits.max_file_bytes) +
                              " (library_limits/max_file_bytes)");
-  std::ifstream in(resolved);
+  std::ifstream in(file->readPath());
   if (!in) throw std::runtime_error("cannot open skill library " + name);
   json j;
   try {

@@ -38,12 +38,13 @@ int findColumn(const std::vector<std::string>& header, const std::string& name) 
 }  // namespace
 
 CsvTrajectory readTrajectoryCsv(const std::string& path, const CsvColumns& columns) {
+  std::ifstream in;
   try {
-    lfd::checkInputFile(path);  // a FIFO would block the read forever
+    const lfd::InputFile file = lfd::openInputFile(path);  // opened once: no FIFO swapped in
+    in.open(file.readPath());
   } catch (const std::invalid_argument& e) {
     throw std::runtime_error(std::string("cannot open CSV file: ") + e.what());
   }
-  std::ifstream in(path);
   if (!in) throw std::runtime_error("cannot open CSV file " + path);
   std::string line;
   size_t line_no = 0;

@@ -16,6 +16,7 @@
 #include "lfd_dmp/plan_messages.hpp"
 
 #include <lfd_msgs/ExecuteTaskAction.h>
+#include <lfd_core/heap_trim.hpp>
 #include <lfd_core/robot_setup.hpp>
 #include <lfd_core/safe_paths.hpp>
 
@@ -338,6 +339,7 @@ class Executor {
 
   // ---- the action ------------------------------------------------------------------------------
   void execute(ActionServer& server, const lfd_msgs::ExecuteTaskGoal& goal) {
+    const lfd::TrimHeapOnExit trim;  // the goal's library and plan go back to the system
     goal_server_ = &server;
     const auto wall0 = Clock::now();
     lfd_msgs::ExecuteTaskResult result;

@@ -4,9 +4,9 @@
 // lfd_dmp::learnSkillLibrary / readDemoBag.
 // Private parameters (config/learner.yaml): ~pose_topic, ~gripper_topic, ~gripper_joint,
 // ~num_basis, ~smoothing_sigma, ~time_alignment/*, ~goal_frames/*, ~allowed_roots,
-// ~limits/{max_bags, max_num_basis, max_demo_seconds, max_samples_per_demo}. Paths: bags must be
-// regular files inside the roots, the library is written atomically, never over a bag, and over an
-// existing file only with overwrite.
+// ~limits/{max_bags, max_total_bytes, max_num_basis, max_demo_seconds, max_samples_per_demo}.
+// Paths: bags must be regular files inside the roots, the library is written atomically, never over
+// a bag, and over an existing file only with overwrite.
 #include "lfd_dmp/demo_bag.hpp"
 #include "lfd_dmp/skill_learner.hpp"
 
@@ -15,9 +15,12 @@
 #include <tf2_ros/buffer.h>
 #include <tf2_ros/transform_listener.h>
 
+#include <lfd_core/heap_trim.hpp>
+#include <lfd_core/input_budget.hpp>
 #include <lfd_core/safe_paths.hpp>
 #include <lfd_core/time_alignment.hpp>
 
+#include <algorithm>
 #include <chrono>
 
 namespace {
@@ -37,6 +40,7 @@ class Learner {
     readTimeAlignment(pnh);
     pnh.param("allowed_roots", paths_.allowed_roots, paths_.allowed_roots);
     pnh.param("limits/max_bags", max_bags_, max_bags_);
+    pnh.param("limits/max_total_bytes", max_total_bytes_, max_total_bytes_);
     pnh.param("limits/max_num_basis", max_num_basis_, max_num_basis_);
     pnh.param("limits/max_demo_seconds", max_demo_seconds_, max_demo_seconds_);
     pnh.param("limits/max_samples_per_demo", max_samples_per_demo_, max_samples_per_demo_);
@@ -50,6 +54,7 @@ class Learner {
   }
 
   bool learn(lfd_msgs::LearnSkills::Request& req, lfd_msgs::LearnSkills::Response& res) {
+    const lfd::TrimHeapOnExit trim;  // the demos read go back to the system once answered
     const auto t0 = std::chrono::steady_clock::now();
     try {
       if (req.output_path.empty()) throw std::invalid_argument("output_path is empty");
@@ -82,11 +87,7 @@ class Learner {
         }
       }
       if (bags.empty()) throw std::invalid_argument("no demonstrations given");
-      if (static_cast<int>(bags.size()) > max_bags_) {
-        throw std::invalid_argument(std::to_string(bags.size()) + " bags, over the limit of " +
-                                    std::to_string(max_bags_) + " (~limits/max_bags)");
-      }
-      for (const auto& b : bags) lfd::checkInputFile(b, paths_);
+      checkBudget(bags);
       const std::string output = lfd::checkOutputFile(req.output_path, paths_, req.overwrite, bags);
       std::vector<lfd_dmp::DemoRecording> demos;
       for (const auto& b : bags) {
@@ -96,6 +97,9 @@ class Learner {
             }));
         checkDemoSize(demos.back(), b);
       }
+      std::vector<std::string> read_warnings;  // stamps the readers put in order, per demo
+      for (const auto& d : demos)
+        read_warnings.insert(read_warnings.end(), d.warnings.begin(), d.warnings.end());
       lfd_dmp::LearnOptions opt;
       opt.task = req.task;
       opt.features = req.selected_features;
@@ -107,11 +111,12 @@ class Learner {
       const lfd_dmp::LearnOutcome out = lfd_dmp::learnSkillLibrary(demos, cps, opt);
       lfd_dmp::saveSkillLibrary(out.library, output, req.overwrite);
       res.success = true;
-      res.warnings = out.warnings;
+      res.warnings = read_warnings;
+      res.warnings.insert(res.warnings.end(), out.warnings.begin(), out.warnings.end());
       res.library_path = output;
       res.num_segments = static_cast<uint32_t>(out.library.segments.size());
       res.num_demos = static_cast<uint32_t>(out.demos_used);
-      for (const auto& w : out.warnings) ROS_WARN("learner: %s", w.c_str());
+      for (const auto& w : res.warnings) ROS_WARN("learner: %s", w.c_str());
       ROS_INFO("learner: %u segments x %u demos -> %s", res.num_segments, res.num_demos,
                req.output_path.c_str());
     } catch (const std::exception& e) {
@@ -124,6 +129,18 @@ class Learner {
   }
 
  private:
+  // The request's work, checked before any bag is read: its bags and their total size (each one
+  // opened by the file-access layer: a regular file inside the roots).
+  void checkBudget(const std::vector<std::string>& bags) const {
+    lfd::InputBudget budget;
+    budget.what = "bags";
+    budget.max_files = static_cast<std::size_t>(std::max(max_bags_, 0));
+    budget.max_files_key = "~limits/max_bags";
+    budget.max_total_bytes = static_cast<std::uint64_t>(std::max(max_total_bytes_, 0.0));
+    budget.max_total_bytes_key = "~limits/max_total_bytes";
+    lfd::checkInputBudget(bags, budget, paths_);
+  }
+
   // A bag without /tf_static (recorded before it was): the live tf tree (e.g. the robot model's
   // fixed world -> base_link from robot_state_publisher), waited for in WALL time.
   Eigen::Isometry3d liveTransform(const std::string& target, const std::string& source) {
@@ -188,6 +205,7 @@ class Learner {
   lfd_dmp::DemoBagTopics topics_;
   lfd::PathPolicy paths_;
   int max_bags_ = 32;
+  double max_total_bytes_ = 1e9;  // a double: ROS int parameters stop at 2^31
   int max_num_basis_ = 1000;
   double max_demo_seconds_ = 120.0;
   int max_samples_per_demo_ = 30000;

@@ -11,10 +11,13 @@
 
 #include <gtest/gtest.h>
 
+#include "link_swap_race.hpp"
+
 #include <unistd.h>
 
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 
 namespace {
 
@@ -242,8 +245,11 @@ TEST(SkillLearner, RejectsUnusableInput) {
 
 // A demo bag as the recorder writes it: poses, gripper, and optionally the metadata (scene) and
 // the static transform world -> base_link (base_link 0.85 m up).
+// `late_index` >= 0: that pose is stamped `late_seconds` after its time, yet recorded in its place
+// (a publisher's clock that jumped): the bag holds it out of stamp order.
 void writeBag(const std::string& path, const lfd_dmp::DemoRecording& rec,
-              const std::string& extra_json, bool tf_static) {
+              const std::string& extra_json, bool tf_static, Eigen::Index late_index = -1,
+              double late_seconds = 0.0) {
   rosbag::Bag bag(path, rosbag::bagmode::Write);
   const ros::Time t0(rec.times[0]);
   if (!extra_json.empty()) {
@@ -273,7 +279,10 @@ void writeBag(const std::string& path, const lfd_dmp::DemoRecording& rec,
     p.pose.orientation.x = rec.quaternions(i, 1);
     p.pose.orientation.y = rec.quaternions(i, 2);
     p.pose.orientation.z = rec.quaternions(i, 3);
-    bag.write("/ee_pose", p.header.stamp, p);
+    const ros::Time received = p.header.stamp;
+    if (i == late_index) p.header.stamp = ros::Time(rec.times[i] + late_seconds);
+    bag.write("/ee_pose", received, p);
+    p.header.stamp = received;
     if (i % 2 == 0) {  // gripper at half the rate: interpolated onto the pose stamps
       sensor_msgs::JointState js;
       js.header.stamp = p.header.stamp;
@@ -301,6 +310,51 @@ TEST(DemoBag, ReadsPosesAndInterpolatesTheGripper) {
   EXPECT_FALSE(back.scene.has_value());  // no metadata: no scene (and no error)
   std::remove(path.c_str());
   EXPECT_THROW(lfd_dmp::readDemoBag(path), std::runtime_error);
+}
+
+// Issue 23 row 1: a link swapped between a demo bag and a FIFO while the learner reads it never
+// hangs it in open() (it checked the path, then opened it again by name).
+TEST(DemoBag, LinkSwappedToFifoNeverHangsTheReader) {
+  const std::string dir = ::testing::TempDir() + "/lfd_dmp_race_" + std::to_string(::getpid());
+  std::filesystem::create_directories(dir);
+  const std::string bag = dir + "/real.bag";
+  writeBag(bag, recording(bag, 0.6, 50.0), "", false);
+  const lfd_test::LinkSwapRaceResult r =
+      lfd_test::raceLinkSwap(dir + "/link.bag", bag, dir + "/pipe.bag",
+                             [](const std::string& link) { lfd_dmp::readDemoBag(link); });
+  EXPECT_EQ(r.hung_calls, 0) << "of " << r.calls << " calls";
+  EXPECT_GT(r.read_calls, 0);
+  std::filesystem::remove_all(dir);
+}
+
+// Issue 23 row 4: one pose stamped 5 s late. The reader used to skip every pose stamped before it
+// (half the demo) and the learner succeeded with its first segment ending 3 s off; the shared
+// timestamp policy keeps every pose in stamp order and warns, naming the topic and the count.
+TEST(DemoBag, APoseStampedLateIsPutInOrderAndWarned) {
+  const std::string path =
+      ::testing::TempDir() + "/lfd_dmp_late_" + std::to_string(::getpid()) + ".bag";
+  lfd_dmp::DemoRecording rec = recording(path, 0.6, 50.0);
+  rec.times = Eigen::VectorXd::LinSpaced(rec.times.size(), 10.0, 20.0);  // a 10 s demo
+  const Eigen::Index late = 50;                                          // at t = 12 s
+  writeBag(path, rec, "", false, late, 5.02);  // between two samples' stamps
+  lfd_dmp::DemoRecording back = lfd_dmp::readDemoBag(path);
+  back.scene = rec.scene;                          // the bag holds no metadata
+  ASSERT_EQ(back.times.size(), rec.times.size());  // nothing dropped
+  for (Eigen::Index i = 1; i < back.times.size(); ++i) ASSERT_LT(back.times[i - 1], back.times[i]);
+  ASSERT_EQ(back.warnings.size(), 1u);
+  EXPECT_NE(back.warnings[0].find("/ee_pose: of 251 messages, 1 stamped out of order"),
+            std::string::npos)
+      << back.warnings[0];
+  // The learner's segment times stay where the changepoints are.
+  lfd_dmp::DemoRecording other = recording("b.bag", 0.7, 50.0);
+  other.times = rec.times;
+  const auto out = lfd_dmp::learnSkillLibrary({back, other}, {{14.0, 18.0}, {14.0, 18.0}}, {});
+  ASSERT_EQ(out.library.segments.size(), 3u);
+  const auto& first = out.library.segments[0].demos[0];
+  EXPECT_NEAR(first.start_time, 10.0, 1e-6);
+  EXPECT_NEAR(first.end_time, 14.0, 0.05);
+  EXPECT_NEAR(out.library.segments[1].demos[0].end_time, 18.0, 0.05);
+  std::remove(path.c_str());
 }
 
 // The scene of the metadata (the "scene" block, or the older object/object_start/goal fields) is

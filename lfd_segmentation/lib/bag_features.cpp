@@ -13,8 +13,10 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "lfd_core/input_budget.hpp"
 #include "lfd_core/ros_message_reader.hpp"
 #include "lfd_core/safe_paths.hpp"
+#include "lfd_core/stamp_order.hpp"
 #include "lfd_core/user_text.hpp"
 
 namespace lfd_segmentation {
@@ -141,10 +143,12 @@ class TopicReader {
   rosmsg::FieldReader* last_reader_ = nullptr;
 };
 
+// Opens the bag through the file-access layer: rosbag reads the file that was checked, never what
+// the path names by then (a link swapped to a FIFO hung open()).
 void open_bag(rosbag::Bag& bag, const std::string& path) {
   try {
-    lfd::checkInputFile(path);  // a FIFO or device would block bag.open forever
-    bag.open(path, rosbag::bagmode::Read);
+    const lfd::InputFile file = lfd::openInputFile(path);
+    bag.open(file.readPath(), rosbag::bagmode::Read);
   } catch (const std::exception& e) {
     throw std::runtime_error("cannot open bag " + lfd::quoted(path) + ": " + e.what());
   }
@@ -189,17 +193,30 @@ void read_part(const std::string& path, const std::vector<TopicConfig>& topics,
   }
 }
 
-// Messages are stored in receive order; sort each stream by stamp so resampling sees a clock.
-void sort_by_time(lfd::Stream& s) {
-  if (std::is_sorted(s.time.begin(), s.time.end())) return;
-  std::vector<std::size_t> order(s.time.size());
-  std::iota(order.begin(), order.end(), 0);
-  std::stable_sort(order.begin(), order.end(),
-                   [&](std::size_t a, std::size_t b) { return s.time[a] < s.time[b]; });
+// Messages are stored in receive order; the shared timestamp policy puts each stream in stamp
+// order (duplicates kept: resampling averages them) and reports what it found.
+lfd::StampReport order_by_stamp(lfd::Stream& s) {
+  lfd::StampReport report;
+  const std::vector<std::size_t> order =
+      lfd::orderByStamp(s.time, lfd::DuplicateStamps::kKeepAll, &report);
   std::vector<double> t, v;
+  t.reserve(order.size());
+  v.reserve(order.size());
   for (std::size_t k : order) t.push_back(s.time[k]), v.push_back(s.values[k]);
   s.time = std::move(t);
   s.values = std::move(v);
+  return report;
+}
+
+// Orders a topic's streams; one warning per topic (its fields share the messages' stamps).
+void order_topic(const std::string& topic, std::vector<lfd::Stream>& streams,
+                 std::vector<std::string>* warnings) {
+  std::string warning;
+  for (lfd::Stream& s : streams) {
+    const std::string w = lfd::stampWarning(topic, order_by_stamp(s));
+    if (warning.empty()) warning = w;
+  }
+  if (warnings && !warning.empty()) warnings->push_back(warning);
 }
 
 }  // namespace
@@ -216,9 +233,37 @@ std::vector<std::string> demo_parts(const std::string& path) {
   return parts;
 }
 
+void check_request_budget(const std::vector<std::string>& entries, const RequestLimits& limits,
+                          const lfd::PathPolicy& paths, const std::string& kind) {
+  if (entries.size() > limits.max_bags) {
+    throw std::invalid_argument(std::to_string(entries.size()) + " " + kind +
+                                " paths, over the limit of " + std::to_string(limits.max_bags) +
+                                " (limits/max_bags)");
+  }
+  std::vector<std::string> files;
+  for (const std::string& entry : entries) {
+    for (std::string& part : demo_parts(entry)) files.push_back(std::move(part));
+  }
+  lfd::InputBudget budget;
+  budget.what = kind + " files";
+  budget.max_files = limits.max_bag_files;
+  budget.max_files_key = "limits/max_bag_files";
+  budget.max_total_bytes = limits.max_total_bytes;
+  budget.max_total_bytes_key = "limits/max_total_bytes";
+  try {
+    lfd::checkInputBudget(files, budget, paths);
+  } catch (const std::invalid_argument& e) {
+    const std::string what = e.what();
+    // A file's own refusal (missing, FIFO, outside the roots) reads as before: "cannot open bag".
+    throw std::invalid_argument(what.rfind("path ", 0) == 0 ? "cannot open " + kind + ": " + what
+                                                            : what);
+  }
+}
+
 std::vector<lfd::Stream> read_bag_streams(const std::string& path,
                                           const std::vector<TopicConfig>& topics,
-                                          std::vector<FeatureRole>* roles) {
+                                          std::vector<FeatureRole>* roles,
+                                          std::vector<std::string>* warnings) {
   if (topics.empty()) throw std::invalid_argument("no topics configured for the features");
   for (const TopicConfig& cfg : topics) {
     if (cfg.topic == kGroundTruthTopic) {
@@ -239,17 +284,18 @@ std::vector<lfd::Stream> read_bag_streams(const std::string& path,
     } catch (const std::invalid_argument& e) {
       throw std::invalid_argument("bag " + lfd::quoted(path) + ": " + e.what());
     }
+    order_topic(topics[k].topic, topic_streams, warnings);
     if (roles) roles->insert(roles->end(), topic_streams.size(), topics[k].role);
     for (lfd::Stream& s : topic_streams) streams.push_back(std::move(s));
   }
-  for (lfd::Stream& s : streams) sort_by_time(s);
   return streams;
 }
 
 DemoFeatures read_bag_features(const std::string& path, const std::vector<TopicConfig>& topics,
                                double rate, const RequestLimits& limits) {
   std::vector<FeatureRole> roles;
-  const std::vector<lfd::Stream> streams = read_bag_streams(path, topics, &roles);
+  std::vector<std::string> warnings;
+  const std::vector<lfd::Stream> streams = read_bag_streams(path, topics, &roles, &warnings);
   check_streams(streams, path, limits);
   double start = -INFINITY, end = INFINITY;  // the span resample() keeps: where all streams overlap
   for (const lfd::Stream& s : streams) {
@@ -265,6 +311,8 @@ DemoFeatures read_bag_features(const std::string& path, const std::vector<TopicC
   }
   DemoFeatures demo;
   demo.source = path;
+  for (const std::string& w : warnings)
+    demo.warnings.push_back("bag " + lfd::quoted(path) + ": " + w);
   try {
     demo.matrix = lfd::resample(streams, rate);
   } catch (const std::invalid_argument& e) {

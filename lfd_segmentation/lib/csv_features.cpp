@@ -39,12 +39,13 @@ std::vector<std::string> split(const std::string& line) {
 
 lfd::FeatureMatrix read_csv_features(const std::string& path, const std::string& time_column,
                                      double rate, const RequestLimits& limits) {
+  std::ifstream in;
   try {
-    lfd::checkInputFile(path);  // a FIFO would block the read forever
+    const lfd::InputFile file = lfd::openInputFile(path);  // opened once: no FIFO swapped in
+    in.open(file.readPath());
   } catch (const std::invalid_argument& e) {
     throw std::invalid_argument(std::string("cannot open CSV file: ") + e.what());
   }
-  std::ifstream in(path);
   if (!in) throw std::invalid_argument("cannot open CSV file " + lfd::quoted(path));
   std::string line;
   std::size_t line_number = 0;

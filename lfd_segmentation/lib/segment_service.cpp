@@ -104,21 +104,13 @@ void handle_segment_request(const SegmentationParams& params,
     if (request.bag_paths.empty()) {
       throw std::invalid_argument("empty request: give at least one bag path");
     }
-    if (request.bag_paths.size() > params.limits.max_bags) {
+    if (request.bag_paths.size() > params.limits.max_bags) {  // before parsing the overrides
       throw std::invalid_argument(std::to_string(request.bag_paths.size()) +
                                   " bag paths, over the limit of " +
                                   std::to_string(params.limits.max_bags) + " (limits/max_bags)");
     }
     const SegmentationParams p = apply_overrides(params, request);
-    for (const std::string& path : request.bag_paths) {
-      for (const std::string& part : demo_parts(path)) {
-        try {
-          lfd::checkInputFile(part, p.paths);
-        } catch (const std::invalid_argument& e) {
-          throw std::invalid_argument(std::string("cannot open bag: ") + e.what());
-        }
-      }
-    }
+    check_request_budget(request.bag_paths, p.limits, p.paths);  // the expanded work, up front
     const std::string key = cache_key(request.bag_paths, p);
     PreparedCache local;  // a request that cannot be cached (no cache, a file not stat-able)
     PreparedCache& used = cache && !key.empty() ? *cache : local;
@@ -137,7 +129,11 @@ void handle_segment_request(const SegmentationParams& params,
     check_demos_fit(p, used.matrices, request.bag_paths);  // this request's window_seconds
     const lfd::SegmentationPipelineResult result =
         lfd::segment_prepared(used.prepared, used.matrices, config);
-    response.warnings = result.warnings;
+    response.warnings.clear();
+    for (const DemoFeatures& demo : used.demos)  // the stamps each bag's reader put in order
+      response.warnings.insert(response.warnings.end(), demo.warnings.begin(), demo.warnings.end());
+    response.warnings.insert(response.warnings.end(), result.warnings.begin(),
+                             result.warnings.end());
     response.selected_features = result.selected_features;
     response.selected_weights = result.feature_weights;
     response.sensor_features = result.sensor_features;

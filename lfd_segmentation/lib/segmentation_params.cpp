@@ -1,5 +1,6 @@
 #include "lfd_segmentation/segmentation_params.hpp"
 
+#include "lfd_core/safe_paths.hpp"
 #include "lfd_core/user_text.hpp"
 
 #include <algorithm>
@@ -268,6 +269,8 @@ SegmentationParams params_from_yaml(const YAML::Node& root) {
   const YAML::Node limits = root["limits"];
   auto& lim = p.limits;
   lim.max_bags = get<std::size_t>(limits, "max_bags", lim.max_bags);
+  lim.max_bag_files = get<std::size_t>(limits, "max_bag_files", lim.max_bag_files);
+  lim.max_total_bytes = get<std::uint64_t>(limits, "max_total_bytes", lim.max_total_bytes);
   lim.max_demo_seconds = positive(get<double>(limits, "max_demo_seconds", lim.max_demo_seconds),
                                   "limits/max_demo_seconds");
   lim.max_samples_per_demo =
@@ -290,7 +293,9 @@ SegmentationParams params_from_yaml(const YAML::Node& root) {
 SegmentationParams load_params_file(const std::string& path) {
   YAML::Node root;
   try {
-    root = YAML::LoadFile(path);
+    root = YAML::LoadFile(lfd::openInputFile(path).readPath());  // no FIFO swapped in
+  } catch (const std::invalid_argument& e) {
+    throw std::invalid_argument("cannot read segmentation parameters: " + std::string(e.what()));
   } catch (const YAML::Exception& e) {
     throw std::invalid_argument("cannot read segmentation parameters " + lfd::quoted(path) + ": " +
                                 e.what());

@@ -227,10 +227,6 @@ nlohmann::json run(const Options& o) {
   lfd_segmentation::check_seconds_override(o.window_seconds, "--window-seconds", params.limits);
   if (o.min_seconds > 0) params.min_segment_seconds = o.min_seconds;
   if (o.window_seconds > 0) params.window_seconds = o.window_seconds;
-  if (o.files.size() > params.limits.max_bags) {
-    throw std::invalid_argument(std::to_string(o.files.size()) + " files, over the limit of " +
-                                std::to_string(params.limits.max_bags) + " (limits/max_bags)");
-  }
   if (o.threads >= 0) params.pipeline.threads = static_cast<int>(o.threads);
   lfd::SegmentationPipelineConfig config = params.pipeline_config();
   if (o.num_changepoints > 0)
@@ -241,6 +237,9 @@ nlohmann::json run(const Options& o) {
   for (const std::string& f : o.files) bags += ends_with(f, ".bag") ? 1 : 0;
   if (bags != 0 && bags != o.files.size())
     throw std::invalid_argument("do not mix bags and CSV files");
+  // The CLI skips the roots (its user owns the shell) but not the budget.
+  lfd_segmentation::check_request_budget(o.files, params.limits, lfd::PathPolicy{},
+                                         bags ? "bag" : "CSV file");
   if (bags != 0 && o.resample > 0)
     throw std::invalid_argument("--resample is for CSV files: a bag's clock is set by --rate");
   std::vector<lfd::FeatureMatrix> demos;
@@ -252,6 +251,7 @@ nlohmann::json run(const Options& o) {
           lfd_segmentation::read_bag_features(f, params.topics, params.rate, params.limits);
       if (demos.empty() && o.sensors.empty()) sensors = demo.sensor_features;
       if (demos.empty() && o.states.empty()) states = demo.state_features;
+      clock_warnings.insert(clock_warnings.end(), demo.warnings.begin(), demo.warnings.end());
       demos.push_back(std::move(demo.matrix));
     } else {
       demos.push_back(lfd_segmentation::read_csv_features(f, o.time_column, o.rate, params.limits));

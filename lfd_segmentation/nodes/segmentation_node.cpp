@@ -5,6 +5,7 @@
 #include <ros/ros.h>
 #include <yaml-cpp/yaml.h>
 
+#include "lfd_core/heap_trim.hpp"
 #include "lfd_segmentation/segment_service.hpp"
 
 namespace {
@@ -60,6 +61,7 @@ int main(int argc, char** argv) {
   lfd_segmentation::PreparedCache cache;  // requests are served one at a time
   auto callback = [&params, &cache](lfd_msgs::Segment::Request& req,
                                     lfd_msgs::Segment::Response& res) {
+    const lfd::TrimHeapOnExit trim;  // what the request freed goes back to the system
     ROS_INFO("segmentation: request with %zu bag(s)", req.bag_paths.size());
     lfd_segmentation::handle_segment_request(params, req, res, &cache);
     for (const std::string& w : res.warnings) ROS_WARN("segmentation: %s", w.c_str());

@@ -32,6 +32,7 @@ struct DemoBagOptions {
   bool constant_gripper = false;  ///< gripper never moves
   double late_twist_seconds = 0;  ///< > 0: one more /ee_twist stamped this long after the end
   double huge_twist = 0;          ///< != 0: one /ee_twist sample with this (finite) value
+  double late_pose_seconds = 0;   ///< > 0: the /ee_pose at a quarter is stamped this late, in place
   std::string touch_name = "r_touch_left";
 };
 
@@ -80,6 +81,8 @@ inline void write_demo_bag(const std::string& path, const DemoBagOptions& o = {}
     pose.pose.position.y = -0.2 + 0.1 * u;
     pose.pose.position.z = 0.8 + (closed ? 0.1 * phase : 0.0);
     pose.pose.orientation.w = 1.0;
+    if (o.late_pose_seconds > 0 && i == samples / 4)
+      pose.header.stamp = ros::Time(t + o.late_pose_seconds);
     bag.write("/ee_pose", stamp, pose);
 
     sensor_msgs::JointState gripper;

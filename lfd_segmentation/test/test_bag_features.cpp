@@ -1,11 +1,13 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 
 #include "demo_bag_writer.hpp"
 #include "lfd_segmentation/bag_features.hpp"
+#include "link_swap_race.hpp"
 
 namespace {
 
@@ -114,6 +116,48 @@ TEST(BagFeatures, UnreadableOrTruncatedBagIsARuntimeError) {
   std::ofstream(garbage) << "this is not a bag";
   EXPECT_THROW(lfd_segmentation::read_bag_features(garbage, default_topics(), 50),
                std::runtime_error);
+}
+
+// Issue 23 row 1: a link swapped between a bag and a FIFO while the reader runs never hangs it
+// (the path was checked, then opened again by name: open() blocked on the FIFO forever).
+TEST(BagFeatures, LinkSwappedToFifoNeverHangsTheReader) {
+  const fs::path dir = temp_dir();
+  const std::string bag = (dir / "real.bag").string();
+  lfd_segmentation_test::DemoBagOptions o;
+  o.duration = 1.0;
+  lfd_segmentation_test::write_demo_bag(bag, o);
+  const std::vector<TopicConfig> topics = default_topics();
+  const lfd_test::LinkSwapRaceResult r = lfd_test::raceLinkSwap(
+      (dir / "link.bag").string(), bag, (dir / "pipe.bag").string(),
+      [&](const std::string& link) { lfd_segmentation::read_bag_streams(link, topics); });
+  EXPECT_EQ(r.hung_calls, 0) << "of " << r.calls << " calls";
+  EXPECT_GT(r.read_calls, 0);  // the bag itself is still read when the link points at it
+}
+
+// Issue 23 row 4: one /ee_pose stamped 5 s late is kept, in stamp order, and warned about by the
+// same policy as the learner's reader (lfd_core/stamp_order.hpp).
+TEST(BagFeatures, AMessageStampedLateIsPutInOrderAndWarned) {
+  const std::string bag = (temp_dir() / "late_pose.bag").string();
+  lfd_segmentation_test::DemoBagOptions o;
+  o.duration = 10.0;
+  o.late_pose_seconds = 5.005;  // between two samples' stamps
+  lfd_segmentation_test::write_demo_bag(bag, o);
+  std::vector<std::string> warnings;
+  const std::vector<lfd::Stream> streams =
+      lfd_segmentation::read_bag_streams(bag, default_topics(), nullptr, &warnings);
+  const auto pose = std::find_if(streams.begin(), streams.end(), [](const lfd::Stream& s) {
+    return s.name == "/ee_pose/pose/position/x";
+  });
+  ASSERT_NE(pose, streams.end());
+  EXPECT_EQ(pose->time.size(), 1000u);  // nothing dropped
+  EXPECT_TRUE(std::is_sorted(pose->time.begin(), pose->time.end()));
+  ASSERT_EQ(warnings.size(), 1u);
+  EXPECT_NE(warnings[0].find("/ee_pose: of 1000 messages, 1 stamped out of order"),
+            std::string::npos)
+      << warnings[0];
+  const auto demo = lfd_segmentation::read_bag_features(bag, default_topics(), 50.0);
+  ASSERT_EQ(demo.warnings.size(), 1u);  // the service and the CLI pass it on
+  EXPECT_NE(demo.warnings[0].find("late_pose.bag"), std::string::npos);
 }
 
 TEST(SegmentationParams, LoadsTheShippedConfigAndRejectsBadValues) {

@@ -248,6 +248,32 @@ TEST_F(SegmentService, TooManyBagsAreRefusedNamingTheLimit) {
   expect_error(r, "limits/max_bags");
 }
 
+// Issue 23 row 2: entries written as parts of one demo ("a.bag,b.bag,...") passed max_bags, which
+// counted entries: 32 of them expanded to 290 bags (120 s, 581 MB). The budget counts the bags
+// the request expands to, and their bytes, before reading any, with the shipped limits.
+TEST_F(SegmentService, PartsOfDemosCountAgainstTheBudgetBeforeAnyWork) {
+  const std::vector<std::string> bags = good_bags(2);
+  std::vector<std::string> entries;
+  for (const std::string& b : bags) {
+    std::string parts = b;
+    for (int k = 1; k < 40; ++k) parts += "," + b;  // 40 parts: 80 bags in two entries
+    entries.push_back(parts);
+  }
+  ASSERT_LE(entries.size(), params_.limits.max_bags);
+  const auto start = std::chrono::steady_clock::now();
+  const lfd_msgs::Segment::Response r = call(entries);
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), 1.0);
+  expect_error(r, "80 bag files, over the limit of 64 (limits/max_bag_files)");
+
+  lfd_segmentation::SegmentationParams small = params_;
+  small.limits.max_total_bytes = fs::file_size(bags[0]) + fs::file_size(bags[1]) / 2;
+  lfd_msgs::Segment::Request request;
+  request.bag_paths = bags;
+  lfd_msgs::Segment::Response bytes;
+  lfd_segmentation::handle_segment_request(small, request, bytes);
+  expect_error(bytes, "(limits/max_total_bytes)");
+}
+
 // Issue 12: one message stamped 20,000 s late made the service unresponsive for over 90 s.
 TEST_F(SegmentService, AMessageStampedHoursLateIsRefusedFast) {
   DemoBagOptions o;

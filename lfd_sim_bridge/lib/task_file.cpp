@@ -1,6 +1,7 @@
 #include "lfd_sim_bridge/task_file.hpp"
 
 #include <yaml-cpp/yaml.h>
+#include <lfd_core/safe_paths.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -24,10 +25,13 @@ class Reader {
 
   YAML::Node load() const {
     try {
-      const YAML::Node root = YAML::LoadFile(path_);
+      // Opened once through the file-access layer: a link swapped to a FIFO cannot hang the read.
+      const YAML::Node root = YAML::LoadFile(lfd::openInputFile(path_).readPath());
       if (!root.IsMap()) fail("(top level)", "expected a mapping");
       return root;
     } catch (const YAML::Exception& e) {
+      throw std::runtime_error(kind_ + " file '" + path_ + "' cannot be read: " + e.what());
+    } catch (const std::invalid_argument& e) {  // the file-access layer's refusal
       throw std::runtime_error(kind_ + " file '" + path_ + "' cannot be read: " + e.what());
     }
   }

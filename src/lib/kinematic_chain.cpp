@@ -1,4 +1,5 @@
 #include "lfd_core/kinematic_chain.hpp"
+#include "lfd_core/safe_paths.hpp"
 
 #include <algorithm>
 #include <fstream>
@@ -25,7 +26,12 @@ Eigen::Isometry3d toIsometry(const urdf::Pose& pose) {
 
 KinematicChain KinematicChain::fromUrdfFile(const std::string& path, const std::string& base_link,
                                             const std::string& tip_link) {
-  std::ifstream in(path);
+  std::ifstream in;
+  try {
+    in.open(openInputFile(path).readPath());  // opened once: no FIFO swapped in
+  } catch (const std::invalid_argument& e) {
+    throw std::runtime_error(std::string("KinematicChain: cannot read URDF file: ") + e.what());
+  }
   if (!in) throw std::runtime_error("KinematicChain: cannot read URDF file '" + path + "'");
   std::stringstream buffer;
   buffer << in.rdbuf();

@@ -1,4 +1,5 @@
 #include "lfd_core/robot_setup.hpp"
+#include "lfd_core/safe_paths.hpp"
 
 #include <cmath>
 #include <stdexcept>
@@ -68,7 +69,9 @@ void readGripper(const YAML::Node& g, const std::string& path, GripperSetup* gri
 RobotSetup loadRobotSetup(const std::string& path) {
   YAML::Node root;
   try {
-    root = YAML::LoadFile(path);
+    root = YAML::LoadFile(openInputFile(path).readPath());  // opened once: no FIFO swapped in
+  } catch (const std::invalid_argument& e) {
+    fail(path, std::string("cannot be read: ") + e.what());
   } catch (const YAML::Exception& e) {
     fail(path, std::string("cannot be read: ") + e.what());
   }

@@ -10,6 +10,7 @@
 #include <cstring>
 #include <filesystem>
 #include <stdexcept>
+#include <utility>
 
 #include "lfd_core/user_text.hpp"
 
@@ -73,18 +74,82 @@ const char* typeName(mode_t mode) {
   return "not a regular file";
 }
 
+// realpath: every link followed, once; the result names no link.
+std::string resolvedPath(const std::string& path) {
+  char* resolved = ::realpath(path.c_str(), nullptr);
+  if (!resolved) refuse(path, std::strerror(errno));
+  std::string result(resolved);
+  std::free(resolved);
+  return result;
+}
+
+// What the kernel says an open descriptor is: its path now.
+std::string descriptorPath(int fd) {
+  std::error_code ec;
+  const fs::path target = fs::read_symlink("/proc/self/fd/" + std::to_string(fd), ec);
+  return ec ? std::string() : target.string();
+}
+
 }  // namespace
 
-std::string checkInputFile(const std::string& path, const PathPolicy& policy) {
+InputFile::InputFile(int fd, std::string resolved, std::uint64_t size)
+    : fd_(fd), resolved_(std::move(resolved)), size_(size) {}
+
+InputFile::InputFile(InputFile&& other) noexcept
+    : fd_(std::exchange(other.fd_, -1)),
+      resolved_(std::move(other.resolved_)),
+      size_(other.size_) {}
+
+InputFile& InputFile::operator=(InputFile&& other) noexcept {
+  if (this != &other) {
+    if (fd_ >= 0) ::close(fd_);
+    fd_ = std::exchange(other.fd_, -1);
+    resolved_ = std::move(other.resolved_);
+    size_ = other.size_;
+  }
+  return *this;
+}
+
+InputFile::~InputFile() {
+  if (fd_ >= 0) ::close(fd_);
+}
+
+std::string InputFile::readPath() const {
+  return "/proc/self/fd/" + std::to_string(fd_);
+}
+
+InputFile openInputFile(const std::string& path, const PathPolicy& policy,
+                        std::uint64_t max_bytes) {
   if (path.empty()) throw std::invalid_argument("empty file path");
   checkParentReferences(path, policy);
+  const std::string resolved = resolvedPath(path);
+  checkRoots(path, resolved, policy);
   struct stat st {};
-  if (::stat(path.c_str(), &st) != 0) refuse(path, std::strerror(errno));
+  // stat opens nothing: a device is refused before open() could touch it (fstat below decides).
+  if (::stat(resolved.c_str(), &st) == 0 && !S_ISREG(st.st_mode))
+    refuse(path, std::string(typeName(st.st_mode)) + ", not a regular file");
+  // The final link was resolved above; one swapped in since is refused (ELOOP), never followed.
+  const int fd = ::open(resolved.c_str(), O_RDONLY | O_NOFOLLOW | O_NONBLOCK | O_CLOEXEC);
+  if (fd < 0)
+    refuse(path, errno == ELOOP ? "changed into a link while opening it" : std::strerror(errno));
+  InputFile file(fd, resolved, 0);  // closes the descriptor on every refusal below
+  if (::fstat(fd, &st) != 0) refuse(path, std::strerror(errno));
   if (!S_ISREG(st.st_mode))
     refuse(path, std::string(typeName(st.st_mode)) + ", not a regular file");
-  const fs::path resolved = fs::canonical(path);
-  checkRoots(path, resolved, policy);
-  return resolved.string();
+  // A folder on the way swapped for a link since realpath would lead outside the roots.
+  if (descriptorPath(fd) != resolved) refuse(path, "changed while opening it");
+  const std::uint64_t size = static_cast<std::uint64_t>(st.st_size);
+  if (max_bytes > 0 && size > max_bytes) {
+    refuse(path, std::to_string(size) + " bytes, over the limit of " + std::to_string(max_bytes));
+  }
+  // Readers block as usual on a regular file; O_NONBLOCK was only for the open itself.
+  ::fcntl(fd, F_SETFL, ::fcntl(fd, F_GETFL) & ~O_NONBLOCK);
+  file.size_ = size;
+  return file;
+}
+
+std::string checkInputFile(const std::string& path, const PathPolicy& policy) {
+  return openInputFile(path, policy).resolved();
 }
 
 std::string checkOutputFile(const std::string& path, const PathPolicy& policy, bool overwrite,

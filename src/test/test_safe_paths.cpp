@@ -6,6 +6,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <chrono>
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -65,6 +66,45 @@ TEST_F(SafePaths, NamedPipeIsRefusedWithoutBlocking) {
   ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
   EXPECT_NE(errorOf([&] { lfd::checkInputFile(fifo); }).find("named pipe"), std::string::npos);
   EXPECT_NE(errorOf([&] { lfd::checkOutputFile(fifo, {}, true); }).find("named pipe"),
+            std::string::npos);
+}
+
+// Issue 23 row 1: a link to a FIFO is refused at once, with the reason, by the file-access layer.
+TEST_F(SafePaths, LinkToNamedPipeIsRefusedAtOnce) {
+  const std::string fifo = (dir_ / "root" / "pipe.bag").string();
+  const std::string link = (dir_ / "root" / "link.bag").string();
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  ASSERT_EQ(::symlink(fifo.c_str(), link.c_str()), 0);
+  const auto start = std::chrono::steady_clock::now();
+  const std::string error = errorOf([&] { lfd::openInputFile(link, rooted()); });
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  EXPECT_LT(seconds, 1.0);
+  EXPECT_NE(error.find("named pipe (FIFO), not a regular file"), std::string::npos) << error;
+  EXPECT_NE(error.find("link.bag"), std::string::npos) << error;  // names the user's path
+}
+
+// Issue 23 row 1: what the layer returns reaches the checked file, whatever the link points at
+// once it was opened (readers open readPath(), never the user's path again).
+TEST_F(SafePaths, LinkSwappedAfterOpeningStillReadsTheCheckedFile) {
+  const std::string file = write(dir_ / "root" / "a.bag", "the real bag");
+  const std::string fifo = (dir_ / "root" / "pipe.bag").string();
+  const std::string link = (dir_ / "root" / "link.bag").string();
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  ASSERT_EQ(::symlink(file.c_str(), link.c_str()), 0);
+  const lfd::InputFile opened = lfd::openInputFile(link, rooted());
+  EXPECT_EQ(opened.resolved(), fs::canonical(file).string());
+  EXPECT_EQ(opened.size(), 12u);
+  fs::remove(link);
+  ASSERT_EQ(::symlink(fifo.c_str(), link.c_str()), 0);  // swapped: the link is a FIFO now
+  EXPECT_EQ(read(opened.readPath()), "the real bag");
+  EXPECT_EQ(read(opened.readPath()), "the real bag");  // every reader that opens it again
+}
+
+TEST_F(SafePaths, InputSizeIsBoundedOnTheOpenDescriptor) {
+  const std::string file = write(dir_ / "root" / "a.bag", "0123456789");
+  EXPECT_EQ(lfd::openInputFile(file, {}, 10).size(), 10u);
+  EXPECT_NE(errorOf([&] { lfd::openInputFile(file, {}, 9); }).find("over the limit of 9"),
             std::string::npos);
 }
 

@@ -2,7 +2,8 @@
 """rostest (issue 12): /learner/learn never destroys a file and stays up on any request. Safe paths
 (a bag is never overwritten, an existing library only with overwrite, a FIFO is refused at once,
 paths outside ~allowed_roots or with '..' are refused), limits (~limits/max_num_basis,
-~limits/max_bags), and 150 seeded random requests of extreme values (seed 12, about 10 s)."""
+~limits/max_bags), 150 seeded random requests of extreme values (seed 12, about 10 s), and a link
+swapped between a bag and a FIFO for 3 s while requests run (issue 23)."""
 import hashlib
 import math
 import os
@@ -126,6 +127,52 @@ class LearnerFuzz(unittest.TestCase):
                          changepoint_counts=[1] * 60,
                          changepoint_times=[START + DURATION / 2] * 60)
         self.assertRefused(self.call(req), "limits/max_bags")
+
+    def test_7_link_swapped_to_fifo_never_hangs(self):
+        """Issue 23 row 1: a link swapped between a bag and a FIFO while requests run (3 s) never
+        hangs the learner in open() (it checked the path, then opened it again by name). A call
+        over 2 s counts as hung; opening the FIFO for writing then lets the node go on."""
+        link = os.path.join(self.dir, "race_link.bag")
+        os.symlink(self.bags[0], link)
+        stop = threading.Event()
+
+        def swap():
+            temp, to_fifo = link + ".swap", True
+            while not stop.is_set():
+                if os.path.lexists(temp):
+                    os.remove(temp)
+                os.symlink(self.fifo if to_fifo else self.bags[0], temp)
+                os.replace(temp, link)
+                to_fifo = not to_fifo
+
+        swapper = threading.Thread(target=swap, daemon=True)
+        swapper.start()
+        calls, hung, answered = 0, 0, 0
+        out = os.path.join(self.dir, "race.json")
+        end = time.time() + 3.0
+        while time.time() < end:
+            req = self.valid(out, overwrite=True, bag_paths=[link] + self.bags[1:])
+            box = {}
+            thread = threading.Thread(target=lambda: box.update(res=self.learn(req)), daemon=True)
+            thread.start()
+            thread.join(2.0)
+            if thread.is_alive():
+                hung += 1
+                while thread.is_alive():  # let the node's open() of the FIFO return
+                    try:
+                        os.close(os.open(self.fifo, os.O_WRONLY | os.O_NONBLOCK))
+                    except OSError:
+                        pass
+                    thread.join(0.05)
+            calls += 1
+            answered += "res" in box
+        stop.set()
+        swapper.join()
+        os.remove(link)
+        self.assertEqual(hung, 0, "%d of %d calls hung" % (hung, calls))
+        self.assertEqual(answered, calls)
+        self.assertTrue(self.call(self.valid(out, overwrite=True)).success)
+        self.assertNothingChanged("link swap race")
 
     def test_6_random_extreme_requests(self):
         rng = random.Random(12)

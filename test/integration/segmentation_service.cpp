@@ -7,6 +7,7 @@
 #include <filesystem>
 
 #include "../../lfd_segmentation/test/demo_bag_writer.hpp"
+#include "../../src/test/support/link_swap_race.hpp"
 
 namespace {
 
@@ -110,6 +111,29 @@ TEST(SegmentationService, SurvivesBadInputAndSegmentsGoodInput) {
   EXPECT_FALSE(good.selected_features.empty());
   // Still alive after everything above.
   EXPECT_TRUE(ros::service::exists("/segmentation/segment", false));
+  fs::remove_all(dir());
+}
+
+// Issue 23 row 1, against the running node: a link swapped between a bag and a FIFO while
+// requests run (3 s) never hangs the node in open(); it still segments afterwards.
+TEST(SegmentationService, LinkSwappedToFifoNeverHangsTheNode) {
+  ASSERT_TRUE(ros::service::waitForService("/segmentation/segment", ros::Duration(30)));
+  fs::create_directories(dir());  // the test before removes it
+  DemoBagOptions o;
+  o.duration = 2.0;
+  const std::string real = bag("race_real", o);
+  const lfd_test::LinkSwapRaceResult r = lfd_test::raceLinkSwap(
+      (dir() / "race_link.bag").string(), real, (dir() / "race_pipe.bag").string(),
+      [](const std::string& link) {
+        lfd_msgs::Segment srv;
+        srv.request.bag_paths = {link};
+        if (!ros::service::call("/segmentation/segment", srv))
+          throw std::runtime_error("the node died");
+      },
+      3.0, 2.0);
+  EXPECT_EQ(r.hung_calls, 0) << "of " << r.calls << " calls";
+  EXPECT_EQ(r.read_calls, r.calls);  // every call answered (a refusal is an answer)
+  EXPECT_TRUE(call(good_bags(2)).success);
   fs::remove_all(dir());
 }
 

@@ -26,8 +26,10 @@ struct DemoBagTopics {
 using TransformLookup =
     std::function<Eigen::Isometry3d(const std::string& target, const std::string& source)>;
 
-/// Throws std::runtime_error naming the bag and topic on missing/unusable data. Poses with
-/// non-increasing stamps are dropped (duplicates), NaN poses are an error. The scene is brought
+/// Throws std::runtime_error naming the bag and topic on missing/unusable data. Poses and gripper
+/// states are put in stamp order by the shared policy (lfd_core/stamp_order.hpp: the first of a
+/// duplicated stamp kept), and what it found is in the recording's `warnings`; NaN poses are an
+/// error. The scene is brought
 /// into the poses' frame with the bag's /tf_static, else with `fallback` (bags recorded before
 /// /tf_static was); neither connecting the frames is an error, no scene is not.
 DemoRecording readDemoBag(const std::string& path, const DemoBagTopics& topics = {},

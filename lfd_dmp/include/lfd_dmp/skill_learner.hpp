@@ -13,13 +13,14 @@ namespace lfd_dmp {
 
 /// One recorded demonstration, resampled on the end-effector pose time stamps.
 struct DemoRecording {
-  std::string id;                   ///< e.g. the bag path
-  Eigen::VectorXd times;            ///< M, strictly increasing (bag time, s)
-  Eigen::MatrixXd positions;        ///< M x 3, end effector in base_link
-  Eigen::MatrixXd quaternions;      ///< M x 4 (w, x, y, z)
-  Eigen::VectorXd gripper;          ///< M gripper opening (empty if not recorded)
-  std::string frame;                ///< frame of the poses ("" = not recorded)
-  std::optional<lfd::Scene> scene;  ///< the demo's scene in that frame (none recorded: empty)
+  std::string id;                     ///< e.g. the bag path
+  Eigen::VectorXd times;              ///< M, strictly increasing (bag time, s)
+  Eigen::MatrixXd positions;          ///< M x 3, end effector in base_link
+  Eigen::MatrixXd quaternions;        ///< M x 4 (w, x, y, z)
+  Eigen::VectorXd gripper;            ///< M gripper opening (empty if not recorded)
+  std::string frame;                  ///< frame of the poses ("" = not recorded)
+  std::optional<lfd::Scene> scene;    ///< the demo's scene in that frame (none recorded: empty)
+  std::vector<std::string> warnings;  ///< what reading it found (stamps out of order, gaps)
 };
 
 struct LearnOptions {

@@ -22,19 +22,31 @@ struct DemoFeatures {
   std::vector<std::string> state_features;
   std::vector<std::string> sensor_features;
   std::vector<std::string> context_features;  ///< role context: in the matrix, used by neither
+  std::vector<std::string> warnings;  ///< stamps out of order, duplicated, with gaps (per topic)
 };
 
 /// The bag files of one demonstration: `path` itself, or its comma-separated parts (unless a file
 /// of that very name exists).
 std::vector<std::string> demo_parts(const std::string& path);
 
+/// The request budget of the segmentation (service and CLI), checked before anything is read:
+/// `entries` (bag paths or CSV files) within limits/max_bags, the files they expand to (demo
+/// parts) within limits/max_bag_files, their total size within limits/max_total_bytes, and each
+/// one a regular file inside `paths`' roots. Throws std::invalid_argument naming the key, or for
+/// a file "cannot open <kind>: ..." and why.
+void check_request_budget(const std::vector<std::string>& entries, const RequestLimits& limits,
+                          const lfd::PathPolicy& paths, const std::string& kind = "bag");
+
 /// Raw (not resampled) streams of the configured fields of one bag. Throws std::runtime_error for
 /// unreadable/truncated bags or messages that do not match their definition, and
 /// std::invalid_argument for a missing topic, a field that does not exist (listing the topic's
-/// numeric fields), a field no message carries, or the ground-truth topic.
+/// numeric fields), a field no message carries, or the ground-truth topic. Each stream is in stamp
+/// order (lfd_core/stamp_order.hpp); `warnings` gets one line per topic whose stamps were out of
+/// order, duplicated or had a gap.
 std::vector<lfd::Stream> read_bag_streams(const std::string& path,
                                           const std::vector<TopicConfig>& topics,
-                                          std::vector<FeatureRole>* roles = nullptr);
+                                          std::vector<FeatureRole>* roles = nullptr,
+                                          std::vector<std::string>* warnings = nullptr);
 
 /// read_bag_streams + resampling at `rate` Hz (errors name the bag). Streams over `limits`
 /// (time span, |value|) are refused before resampling (check_streams).

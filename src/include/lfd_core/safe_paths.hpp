@@ -5,6 +5,7 @@
 // roots. Every refusal is a std::invalid_argument whose message names the path and the reason.
 #pragma once
 
+#include <cstdint>
 #include <functional>
 #include <string>
 #include <vector>
@@ -17,8 +18,44 @@ struct PathPolicy {
   std::vector<std::string> allowed_roots;
 };
 
-/// Checks a file to read and returns its canonical path: it exists, is a regular file (checked
-/// with stat before anything opens it) and, under roots, lies inside one of them.
+/// A file to read, opened once (issue 23: checking a path and opening it again by name let a link
+/// swapped in between to a FIFO hang open()). Readers that take a file name (rosbag, ifstream,
+/// yaml-cpp) open `readPath()`, the still-open descriptor's /proc entry: it always reaches the
+/// file that was checked, whatever the user's path points at by then. Move-only; closes on
+/// destruction, so keep it alive while the reader opens `readPath()`.
+class InputFile {
+ public:
+  InputFile(InputFile&& other) noexcept;
+  InputFile& operator=(InputFile&& other) noexcept;
+  InputFile(const InputFile&) = delete;
+  InputFile& operator=(const InputFile&) = delete;
+  ~InputFile();
+
+  /// The canonical path the user's path resolved to (for messages and comparisons).
+  const std::string& resolved() const { return resolved_; }
+  /// "/proc/self/fd/N": the name to hand to readers.
+  std::string readPath() const;
+  std::uint64_t size() const { return size_; }
+  int fd() const { return fd_; }
+
+ private:
+  friend InputFile openInputFile(const std::string&, const PathPolicy&, std::uint64_t);
+  InputFile(int fd, std::string resolved, std::uint64_t size);
+  int fd_ = -1;
+  std::string resolved_;
+  std::uint64_t size_ = 0;
+};
+
+/// Opens a file to read: the path is resolved once (realpath) and checked against the roots, the
+/// resolved path is opened without following a final link and without blocking
+/// (O_NOFOLLOW | O_NONBLOCK: a FIFO without a writer opens at once), and the open descriptor must
+/// be a regular file of at most `max_bytes` (0 = no bound) that still is the resolved path.
+/// Throws std::invalid_argument naming the path and the reason.
+InputFile openInputFile(const std::string& path, const PathPolicy& policy = {},
+                        std::uint64_t max_bytes = 0);
+
+/// Checks a file to read and returns its canonical path (openInputFile, then closed): for early
+/// checks of a whole request; readers open their file with openInputFile themselves.
 std::string checkInputFile(const std::string& path, const PathPolicy& policy = {});
 
 /// Checks a file to write: its folder exists, it lies inside a root, it is not one of `inputs`
