@@ -79,7 +79,7 @@ std::vector<Eigen::MatrixXd> sensor_magnitudes(const std::vector<FeatureMatrix>&
   std::vector<Eigen::MatrixXd> out;
   for (const FeatureMatrix& demo : demos) {
     const Eigen::MatrixXd raw = demo.select(names).data;
-    Eigen::MatrixXd m = Eigen::MatrixXd::Zero(raw.rows(), static_cast<Eigen::Index>(sensors));
+    Eigen::MatrixXd m = Eigen::MatrixXd::Zero(demo.rows(), static_cast<Eigen::Index>(sensors));
     for (Eigen::Index c = 0; c < raw.cols(); ++c) {
       const auto g = static_cast<Eigen::Index>(groups[static_cast<std::size_t>(c)]);
       m.col(g) += (raw.col(c).array() - raw(0, c)).square().matrix();
@@ -639,8 +639,8 @@ SegmentationPipelineResult segment_jointly(const PreparedSegmentation& prepared,
   const std::vector<std::size_t> groups = sensor_channel_groups(result.sensor_features);
   const bool sensors = !result.sensor_features.empty() && config.validate_with_sensors;
   const std::vector<Eigen::MatrixXd> scaled_sensors =
-      sensors ? sensor_magnitudes(demos, result.sensor_features, groups)
-              : std::vector<Eigen::MatrixXd>(n, Eigen::MatrixXd(0, 0));
+      sensor_magnitudes(demos, sensors ? result.sensor_features : std::vector<std::string>{},
+                        sensors ? groups : std::vector<std::size_t>{});
 
   std::vector<Eigen::VectorXd> speeds(n);
   parallel_for(n, config.threads, [&](std::size_t d) {
