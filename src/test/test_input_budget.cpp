@@ -11,18 +11,11 @@
 #include <functional>
 #include <stdexcept>
 
+#include "support/error_of.hpp"
+
 namespace {
 
 namespace fs = std::filesystem;
-
-std::string errorOf(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const std::invalid_argument& e) {
-    return e.what();
-  }
-  return "";
-}
 
 class InputBudgetTest : public ::testing::Test {
  protected:

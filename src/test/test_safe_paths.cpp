@@ -13,6 +13,8 @@
 #include <iterator>
 #include <stdexcept>
 
+#include "support/error_of.hpp"
+
 namespace {
 
 namespace fs = std::filesystem;
@@ -39,15 +41,6 @@ class SafePaths : public ::testing::Test {
 
   fs::path dir_;
 };
-
-std::string errorOf(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const std::invalid_argument& e) {
-    return e.what();
-  }
-  return "";
-}
 
 TEST_F(SafePaths, InputMustBeAnExistingRegularFile) {
   const std::string file = write(dir_ / "root" / "a.bag", "x");
