@@ -132,6 +132,9 @@ void parse_joint(const YAML::Node& node, lfd::JointSegmentationConfig* joint) {
                    "joint/event_merge_gap_seconds");
   joint->ramp_fold = non_negative(get<double>(node, "ramp_fold_seconds", joint->ramp_fold),
                                   "joint/ramp_fold_seconds");
+  joint->stale_reading =
+      non_negative(get<double>(node, "stale_reading_seconds", joint->stale_reading),
+                   "joint/stale_reading_seconds");
   joint->min_piece_weight = fraction(get<double>(node, "min_piece_weight", joint->min_piece_weight),
                                      "joint/min_piece_weight");
   joint->colocation = non_negative(get<double>(node, "colocation_seconds", joint->colocation),

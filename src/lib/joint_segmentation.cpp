@@ -8,6 +8,7 @@
 
 #include "lfd_core/demo_alignment.hpp"
 #include "lfd_core/parallel_for.hpp"
+#include "lfd_core/stale_readings.hpp"
 
 namespace lfd {
 
@@ -218,12 +219,65 @@ SensorSelection contact_sensors(const std::vector<std::string>& names,
   return out;
 }
 
+// Per demo, where a contact sensor repeated one reading although it has noise (stale_readings.hpp):
+// the union over the sensors, each reported.
+std::vector<std::vector<SampleSpan>> stale_contact_readings(const std::vector<FeatureMatrix>& demos,
+                                                            const SensorSelection& contact,
+                                                            double min_seconds,
+                                                            std::vector<std::string>* warnings) {
+  std::vector<std::vector<SampleSpan>> out(demos.size());
+  if (!(min_seconds > 0.0) || contact.names.empty()) return out;
+  std::vector<std::size_t> min_samples;
+  for (const FeatureMatrix& demo : demos)
+    min_samples.push_back(std::max<std::size_t>(
+        2, static_cast<std::size_t>(std::lround(min_seconds * sample_rate_of(demo)))));
+  const std::size_t sensors = *std::max_element(contact.groups.begin(), contact.groups.end()) + 1;
+  for (std::size_t g = 0; g < sensors; ++g) {
+    std::vector<std::string> names;
+    for (std::size_t c = 0; c < contact.names.size(); ++c)
+      if (contact.groups[c] == g) names.push_back(contact.names[c]);
+    std::vector<Eigen::MatrixXd> channels;
+    for (const FeatureMatrix& demo : demos) channels.push_back(demo.select(names).data);
+    const auto stale = stale_readings(channels, min_samples);
+    for (std::size_t d = 0; d < demos.size(); ++d) {
+      for (const SampleSpan& s : stale[d]) {
+        if (s.begin == 0 && s.end == static_cast<std::size_t>(demos[d].rows())) continue;  // dead
+        out[d].push_back(s);
+        std::ostringstream msg;
+        msg.precision(3);
+        msg << "sensor " << names.front() << (names.size() > 1 ? ", ..." : "")
+            << " repeats one reading from " << demos[d].time_at(static_cast<Eigen::Index>(s.begin))
+            << " s to " << demos[d].time_at(static_cast<Eigen::Index>(s.end - 1))
+            << " s (a driver's cached value?): its events there are not used";
+        warnings->push_back(describe(msg.str(), d));
+      }
+    }
+  }
+  return out;
+}
+
+// Drops the events within `margin` samples of a stale stretch: the sensor wakes up there.
+void drop_stale_events(const std::vector<SampleSpan>& stale, std::size_t margin,
+                       SensorEvents* events) {
+  const auto stale_at = [&](std::size_t index) {
+    return std::any_of(stale.begin(), stale.end(), [&](const SampleSpan& s) {
+      return index + margin >= s.begin && index <= s.end + margin;
+    });
+  };
+  events->details.erase(std::remove_if(events->details.begin(), events->details.end(),
+                                       [&](const SensoryEvent& e) { return stale_at(e.index); }),
+                        events->details.end());
+  events->all.erase(std::remove_if(events->all.begin(), events->all.end(), stale_at),
+                    events->all.end());
+}
+
 // A demo's evidence of every kind, and its features and speed on the alignment grid.
 void gather_evidence(const FeatureMatrix& demo, const Eigen::MatrixXd& scaled,
                      const Eigen::VectorXd& consistency, const Eigen::VectorXd& speed,
                      const Eigen::MatrixXd& scaled_sensors, const SegmentationPipelineResult& base,
-                     const SensorSelection& contact, const SegmentationPipelineConfig& config,
-                     DemoSegmentationResult* out, DemoEvidence* evidence, Eigen::MatrixXd* grid) {
+                     const SensorSelection& contact, const std::vector<SampleSpan>& stale,
+                     const SegmentationPipelineConfig& config, DemoSegmentationResult* out,
+                     DemoEvidence* evidence, Eigen::MatrixXd* grid) {
   const JointSegmentationConfig& joint = config.joint;
   const double rate = sample_rate_of(demo);
   SegmentationPipelineConfig own = in_samples(config, rate);
@@ -237,8 +291,9 @@ void gather_evidence(const FeatureMatrix& demo, const Eigen::MatrixXd& scaled,
   std::vector<BoundaryEvidence>& pieces = evidence->pieces;
   pieces = clasp_evidence(out->clasp, joint.weights.clasp);
   if (!contact.names.empty()) {
-    const SensorEvents events =
+    SensorEvents events =
         detect_sensor_events(demo.select(contact.names).data, own.events, contact.groups);
+    drop_stale_events(stale, own.events.difference_lag, &events);
     out->events = events.all;
     out->event_details = events.details;
     const auto s = sensory_evidence(events, joint.weights,
@@ -652,12 +707,15 @@ SegmentationPipelineResult segment_jointly(const PreparedSegmentation& prepared,
                                 config.joint.max_speed_correlation, &result.warnings)
               : SensorSelection{};
 
+  const std::vector<std::vector<SampleSpan>> stale =
+      stale_contact_readings(demos, contact, config.joint.stale_reading, &result.warnings);
+
   std::vector<DemoEvidence> evidence(n);
   std::vector<Eigen::MatrixXd> grids(n);
   parallel_for(n, config.threads, [&](std::size_t d) {
     try {
       gather_evidence(demos[d], scaled[d], consistency, speeds[d], scaled_sensors[d], result,
-                      contact, config, &result.demos[d], &evidence[d], &grids[d]);
+                      contact, stale[d], config, &result.demos[d], &evidence[d], &grids[d]);
     } catch (const std::invalid_argument& e) {
       throw std::invalid_argument(describe(e.what(), d));
     }

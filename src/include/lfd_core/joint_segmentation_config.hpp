@@ -35,6 +35,10 @@ struct JointSegmentationConfig {
   /// A sensor level step within this of a rest edge (s) is that contact's own force building up
   /// or fading, and joins the rest edge.
   double ramp_fold = 1.0;
+  /// A contact sensor that repeats one reading on all its channels for this long (s), while it
+  /// repeats none in most demos (it has noise), did not measure then: its events within a lag
+  /// of that stretch are not used (stale_readings.hpp). 0 = off.
+  double stale_reading = 0.5;
   /// A demo's own evidence for a boundary must be at least this sure (as an instant of rest): a
   /// hesitation is no boundary, even where the other demos have one.
   double min_piece_weight = 0.3;
