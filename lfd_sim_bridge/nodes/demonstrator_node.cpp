@@ -49,6 +49,7 @@
 #include <trajectory_msgs/JointTrajectory.h>
 
 #include "lfd_core/robot_setup.hpp"
+#include "lfd_ros/master_watch.hpp"
 #include "lfd_sim_bridge/demo_jobs.hpp"
 #include "lfd_sim_bridge/demo_metadata.hpp"
 #include "lfd_sim_bridge/demo_plan.hpp"
@@ -752,6 +753,9 @@ class Demonstrator {
 int main(int argc, char** argv) {
   ros::init(argc, argv, "demonstrator");
   ros::NodeHandle nh, pnh("~");
+  // A restarted master: the datasets cannot go on (the simulation and the recorder restart too);
+  // the node ends with an error, and with it the launch (required="true").
+  const lfd_ros::MasterWatch master_watch({"/use_sim_time"});
   try {
     Demonstrator demonstrator(nh, pnh);
     // Declared after the demonstrator so it is destroyed (its threads joined) first: callbacks
@@ -767,5 +771,5 @@ int main(int argc, char** argv) {
     return 1;
   }
   ros::shutdown();
-  return 0;
+  return master_watch.exitCode();
 }
