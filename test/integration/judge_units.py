@@ -266,11 +266,11 @@ class CriteriaFromTheTaskFiles(unittest.TestCase):
     def test_bad_task_files_are_a_clear_error(self):
         grasp = self.shipped("grasp")
         cases = ((dict(grasp, success=[dict(grasp["success"][0], distance="xz")]), r"success\[0\]: distance"),
-                 (dict(grasp, objects=["mug"]), "objects: 'mug' is not an object of the scene"),
+                 (dict(grasp, objects=["mug"]), r"objects\[0\]: 'mug' is not an object of the scene"),
                  (dict(grasp, speed=2), "unknown key"),
                  (dict(grasp, configurations={"sim": grasp["configurations"]["sim"]}), "configurations.teleop"),
                  (dict(grasp, configurations={"sim": [{"id": 0, "goal": [0, 0, 0]}], "teleop": []}),
-                  r"configurations.sim\[0\]: lacks stick"))
+                  r"configurations.sim\[0\].stick: expected a pose"))
         for i, (content, says) in enumerate(cases):
             self.write("bad%d" % i, content)
             with self.assertRaisesRegex(RuntimeError, "bad%d.yaml.*%s" % (i, says)):
