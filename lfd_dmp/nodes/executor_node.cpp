@@ -389,6 +389,15 @@ class Executor {
     } catch (const std::exception& e) {
       finish(&result, e.what(), false);
     }
+    releaseGoalState();
+  }
+
+  // What the goal built up and nobody reads once it ended (its executed path, published; its
+  // feedback): freed before the heap is trimmed, so an idle executor holds no goal's data.
+  void releaseGoalState() {
+    executed_ = nav_msgs::Path();
+    feedback_ = lfd_msgs::ExecuteTaskFeedback();
+    tracked_stamp_ = ros::Time();
   }
 
   void finish(lfd_msgs::ExecuteTaskResult* result, const std::string& error, bool preempted) {

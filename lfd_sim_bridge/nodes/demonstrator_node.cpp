@@ -48,6 +48,7 @@
 #include <tf2_ros/transform_listener.h>
 #include <trajectory_msgs/JointTrajectory.h>
 
+#include "lfd_core/heap_trim.hpp"
 #include "lfd_core/robot_setup.hpp"
 #include "lfd_ros/master_watch.hpp"
 #include "lfd_sim_bridge/demo_jobs.hpp"
@@ -228,6 +229,7 @@ class Demonstrator {
     for (const task::Configuration& c : d.configurations) {
       if (!ros::ok()) break;
       results.push_back(runDemo(c));
+      lfd::trimHeap();  // the demo's plan and IK solutions go back to the system
     }
     writeSummary(results);
     int recorded = 0;

@@ -26,6 +26,7 @@
 #include <rosgraph_msgs/Clock.h>
 #include <topic_tools/shape_shifter.h>
 
+#include <lfd_core/heap_trim.hpp>
 #include <lfd_core/safe_paths.hpp>
 
 #include "lfd_ros/master_watch.hpp"
@@ -288,6 +289,7 @@ class Recorder {
   }
 
   bool onStop(lfd_msgs::StopRecording::Request&, lfd_msgs::StopRecording::Response& res) {
+    const lfd::TrimHeapOnExit trim;  // the closed bag's buffers go back to the system
     std::unique_lock<std::mutex> lock(mutex_);
     if (!bag_) {
       res.success = false;
