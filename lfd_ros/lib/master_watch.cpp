@@ -58,7 +58,7 @@ bool MasterIdentity::differsFrom(const MasterIdentity& before) const {
 }
 
 MasterWatch::MasterWatch(std::vector<std::string> global_params) {
-  askIdentity(&identity_);  // the master of the node's start (ros::init has reached it)
+  known_ = askIdentity(&identity_);  // the master of the node's start
   global_params.push_back(ros::this_node::getName());
   for (const std::string& key : global_params) {
     XmlRpc::XmlRpcValue value;
@@ -89,6 +89,11 @@ void MasterWatch::run() {
             "until one comes back (then it ends, for roslaunch to respawn it)",
             node.c_str(), ros::master::getURI().c_str());
       away = true;
+      continue;
+    }
+    if (!known_) {  // the start's master did not answer at once: this one is it
+      identity_ = now;
+      known_ = true;
       continue;
     }
     if (!now.differsFrom(identity_)) {

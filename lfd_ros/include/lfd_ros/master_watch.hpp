@@ -55,6 +55,7 @@ class MasterWatch {
   void restoreParameters() const;
 
   MasterIdentity identity_;
+  bool known_ = false;  // identity_ is the start's master (asked again until it answers)
   std::vector<std::pair<std::string, XmlRpc::XmlRpcValue>> params_;  // as the node started
   std::atomic<bool> restarted_{false};
   std::mutex mutex_;
