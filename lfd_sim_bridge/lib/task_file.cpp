@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <fstream>
 #include <limits>
 #include <set>
@@ -37,7 +38,7 @@ std::string textProblem(const std::string& bytes) {
                       : (b >> 4) == 0xE  ? 2
                       : (b >> 3) == 0x1E ? 3
                                          : -1;
-    if (extra < 0 || i + extra >= bytes.size() + (extra == 0 ? 1 : 0))
+    if (extra < 0 || i + extra >= bytes.size())  // not a lead byte, or cut off
       return "line " + std::to_string(line) + " is not UTF-8 text";
     std::uint32_t c = extra == 0 ? b : b & (0x3F >> extra);
     for (int k = 1; k <= extra; ++k) {
