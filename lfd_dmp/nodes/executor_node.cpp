@@ -19,6 +19,7 @@
 #include <lfd_core/heap_trim.hpp>
 #include <lfd_core/robot_setup.hpp>
 #include <lfd_core/safe_paths.hpp>
+#include <lfd_ros/master_watch.hpp>
 
 #include <actionlib/server/simple_action_server.h>
 #include <ros/ros.h>
@@ -388,6 +389,15 @@ class Executor {
     } catch (const std::exception& e) {
       finish(&result, e.what(), false);
     }
+    releaseGoalState();
+  }
+
+  // What the goal built up and nobody reads once it ended (its executed path, published; its
+  // feedback): freed before the heap is trimmed, so an idle executor holds no goal's data.
+  void releaseGoalState() {
+    executed_ = nav_msgs::Path();
+    feedback_ = lfd_msgs::ExecuteTaskFeedback();
+    tracked_stamp_ = ros::Time();
   }
 
   void finish(lfd_msgs::ExecuteTaskResult* result, const std::string& error, bool preempted) {
@@ -619,6 +629,9 @@ class Executor {
 int main(int argc, char** argv) {
   ros::init(argc, argv, "executor");
   ros::NodeHandle nh, pnh("~");
+  // A restarted master: the node ends, to be respawned (with the robot model and the clock choice
+  // its launch file had set).
+  const lfd_ros::MasterWatch master_watch({"/use_sim_time", "/robot_description"});
   try {
     Executor executor(nh, pnh);
     // Several threads: the action's goal thread plans and monitors while state callbacks and
@@ -630,5 +643,5 @@ int main(int argc, char** argv) {
     ROS_FATAL("executor: %s", e.what());
     return 1;
   }
-  return 0;
+  return master_watch.exitCode();
 }

@@ -19,6 +19,7 @@
 #include <lfd_core/input_budget.hpp>
 #include <lfd_core/safe_paths.hpp>
 #include <lfd_core/time_alignment.hpp>
+#include <lfd_ros/master_watch.hpp>
 
 #include <algorithm>
 #include <chrono>
@@ -224,9 +225,10 @@ int main(int argc, char** argv) {
   ros::init(argc, argv, "learner");
   ros::NodeHandle nh;
   ros::NodeHandle pnh("~");
+  const lfd_ros::MasterWatch master_watch;  // a restarted master: the node ends, to be respawned
   Learner learner(pnh);
   ros::ServiceServer srv = nh.advertiseService("/learner/learn", &Learner::learn, &learner);
   ROS_INFO("learner: ready on /learner/learn");
   ros::spin();  // tf arrives on the listener's own thread while a request waits for it
-  return 0;
+  return master_watch.exitCode();
 }

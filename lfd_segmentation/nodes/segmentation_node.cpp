@@ -6,6 +6,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "lfd_core/heap_trim.hpp"
+#include "lfd_ros/master_watch.hpp"
 #include "lfd_segmentation/segment_service.hpp"
 
 namespace {
@@ -43,6 +44,7 @@ YAML::Node to_yaml(const XmlRpc::XmlRpcValue& v) {
 int main(int argc, char** argv) {
   ros::init(argc, argv, "segmentation");
   ros::NodeHandle pnh("~");
+  const lfd_ros::MasterWatch master_watch;  // a restarted master: the node ends, to be respawned
   XmlRpc::XmlRpcValue tree;
   YAML::Node root(YAML::NodeType::Map);
   if (ros::param::get(ros::this_node::getName(), tree)) root = to_yaml(tree);
@@ -81,5 +83,5 @@ int main(int argc, char** argv) {
   ROS_INFO("segmentation: serving %s (%zu topics, %.0f Hz)", server.getService().c_str(),
            params.topics.size(), params.rate);
   ros::spin();
-  return 0;
+  return master_watch.exitCode();
 }

@@ -1,18 +1,97 @@
 #include "lfd_sim_bridge/task_file.hpp"
 
+#include <yaml-cpp/depthguard.h>
 #include <yaml-cpp/yaml.h>
 #include <lfd_core/safe_paths.hpp>
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <fstream>
+#include <limits>
 #include <set>
+#include <sstream>
 #include <stdexcept>
+#include <utility>
 
 namespace lfd_sim_bridge {
 namespace task {
 namespace {
 
 const char* const kModes[] = {"sim", "teleop"};
+
+// The YAML spec's printable characters (c-printable), the only ones a YAML stream may hold.
+// yaml-cpp does not check them; PyYAML (lfd_tools.tasks) refuses the others, so both refuse.
+bool printable(std::uint32_t c) {
+  return c == 0x09 || c == 0x0A || c == 0x0D || (c >= 0x20 && c <= 0x7E) || c == 0x85 ||
+         (c >= 0xA0 && c <= 0xD7FF) || (c >= 0xE000 && c <= 0xFFFD) ||
+         (c >= 0x10000 && c <= 0x10FFFF);
+}
+
+// "" when `bytes` are UTF-8 text of printable characters, else what is wrong and where.
+std::string textProblem(const std::string& bytes) {
+  std::size_t line = 1;
+  for (std::size_t i = 0; i < bytes.size();) {
+    const auto b = static_cast<unsigned char>(bytes[i]);
+    const int extra = b < 0x80           ? 0
+                      : (b >> 5) == 0x6  ? 1
+                      : (b >> 4) == 0xE  ? 2
+                      : (b >> 3) == 0x1E ? 3
+                                         : -1;
+    if (extra < 0 || i + extra >= bytes.size())  // not a lead byte, or cut off
+      return "line " + std::to_string(line) + " is not UTF-8 text";
+    std::uint32_t c = extra == 0 ? b : b & (0x3F >> extra);
+    for (int k = 1; k <= extra; ++k) {
+      const auto cont = static_cast<unsigned char>(bytes[i + k]);
+      if ((cont >> 6) != 0x2) return "line " + std::to_string(line) + " is not UTF-8 text";
+      c = (c << 6) | (cont & 0x3F);
+    }
+    static const std::uint32_t kLeast[] = {0, 0x80, 0x800, 0x10000};  // overlong forms
+    if (c < kLeast[extra] || !printable(c))
+      return "line " + std::to_string(line) + " holds a character that is not printable text";
+    if (c == '\n') ++line;
+    i += 1 + extra;
+  }
+  return "";
+}
+
+std::string tooDeep(int max_depth) {
+  if (max_depth <= 0) return "nested too deep";
+  return "nested deeper than " + std::to_string(max_depth) +
+         " levels (task_limits/max_nesting_depth of the scene file)";
+}
+
+std::string lineOf(const YAML::Node& n) {
+  return "line " + std::to_string(n.Mark().line + 1);
+}
+
+// "" when the tree nests at most `max_depth` collections, has no key twice in a mapping, no key
+// that is not a plain value and no tag; else what is wrong and where. Iterative: the depth is not
+// known yet, so no recursion may depend on it.
+std::string treeProblem(const YAML::Node& root, int max_depth) {
+  std::vector<std::pair<YAML::Node, int>> todo{{root, root.IsScalar() ? 0 : 1}};
+  while (!todo.empty()) {
+    const auto [n, depth] = todo.back();
+    todo.pop_back();
+    if (n.Tag() != "?" && n.Tag() != "!" && !n.Tag().empty())
+      return lineOf(n) + ": tag '" + n.Tag() + "' (task files use none)";
+    if (!n.IsMap() && !n.IsSequence()) continue;
+    if (depth > max_depth) return lineOf(n) + ": " + tooDeep(max_depth);
+    std::set<std::string> keys;
+    for (const auto& child : n) {
+      if (n.IsSequence()) {
+        todo.emplace_back(child, depth + 1);
+        continue;
+      }
+      if (!child.first.IsScalar()) return lineOf(child.first) + ": a key must be a plain value";
+      if (!keys.insert(child.first.Scalar()).second)
+        return lineOf(child.first) + ": key '" + child.first.Scalar() + "' given twice";
+      todo.emplace_back(child.first, depth + 1);
+      todo.emplace_back(child.second, depth + 1);
+    }
+  }
+  return "";
+}
 
 // Reads one file's nodes; every error names the file and the key.
 class Reader {
@@ -23,17 +102,27 @@ class Reader {
     throw std::runtime_error(kind_ + " file '" + path_ + "': " + key + ": " + what);
   }
 
-  YAML::Node load() const {
+  // The file's tree, its text and its shape checked (max_depth > 0: a task file's bounds).
+  YAML::Node load(int max_depth = 0) const {
+    YAML::Node root;
     try {
-      // Opened once through the file-access layer: a link swapped to a FIFO cannot hang the read.
-      const YAML::Node root = YAML::LoadFile(lfd::openInputFile(path_).readPath());
-      if (!root.IsMap()) fail("(top level)", "expected a mapping");
-      return root;
+      root = YAML::Load(text());
+    } catch (
+        const YAML::DeepRecursion&) {  // yaml-cpp's own bound (500 levels), far beyond any file
+      unreadable(tooDeep(max_depth));
     } catch (const YAML::Exception& e) {
-      throw std::runtime_error(kind_ + " file '" + path_ + "' cannot be read: " + e.what());
-    } catch (const std::invalid_argument& e) {  // the file-access layer's refusal
-      throw std::runtime_error(kind_ + " file '" + path_ + "' cannot be read: " + e.what());
+      unreadable(e.what());
     }
+    if (max_depth > 0) {
+      const std::string problem = treeProblem(root, max_depth);
+      if (!problem.empty()) unreadable(problem);
+    }
+    if (!root.IsMap()) fail("(top level)", "expected a mapping");
+    return root;
+  }
+
+  [[noreturn]] void unreadable(const std::string& why) const {
+    throw std::runtime_error(kind_ + " file '" + path_ + "' cannot be read: " + why);
   }
 
   double number(const YAML::Node& n, const std::string& key) const {
@@ -51,6 +140,44 @@ class Reader {
     const double v = number(n, key);
     if (!(v > 0.0)) fail(key, "must be > 0");
     return v;
+  }
+
+  // A time of the file: 0 to `max` s (the scene's task_limits/max_step_seconds).
+  double seconds(const YAML::Node& n, const std::string& key, double max) const {
+    const double v = number(n, key);
+    if (v < 0.0) fail(key, "must be >= 0 s");
+    atMost(v, key, max);
+    return v;
+  }
+
+  void atMost(double seconds, const std::string& key, double max) const {
+    if (seconds > max)
+      fail(key, std::to_string(seconds) + " s is over " + std::to_string(max) +
+                    " s (task_limits/max_step_seconds of the scene file)");
+  }
+
+  // A whole number from `lo` to the largest int.
+  int whole(const YAML::Node& n, const std::string& key, int lo) const {
+    const double v = number(n, key);
+    if (v < lo || v > std::numeric_limits<int>::max() || v != std::floor(v))
+      fail(key, "expected a whole number >= " + std::to_string(lo));
+    return static_cast<int>(v);
+  }
+
+  // The file's bytes, read once through the file-access layer (a link swapped to a FIFO cannot
+  // hang the read), checked to be printable UTF-8 text.
+  std::string text() const {
+    std::ostringstream bytes;
+    try {
+      const lfd::InputFile file = lfd::openInputFile(path_);
+      std::ifstream in(file.readPath(), std::ios::binary);
+      bytes << in.rdbuf();
+    } catch (const std::invalid_argument& e) {  // the file-access layer's refusal
+      unreadable(e.what());
+    }
+    const std::string problem = textProblem(bytes.str());
+    if (!problem.empty()) unreadable(problem);
+    return bytes.str();
   }
 
   std::string text(const YAML::Node& n, const std::string& key) const {
@@ -162,7 +289,7 @@ class TaskReader {
   TaskReader(const std::string& path, const Scene& scene) : r_("task", path), scene_(scene) {}
 
   TaskDefinition read() {
-    const YAML::Node root = r_.load();
+    const YAML::Node root = r_.load(scene_.task_limits.max_nesting_depth);
     r_.onlyKeys(root, "(top level)",
                 {"description", "objects", "goal", "gripper_at_start", "variation",
                  "teleop_placement", "frames", "phases", "success", "configurations", "unseen"});
@@ -261,11 +388,7 @@ class TaskReader {
     }
     if (n["position"]) s.position = r_.vec3(n["position"], key + ".position");
     if (n["yaw"]) s.yaw = r_.number(n["yaw"], key + ".yaw");
-    if (n["symmetry"]) {
-      const double k = r_.number(n["symmetry"], key + ".symmetry");
-      if (k < 1 || k != std::floor(k)) r_.fail(key + ".symmetry", "expected a whole number >= 1");
-      s.symmetry = static_cast<int>(k);
-    }
+    if (n["symmetry"]) s.symmetry = r_.whole(n["symmetry"], key + ".symmetry", 1);
     return s;
   }
 
@@ -334,8 +457,7 @@ class TaskReader {
       r_.onlyKeys(n, key, {p, "label"});
       s.kind = p == "hold" ? StepKind::kHold : StepKind::kGripper;
       s.open = true;
-      s.duration = r_.number(n[p], key + "." + p);
-      if (s.duration < 0) r_.fail(key + "." + p, "must be >= 0 s");
+      s.duration = r_.seconds(n[p], key + "." + p, maxSeconds());
       return s;
     }
     if (p == "gripper") {
@@ -372,10 +494,12 @@ class TaskReader {
       s.target = poseSpec(n["to"], key + ".to");
     }
     s.duration = r_.positive(n["duration"], key + ".duration");
-    if (n["settle"]) s.settle = r_.number(n["settle"], key + ".settle");
-    if (s.settle < 0) r_.fail(key + ".settle", "must be >= 0 s");
+    r_.atMost(s.duration, key + ".duration", maxSeconds());
+    if (n["settle"]) s.settle = r_.seconds(n["settle"], key + ".settle", maxSeconds());
     return s;
   }
+
+  double maxSeconds() const { return scene_.task_limits.max_step_seconds; }
 
   void readPhases(const YAML::Node& n) {
     if (!n || !n.IsSequence() || n.size() == 0) r_.fail("phases", "expected a non-empty list");
@@ -425,7 +549,7 @@ class TaskReader {
       const YAML::Node e = n[i];
       if (!e.IsMap()) r_.fail(ckey, "expected a mapping");
       Configuration c;
-      c.id = static_cast<int>(r_.number(e["id"], ckey + ".id"));
+      c.id = r_.whole(e["id"], ckey + ".id", 0);
       for (const std::string& object : t_.objects)
         c.objects[object] = r_.pose(e[object], ckey + "." + object);
       c.goal = r_.pose(e["goal"], ckey + ".goal");
@@ -469,7 +593,9 @@ const SceneObject* Scene::find(const std::string& name) const {
   return nullptr;
 }
 
-Scene loadScene(const std::string& path) {
+namespace {
+
+Scene readScene(const std::string& path) {
   const Reader r("scene", path);
   const YAML::Node root = r.load();
   Scene s;
@@ -487,7 +613,25 @@ Scene loadScene(const std::string& path) {
   if (!objects || !objects.IsMap()) r.fail("objects", "expected a mapping of objects");
   for (const auto& kv : objects)
     s.objects.push_back(readSceneObject(r, kv.first.Scalar(), kv.second));
+  const YAML::Node limits = root["task_limits"];
+  if (!limits || !limits.IsMap())
+    r.fail("task_limits",
+           "expected {max_step_seconds, max_nesting_depth}: every task file's bounds");
+  s.task_limits.max_step_seconds =
+      r.positive(limits["max_step_seconds"], "task_limits.max_step_seconds");
+  s.task_limits.max_nesting_depth =
+      r.whole(limits["max_nesting_depth"], "task_limits.max_nesting_depth", 1);
   return s;
+}
+
+}  // namespace
+
+Scene loadScene(const std::string& path) {
+  try {
+    return readScene(path);
+  } catch (const YAML::Exception& e) {  // a node of another kind than the reader asked for
+    throw std::runtime_error("scene file '" + path + "' is malformed: " + e.what());
+  }
 }
 
 std::vector<std::string> TaskDefinition::joints(const Scene& scene) const {
@@ -500,7 +644,12 @@ std::vector<std::string> TaskDefinition::joints(const Scene& scene) const {
 
 TaskDefinition loadTask(const std::string& path, const Scene& scene) {
   TaskReader reader(path, scene);
-  TaskDefinition t = reader.read();
+  TaskDefinition t;
+  try {
+    t = reader.read();
+  } catch (const YAML::Exception& e) {  // a node of another kind than the reader asked for
+    throw std::runtime_error("task file '" + path + "' is malformed: " + e.what());
+  }
   t.path = path;
   std::string stem = path.substr(path.find_last_of('/') + 1);
   if (stem.size() > 5 && stem.substr(stem.size() - 5) == ".yaml") stem.resize(stem.size() - 5);

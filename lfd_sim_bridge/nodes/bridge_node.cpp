@@ -45,6 +45,7 @@
 #include <utility>
 #include <vector>
 
+#include "lfd_ros/master_watch.hpp"
 #include "lfd_sim_bridge/workcell_sim.hpp"
 
 namespace {
@@ -642,6 +643,8 @@ class BridgeNode {
 int main(int argc, char** argv) {
   ros::init(argc, argv, "bridge");
   ros::NodeHandle nh, pnh("~");
+  // A restarted master: the node ends, to be respawned (with the clock choice of its launch file).
+  const lfd_ros::MasterWatch master_watch({"/use_sim_time"});
   try {
     BridgeNode bridge(nh, pnh);
     bridge.run();
@@ -649,5 +652,5 @@ int main(int argc, char** argv) {
     ROS_FATAL("bridge: %s", e.what());
     return 1;
   }
-  return 0;
+  return master_watch.exitCode();
 }

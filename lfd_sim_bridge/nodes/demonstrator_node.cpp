@@ -48,7 +48,9 @@
 #include <tf2_ros/transform_listener.h>
 #include <trajectory_msgs/JointTrajectory.h>
 
+#include "lfd_core/heap_trim.hpp"
 #include "lfd_core/robot_setup.hpp"
+#include "lfd_ros/master_watch.hpp"
 #include "lfd_sim_bridge/demo_jobs.hpp"
 #include "lfd_sim_bridge/demo_metadata.hpp"
 #include "lfd_sim_bridge/demo_plan.hpp"
@@ -227,6 +229,7 @@ class Demonstrator {
     for (const task::Configuration& c : d.configurations) {
       if (!ros::ok()) break;
       results.push_back(runDemo(c));
+      lfd::trimHeap();  // the demo's plan and IK solutions go back to the system
     }
     writeSummary(results);
     int recorded = 0;
@@ -752,6 +755,9 @@ class Demonstrator {
 int main(int argc, char** argv) {
   ros::init(argc, argv, "demonstrator");
   ros::NodeHandle nh, pnh("~");
+  // A restarted master: the datasets cannot go on (the simulation and the recorder restart too);
+  // the node ends with an error, and with it the launch (required="true").
+  const lfd_ros::MasterWatch master_watch({"/use_sim_time"});
   try {
     Demonstrator demonstrator(nh, pnh);
     // Declared after the demonstrator so it is destroyed (its threads joined) first: callbacks
@@ -767,5 +773,5 @@ int main(int argc, char** argv) {
     return 1;
   }
   ros::shutdown();
-  return 0;
+  return master_watch.exitCode();
 }

@@ -26,8 +26,10 @@
 #include <rosgraph_msgs/Clock.h>
 #include <topic_tools/shape_shifter.h>
 
+#include <lfd_core/heap_trim.hpp>
 #include <lfd_core/safe_paths.hpp>
 
+#include "lfd_ros/master_watch.hpp"
 #include "lfd_sim_bridge/bag_recorder.hpp"
 #include "lfd_sim_bridge/topic_connections.hpp"
 
@@ -287,6 +289,7 @@ class Recorder {
   }
 
   bool onStop(lfd_msgs::StopRecording::Request&, lfd_msgs::StopRecording::Response& res) {
+    const lfd::TrimHeapOnExit trim;  // the closed bag's buffers go back to the system
     std::unique_lock<std::mutex> lock(mutex_);
     if (!bag_) {
       res.success = false;
@@ -399,6 +402,8 @@ int main(int argc, char** argv) {
   std::signal(SIGINT, onSignal);
   std::signal(SIGTERM, onSignal);
   ros::NodeHandle nh, pnh("~");
+  // A restarted master: the node ends (closing an open bag as on a signal), to be respawned.
+  const lfd_ros::MasterWatch master_watch({"/use_sim_time"});
   std::unique_ptr<Recorder> recorder;
   try {
     recorder = std::make_unique<Recorder>(nh, pnh);
@@ -411,5 +416,5 @@ int main(int argc, char** argv) {
   queue->callAvailable();  // messages already received are part of the demonstration: write them
   recorder->closeOnShutdown();
   ros::shutdown();
-  return 0;
+  return master_watch.exitCode();
 }

@@ -4,6 +4,7 @@
 
 #include <cstdio>
 #include <fstream>
+#include <iterator>
 #include <string>
 
 #include "lfd_sim_bridge/task_file.hpp"
@@ -176,4 +177,75 @@ TEST(TaskFile, BadSceneFilesAreRefusedNamingTheKey) {
     EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
   }
   EXPECT_THROW(task::loadScene("/nonexistent/scene.yaml"), std::runtime_error);
+}
+
+// Issue 23, round two: the bounds of the scene's task_limits (max_step_seconds 120,
+// max_nesting_depth 16), which lfd_tools.tasks reads too.
+TEST(TaskFile, TimesOverTheScenesBoundAreRefused) {
+  const std::string over = "is over 120";
+  auto replaced = [](std::string text, const std::string& from, const std::string& to) {
+    return text.replace(text.find(from), from.size(), to);
+  };
+  expectRefused(replaced(validTask(), "duration: 2.0}", "duration: 1.0e+9}"), over);
+  expectRefused(replaced(validTask(), "settle: 0.3", "settle: 1.0e+9"), over);
+  expectRefused(replaced(validTask(), "{gripper: open, duration: 0.5}", "{hold: 1.0e+9}"), over);
+  expectRefused(replaced(validTask(), "{gripper: open, duration: 0.5}", "{release: 121}"), over);
+  expectRefused(replaced(validTask(), "{gripper: open, duration: 0.5}", "{hold: -1}"),
+                "must be >= 0 s");
+  EXPECT_NO_THROW(
+      task::loadTask(write(replaced(validTask(), "duration: 2.0}", "duration: 120}")), scene()));
+}
+
+TEST(TaskFile, NumbersThatAreNotFiniteOrWholeAreRefused) {
+  auto with_stick = [](const std::string& stick) {
+    std::string text = validTask();
+    const std::string from = "stick: [0.5, -0.3, 0.815, 0.1]";
+    return text.replace(text.find(from), from.size(), "stick: " + stick);
+  };
+  expectRefused(with_stick("[0.5, .nan, 0.815, 0.1]"),
+                "configurations.sim[0].stick[1]: is not finite");
+  expectRefused(with_stick("[0.5, -.inf, 0.815, 0.1]"), "is not finite");
+  expectRefused(with_stick("[0.5, 1e999, 0.815, 0.1]"), "configurations.sim[0].stick[1]");
+  std::string text = validTask();
+  text.replace(text.find("{id: 0"), 6, "{id: 1.0e+300");
+  expectRefused(text, "configurations.sim[0].id: expected a whole number >= 0");
+}
+
+TEST(TaskFile, DeepNestingIsRefusedBeforeItIsRead) {
+  for (int depth : {17, 1000, 100000}) {
+    const std::string nest = std::string(depth, '[') + std::string(depth, ']');
+    expectRefused("description: " + nest + "\n" + validTask(), "nested deeper than 16 levels");
+  }
+  EXPECT_NO_THROW(task::loadTask(
+      write("description: " + std::string(15, '[') + std::string(15, ']') + "\n" + validTask()),
+      scene()));
+}
+
+TEST(TaskFile, BytesThatAreNotPrintableTextAreRefused) {
+  expectRefused("description: \xff\n" + validTask(), "line 1 is not UTF-8 text");
+  expectRefused("description: \xc3\x28\n" + validTask(), "not UTF-8 text");
+  expectRefused(validTask() + "# \xe2\x82", "not UTF-8 text");  // cut off in a character
+  expectRefused("description: a" + std::string(1, '\0') + "b\n" + validTask(), "not printable");
+  expectRefused("description: \x7f\n" + validTask(), "not printable");
+  EXPECT_NO_THROW(task::loadTask(write("\xef\xbb\xbf" + validTask()), scene()));  // a BOM
+  EXPECT_NO_THROW(task::loadTask(write("description: caf\xc3\xa9\n" + validTask()), scene()));
+}
+
+TEST(TaskFile, KeysGivenTwiceAndTagsAreRefused) {
+  expectRefused("objects: [stick]\n" + validTask(), "key 'objects' given twice");
+  expectRefused("description: !foo bar\n" + validTask(), "tag '!foo'");
+  expectRefused("? [a, b]\n: 1\n" + validTask(), "a key must be a plain value");
+}
+
+TEST(TaskFile, ASceneWithoutTaskLimitsIsRefused) {
+  std::ifstream in(kConfig + "scene.yaml");
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  text.replace(text.find("task_limits:"), 12, "task_limitz:");
+  const std::string path = write(text, "scene");
+  try {
+    task::loadScene(path);
+    ADD_FAILURE() << "accepted a scene without task_limits";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("task_limits"), std::string::npos) << e.what();
+  }
 }

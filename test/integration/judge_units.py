@@ -20,7 +20,8 @@ import rostest
 import yaml
 from geometry_msgs.msg import PoseStamped
 from lfd_msgs.msg import DemoMetadata, Phase
-from lfd_tools import bags, config, judge, redo, report, tasks
+from std_msgs.msg import Header
+from lfd_tools import bags, config, judge, redo, report, stamps, tasks
 
 GRASP = {"object": "stick", "distance": "xyz", "tolerance_m": 0.03, "min_lift_m": 0.10, "yaw_symmetry": 2}
 PUSH = {"object": "box", "distance": "xy", "tolerance_m": 0.03, "yaw_symmetry": 4}
@@ -265,11 +266,11 @@ class CriteriaFromTheTaskFiles(unittest.TestCase):
     def test_bad_task_files_are_a_clear_error(self):
         grasp = self.shipped("grasp")
         cases = ((dict(grasp, success=[dict(grasp["success"][0], distance="xz")]), r"success\[0\]: distance"),
-                 (dict(grasp, objects=["mug"]), "objects: 'mug' is not an object of the scene"),
+                 (dict(grasp, objects=["mug"]), r"objects\[0\]: 'mug' is not an object of the scene"),
                  (dict(grasp, speed=2), "unknown key"),
                  (dict(grasp, configurations={"sim": grasp["configurations"]["sim"]}), "configurations.teleop"),
                  (dict(grasp, configurations={"sim": [{"id": 0, "goal": [0, 0, 0]}], "teleop": []}),
-                  r"configurations.sim\[0\]: lacks stick"))
+                  r"configurations.sim\[0\].stick: expected a pose"))
         for i, (content, says) in enumerate(cases):
             self.write("bad%d" % i, content)
             with self.assertRaisesRegex(RuntimeError, "bad%d.yaml.*%s" % (i, says)):
@@ -278,9 +279,10 @@ class CriteriaFromTheTaskFiles(unittest.TestCase):
             tasks.success_criterion("wipes")
 
 
-def write_grasp_bag(path, final_z):
+def write_grasp_bag(path, final_z, extra_poses=()):
     """A hand-written grasp demo bag: metadata scene, ground-truth phases and the stick's last pose
-    (final_z: where the stick ends, 0.95 = lifted to its goal)."""
+    (final_z: where the stick ends, 0.95 = lifted to its goal); extra_poses: (recorded at, header
+    stamp, z) of more stick poses."""
     goal = {"position": [0.5, -0.3, 0.95], "orientation": [1.0, 0.0, 0.0, 0.0]}
     extra = {"task": "grasp", "scene": {"frame": "world", "objects": {}, "goal": goal, "joints": {}}}
     with rosbag.Bag(path, "w") as b:
@@ -288,8 +290,9 @@ def write_grasp_bag(path, final_z):
                                               extra_json=json.dumps(extra)), rospy.Time(10.0))
         for t, name in ((10.0, "approach"), (12.0, "grasp"), (13.0, "move"), (13.5, "move"), (18.0, "done")):
             b.write("/lfd/phase", Phase(task="grasp", name=name), rospy.Time(t))
-        for t, z in ((10.5, TABLE + 0.015), (18.5, final_z)):
+        for t, stamp, z in sorted(((10.5, 0.0, TABLE + 0.015), (18.5, 0.0, final_z)) + tuple(extra_poses)):
             p = PoseStamped()
+            p.header.stamp = rospy.Time(stamp)
             p.pose.position.x, p.pose.position.y, p.pose.position.z = 0.5, -0.3, z
             p.pose.orientation.w = 1.0
             b.write("/objects/stick/pose", p, rospy.Time(t))
@@ -355,6 +358,32 @@ class DemoBagJudged(unittest.TestCase):
         self.assertFalse(dropped["success"])
         self.assertAlmostEqual(dropped["height_m"], 0.015)
 
+    def test_a_pose_stamped_out_of_order_is_judged_in_stamp_order(self):
+        """Issue 23 (the C++ readers' stamp policy, lfd_tools.stamps): a pose of the stick on the
+        table stamped 11 s arrives last, after the lifted one of 18.5 s. By arrival it was the final
+        pose (the demo failed); by stamp the demo is judged as the sorted bag, with a warning."""
+        folder = tempfile.mkdtemp()
+        self.addCleanup(shutil.rmtree, folder)
+        in_order = write_grasp_bag(os.path.join(folder, "in_order.bag"), 0.95,
+                                   [(11.0, 11.0, TABLE + 0.015)])
+        late = write_grasp_bag(os.path.join(folder, "late.bag"), 0.95, [(19.0, 11.0, TABLE + 0.015)])
+        expected, got = bags.demo_outcome(in_order), bags.demo_outcome(late)
+        self.assertTrue(expected["success"], expected["reason"])
+        self.assertEqual(expected["warnings"], [])
+        for key in ("success", "distance_m", "height_m", "reason"):
+            self.assertEqual(got[key], expected[key], key)
+        self.assertEqual(got["warnings"], ["/objects/stick/pose: of 3 messages, 1 stamped out of order (put in order)"])
+
+    def test_phases_are_taken_in_stamp_order(self):
+        folder = tempfile.mkdtemp()
+        self.addCleanup(shutil.rmtree, folder)
+        path = os.path.join(folder, "phases.bag")
+        with rosbag.Bag(path, "w") as b:
+            for t, stamp, name in ((10.0, 10.0, "approach"), (13.0, 13.0, "move"), (13.1, 12.0, "grasp")):
+                b.write("/lfd/phase", Phase(header=Header(stamp=rospy.Time(stamp)), task="grasp", name=name),
+                        rospy.Time(t))
+        self.assertEqual(bags.phase_transitions(path)[1], [("approach", 10.0), ("grasp", 12.0), ("move", 13.0)])
+
     def test_ground_truth_changepoints_start_each_expected_phase(self):
         path = self.bag(0.95)
         self.assertEqual(bags.ground_truth_changepoints(path, GRASP_EXPECTED), [13.0])
@@ -362,6 +391,32 @@ class DemoBagJudged(unittest.TestCase):
                                                            ("done", 18.0)])
         with self.assertRaisesRegex(RuntimeError, "push"):
             bags.ground_truth_changepoints(path, PUSH_EXPECTED)
+
+
+class StampPolicy(unittest.TestCase):
+    """lfd_tools.stamps on the cases of lfd_core's test_stamp_order.cpp: the same order, counts and
+    warnings as the C++ readers."""
+
+    def test_one_late_message_is_moved_and_counted_once(self):
+        order, r = stamps.order_by_stamp([0.0, 0.1, 0.75, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8], False)
+        self.assertEqual(order, [0, 1, 3, 4, 5, 6, 7, 8, 2, 9])
+        self.assertEqual((r["out_of_order"], r["duplicates"]), (1, 0))
+        self.assertEqual(stamps.warning("/ee_pose", r), "/ee_pose: of 10 messages, 1 stamped out of order (put in order)")
+
+    def test_duplicates_are_kept_or_left_out_but_always_counted(self):
+        kept_all, everything = stamps.order_by_stamp([0.0, 0.1, 0.1, 0.2], True)
+        firsts, first = stamps.order_by_stamp([0.0, 0.1, 0.1, 0.2], False)
+        self.assertEqual((len(kept_all), firsts), (4, [0, 1, 3]))
+        self.assertEqual((everything["duplicates"], everything["dropped"], first["dropped"]), (1, 0, 1))
+        self.assertIn("1 with a duplicate stamp (the first of each kept)", stamps.warning("/t", first))
+
+    def test_gaps_are_reported_and_a_regular_clock_says_nothing(self):
+        regular = [0.01 * i for i in range(100)]
+        self.assertEqual(stamps.warning("/t", stamps.order_by_stamp(regular, True)[1]), "")
+        _, r = stamps.order_by_stamp([t + (0.3 if t > 0.5 else 0.0) for t in regular], True)
+        self.assertAlmostEqual(r["largest_gap"], 0.31)
+        self.assertAlmostEqual(r["gap_start"], 0.5)
+        self.assertIn("a gap of 0.31 s at t = 0.5", stamps.warning("/t", r))
 
 
 class Response(object):
@@ -414,7 +469,7 @@ class Records(unittest.TestCase):
 def all_tests():
     return unittest.TestSuite([unittest.defaultTestLoader.loadTestsFromTestCase(c) for c in (
         SegmentationRule, SegmentationFigures, PhysicalSuccess, Rules, CriteriaFromTheTaskFiles, DemoBagJudged,
-        RedoDemos, Records)])
+        StampPolicy, RedoDemos, Records)])
 
 
 if __name__ == "__main__":

@@ -7,7 +7,7 @@ import os
 
 import rosbag
 
-from lfd_tools import config, judge, tasks
+from lfd_tools import config, judge, stamps, tasks
 
 PHASE_TOPIC = "/lfd/phase"
 METADATA_TOPIC = "/lfd/metadata"
@@ -35,11 +35,10 @@ def bag_span(bag_path):
 
 
 def phase_transitions(bag_path):
-    """(task, [(phase name, start time)]) from the ground-truth phase topic, in order."""
+    """(task, [(phase name, start time)]) from the ground-truth phase topic, in stamp order."""
     task, phases = None, []
     with rosbag.Bag(bag_path) as bag:
-        for _, msg, t in bag.read_messages(topics=[PHASE_TOPIC]):
-            stamp = msg.header.stamp.to_sec() if msg.header.stamp.to_sec() > 0 else t.to_sec()
+        for _, msg, stamp in stamps.read_in_stamp_order(bag, [PHASE_TOPIC], keep_duplicates=True)[0]:
             task = task or msg.task
             if not phases or phases[-1][0] != msg.name:
                 phases.append((msg.name, stamp))
@@ -125,14 +124,16 @@ def topics_for(criterion):
 def measure(bag, criterion, base_in_world):
     """What the rules of `criterion` judge, from an open bag: the last pose of each judged object
     (by its name in the task file), the last value of each judged joint, and for a contact path
-    every (time, the pads' mean force, TCP world position) at the same stamp."""
+    every (time, the pads' mean force, TCP world position) at the same stamp. Last by stamp, not by
+    arrival (lfd_tools.stamps); "warnings" tells what had to be put in order."""
     wanted = topics_for(criterion)
     names = {"/objects/%s/pose" % tasks.body_of(r["object"]): r["object"]
              for r in criterion["rules"] if "object" in r}
     joint_names = {r["joint"] for r in criterion["rules"] if r["rule"] == "joint"}
-    out = {"objects": {}, "joints": {}, "contact": []}
+    messages, warnings = stamps.read_in_stamp_order(bag, wanted)
+    out = {"objects": {}, "joints": {}, "contact": [], "warnings": warnings}
     touch, tcp = {}, {}
-    for topic, msg, t in bag.read_messages(topics=wanted):
+    for topic, msg, stamp in messages:
         if topic in names:
             p, q = msg.pose.position, msg.pose.orientation
             out["objects"][names[topic]] = {"position": [p.x, p.y, p.z], "orientation": [q.w, q.x, q.y, q.z]}
@@ -141,11 +142,10 @@ def measure(bag, criterion, base_in_world):
                 if name in joint_names:
                     out["joints"][name] = value
         elif topic == TOUCH_TOPIC and msg.values:
-            touch[round(msg.header.stamp.to_sec(), 4)] = sum(msg.values) / len(msg.values)
+            touch[round(stamp, 4)] = sum(msg.values) / len(msg.values)
         elif topic == EE_TOPIC:
             p = msg.pose.position
-            tcp[round(msg.header.stamp.to_sec(), 4)] = [p.x + base_in_world[0], p.y + base_in_world[1],
-                                                         p.z + base_in_world[2]]
+            tcp[round(stamp, 4)] = [p.x + base_in_world[0], p.y + base_in_world[1], p.z + base_in_world[2]]
     out["contact"] = [(stamp, touch[stamp], tcp[stamp]) for stamp in sorted(touch) if stamp in tcp]
     return out
 
@@ -157,15 +157,15 @@ def physical_outcome(path, task, scene):
     criterion = tasks.success_criterion(task)
     with rosbag.Bag(path) as bag:
         measured = measure(bag, criterion, tasks.base_in_world())
-    return judge.judge_rules(criterion, measured, scene, tasks.table_top())
+    return dict(judge.judge_rules(criterion, measured, scene, tasks.table_top()), warnings=measured["warnings"])
 
 
 def demo_outcome(path):
     """Physical success of a recorded demonstration, from its bag alone: the task and the scene
     (goal) from its metadata (the first message, /lfd/metadata extra_json), judged with the task
     file's criterion. A dict: bag, task, mode, configuration, speed, success, distance_m, height_m,
-    rules, duration, topics (name -> count), reason."""
-    result = {"bag": path, "success": False, "reason": ""}
+    rules, duration, topics (name -> count), reason, warnings (stamps put in order)."""
+    result = {"bag": path, "success": False, "reason": "", "warnings": []}
     try:
         with rosbag.Bag(path) as bag:
             info = bag.get_type_and_topic_info().topics
@@ -185,5 +185,5 @@ def demo_outcome(path):
         return result
     outcome = judge.judge_rules(criterion, measured, scene, tasks.table_top())
     result.update(success=outcome["success"], distance_m=outcome["distance_m"], height_m=outcome["height_m"],
-                  rules=outcome["rules"], reason=outcome["reason"])
+                  rules=outcome["rules"], reason=outcome["reason"], warnings=measured["warnings"])
     return result

@@ -25,6 +25,40 @@ def load_yaml(path):
         return yaml.safe_load(f)
 
 
+class _BoundedLoader(yaml.SafeLoader):
+    """yaml.SafeLoader composing at most `max_depth` mappings and lists within one another: PyYAML's
+    composer recurses once per level, and a deeply nested file ended in a RecursionError."""
+    max_depth = 0
+
+    def __init__(self, stream):
+        super().__init__(stream)
+        self._depth = 0
+
+    def compose_sequence_node(self, anchor):
+        return self._nested(super().compose_sequence_node, anchor)
+
+    def compose_mapping_node(self, anchor):
+        return self._nested(super().compose_mapping_node, anchor)
+
+    def _nested(self, compose, anchor):
+        self._depth += 1
+        try:
+            if self._depth > self.max_depth:
+                raise yaml.composer.ComposerError(None, None, "nested deeper than %d levels" % self.max_depth,
+                                                  self.peek_event().start_mark)
+            return compose(anchor)
+        finally:
+            self._depth -= 1
+
+
+def load_yaml_bounded(path, max_depth):
+    """A YAML file of untrusted shape (its bytes decoded as YAML says: UTF-8 unless a BOM tells
+    otherwise), at most `max_depth` collections deep. Raises yaml.YAMLError."""
+    loader = type("BoundedLoader", (_BoundedLoader,), {"max_depth": max_depth})
+    with open(path, "rb") as f:
+        return yaml.load(f, Loader=loader)
+
+
 def load_evaluation(path=None):
     """config/evaluation.yaml (the segmentation protocol: tolerance_s, methods), checked (a clear
     error, not a KeyError in the middle of a run)."""

@@ -137,10 +137,11 @@ RULE_PARAMETERS = {  # rule -> (required, optional)
 DISTANCES = ("xyz", "xy")  # 3-D distance to the goal, or horizontal distance
 
 
-def check_rule(rule, objects, joints):
+def check_rule(rule, objects, joints, max_seconds=math.inf):
     """Raises ValueError naming what is wrong with one rule of a criterion; `objects` are the names
-    a rule may judge (the task's objects and their frames), `joints` its articulated joints."""
-    if not isinstance(rule, dict) or rule.get("rule") not in RULE_PARAMETERS:
+    a rule may judge (the task's objects and their frames), `joints` its articulated joints,
+    `max_seconds` the longest time (a parameter named *_s) a task file may give."""
+    if not isinstance(rule, dict) or not isinstance(rule.get("rule"), str) or rule["rule"] not in RULE_PARAMETERS:
         raise ValueError("expected {rule: %s, ...}" % " | ".join(sorted(RULE_PARAMETERS)))
     required, optional = RULE_PARAMETERS[rule["rule"]]
     keys = set(rule) - {"rule"}
@@ -148,7 +149,7 @@ def check_rule(rule, objects, joints):
         raise ValueError("rule %s lacks %s" % (rule["rule"], ", ".join(sorted(required - keys))))
     if keys - required - optional:
         raise ValueError("rule %s: unknown key(s) %s" % (rule["rule"], ", ".join(sorted(keys - required - optional))))
-    if "object" in rule and rule["object"] not in objects:
+    if "object" in rule and (not isinstance(rule["object"], str) or rule["object"] not in objects):
         raise ValueError("'%s' is not an object (or object.frame) of the task (%s)"
                          % (rule["object"], ", ".join(sorted(objects)) or "none"))
     if "joint" in rule and rule["joint"] not in joints:
@@ -160,6 +161,9 @@ def check_rule(rule, objects, joints):
     for key in keys - {"object", "distance", "joint"}:
         if not isinstance(rule[key], (int, float)) or isinstance(rule[key], bool) or not math.isfinite(rule[key]):
             raise ValueError("%s must be a number" % key)
+        if key.endswith("_s") and rule[key] > max_seconds:
+            raise ValueError("%s: %g s is over %g s (task_limits/max_step_seconds of the scene file)"
+                             % (key, rule[key], max_seconds))
 
 
 def _yaw(q):

@@ -70,11 +70,12 @@ class LiveRecording(object):
             sub.unregister()
 
     def read_messages(self, topics=None):
-        """(topic, message, stamp) in stamp order, as rosbag.Bag.read_messages."""
-        items = [(m.header.stamp, t, m) for t, ms in self.messages.items()
-                 if topics is None or t in topics for m in ms]
-        for stamp, topic, msg in sorted(items, key=lambda x: x[0]):
-            yield topic, msg, stamp
+        """(topic, message, stamp) in arrival order, as rosbag.Bag.read_messages (its readers put
+        them in stamp order: lfd_tools.stamps)."""
+        for topic, ms in self.messages.items():
+            if topics is None or topic in topics:
+                for m in ms:
+                    yield topic, m, m.header.stamp
 
 
 def execute_goal(library, scene, duration_scale=1.0, allow_extrapolation=False, dry_run=False):

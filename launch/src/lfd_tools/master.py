@@ -45,6 +45,20 @@ def master_online(env=None):
     return bool(uri) and rosgraph.is_master_online(uri)
 
 
+def roscore_on(port, env):
+    """A roscore on `port` with `env` once its port is open, or None when it exited at start (the
+    port was taken)."""
+    core = subprocess.Popen(["roscore", "-p", str(port)], env=env, stdout=subprocess.DEVNULL,
+                            stderr=subprocess.DEVNULL, start_new_session=True)
+    deadline = time.time() + START_TIMEOUT_S
+    while not port_open(port) and core.poll() is None:
+        if time.time() > deadline:
+            stop_group(core, 15)
+            raise RuntimeError("roscore did not come up on port %d" % port)
+        time.sleep(0.2)
+    return core if core.poll() is None else None
+
+
 def start_roscore():
     """(process, env) of a roscore on a free port. The port is free when chosen, but another
     process (a second master's servers, starting at the same time) may take it before roscore
@@ -52,15 +66,8 @@ def start_roscore():
     for _ in range(START_ATTEMPTS):
         port = free_port()
         env = dict(os.environ, ROS_MASTER_URI=master_uri(port))
-        core = subprocess.Popen(["roscore", "-p", str(port)], env=env, stdout=subprocess.DEVNULL,
-                                stderr=subprocess.DEVNULL, start_new_session=True)
-        deadline = time.time() + START_TIMEOUT_S
-        while not port_open(port) and core.poll() is None:
-            if time.time() > deadline:
-                stop_group(core, 15)
-                raise RuntimeError("roscore did not come up on port %d" % port)
-            time.sleep(0.2)
-        if core.poll() is None:
+        core = roscore_on(port, env)
+        if core is not None:
             return core, env
     raise RuntimeError("roscore exited at start %d times (last port %d)" % (START_ATTEMPTS, port))
 

@@ -10,18 +10,25 @@ its objects. The objects a task does not use wait at their `parked` poses.
 Task files are found in config/tasks/ and in the folders of $LFD_TASKS_PATH (colon-separated,
 searched first), so a task of one's own needs no change to the repository: a file
 <folder>/<name>.yaml is the task <name>.
+
+A task file is checked once, by the demonstrator's own loader (lfd_sim_bridge's check_task: the
+format, every number finite, every time within the scene's task_limits), then read here within the
+same bounds, and its success criterion checked by the judge's rules: one check of the format, not
+two that could disagree.
 """
 import glob
 import math
 import os
+import subprocess
+
+import yaml
 
 from lfd_tools import config as lfd_config
 from lfd_tools import judge
 
 MODES = ("sim", "teleop")
 TASKS_PATH_VAR = "LFD_TASKS_PATH"
-TOP_KEYS = {"description", "objects", "goal", "gripper_at_start", "variation", "teleop_placement",
-            "frames", "phases", "success", "configurations", "unseen"}
+CHECK_TIMEOUT_S = 30.0  # check_task reads one small file: seconds would mean it hangs
 _cache = {}
 
 
@@ -65,12 +72,10 @@ def task_file(task):
                        % (task, ", ".join(directories()), ", ".join(names())))
 
 
-def _load(path, check):
+def _load(path, read):
     key = (path, os.path.getmtime(path))
     if key not in _cache:
-        data = lfd_config.load_yaml(path)
-        check(data, path)
-        _cache[key] = data
+        _cache[key] = read(path)
     return _cache[key]
 
 
@@ -79,18 +84,25 @@ def scene_file():
 
 
 def scene():
-    """config/scene.yaml: table_top, base_link_in_world, tool_orientation, objects."""
-    return _load(scene_file(), _check_scene)
+    """config/scene.yaml: table_top, base_link_in_world, tool_orientation, objects, task_limits."""
+    return _load(scene_file(), _read_scene)
 
 
-def _check_scene(data, path):
-    for key in ("table_top", "base_link_in_world", "objects"):
+def task_limits():
+    """{max_step_seconds, max_nesting_depth}: the bounds of every task file (config/scene.yaml)."""
+    return scene()["task_limits"]
+
+
+def _read_scene(path):
+    data = lfd_config.load_yaml(path)
+    for key in ("table_top", "base_link_in_world", "objects", "task_limits"):
         if not isinstance(data, dict) or key not in data:
             raise RuntimeError("scene file '%s': '%s' is missing" % (path, key))
+    return data
 
 
 def _task(task):
-    return _load(task_file(task), _check_task)
+    return _load(task_file(task), read_task_file)
 
 
 def names():
@@ -217,29 +229,46 @@ def success_criterion(task):
 # ---- checks ---------------------------------------------------------------------------------------
 
 
-def _check_task(data, path):
-    """What the scripts rely on, with an error naming the file and the key (the demonstrator
-    checks the phases and primitives it runs)."""
+def read_task_file(path):
+    """A task file's content, checked: RuntimeError naming the file (and the key) otherwise."""
+    check_format(path)
+    try:
+        data = lfd_config.load_yaml_bounded(path, task_limits()["max_nesting_depth"])
+    except yaml.YAMLError as exc:
+        raise RuntimeError("task file '%s' cannot be read: %s" % (path, exc))
+    _check_success(data, path)
+    return data
+
+
+def check_format(path):
+    """The task format, checked by the demonstrator's loader (lfd_sim_bridge check_task)."""
+    from catkin.find_in_workspaces import find_in_workspaces
+    found = find_in_workspaces(search_dirs=["libexec"], project="lfd_sim_bridge", path="check_task")
+    if not found:
+        raise RuntimeError("lfd_sim_bridge's check_task is not built (./lfd build): task files cannot be checked")
+    try:
+        done = subprocess.run([found[0], "--scene", scene_file(), path], stdout=subprocess.DEVNULL,
+                              stderr=subprocess.PIPE, universal_newlines=True, errors="replace",
+                              timeout=CHECK_TIMEOUT_S)
+    except subprocess.TimeoutExpired:
+        raise RuntimeError("task file '%s': check_task took over %.0f s" % (path, CHECK_TIMEOUT_S))
+    if done.returncode in (1, 2):
+        raise RuntimeError(done.stderr.strip())
+    if done.returncode != 0:
+        raise RuntimeError("task file '%s': check_task failed (status %d): %s"
+                           % (path, done.returncode, done.stderr.strip()))
+
+
+def _check_success(data, path):
+    """The success criterion (the judge's rules; the demonstrator never judges), with an error
+    naming the file and the key."""
     def fail(key, what):
         raise RuntimeError("task file '%s': %s: %s" % (path, key, what))
 
-    if not isinstance(data, dict):
-        fail("(top level)", "expected a mapping")
-    unknown = set(data) - TOP_KEYS
-    if unknown:
-        fail("(top level)", "unknown key(s) %s" % ", ".join(sorted(unknown)))
-    objs = data.get("objects")
-    if not isinstance(objs, list):
-        fail("objects", "expected a list of scene objects ([] for none)")
     known = scene()["objects"]
-    for o in objs:
-        if o not in known:
-            fail("objects", "'%s' is not an object of the scene file '%s'" % (o, scene_file()))
-    phases_ = data.get("phases")
-    if not isinstance(phases_, list) or not phases_ or not all(isinstance(p, dict) and p.get("name") for p in phases_):
-        fail("phases", "expected a list of {name, steps}")
-    if phases_[0].get("window") or phases_[-1].get("window"):
-        fail("phases", "the first and the last phase are skills, not windows")
+    objs = data.get("objects") if isinstance(data, dict) else None
+    if not isinstance(objs, list) or not all(isinstance(o, str) and o in known for o in objs):
+        fail("objects", "not read as check_task read them")
     parts = {"%s.%s" % (o, f) for o in objs for f in (known[o].get("frames") or {})}
     task_joints = [j for o in objs for j in (known[o].get("joints") or {})]
     rules = data.get("success")
@@ -247,22 +276,6 @@ def _check_task(data, path):
         fail("success", "expected a list of rules")
     for i, rule in enumerate(rules):
         try:
-            judge.check_rule(rule, set(objs) | parts, task_joints)
+            judge.check_rule(rule, set(objs) | parts, task_joints, task_limits()["max_step_seconds"])
         except ValueError as exc:
             fail("success[%d]" % i, str(exc))
-    for section, required in (("configurations", True), ("unseen", False)):
-        for mode in MODES:
-            entries = (data.get(section) or {}).get(mode)
-            if entries is None and not required:
-                continue
-            key = "%s.%s" % (section, mode)
-            if not isinstance(entries, list) or (required and not entries):
-                fail(key, "expected a non-empty list of scenes")
-            for k, e in enumerate(entries):
-                missing = [x for x in ["id", "goal"] + objs if not isinstance(e, dict) or x not in e]
-                if missing:
-                    fail("%s[%d]" % (key, k), "lacks %s" % ", ".join(missing))
-                try:
-                    [pose(e[x]) for x in ["goal"] + objs]
-                except (ValueError, TypeError, KeyError) as exc:
-                    fail("%s[%d]" % (key, k), "bad pose: %s" % exc)

@@ -40,8 +40,16 @@ struct SceneObject {
   std::map<std::string, SceneJoint> joints;             // articulated joints
 };
 
+// Bounds of every task file, written once in the scene file's task_limits (config/scene.yaml),
+// where both loaders read them: this one and lfd_tools.tasks.
+struct TaskLimits {
+  double max_step_seconds = 0.0;  // any time of a task file: a duration, a hold, a settle
+  int max_nesting_depth = 0;      // mappings and lists within one another (the file is 1)
+};
+
 struct Scene {
   std::string path;
+  TaskLimits task_limits;
   double table_top = 0.0;                                   // world z of the table surface
   Eigen::Vector3d base_in_world = Eigen::Vector3d::Zero();  // base_link (no rotation)
   Eigen::Quaterniond tool_orientation = Eigen::Quaterniond::Identity();  // TCP at yaw 0
@@ -134,7 +142,9 @@ struct TaskDefinition {
 
 // Throws std::runtime_error naming the file and the key: a missing or malformed entry, an unknown
 // object, frame or primitive, a guarded move that is not the last step of its phase, a carry
-// before any gripper close.
+// before any gripper close, a number that is not finite, a time over the scene's
+// max_step_seconds; and naming the file: bytes that are not printable UTF-8 text, nesting deeper
+// than max_nesting_depth, a key given twice, a tag (task files use none).
 TaskDefinition loadTask(const std::string& path, const Scene& scene);
 
 // <dir>/<name>.yaml
