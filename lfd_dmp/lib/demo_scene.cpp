@@ -1,5 +1,7 @@
 #include "lfd_dmp/demo_scene.hpp"
 
+#include <geometry_msgs/TransformStamped.h>
+#include <tf2/buffer_core.h>
 #include <nlohmann/json.hpp>
 
 #include <cmath>
@@ -86,39 +88,57 @@ lfd::Scene transformScene(const lfd::Scene& scene, const Eigen::Isometry3d& fram
   return out;
 }
 
+namespace {
+
+// tf2 drops a leading '/' of the frames it stores ("/world" is "world") but refuses one in a
+// lookup: drop it there too, so that a tf1-era name finds its frame.
+std::string tf2Frame(const std::string& frame) {
+  return !frame.empty() && frame.front() == '/' ? frame.substr(1) : frame;
+}
+
+}  // namespace
+
+StaticTransforms::StaticTransforms() : buffer_(std::make_unique<tf2::BufferCore>()) {}
+StaticTransforms::~StaticTransforms() = default;
+StaticTransforms::StaticTransforms(StaticTransforms&&) noexcept = default;
+StaticTransforms& StaticTransforms::operator=(StaticTransforms&&) noexcept = default;
+
 void StaticTransforms::add(const std::string& parent, const std::string& child,
                            const Eigen::Isometry3d& child_in_parent) {
-  if (parent.empty() || child.empty() || parent == child)
+  // Checked here: BufferCore would only log these and drop the transform.
+  if (tf2Frame(parent).empty() || tf2Frame(child).empty() || tf2Frame(parent) == tf2Frame(child))
     throw std::runtime_error("static transform '" + parent + "' -> '" + child + "' is not valid");
   if (!child_in_parent.matrix().allFinite())
     throw std::runtime_error("static transform '" + parent + "' -> '" + child + "' is not finite");
-  parent_[child] = {parent, child_in_parent};
-}
-
-Eigen::Isometry3d StaticTransforms::inRoot(const std::string& frame, std::string* root) const {
-  Eigen::Isometry3d t = Eigen::Isometry3d::Identity();
-  std::string f = frame;
-  for (size_t depth = 0; depth <= parent_.size(); ++depth) {
-    const auto it = parent_.find(f);
-    if (it == parent_.end()) {
-      *root = f;
-      return t;
-    }
-    t = it->second.second * t;
-    f = it->second.first;
-  }
-  throw std::runtime_error("static transforms form a loop through '" + frame + "'");
+  geometry_msgs::TransformStamped t;
+  t.header.frame_id = parent;
+  t.child_frame_id = child;
+  const Eigen::Vector3d p = child_in_parent.translation();
+  const Eigen::Quaterniond q(child_in_parent.rotation());
+  t.transform.translation.x = p.x();
+  t.transform.translation.y = p.y();
+  t.transform.translation.z = p.z();
+  t.transform.rotation.w = q.w();
+  t.transform.rotation.x = q.x();
+  t.transform.rotation.y = q.y();
+  t.transform.rotation.z = q.z();
+  if (!buffer_->setTransform(t, "bag", /*is_static=*/true))
+    throw std::runtime_error("static transform '" + parent + "' -> '" + child +
+                             "' is refused by tf2");
+  empty_ = false;
 }
 
 Eigen::Isometry3d StaticTransforms::lookup(const std::string& target,
                                            const std::string& source) const {
   if (target == source) return Eigen::Isometry3d::Identity();
-  std::string root_target, root_source;
-  const Eigen::Isometry3d target_in_root = inRoot(target, &root_target);
-  const Eigen::Isometry3d source_in_root = inRoot(source, &root_source);
-  if (root_target != root_source)
-    throw std::runtime_error("no static transform connects '" + source + "' to '" + target + "'");
-  return target_in_root.inverse() * source_in_root;
+  // Static transforms hold at every time: time 0 is "the latest".
+  const geometry_msgs::Transform t =
+      buffer_->lookupTransform(tf2Frame(target), tf2Frame(source), ros::Time()).transform;
+  Eigen::Isometry3d out = Eigen::Isometry3d::Identity();
+  out.translation() = Eigen::Vector3d(t.translation.x, t.translation.y, t.translation.z);
+  out.linear() =
+      Eigen::Quaterniond(t.rotation.w, t.rotation.x, t.rotation.y, t.rotation.z).toRotationMatrix();
+  return out;
 }
 
 }  // namespace lfd_dmp

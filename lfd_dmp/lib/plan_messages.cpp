@@ -5,18 +5,6 @@
 
 namespace lfd_dmp {
 
-geometry_msgs::Pose toPoseMsg(const lfd::Pose& p) {
-  geometry_msgs::Pose m;
-  m.position.x = p.position.x();
-  m.position.y = p.position.y();
-  m.position.z = p.position.z();
-  m.orientation.w = p.orientation.w();
-  m.orientation.x = p.orientation.x();
-  m.orientation.y = p.orientation.y();
-  m.orientation.z = p.orientation.z();
-  return m;
-}
-
 trajectory_msgs::JointTrajectory toJointTrajectory(const ExecutionPlan& plan,
                                                    const ros::Time& start, double period) {
   trajectory_msgs::JointTrajectory msg;

@@ -18,6 +18,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <random>
 
 namespace {
 
@@ -424,6 +425,58 @@ TEST(DemoScene, StaticTransformsChainAndRefuseWhatDoesNotConnect) {
                    R"({"object": "s", "object_start": {"position": [0, 0, 0],)"
                    R"( "orientation": [0, 0, 0, 0]}, "goal": {"position": [0, 0, 0]}})"),
                std::runtime_error);
+}
+
+// A transform of random rotation and translation (seeded: the same every run).
+Eigen::Isometry3d randomTransform(std::mt19937& rng) {
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  Eigen::Isometry3d t = Eigen::Isometry3d::Identity();
+  t.linear() = Eigen::Quaterniond(u(rng), u(rng), u(rng), u(rng)).normalized().toRotationMatrix();
+  t.translation() = Eigen::Vector3d(u(rng), u(rng), u(rng));
+  return t;
+}
+
+// Lookups chain through the tree as the products of the transforms along it: up from the source
+// to the frame both descend from, down to the target (here across two branches of depth 3).
+TEST(DemoScene, StaticTransformsChainedLookupsEqualTheProducts) {
+  std::mt19937 rng(7);
+  const Eigen::Isometry3d base_in_world = randomTransform(rng),
+                          chest_in_base = randomTransform(rng),
+                          camera_in_chest = randomTransform(rng),
+                          table_in_world = randomTransform(rng),
+                          box_in_table = randomTransform(rng);
+  lfd_dmp::StaticTransforms tf;
+  EXPECT_TRUE(tf.empty());
+  tf.add("world", "base_link", base_in_world);
+  tf.add("base_link", "chest", chest_in_base);
+  tf.add("chest", "head_camera", camera_in_chest);
+  tf.add("world", "table", table_in_world);
+  tf.add("/table", "box", box_in_table);  // tf2 drops the leading '/': the same "table"
+  EXPECT_FALSE(tf.empty());
+
+  const Eigen::Isometry3d camera_in_world = base_in_world * chest_in_base * camera_in_chest;
+  const Eigen::Isometry3d box_in_world = table_in_world * box_in_table;
+  auto expectNear = [](const Eigen::Isometry3d& got, const Eigen::Isometry3d& want) {
+    EXPECT_LT((got.matrix() - want.matrix()).cwiseAbs().maxCoeff(), 1e-12) << got.matrix();
+  };
+  expectNear(tf.lookup("world", "head_camera"), camera_in_world);
+  expectNear(tf.lookup("head_camera", "world"), camera_in_world.inverse());
+  expectNear(tf.lookup("box", "head_camera"), box_in_world.inverse() * camera_in_world);
+  expectNear(tf.lookup("chest", "box"), (base_in_world * chest_in_base).inverse() * box_in_world);
+  expectNear(tf.lookup("/world", "box"), box_in_world);
+  // A point through the chain and back is where it started.
+  const Eigen::Vector3d p(0.3, -0.2, 0.9);
+  EXPECT_LT((tf.lookup("box", "head_camera") * (tf.lookup("head_camera", "box") * p) - p).norm(),
+            1e-12);
+  // A frame given a new parent moves with it (a later /tf_static message replaces the former).
+  tf.add("chest", "box", box_in_table);
+  expectNear(tf.lookup("world", "box"), base_in_world * chest_in_base * box_in_table);
+  EXPECT_THROW(tf.lookup("world", "nowhere"), std::runtime_error);
+  EXPECT_THROW(tf.add("", "a", box_in_table), std::runtime_error);
+  EXPECT_THROW(tf.add("/a", "a", box_in_table), std::runtime_error);
+  Eigen::Isometry3d bad = box_in_table;
+  bad.translation().x() = std::nan("");
+  EXPECT_THROW(tf.add("world", "c", bad), std::runtime_error);
 }
 
 }  // namespace

@@ -12,10 +12,9 @@
 // CLI reports changepoint_times), or seconds from the bag's start with --relative. Writes
 // DIR/snapshot_<k>_<t>s.png and prints one "t file" line per picture.
 //
-// Rendering needs no display: an OSMesa context (libOSMesa, loaded at run time so the package
-// does not link it; MuJoCo's GL loader then finds OSMesaGetProcAddress in the process).
+// Rendering needs no display: an OSMesa context (libOSMesa, linked; MuJoCo's GL loader finds
+// OSMesaGetProcAddress in the process). The pictures are encoded by libpng (png_file.hpp).
 #include <GL/osmesa.h>
-#include <dlfcn.h>
 #include <mujoco/mujoco.h>
 #include <rosbag/bag.h>
 #include <rosbag/view.h>
@@ -30,7 +29,6 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
 #include <iostream>
 #include <map>
 #include <memory>
@@ -38,6 +36,8 @@
 #include <stdexcept>
 #include <string>
 #include <vector>
+
+#include "lfd_sim_bridge/png_file.hpp"
 
 namespace {
 
@@ -256,138 +256,25 @@ void apply_state(const mjModel* m, mjData* d, const Recording& r, double t) {
   mj_forward(m, d);
 }
 
-// ---- PNG -------------------------------------------------------------------------------------
-
-std::uint32_t crc32(const std::uint8_t* data, std::size_t n, std::uint32_t crc = 0) {
-  static const auto table = [] {
-    std::array<std::uint32_t, 256> t{};
-    for (std::uint32_t i = 0; i < 256; ++i) {
-      std::uint32_t c = i;
-      for (int k = 0; k < 8; ++k) c = (c & 1) ? 0xEDB88320u ^ (c >> 1) : c >> 1;
-      t[i] = c;
-    }
-    return t;
-  }();
-  crc = ~crc;
-  for (std::size_t i = 0; i < n; ++i) crc = table[(crc ^ data[i]) & 0xFF] ^ (crc >> 8);
-  return ~crc;
-}
-
-void put_u32(std::vector<std::uint8_t>& out, std::uint32_t v) {
-  for (int s = 24; s >= 0; s -= 8) out.push_back(static_cast<std::uint8_t>(v >> s));
-}
-
-// A zlib stream of data: compressed by the system's libz when it loads (dlopen: no link-time
-// dependency), else stored deflate blocks (valid PNG data, ~4x larger).
-std::vector<std::uint8_t> zlib_compress(const std::vector<std::uint8_t>& data) {
-  using Compress2 =
-      int (*)(unsigned char*, unsigned long*, const unsigned char*, unsigned long, int);
-  using CompressBound = unsigned long (*)(unsigned long);
-  static void* libz = dlopen("libz.so.1", RTLD_NOW | RTLD_LOCAL);
-  if (libz) {
-    auto compress2 = reinterpret_cast<Compress2>(dlsym(libz, "compress2"));
-    auto bound = reinterpret_cast<CompressBound>(dlsym(libz, "compressBound"));
-    if (compress2 && bound) {
-      unsigned long size = bound(data.size());
-      std::vector<std::uint8_t> out(size);
-      if (compress2(out.data(), &size, data.data(), data.size(), 6) == 0) {  // Z_OK
-        out.resize(size);
-        return out;
-      }
-    }
-  }
-  std::vector<std::uint8_t> z = {0x78, 0x01};  // zlib header, stored blocks
-  for (std::size_t pos = 0; pos < data.size() || pos == 0; pos += 65535) {
-    std::size_t len = std::min<std::size_t>(65535, data.size() - pos);
-    z.push_back(pos + len >= data.size() ? 1 : 0);
-    z.push_back(static_cast<std::uint8_t>(len & 0xFF));
-    z.push_back(static_cast<std::uint8_t>(len >> 8));
-    z.push_back(static_cast<std::uint8_t>(~len & 0xFF));
-    z.push_back(static_cast<std::uint8_t>((~len >> 8) & 0xFF));
-    z.insert(z.end(), data.begin() + static_cast<std::ptrdiff_t>(pos),
-             data.begin() + static_cast<std::ptrdiff_t>(pos + len));
-    if (len == 0) break;
-  }
-  std::uint32_t a = 1, b = 0;  // adler32 of the uncompressed data
-  for (std::uint8_t v : data) {
-    a = (a + v) % 65521;
-    b = (b + a) % 65521;
-  }
-  put_u32(z, (b << 16) | a);
-  return z;
-}
-
-void write_chunk(std::ofstream& f, const char* type, const std::vector<std::uint8_t>& data) {
-  std::vector<std::uint8_t> chunk;
-  put_u32(chunk, static_cast<std::uint32_t>(data.size()));
-  chunk.insert(chunk.end(), type, type + 4);
-  chunk.insert(chunk.end(), data.begin(), data.end());
-  std::uint32_t crc = crc32(chunk.data() + 4, chunk.size() - 4);
-  put_u32(chunk, crc);
-  f.write(reinterpret_cast<const char*>(chunk.data()), static_cast<std::streamsize>(chunk.size()));
-}
-
-// rgb: width*height*3 bytes, top row first.
-void write_png(const std::string& path, const std::vector<std::uint8_t>& rgb, int width,
-               int height) {
-  std::vector<std::uint8_t> raw;  // each row: filter byte 0, then the pixels
-  raw.reserve(static_cast<std::size_t>(height) * (3 * width + 1));
-  for (int y = 0; y < height; ++y) {
-    raw.push_back(0);
-    raw.insert(raw.end(), rgb.begin() + static_cast<std::ptrdiff_t>(y) * 3 * width,
-               rgb.begin() + static_cast<std::ptrdiff_t>(y + 1) * 3 * width);
-  }
-  std::vector<std::uint8_t> z = zlib_compress(raw);
-
-  std::ofstream f(path, std::ios::binary);
-  if (!f) throw std::runtime_error("cannot write '" + path + "'");
-  const std::uint8_t signature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n'};
-  f.write(reinterpret_cast<const char*>(signature), 8);
-  std::vector<std::uint8_t> header;
-  put_u32(header, static_cast<std::uint32_t>(width));
-  put_u32(header, static_cast<std::uint32_t>(height));
-  header.insert(header.end(), {8, 2, 0, 0, 0});  // 8-bit RGB, no interlace
-  write_chunk(f, "IHDR", header);
-  write_chunk(f, "IDAT", z);
-  write_chunk(f, "IEND", {});
-  if (!f) throw std::runtime_error("cannot write '" + path + "'");
-}
-
 // ---- offscreen GL -----------------------------------------------------------------------------
 
-// An OSMesa context with its own pixel buffer, loaded with dlopen.
+// An OSMesa context with its own pixel buffer.
 class OffscreenGL {
  public:
   OffscreenGL(int width, int height) : buffer_(static_cast<std::size_t>(width) * height * 4) {
-    for (const char* name : {"libOSMesa.so.8", "libOSMesa.so"}) {
-      lib_ = dlopen(name, RTLD_NOW | RTLD_GLOBAL);
-      if (lib_) break;
-    }
-    if (!lib_) throw std::runtime_error("cannot load libOSMesa (apt install libosmesa6)");
-    auto create = reinterpret_cast<OSMesaContext (*)(GLenum, GLint, GLint, GLint, OSMesaContext)>(
-        dlsym(lib_, "OSMesaCreateContextExt"));
-    auto make_current =
-        reinterpret_cast<GLboolean (*)(OSMesaContext, void*, GLenum, GLsizei, GLsizei)>(
-            dlsym(lib_, "OSMesaMakeCurrent"));
-    destroy_ = reinterpret_cast<void (*)(OSMesaContext)>(dlsym(lib_, "OSMesaDestroyContext"));
-    if (!create || !make_current || !destroy_)
-      throw std::runtime_error("libOSMesa lacks OSMesaCreateContextExt/MakeCurrent/Destroy");
-    context_ = create(OSMESA_RGBA, 24, 8, 0, nullptr);
+    context_ = OSMesaCreateContextExt(OSMESA_RGBA, 24, 8, 0, nullptr);
     if (!context_) throw std::runtime_error("OSMesaCreateContextExt failed");
-    if (!make_current(context_, buffer_.data(), GL_UNSIGNED_BYTE, width, height))
+    if (!OSMesaMakeCurrent(context_, buffer_.data(), GL_UNSIGNED_BYTE, width, height))
       throw std::runtime_error("OSMesaMakeCurrent failed");
   }
   ~OffscreenGL() {
-    if (context_) destroy_(context_);
-    // lib_ stays loaded: MuJoCo keeps GL function pointers into it until exit.
+    if (context_) OSMesaDestroyContext(context_);
   }
   OffscreenGL(const OffscreenGL&) = delete;
   OffscreenGL& operator=(const OffscreenGL&) = delete;
 
  private:
-  void* lib_ = nullptr;
   OSMesaContext context_ = nullptr;
-  void (*destroy_)(OSMesaContext) = nullptr;
   std::vector<std::uint8_t> buffer_;
 };
 
@@ -453,7 +340,7 @@ int run(const Options& o) {
     char name[64];
     std::snprintf(name, sizeof(name), "snapshot_%02zu_%.2fs.png", k, times[k] - rec.start);
     std::string file = (std::filesystem::path(o.out) / name).string();
-    write_png(file, rgb, o.width, o.height);
+    lfd_sim_bridge::writePng(file, rgb, o.width, o.height);
     std::printf("%.3f %s\n", times[k] - rec.start, file.c_str());
   }
   mjr_freeContext(&con);

@@ -1,14 +1,13 @@
 #include "lfd_core/dtw.hpp"
+#include "lfd_core/parallel_for.hpp"
 
 #include <algorithm>
-#include <atomic>
 #include <cmath>
 #include <cstdint>
 #include <limits>
 #include <numeric>
 #include <stdexcept>
 #include <string>
-#include <thread>
 
 #include <immintrin.h>  // usable without -mavx: the AVX2 sweep enables the ISA per function
 
@@ -349,44 +348,24 @@ void run_batches(const std::vector<DtwPairView>& pairs, const DtwOptions& option
   const std::size_t groups = (pairs.size() + kDtwLanes - 1) / kDtwLanes;
   costs.assign(pairs.size(), 0.0);
   if (paths) paths->assign(pairs.size(), {});
-  if (threads <= 0) threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
-  threads = static_cast<int>(std::min<std::size_t>(threads, std::max<std::size_t>(groups, 1)));
-
-  std::atomic<std::size_t> next{0};
-  std::exception_ptr error;
-  std::atomic<bool> failed{false};
-  auto worker = [&]() {
-    Workspace ws;
-    try {
-      for (std::size_t g = next++; g < groups && !failed; g = next++) {
-        const DtwPairView* lanes[kDtwLanes];
-        double lane_costs[kDtwLanes] = {};
-        WarpingPath lane_paths[kDtwLanes];
-        const std::size_t first = g * kDtwLanes;
-        const int used = static_cast<int>(std::min<std::size_t>(kDtwLanes, pairs.size() - first));
-        for (int k = 0; k < used; ++k) lanes[k] = &pairs[order[first + k]];
-        if (options.band >= 0) {
-          run_group<kPaths, true>(lanes, used, options.band, ws, lane_costs, lane_paths);
-        } else {
-          run_group<kPaths, false>(lanes, used, options.band, ws, lane_costs, lane_paths);
-        }
-        for (int k = 0; k < used; ++k) {
-          costs[order[first + k]] = lane_costs[k];
-          if (paths) (*paths)[order[first + k]] = std::move(lane_paths[k]);
-        }
-      }
-    } catch (...) {
-      if (!failed.exchange(true)) error = std::current_exception();
+  // One workspace per worker thread: its buffers grow to the largest group and are reused.
+  parallel_for_with_scratch<Workspace>(groups, threads, [&](std::size_t g, Workspace& ws) {
+    const DtwPairView* lanes[kDtwLanes];
+    double lane_costs[kDtwLanes] = {};
+    WarpingPath lane_paths[kDtwLanes];
+    const std::size_t first = g * kDtwLanes;
+    const int used = static_cast<int>(std::min<std::size_t>(kDtwLanes, pairs.size() - first));
+    for (int k = 0; k < used; ++k) lanes[k] = &pairs[order[first + k]];
+    if (options.band >= 0) {
+      run_group<kPaths, true>(lanes, used, options.band, ws, lane_costs, lane_paths);
+    } else {
+      run_group<kPaths, false>(lanes, used, options.band, ws, lane_costs, lane_paths);
     }
-  };
-  if (threads <= 1) {
-    worker();
-  } else {
-    std::vector<std::thread> pool;
-    for (int t = 0; t < threads; ++t) pool.emplace_back(worker);
-    for (std::thread& t : pool) t.join();
-  }
-  if (error) std::rethrow_exception(error);
+    for (int k = 0; k < used; ++k) {
+      costs[order[first + k]] = lane_costs[k];
+      if (paths) (*paths)[order[first + k]] = std::move(lane_paths[k]);
+    }
+  });
 }
 
 }  // namespace

@@ -19,18 +19,6 @@ bool is_weighted(ProfileCombination c) {
          c == ProfileCombination::kWeightedDistanceAverage;
 }
 
-// Zeroth-order modified Bessel function of the first kind (power series; converges for all x).
-double bessel_i0(double x) {
-  double sum = 1.0, term = 1.0;
-  const double q = 0.25 * x * x;
-  for (int k = 1; k < 500; ++k) {
-    term *= q / (static_cast<double>(k) * static_cast<double>(k));
-    sum += term;
-    if (term < 1e-17 * sum) break;
-  }
-  return sum;
-}
-
 }  // namespace
 
 ProfileCombination parse_profile_combination(const std::string& name) {
@@ -112,11 +100,12 @@ Eigen::VectorXd kaiser_window(std::size_t n, double beta) {
     win[0] = 1.0;
     return win;
   }
-  const double norm = bessel_i0(beta);
+  // I0, the zeroth-order modified Bessel function of the first kind (C++17 special math).
+  const double norm = std::cyl_bessel_i(0.0, beta);
   for (std::size_t k = 0; k < n; ++k) {
     const double r = 2.0 * static_cast<double>(k) / static_cast<double>(n - 1) - 1.0;
     win[static_cast<Eigen::Index>(k)] =
-        bessel_i0(beta * std::sqrt(std::max(0.0, 1.0 - r * r))) / norm;
+        std::cyl_bessel_i(0.0, beta * std::sqrt(std::max(0.0, 1.0 - r * r))) / norm;
   }
   return win;
 }

@@ -77,6 +77,9 @@ TEST(KaiserWindow, ShapeAndKnownValues) {
     EXPECT_LT(k[i], k[i + 1]);
     EXPECT_NEAR(k[i], k[100 - i], 1e-12);
   }
+  // Stronger fades: the ends are 1 / I0(beta) (I0 values of scipy.special.i0).
+  EXPECT_NEAR(lfd::kaiser_window(11, 5.0)[0] * 27.239871823604442, 1.0, 1e-13);
+  EXPECT_NEAR(lfd::kaiser_window(11, 10.0)[10] * 2815.716628466254, 1.0, 1e-13);
   EXPECT_TRUE(lfd::kaiser_window(10, 0.0).isOnes());
   EXPECT_THROW(lfd::kaiser_window(10, -1.0), std::invalid_argument);
 }

@@ -5,8 +5,9 @@ display) at the end of each segment.
 The test writes a synthetic 4 s demonstration bag whose second segment moves the right arm and the
 box, runs `snapshot` on it and checks the PNGs: one per segment end, the requested size, the
 table's brown, the robot's grey, the box's green and the stick's orange all present, and the box
-drawn where the bag put it (its green moves between the two pictures by as much as the box moved).
-Bad input (missing bag, a time after the bag's end, an unknown camera) is a clear error.
+drawn where the bag put it (its green moves between the two pictures by as much as the box moved),
+the files valid compressed 8-bit RGB PNGs. Bad input (missing bag, a time after the bag's end, an
+unknown camera) is a clear error.
 """
 import glob
 import os
@@ -145,6 +146,21 @@ class SnapshotRender(unittest.TestCase):
             rgb = np.asarray(Image.open(f).convert("RGB"))
             self.assertEqual(rgb.shape, (240, 320, 3))
             self.assertGreater(int(colour_masks(rgb)["table"].sum()), 1000, f)
+
+    def test_pictures_are_valid_8bit_rgb_png(self):
+        # Encoded by libpng: chunks whose CRCs check, 8-bit RGB without alpha or interlacing, and
+        # compressed (a 640 x 480 scene is far below its 900 KB of raw pixels).
+        out = os.path.join(self.workdir, "format")
+        run = self.snapshot("--out", out, "--times", "end", "--width", "640", "--height", "480")
+        self.assertEqual(run.returncode, 0, run.stderr)
+        files = glob.glob(os.path.join(out, "*.png"))
+        self.assertEqual(len(files), 1)
+        with Image.open(files[0]) as im:
+            im.verify()
+        with Image.open(files[0]) as im:
+            self.assertEqual((im.format, im.mode, im.size), ("PNG", "RGB", (640, 480)))
+            self.assertFalse(im.info.get("interlace"))
+        self.assertLess(os.path.getsize(files[0]), 640 * 480 * 3 // 4)
 
     def test_bad_input_is_a_clear_error(self):
         out = os.path.join(self.workdir, "bad")

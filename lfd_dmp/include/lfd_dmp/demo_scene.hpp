@@ -1,4 +1,4 @@
-// The scene of a demonstration as its bag records it, ROS-free: the `/lfd/metadata` extra_json
+// The scene of a demonstration as its bag records it, master-free: the `/lfd/metadata` extra_json
 // (objects and goal, in a named frame) and the static transforms (`/tf_static`) that bring it into
 // the robot's Cartesian frame, where the learner compares it with the end-effector poses.
 //
@@ -13,8 +13,13 @@
 #include <Eigen/Geometry>
 
 #include <map>
+#include <memory>
 #include <optional>
 #include <string>
+
+namespace tf2 {
+class BufferCore;
+}
 
 namespace lfd_dmp {
 
@@ -31,20 +36,28 @@ std::optional<SceneRecord> sceneFromMetadata(const std::string& extra_json);
 /// The scene with every pose moved by `frame_in_target` (the scene frame's pose in the target).
 lfd::Scene transformScene(const lfd::Scene& scene, const Eigen::Isometry3d& frame_in_target);
 
-/// A tree of static transforms (tf2 semantics: each child has one parent).
+/// A tree of static transforms (a bag's /tf_static), held by tf2's BufferCore: each child has one
+/// parent, a frame name's leading '/' is dropped (tf2's convention), lookups chain through the
+/// tree as tf does.
 class StaticTransforms {
  public:
-  /// `child_in_parent`: the child frame's pose in the parent frame.
+  StaticTransforms();
+  ~StaticTransforms();
+  StaticTransforms(StaticTransforms&&) noexcept;
+  StaticTransforms& operator=(StaticTransforms&&) noexcept;
+
+  /// `child_in_parent`: the child frame's pose in the parent frame (a rigid transform). Throws
+  /// std::runtime_error for an empty or self-referencing pair of frames or a non-finite pose.
   void add(const std::string& parent, const std::string& child,
            const Eigen::Isometry3d& child_in_parent);
-  /// The pose of `source` in `target`. Throws std::runtime_error when they are not connected.
+  /// The pose of `source` in `target`. Throws std::runtime_error (tf2::TransformException) when
+  /// they are not connected.
   Eigen::Isometry3d lookup(const std::string& target, const std::string& source) const;
-  bool empty() const { return parent_.empty(); }
+  bool empty() const { return empty_; }
 
  private:
-  // The frame's pose in the root of its tree, and that root.
-  Eigen::Isometry3d inRoot(const std::string& frame, std::string* root) const;
-  std::map<std::string, std::pair<std::string, Eigen::Isometry3d>> parent_;
+  std::unique_ptr<tf2::BufferCore> buffer_;
+  bool empty_ = true;
 };
 
 }  // namespace lfd_dmp

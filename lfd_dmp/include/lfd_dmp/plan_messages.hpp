@@ -6,6 +6,7 @@
 #include "lfd_dmp/executor.hpp"
 
 #include <lfd_msgs/GripperCommand.h>
+#include <lfd_msgs/pose_msg.h>
 #include <lfd_core/robot_setup.hpp>
 
 #include <geometry_msgs/Pose.h>
@@ -18,7 +19,8 @@
 
 namespace lfd_dmp {
 
-geometry_msgs::Pose toPoseMsg(const lfd::Pose& p);
+/// A TCP pose as its message: the suite's one conversion (the demonstrator's too).
+using lfd_msgs::toPoseMsg;
 
 /// The planned joints every `period` s (and the last sample), velocities by central differences,
 /// header.stamp = `start`: the driver interpolates them on its clock from then on.
