@@ -143,12 +143,19 @@ class TopicReader {
   rosmsg::FieldReader* last_reader_ = nullptr;
 };
 
-// Opens the bag through the file-access layer: rosbag reads the file that was checked, never what
-// the path names by then (a link swapped to a FIFO hung open()).
-void open_bag(rosbag::Bag& bag, const std::string& path) {
+// Opens the bag through the file-access layer's descriptor: rosbag reads the file that was checked,
+// never what the path names by then (a link swapped to a FIFO hung open()).
+void open_bag(rosbag::Bag& bag, const lfd::InputFile& file, const std::string& name) {
   try {
-    const lfd::InputFile file = lfd::openInputFile(path);
     bag.open(file.readPath(), rosbag::bagmode::Read);
+  } catch (const std::exception& e) {
+    throw std::runtime_error("cannot open bag " + lfd::quoted(name) + ": " + e.what());
+  }
+}
+
+lfd::InputFile open_part(const std::string& path, const lfd::PathPolicy& policy = {}) {
+  try {
+    return lfd::openInputFile(path, policy);
   } catch (const std::exception& e) {
     throw std::runtime_error("cannot open bag " + lfd::quoted(path) + ": " + e.what());
   }
@@ -166,10 +173,10 @@ std::string topics_in(rosbag::Bag& bag) {
 // Reads every configured topic of one bag file into the readers, a view per topic as the typed
 // reader did (measured: one view over all topics saved no CPU, its connection merge costs as much
 // as rereading the cached chunks).
-void read_part(const std::string& path, const std::vector<TopicConfig>& topics,
-               std::vector<TopicReader>& readers) {
+void read_part(const lfd::InputFile& file, const std::string& path,
+               const std::vector<TopicConfig>& topics, std::vector<TopicReader>& readers) {
   rosbag::Bag bag;
-  open_bag(bag, path);
+  open_bag(bag, file, path);
   try {
     for (const TopicConfig& cfg : topics) {
       if (rosbag::View(bag, rosbag::TopicQuery(cfg.topic)).size() == 0) {
@@ -260,10 +267,26 @@ void check_request_budget(const std::vector<std::string>& entries, const Request
   }
 }
 
+DemoFiles open_demo_files(const std::string& path, const lfd::PathPolicy& policy) {
+  DemoFiles files;
+  files.path = path;
+  files.names = demo_parts(path);
+  for (const std::string& name : files.names) files.parts.push_back(open_part(name, policy));
+  return files;
+}
+
 std::vector<lfd::Stream> read_bag_streams(const std::string& path,
                                           const std::vector<TopicConfig>& topics,
                                           std::vector<FeatureRole>* roles,
                                           std::vector<std::string>* warnings) {
+  return read_bag_streams(open_demo_files(path), topics, roles, warnings);
+}
+
+std::vector<lfd::Stream> read_bag_streams(const DemoFiles& files,
+                                          const std::vector<TopicConfig>& topics,
+                                          std::vector<FeatureRole>* roles,
+                                          std::vector<std::string>* warnings) {
+  const std::string& path = files.path;
   if (topics.empty()) throw std::invalid_argument("no topics configured for the features");
   for (const TopicConfig& cfg : topics) {
     if (cfg.topic == kGroundTruthTopic) {
@@ -274,7 +297,8 @@ std::vector<lfd::Stream> read_bag_streams(const std::string& path,
   std::vector<TopicReader> readers;
   readers.reserve(topics.size());
   for (const TopicConfig& cfg : topics) readers.emplace_back(cfg);
-  for (const std::string& part : demo_parts(path)) read_part(part, topics, readers);
+  for (std::size_t k = 0; k < files.parts.size(); ++k)
+    read_part(files.parts[k], files.names[k], topics, readers);
   std::vector<lfd::Stream> streams;
   if (roles) roles->clear();
   for (std::size_t k = 0; k < topics.size(); ++k) {
@@ -293,9 +317,15 @@ std::vector<lfd::Stream> read_bag_streams(const std::string& path,
 
 DemoFeatures read_bag_features(const std::string& path, const std::vector<TopicConfig>& topics,
                                double rate, const RequestLimits& limits) {
+  return read_bag_features(open_demo_files(path), topics, rate, limits);
+}
+
+DemoFeatures read_bag_features(const DemoFiles& files, const std::vector<TopicConfig>& topics,
+                               double rate, const RequestLimits& limits) {
+  const std::string& path = files.path;
   std::vector<FeatureRole> roles;
   std::vector<std::string> warnings;
-  const std::vector<lfd::Stream> streams = read_bag_streams(path, topics, &roles, &warnings);
+  const std::vector<lfd::Stream> streams = read_bag_streams(files, topics, &roles, &warnings);
   check_streams(streams, path, limits);
   double start = -INFINITY, end = INFINITY;  // the span resample() keeps: where all streams overlap
   for (const lfd::Stream& s : streams) {
@@ -330,7 +360,8 @@ std::string describe_bag(const std::string& path) {
   std::ostringstream out;
   for (const std::string& part : demo_parts(path)) {
     rosbag::Bag bag;
-    open_bag(bag, part);
+    const lfd::InputFile file = open_part(part);
+    open_bag(bag, file, part);
     out << part << "\n";
     try {
       rosbag::View all(bag);

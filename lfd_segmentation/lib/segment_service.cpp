@@ -1,7 +1,5 @@
 #include "lfd_segmentation/segment_service.hpp"
 
-#include <sys/stat.h>
-
 #include <chrono>
 #include <cmath>
 #include <sstream>
@@ -44,18 +42,16 @@ SegmentationParams apply_overrides(const SegmentationParams& params,
 
 namespace {
 
-// PreparedCache's key: what the bags' features and their selection depend on.
-std::string cache_key(const std::vector<std::string>& paths, const SegmentationParams& p) {
+// PreparedCache's key: what the bags' features and their selection depend on. Each file is named by
+// the identity of the descriptor that is read (device, inode, size, mtime and ctime in ns): a bag
+// replaced by a same-size file with the old mtime (touch -r; mv) is another file, never the cache.
+std::string cache_key(const std::vector<DemoFiles>& demos, const SegmentationParams& p) {
   std::ostringstream key;
   key.precision(17);
   key << "T=" << p.pipeline.relevance.threshold;
-  for (const std::string& path : paths) {
-    for (const std::string& part : demo_parts(path)) {
-      struct stat st {};
-      if (::stat(part.c_str(), &st) != 0) return "";  // not cacheable: read (and fail) afresh
-      key << "|" << part << ":" << st.st_size << ":" << st.st_mtim.tv_sec << "."
-          << st.st_mtim.tv_nsec;
-    }
+  for (const DemoFiles& demo : demos) {
+    for (std::size_t k = 0; k < demo.parts.size(); ++k)
+      key << "|" << demo.names[k] << ":" << demo.parts[k].identity().key();
     key << ";";
   }
   return key.str();
@@ -111,14 +107,17 @@ void handle_segment_request(const SegmentationParams& params,
     }
     const SegmentationParams p = apply_overrides(params, request);
     check_request_budget(request.bag_paths, p.limits, p.paths);  // the expanded work, up front
-    const std::string key = cache_key(request.bag_paths, p);
-    PreparedCache local;  // a request that cannot be cached (no cache, a file not stat-able)
-    PreparedCache& used = cache && !key.empty() ? *cache : local;
+    std::vector<DemoFiles> files;  // opened once: the cache key names what is read
+    for (const std::string& path : request.bag_paths)
+      files.push_back(open_demo_files(path, p.paths));
+    const std::string key = cache_key(files, p);
+    PreparedCache local;  // without a cache
+    PreparedCache& used = cache ? *cache : local;
     const lfd::SegmentationPipelineConfig config = p.pipeline_config();
     if (used.key.empty() || used.key != key) {
       used = PreparedCache{};  // the stale entry goes before anything is read
-      for (const std::string& path : request.bag_paths) {
-        used.demos.push_back(read_bag_features(path, p.topics, p.rate, p.limits));
+      for (const DemoFiles& demo : files) {
+        used.demos.push_back(read_bag_features(demo, p.topics, p.rate, p.limits));
         used.matrices.push_back(used.demos.back().matrix);
       }
       check_demos_fit(p, used.matrices, request.bag_paths);

@@ -101,6 +101,46 @@ TEST_F(SegmentService, ACachedSelectionGivesTheUncachedAnswer) {
   fs::remove(bags[1]);  // good1 is written afresh by the next test that needs it
 }
 
+// Issue 23: a bag replaced by a corrupt file of the same size and modification time (touch -r
+// old new; mv new bag) still got the cached success: the cache was keyed by path, size and mtime.
+// Keyed by the identity of the descriptor read (inode, ctime...), the request reads the new file
+// and fails naming it.
+TEST_F(SegmentService, ABagReplacedBySameSizeSameTimeCorruptFileIsNotTheCachedOne) {
+  const std::vector<std::string> bags = good_bags(2);
+  std::vector<std::string> request_bags;
+  for (std::size_t d = 0; d < bags.size(); ++d) {  // copies: the other tests keep their bags
+    request_bags.push_back((dir_ / ("stale" + std::to_string(d) + ".bag")).string());
+    fs::copy_file(bags[d], request_bags.back(), fs::copy_options::overwrite_existing);
+  }
+  lfd_segmentation::PreparedCache cache;
+  lfd_msgs::Segment::Request request;
+  request.bag_paths = request_bags;
+  lfd_msgs::Segment::Response first;
+  lfd_segmentation::handle_segment_request(params_, request, first, &cache);
+  ASSERT_TRUE(first.success) << first.error;
+
+  const std::string& victim = request_bags[1];
+  struct stat old {};
+  ASSERT_EQ(::stat(victim.c_str(), &old), 0);
+  const std::string fake = (dir_ / "fake.bag").string();
+  std::ofstream(fake, std::ios::binary) << std::string(static_cast<std::size_t>(old.st_size), 'x');
+  const struct timespec times[2] = {old.st_atim, old.st_mtim};
+  ASSERT_EQ(::utimensat(AT_FDCWD, fake.c_str(), times, 0), 0);  // touch -r old new
+  fs::rename(fake, victim);                                     // mv new bag
+  struct stat now {};
+  ASSERT_EQ(::stat(victim.c_str(), &now), 0);
+  ASSERT_EQ(now.st_size, old.st_size);
+  ASSERT_EQ(now.st_mtim.tv_sec, old.st_mtim.tv_sec);
+  ASSERT_EQ(now.st_mtim.tv_nsec, old.st_mtim.tv_nsec);
+
+  lfd_msgs::Segment::Response again;
+  lfd_segmentation::handle_segment_request(params_, request, again, &cache);
+  EXPECT_FALSE(again.success) << "the cached success answered for a corrupt bag";
+  EXPECT_NE(again.error.find("cannot open bag"), std::string::npos) << again.error;
+  EXPECT_NE(again.error.find("stale1.bag"), std::string::npos) << again.error;
+  for (const std::string& b : request_bags) fs::remove(b);
+}
+
 TEST_F(SegmentService, GoodRequestValidatesTheGraspChangepoint) {
   const auto bags = good_bags(3);
   const auto r = call(bags);

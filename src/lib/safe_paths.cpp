@@ -90,22 +90,39 @@ std::string descriptorPath(int fd) {
   return ec ? std::string() : target.string();
 }
 
+FileIdentity identityOf(const struct stat& st) {
+  FileIdentity id;
+  id.device = static_cast<std::uint64_t>(st.st_dev);
+  id.inode = static_cast<std::uint64_t>(st.st_ino);
+  id.size = static_cast<std::uint64_t>(st.st_size);
+  id.mtime_sec = st.st_mtim.tv_sec;
+  id.mtime_nsec = st.st_mtim.tv_nsec;
+  id.ctime_sec = st.st_ctim.tv_sec;
+  id.ctime_nsec = st.st_ctim.tv_nsec;
+  return id;
+}
+
 }  // namespace
 
-InputFile::InputFile(int fd, std::string resolved, std::uint64_t size)
-    : fd_(fd), resolved_(std::move(resolved)), size_(size) {}
+std::string FileIdentity::key() const {
+  return std::to_string(device) + ":" + std::to_string(inode) + ":" + std::to_string(size) + ":" +
+         std::to_string(mtime_sec) + "." + std::to_string(mtime_nsec) + ":" +
+         std::to_string(ctime_sec) + "." + std::to_string(ctime_nsec);
+}
+
+InputFile::InputFile(int fd, std::string resolved) : fd_(fd), resolved_(std::move(resolved)) {}
 
 InputFile::InputFile(InputFile&& other) noexcept
     : fd_(std::exchange(other.fd_, -1)),
       resolved_(std::move(other.resolved_)),
-      size_(other.size_) {}
+      identity_(other.identity_) {}
 
 InputFile& InputFile::operator=(InputFile&& other) noexcept {
   if (this != &other) {
     if (fd_ >= 0) ::close(fd_);
     fd_ = std::exchange(other.fd_, -1);
     resolved_ = std::move(other.resolved_);
-    size_ = other.size_;
+    identity_ = other.identity_;
   }
   return *this;
 }
@@ -132,7 +149,7 @@ InputFile openInputFile(const std::string& path, const PathPolicy& policy,
   const int fd = ::open(resolved.c_str(), O_RDONLY | O_NOFOLLOW | O_NONBLOCK | O_CLOEXEC);
   if (fd < 0)
     refuse(path, errno == ELOOP ? "changed into a link while opening it" : std::strerror(errno));
-  InputFile file(fd, resolved, 0);  // closes the descriptor on every refusal below
+  InputFile file(fd, resolved);  // closes the descriptor on every refusal below
   if (::fstat(fd, &st) != 0) refuse(path, std::strerror(errno));
   if (!S_ISREG(st.st_mode))
     refuse(path, std::string(typeName(st.st_mode)) + ", not a regular file");
@@ -144,7 +161,7 @@ InputFile openInputFile(const std::string& path, const PathPolicy& policy,
   }
   // Readers block as usual on a regular file; O_NONBLOCK was only for the open itself.
   ::fcntl(fd, F_SETFL, ::fcntl(fd, F_GETFL) & ~O_NONBLOCK);
-  file.size_ = size;
+  file.identity_ = identityOf(st);
   return file;
 }
 

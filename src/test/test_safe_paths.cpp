@@ -1,7 +1,8 @@
 // Safe paths (issue 12): regular-file inputs, roots, "..", no output over an input, atomic writes
-// that keep an existing file unless asked to overwrite.
+// that keep an existing file unless asked to overwrite. Issue 23: file identities for caches.
 #include "lfd_core/safe_paths.hpp"
 
+#include <fcntl.h>
 #include <gtest/gtest.h>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -12,6 +13,7 @@
 #include <functional>
 #include <iterator>
 #include <stdexcept>
+#include <thread>
 
 #include "support/error_of.hpp"
 
@@ -169,6 +171,36 @@ TEST_F(SafePaths, AtomicWriteKeepsOrReplaces) {
   const std::string fresh = (dir_ / "root" / "fresh.json").string();
   lfd::writeTextAtomically(fresh, false, "first");
   EXPECT_EQ(read(fresh), "first");
+}
+
+// Issue 23: a bag replaced by another file of the same size and modification time looked the
+// same to a cache keyed by path, size and mtime. The identity of an open file tells them apart.
+TEST_F(SafePaths, IdentityTellsAReplacedFileOfTheSameSizeAndTime) {
+  const std::string bag = write(dir_ / "root" / "a.bag", "the real bag");
+  const lfd::FileIdentity before = lfd::openInputFile(bag).identity();
+  EXPECT_EQ(before, lfd::openInputFile(bag).identity());
+  EXPECT_EQ(before.size, 12u);
+  struct stat st {};
+  ASSERT_EQ(::stat(bag.c_str(), &st), 0);
+  const struct timespec times[2] = {st.st_atim, st.st_mtim};
+  // A same-size file with the old times, renamed over the bag (touch -r old new; mv new bag).
+  const std::string fake = write(dir_ / "root" / "fake", "corrupt data");
+  ASSERT_EQ(::utimensat(AT_FDCWD, fake.c_str(), times, 0), 0);
+  fs::rename(fake, bag);
+  const lfd::FileIdentity renamed = lfd::openInputFile(bag).identity();
+  EXPECT_EQ(renamed.size, before.size);
+  EXPECT_EQ(renamed.mtime_sec, before.mtime_sec);
+  EXPECT_EQ(renamed.mtime_nsec, before.mtime_nsec);
+  EXPECT_FALSE(renamed == before);
+  // Rewritten in place (same inode) with its times set back: the change time moved. (Apart from
+  // the rename by more than the kernel's coarse clock step, a few ms.)
+  std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  write(bag, "other bytes!");
+  ASSERT_EQ(::utimensat(AT_FDCWD, bag.c_str(), times, 0), 0);
+  const lfd::FileIdentity rewritten = lfd::openInputFile(bag).identity();
+  EXPECT_EQ(rewritten.inode, renamed.inode);
+  EXPECT_EQ(rewritten.mtime_nsec, before.mtime_nsec);
+  EXPECT_FALSE(rewritten == renamed);
 }
 
 }  // namespace

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "lfd_core/safe_paths.hpp"
 #include "lfd_core/time_series.hpp"
 #include "lfd_segmentation/segmentation_params.hpp"
 
@@ -29,6 +30,18 @@ struct DemoFeatures {
 /// of that very name exists).
 std::vector<std::string> demo_parts(const std::string& path);
 
+/// One demonstration's bag files, each opened once by the file-access layer: the reader reads
+/// these descriptors, and their identities (lfd::FileIdentity) key the service's cache, so a key
+/// always describes the very files that were read.
+struct DemoFiles {
+  std::string path;                ///< as the request gave it
+  std::vector<std::string> names;  ///< demo_parts(path), for messages
+  std::vector<lfd::InputFile> parts;
+};
+
+/// Opens the parts of `path` under `policy`. Throws std::runtime_error "cannot open bag ...: why".
+DemoFiles open_demo_files(const std::string& path, const lfd::PathPolicy& policy = {});
+
 /// The request budget of the segmentation (service and CLI), checked before anything is read:
 /// `entries` (bag paths or CSV files) within limits/max_bags, the files they expand to (demo
 /// parts) within limits/max_bag_files, their total size within limits/max_total_bytes, and each
@@ -43,6 +56,10 @@ void check_request_budget(const std::vector<std::string>& entries, const Request
 /// numeric fields), a field no message carries, or the ground-truth topic. Each stream is in stamp
 /// order (lfd_core/stamp_order.hpp); `warnings` gets one line per topic whose stamps were out of
 /// order, duplicated or had a gap.
+std::vector<lfd::Stream> read_bag_streams(const DemoFiles& files,
+                                          const std::vector<TopicConfig>& topics,
+                                          std::vector<FeatureRole>* roles = nullptr,
+                                          std::vector<std::string>* warnings = nullptr);
 std::vector<lfd::Stream> read_bag_streams(const std::string& path,
                                           const std::vector<TopicConfig>& topics,
                                           std::vector<FeatureRole>* roles = nullptr,
@@ -50,6 +67,8 @@ std::vector<lfd::Stream> read_bag_streams(const std::string& path,
 
 /// read_bag_streams + resampling at `rate` Hz (errors name the bag). Streams over `limits`
 /// (time span, |value|) are refused before resampling (check_streams).
+DemoFeatures read_bag_features(const DemoFiles& files, const std::vector<TopicConfig>& topics,
+                               double rate, const RequestLimits& limits = RequestLimits());
 DemoFeatures read_bag_features(const std::string& path, const std::vector<TopicConfig>& topics,
                                double rate, const RequestLimits& limits = RequestLimits());
 

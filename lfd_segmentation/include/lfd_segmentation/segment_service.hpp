@@ -18,8 +18,9 @@ SegmentationParams apply_overrides(const SegmentationParams& params,
 
 /// The last request's bags read and features selected (II-B), for the next request on the same
 /// bags: an evaluation asks for every combination method in turn, and neither the bags nor the
-/// selection depend on the method. Keyed by the bag paths, each file's size and modification
-/// time, and the relevance threshold; anything else may differ between the requests.
+/// selection depend on the method. Keyed by the bag paths, each file's identity as read (device,
+/// inode, size, mtime and ctime in ns: lfd::FileIdentity), and the relevance threshold; anything
+/// else may differ between the requests.
 struct PreparedCache {
   std::string key;
   std::vector<DemoFeatures> demos;

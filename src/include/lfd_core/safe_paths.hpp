@@ -18,6 +18,18 @@ struct PathPolicy {
   std::vector<std::string> allowed_roots;
 };
 
+/// What identifies a file's content without reading it, from the fstat of an open descriptor:
+/// device and inode (a file renamed over the path is another inode), size, and modification and
+/// status-change times in nanoseconds. A user can set mtime back (touch -r) but not ctime, which
+/// every write and rename of the inode moves.
+struct FileIdentity {
+  std::uint64_t device = 0, inode = 0, size = 0;
+  std::int64_t mtime_sec = 0, mtime_nsec = 0, ctime_sec = 0, ctime_nsec = 0;
+  /// "dev:ino:size:mtime.ns:ctime.ns", for cache keys.
+  std::string key() const;
+  bool operator==(const FileIdentity& other) const { return key() == other.key(); }
+};
+
 /// A file to read, opened once (issue 23: checking a path and opening it again by name let a link
 /// swapped in between to a FIFO hang open()). Readers that take a file name (rosbag, ifstream,
 /// yaml-cpp) open `readPath()`, the still-open descriptor's /proc entry: it always reaches the
@@ -35,15 +47,17 @@ class InputFile {
   const std::string& resolved() const { return resolved_; }
   /// "/proc/self/fd/N": the name to hand to readers.
   std::string readPath() const;
-  std::uint64_t size() const { return size_; }
+  std::uint64_t size() const { return identity_.size; }
+  /// The fstat of the descriptor when it was opened: the file that readPath() reads.
+  const FileIdentity& identity() const { return identity_; }
   int fd() const { return fd_; }
 
  private:
   friend InputFile openInputFile(const std::string&, const PathPolicy&, std::uint64_t);
-  InputFile(int fd, std::string resolved, std::uint64_t size);
+  InputFile(int fd, std::string resolved);
   int fd_ = -1;
   std::string resolved_;
-  std::uint64_t size_ = 0;
+  FileIdentity identity_;
 };
 
 /// Opens a file to read: the path is resolved once (realpath) and checked against the roots, the
