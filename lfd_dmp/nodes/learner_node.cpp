@@ -6,7 +6,8 @@
 // ~num_basis, ~smoothing_sigma, ~time_alignment/*, ~goal_frames/*, ~allowed_roots,
 // ~limits/{max_bags, max_total_bytes, max_num_basis, max_demo_seconds, max_samples_per_demo}.
 // Paths: bags must be regular files inside the roots, the library is written atomically, never over
-// a bag, and over an existing file only with overwrite.
+// a bag, and over an existing file only with overwrite and only when that file is a skill library
+// lfd wrote.
 #include "lfd_dmp/demo_bag.hpp"
 #include "lfd_dmp/skill_learner.hpp"
 
@@ -88,7 +89,8 @@ class Learner {
       }
       if (bags.empty()) throw std::invalid_argument("no demonstrations given");
       checkBudget(bags);
-      const std::string output = lfd::checkOutputFile(req.output_path, paths_, req.overwrite, bags);
+      const std::string output = lfd::checkOutputFile(req.output_path, paths_, req.overwrite, bags,
+                                                      lfd_dmp::skillLibraryOutput());
       std::vector<lfd_dmp::DemoRecording> demos;
       for (const auto& b : bags) {
         demos.push_back(lfd_dmp::readDemoBag(

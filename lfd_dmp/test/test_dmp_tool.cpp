@@ -222,9 +222,41 @@ TEST(DmpTool, KeepsAnExistingOutputUnlessOverwrite) {
   EXPECT_EQ(run({"learn", "--csv", csv, "--out", json}, &out, &err), 1);
   EXPECT_NE(err.find("exists; set overwrite"), std::string::npos) << err;
   EXPECT_EQ(fileText(json), "precious\n");
-  ASSERT_EQ(run({"learn", "--csv", csv, "--out", json, "--overwrite"}, &out, &err), 0) << err;
-  EXPECT_EQ(lfd_dmp::loadSkillLibrary(json).segments.size(), 1u);
+  // Issue 23: --overwrite replaced any file; it replaces only a skill library lfd wrote.
+  EXPECT_EQ(run({"learn", "--csv", csv, "--out", json, "--overwrite"}, &out, &err), 1);
+  EXPECT_NE(err.find("keep.json"), std::string::npos) << err;
+  EXPECT_NE(err.find("was not written by lfd as a skill library"), std::string::npos) << err;
+  EXPECT_EQ(fileText(json), "precious\n");
+  std::remove(json.c_str());
+  ASSERT_EQ(run({"learn", "--csv", csv, "--out", json}, &out, &err), 0) << err;
+  ASSERT_EQ(
+      run({"learn", "--csv", csv, "--out", json, "--overwrite", "--task", "again"}, &out, &err), 0)
+      << err;
+  EXPECT_EQ(lfd_dmp::loadSkillLibrary(json).task, "again");
   for (const auto& p : {csv, json}) std::remove(p.c_str());
+}
+
+// Issue 23: a rollout's --overwrite replaces only a trajectory CSV dmp_tool wrote (its first line
+// marks it); a demonstration CSV or any other file of that name is kept.
+TEST(DmpTool, RolloutOverwritesOnlyATrajectoryItWrote) {
+  const std::string csv = writeDemoCsv("roll.csv", 0.6, 100);
+  const std::string json = tempPath("roll.json");
+  const std::string traj = tempPath("roll_traj.csv");
+  const std::string other = writeDemoCsv("roll_other.csv", 0.5, 50);  // a CSV lfd did not write
+  const std::string before = fileText(other);
+  std::string out, err;
+  ASSERT_EQ(run({"learn", "--csv", csv, "--out", json}, &out, &err), 0) << err;
+  EXPECT_EQ(run({"rollout", "--library", json, "--out", other, "--overwrite"}, &out, &err), 1);
+  EXPECT_NE(err.find("was not written by lfd as a trajectory CSV"), std::string::npos) << err;
+  EXPECT_EQ(fileText(other), before);
+  ASSERT_EQ(run({"rollout", "--library", json, "--out", traj}, &out, &err), 0) << err;
+  EXPECT_EQ(fileText(traj).rfind(std::string(lfd_dmp::kTrajectoryCsvMarker) + "\nt,x,y,z", 0), 0u);
+  ASSERT_EQ(
+      run({"rollout", "--library", json, "--out", traj, "--overwrite", "--tau", "3"}, &out, &err),
+      0)
+      << err;
+  EXPECT_NEAR(lfd_dmp::readTrajectoryCsv(traj).demo.times.tail(1)(0), 3.0, 0.01);
+  for (const auto& p : {csv, json, traj, other}) std::remove(p.c_str());
 }
 
 TEST(DmpTool, NeverWritesOverItsInput) {

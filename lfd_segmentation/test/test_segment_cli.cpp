@@ -389,6 +389,40 @@ TEST(CsvFeatures, LimitsStopTheReadAndNameRowAndColumn) {
   }
 }
 
+// Issue 23: an output replaced any regular file. --output replaces a result file the CLI wrote
+// (scripts rerun into their folder), never another file: it is kept and the error says why.
+TEST(SegmentCli, OutputReplacesOnlyAResultFileItWrote) {
+  const fs::path dir = temp_dir();
+  const std::string csv = (dir / "output_demo.csv").string();
+  write_demo_csv(csv, 300, 6);
+  const std::string bashrc = (dir / ".bashrc").string();
+  std::ofstream(bashrc) << "export PATH=$HOME/bin:$PATH\n";
+  const std::string err = (dir / "stderr.txt").string();
+  const std::string cmd =
+      std::string(SEGMENT_CLI) + " " + csv + " --output " + bashrc + " 2>" + err;
+  EXPECT_EQ(WEXITSTATUS(std::system(cmd.c_str())), 1);
+  std::ifstream kept(bashrc);
+  EXPECT_EQ(std::string((std::istreambuf_iterator<char>(kept)), {}),
+            "export PATH=$HOME/bin:$PATH\n");
+  std::ifstream err_in(err);
+  const std::string message((std::istreambuf_iterator<char>(err_in)), {});
+  EXPECT_NE(message.find(".bashrc"), std::string::npos) << message;
+  EXPECT_NE(message.find("was not written by lfd"), std::string::npos) << message;
+  // Its own result is replaced, run after run (also one written before the format marker).
+  int status = -1;
+  auto j = run_cli(csv, &status);
+  EXPECT_EQ(status, 0);
+  EXPECT_EQ(j["format"], "lfd_segmentation_result");
+  const std::string out = (dir / "result.json").string();
+  std::ofstream(out) << R"({"mode": "clasp", "success": true})";
+  const std::string again =
+      std::string(SEGMENT_CLI) + " " + csv + " --output " + out + " 2>/dev/null";
+  EXPECT_EQ(WEXITSTATUS(std::system(again.c_str())), 0);
+  EXPECT_EQ(WEXITSTATUS(std::system(again.c_str())), 0);
+  std::ifstream result(out);
+  EXPECT_EQ(nlohmann::json::parse(result)["format"], "lfd_segmentation_result");
+}
+
 TEST(SegmentCli, RefusesAPipeAndNeverWritesOverAnInput) {
   const fs::path dir = temp_dir();
   const std::string fifo = (dir / "pipe.csv").string();

@@ -102,6 +102,22 @@ FileIdentity identityOf(const struct stat& st) {
   return id;
 }
 
+// An existing output may be replaced only when its kind recognises it as lfd's own product.
+void checkReplaceable(const std::string& path, const std::string& resolved,
+                      const OutputKind& kind) {
+  bool ours = false;
+  try {
+    ours = kind.written_by_lfd && kind.written_by_lfd(openInputFile(resolved));
+  } catch (const std::exception& e) {
+    refuse(path, "exists and cannot be checked (" + std::string(e.what()) + "); it is kept");
+  }
+  if (!ours) {
+    refuse(path, "exists and was not written by lfd as a " + kind.name +
+                     "; it is kept (overwrite replaces only lfd's own " + kind.name +
+                     " files): remove it or choose another path");
+  }
+}
+
 }  // namespace
 
 std::string FileIdentity::key() const {
@@ -170,7 +186,7 @@ std::string checkInputFile(const std::string& path, const PathPolicy& policy) {
 }
 
 std::string checkOutputFile(const std::string& path, const PathPolicy& policy, bool overwrite,
-                            const std::vector<std::string>& inputs) {
+                            const std::vector<std::string>& inputs, const OutputKind& kind) {
   if (path.empty()) throw std::invalid_argument("empty output path");
   checkParentReferences(path, policy);
   const fs::path absolute = fs::absolute(path);
@@ -198,6 +214,7 @@ std::string checkOutputFile(const std::string& path, const PathPolicy& policy, b
   if (exists && !S_ISREG(out.st_mode))
     refuse(path, std::string("exists and is ") + typeName(out.st_mode));
   if (exists && !overwrite) refuse(path, "exists; set overwrite to replace it");
+  if (exists) checkReplaceable(path, resolved.string(), kind);
   return resolved.string();
 }
 
@@ -209,7 +226,7 @@ std::string checkPathInRoots(const std::string& path, const PathPolicy& policy) 
   return resolved.string();
 }
 
-void writeFileAtomically(const std::string& path, bool overwrite,
+void writeFileAtomically(const std::string& path, bool overwrite, const OutputKind& kind,
                          const std::function<void(const std::string& temp_path)>& write) {
   const fs::path target = fs::absolute(path);
   std::string temp =
@@ -226,6 +243,13 @@ void writeFileAtomically(const std::string& path, bool overwrite,
       ::close(sync_fd);
     }
     int rc = 0;
+    struct stat existing {};
+    if (overwrite && ::stat(target.c_str(), &existing) == 0) {
+      // Checked again as late as possible: what the rename replaces must be lfd's own.
+      if (!S_ISREG(existing.st_mode))
+        refuse(path, std::string("exists and is ") + typeName(existing.st_mode));
+      checkReplaceable(path, target.string(), kind);
+    }
     if (overwrite) {
       rc = ::rename(temp.c_str(), target.c_str());
     } else {
@@ -247,8 +271,9 @@ void writeFileAtomically(const std::string& path, bool overwrite,
   }
 }
 
-void writeTextAtomically(const std::string& path, bool overwrite, const std::string& text) {
-  writeFileAtomically(path, overwrite, [&](const std::string& temp) {
+void writeTextAtomically(const std::string& path, bool overwrite, const OutputKind& kind,
+                         const std::string& text) {
+  writeFileAtomically(path, overwrite, kind, [&](const std::string& temp) {
     FILE* f = std::fopen(temp.c_str(), "w");
     if (!f) refuse(path, std::string("cannot write: ") + std::strerror(errno));
     const bool ok = std::fwrite(text.data(), 1, text.size(), f) == text.size();

@@ -1,8 +1,9 @@
 // Safe file paths for every node and CLI that reads or writes a file a request names: inputs must
 // be regular files (a FIFO or device would block open() forever), outputs are written atomically
-// next to their destination, an existing file is kept unless the caller asks to overwrite it, an
-// output never replaces one of the request's inputs, and request paths stay inside configured
-// roots. Every refusal is a std::invalid_argument whose message names the path and the reason.
+// next to their destination, an existing file is kept unless the caller asks to overwrite it and
+// it is an lfd product of the output's kind, an output never replaces one of the request's
+// inputs, and request paths stay inside configured roots. Every refusal is a
+// std::invalid_argument whose message names the path and the reason.
 #pragma once
 
 #include <cstdint>
@@ -72,11 +73,30 @@ InputFile openInputFile(const std::string& path, const PathPolicy& policy = {},
 /// checks of a whole request; readers open their file with openInputFile themselves.
 std::string checkInputFile(const std::string& path, const PathPolicy& policy = {});
 
+/// The kind of file an output is. `overwrite` replaces an existing file only when it is
+/// recognisably an lfd product of that kind (issue 23: overwrite: true replaced a test .bashrc,
+/// any regular file under the roots could go). The predicate gets the existing file, opened by
+/// the file-access layer, and says whether lfd wrote it.
+struct OutputKind {
+  std::string name;  ///< "skill library", for messages
+  std::function<bool(const InputFile& existing)> written_by_lfd;
+};
+
+/// A ROS bag: the file starts with rosbag's version line "#ROSBAG V2.0\n".
+OutputKind bagOutput();
+/// A text file lfd writes with `first_line` (e.g. a CSV's "# lfd ..." comment line) first.
+OutputKind textOutput(const std::string& name, const std::string& first_line);
+/// A JSON object whose top-level "format" is `format`. An older file without any "format" member
+/// counts when it has every one of `legacy_members` at its top level (what lfd always wrote
+/// there). Read as a stream (nothing is kept), so a large file costs no memory.
+OutputKind jsonOutput(const std::string& name, const std::string& format,
+                      const std::vector<std::string>& legacy_members = {});
+
 /// Checks a file to write: its folder exists, it lies inside a root, it is not one of `inputs`
-/// (same file, also through a link), and if it exists it is a regular file and `overwrite` is set.
-/// Returns the absolute path to write.
+/// (same file, also through a link), and if it exists it is a regular file, `overwrite` is set
+/// and `kind` recognises it as lfd's. Returns the absolute path to write.
 std::string checkOutputFile(const std::string& path, const PathPolicy& policy, bool overwrite,
-                            const std::vector<std::string>& inputs = {});
+                            const std::vector<std::string>& inputs, const OutputKind& kind);
 
 /// Checks a path a request names for a file that may not exist yet (nor its folder: e.g. a bag the
 /// recorder creates with its folders): under roots, no ".." and inside a root once the part that
@@ -85,11 +105,14 @@ std::string checkPathInRoots(const std::string& path, const PathPolicy& policy);
 
 /// Writes `path` atomically: `write` fills a temporary file in the same folder, which is then
 /// renamed over `path` (readers see the old file or the whole new one, never half of one). Without
-/// `overwrite` an existing `path` is kept and the call throws. The temporary is removed on error.
-void writeFileAtomically(const std::string& path, bool overwrite,
+/// `overwrite` an existing `path` is kept and the call throws; with it, an existing `path` is
+/// replaced only when `kind` recognises it (checked again just before the rename). The temporary
+/// is removed on error.
+void writeFileAtomically(const std::string& path, bool overwrite, const OutputKind& kind,
                          const std::function<void(const std::string& temp_path)>& write);
 
 /// The same for text content.
-void writeTextAtomically(const std::string& path, bool overwrite, const std::string& text);
+void writeTextAtomically(const std::string& path, bool overwrite, const OutputKind& kind,
+                         const std::string& text);
 
 }  // namespace lfd
