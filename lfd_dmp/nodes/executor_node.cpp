@@ -199,6 +199,7 @@ class Executor {
     trajectory_period_ = param(pnh, "trajectory_period", trajectory_period_);
     feedback_period_ = param(pnh, "feedback_period", feedback_period_);
     paths_.allowed_roots = param(pnh, "allowed_roots", paths_.allowed_roots);
+    paths_.require_absolute = true;  // the node's working directory is not the caller's
     limits_.min_duration_scale =
         param(pnh, "limits/min_duration_scale", limits_.min_duration_scale);
     limits_.max_duration_scale =
@@ -258,8 +259,10 @@ class Executor {
   std::string libraryPath(const std::string& s) const {
     lfd_dmp::checkNameLength(s, "library", limits_);
     if (s.empty()) throw std::invalid_argument("library is empty (a path or a name)");
-    if (s.find('/') != std::string::npos || (s.size() > 5 && s.substr(s.size() - 5) == ".json"))
+    if (s.find('/') != std::string::npos || (s.size() > 5 && s.substr(s.size() - 5) == ".json")) {
+      lfd::checkRequestPath("library", s, paths_);
       return lfd::checkInputFile(s, paths_);
+    }
     if (library_dir_.empty() || s == "." || s == "..")
       throw std::invalid_argument("'" + s + "' is not a path and ~library_dir is not set");
     return lfd::checkInputFile(library_dir_ + "/" + s + ".json", paths_);

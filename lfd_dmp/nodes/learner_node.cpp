@@ -5,9 +5,9 @@
 // Private parameters (config/learner.yaml): ~pose_topic, ~gripper_topic, ~gripper_joint,
 // ~num_basis, ~smoothing_sigma, ~time_alignment/*, ~goal_frames/*, ~allowed_roots,
 // ~limits/{max_bags, max_total_bytes, max_num_basis, max_demo_seconds, max_samples_per_demo}.
-// Paths: bags must be regular files inside the roots, the library is written atomically, never over
-// a bag, and over an existing file only with overwrite and only when that file is a skill library
-// lfd wrote.
+// Paths: absolute, bags must be regular files inside the roots, the library is written atomically,
+// never over a bag, and over an existing file only with overwrite and only when that file is a
+// skill library lfd wrote.
 #include "lfd_dmp/demo_bag.hpp"
 #include "lfd_dmp/skill_learner.hpp"
 
@@ -40,6 +40,7 @@ class Learner {
     }
     readTimeAlignment(pnh);
     pnh.param("allowed_roots", paths_.allowed_roots, paths_.allowed_roots);
+    paths_.require_absolute = true;  // the node's working directory is not the caller's
     pnh.param("limits/max_bags", max_bags_, max_bags_);
     pnh.param("limits/max_total_bytes", max_total_bytes_, max_total_bytes_);
     pnh.param("limits/max_num_basis", max_num_basis_, max_num_basis_);
@@ -59,11 +60,15 @@ class Learner {
     const auto t0 = std::chrono::steady_clock::now();
     try {
       if (req.output_path.empty()) throw std::invalid_argument("output_path is empty");
+      lfd::checkRequestPath("output_path", req.output_path, paths_);
       checkCounts(req);
       std::vector<std::string> bags;
       std::vector<std::vector<double>> cps;
       if (!req.segmentations.empty()) {
-        for (const auto& s : req.segmentations) {
+        for (size_t i = 0; i < req.segmentations.size(); ++i) {
+          const auto& s = req.segmentations[i];
+          lfd::checkRequestPath("segmentations[" + std::to_string(i) + "].source", s.source,
+                                paths_);
           bags.push_back(s.source);
           cps.push_back(s.changepoint_times);
         }
@@ -73,6 +78,7 @@ class Learner {
         }
         size_t k = 0;
         for (size_t i = 0; i < req.bag_paths.size(); ++i) {
+          lfd::checkRequestPath("bag_paths[" + std::to_string(i) + "]", req.bag_paths[i], paths_);
           bags.push_back(req.bag_paths[i]);
           std::vector<double> c;
           for (uint32_t j = 0; j < req.changepoint_counts[i]; ++j) {

@@ -57,6 +57,15 @@ std::string cache_key(const std::vector<DemoFiles>& demos, const SegmentationPar
   return key.str();
 }
 
+// Service requests name absolute paths (the node's working directory is not the caller's), every
+// part of a demo written as "a.bag,b.bag" too; the error names the field.
+void check_request_paths(const std::vector<std::string>& bag_paths, const lfd::PathPolicy& policy) {
+  for (std::size_t i = 0; i < bag_paths.size(); ++i) {
+    for (const std::string& part : demo_parts(bag_paths[i]))
+      lfd::checkRequestPath("bag_paths[" + std::to_string(i) + "]", part, policy);
+  }
+}
+
 lfd_msgs::DemoSegmentation demo_message(const DemoFeatures& demo,
                                         const lfd::DemoSegmentationResult& r, double rate) {
   lfd_msgs::DemoSegmentation m;
@@ -106,10 +115,12 @@ void handle_segment_request(const SegmentationParams& params,
                                   std::to_string(params.limits.max_bags) + " (limits/max_bags)");
     }
     const SegmentationParams p = apply_overrides(params, request);
-    check_request_budget(request.bag_paths, p.limits, p.paths);  // the expanded work, up front
+    lfd::PathPolicy paths = p.paths;
+    paths.require_absolute = true;  // a service: the CLI takes relative paths, the node does not
+    check_request_paths(request.bag_paths, paths);
+    check_request_budget(request.bag_paths, p.limits, paths);  // the expanded work, up front
     std::vector<DemoFiles> files;  // opened once: the cache key names what is read
-    for (const std::string& path : request.bag_paths)
-      files.push_back(open_demo_files(path, p.paths));
+    for (const std::string& path : request.bag_paths) files.push_back(open_demo_files(path, paths));
     const std::string key = cache_key(files, p);
     PreparedCache local;  // without a cache
     PreparedCache& used = cache ? *cache : local;

@@ -141,6 +141,20 @@ TEST_F(SegmentService, ABagReplacedBySameSizeSameTimeCorruptFileIsNotTheCachedOn
   for (const std::string& b : request_bags) fs::remove(b);
 }
 
+// Issue 23: a service resolves a relative path against its own working directory, which the
+// client neither sees nor chose. Every bag path (every part of one) must be absolute; the error
+// names the field.
+TEST_F(SegmentService, RelativeBagPathsAreRefusedNamingTheField) {
+  const std::vector<std::string> bags = good_bags(2);
+  const fs::path cwd = fs::current_path();
+  fs::current_path(dir_);  // where the relative names would resolve: they exist there
+  const auto r = call({bags[0], fs::path(bags[1]).filename().string()});
+  expect_error(r, "bag_paths[1]: path 'good1.bag' is relative");
+  expect_error(call({bags[0], bags[1] + ",good0.bag"}), "bag_paths[1]: path 'good0.bag'");
+  fs::current_path(cwd);
+  expect_error(r, "absolute path");
+}
+
 TEST_F(SegmentService, GoodRequestValidatesTheGraspChangepoint) {
   const auto bags = good_bags(3);
   const auto r = call(bags);

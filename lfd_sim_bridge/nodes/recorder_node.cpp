@@ -77,6 +77,7 @@ class Recorder {
     connect_timeout_ = pnh.param("connect_timeout", 5.0);
     max_unflushed_ = pnh.param("max_unflushed_seconds", max_unflushed_);
     paths_.allowed_roots = pnh.param("allowed_roots", paths_.allowed_roots);
+    paths_.require_absolute = true;  // the node's working directory is not the caller's
     for (const std::string& folder : pnh.param("recovery_folders", std::vector<std::string>{}))
       reportRecovered(lfd_sim_bridge::recoverCrashedBags(folder));
     for (const TopicSpec& spec : topics_) {
@@ -263,6 +264,7 @@ class Recorder {
         req.metadata.header.stamp.isZero() ? ros::Time::now() : req.metadata.header.stamp;
     std::string recovered;
     try {
+      lfd::checkRequestPath("bag_path", req.bag_path, paths_);
       lfd::checkPathInRoots(req.bag_path, paths_);
       // A crash may have left this very bag's `.active`: keep and reindex it. Only this path, and
       // only when no live recorder holds it (another recorder may be recording next to it).

@@ -60,8 +60,14 @@ void checkRoots(const std::string& path, const fs::path& resolved, const PathPol
   refuse(path, "outside the allowed roots (allowed_roots: " + roots + ")");
 }
 
-// Checked first: a request path with ".." is refused whether or not its target exists.
+constexpr const char* kRelativeWhy =
+    "is relative; a service request needs an absolute path (the node resolves a relative one "
+    "against its own working directory, not the caller's)";
+
+// Checked first: a relative request path, or one with "..", is refused whether or not its target
+// exists.
 void checkParentReferences(const std::string& path, const PathPolicy& policy) {
+  if (policy.require_absolute && !fs::path(path).is_absolute()) refuse(path, kRelativeWhy);
   if (!policy.allowed_roots.empty() && hasParentReference(path))
     refuse(path, "'..' is not allowed in request paths");
 }
@@ -119,6 +125,11 @@ void checkReplaceable(const std::string& path, const std::string& resolved,
 }
 
 }  // namespace
+
+void checkRequestPath(const std::string& field, const std::string& path, const PathPolicy& policy) {
+  if (policy.require_absolute && !fs::path(path).is_absolute())
+    throw std::invalid_argument(field + ": path " + lfd::quoted(path) + " " + kRelativeWhy);
+}
 
 std::string FileIdentity::key() const {
   return std::to_string(device) + ":" + std::to_string(inode) + ":" + std::to_string(size) + ":" +

@@ -1,6 +1,6 @@
 // Safe paths (issue 12): regular-file inputs, roots, "..", no output over an input, atomic writes
 // that keep an existing file unless asked to overwrite. Issue 23: file identities for caches,
-// overwrite replaces only lfd's own files.
+// overwrite replaces only lfd's own files, relative request paths refused in services.
 #include "lfd_core/safe_paths.hpp"
 
 #include <fcntl.h>
@@ -241,6 +241,33 @@ TEST_F(SafePaths, OverwriteReplacesOnlyFilesLfdWroteOfThatKind) {
   EXPECT_EQ(read(traj), "# lfd trajectory\nt,x\n0,2\n");
   const std::string foreign = write(dir_ / "root" / "u.csv", "t,x\n0,1\n");
   EXPECT_NE(errorOf([&] { lfd::checkOutputFile(foreign, rooted(), true, {}, csv); }), "");
+}
+
+// Issue 23: service request paths must be absolute (a relative one resolves against the node's
+// working directory); the CLIs keep taking relative paths.
+TEST_F(SafePaths, RelativeRequestPathsAreRefusedUnderRequireAbsolute) {
+  lfd::PathPolicy service;
+  service.require_absolute = true;
+  const std::string error =
+      errorOf([&] { lfd::checkRequestPath("bag_paths[1]", "demo.bag", service); });
+  EXPECT_NE(error.find("bag_paths[1]: path 'demo.bag' is relative"), std::string::npos) << error;
+  EXPECT_NE(error.find("absolute path"), std::string::npos) << error;
+  EXPECT_EQ(errorOf([&] { lfd::checkRequestPath("bag_paths[0]", "/tmp/demo.bag", service); }), "");
+  EXPECT_EQ(errorOf([&] { lfd::checkRequestPath("bag_paths[0]", "demo.bag", {}); }), "");
+  // The same rule in every path check, as a backstop.
+  const std::string file = write(dir_ / "root" / "a.bag", "x");
+  const fs::path cwd = fs::current_path();
+  fs::current_path(dir_ / "root");
+  EXPECT_NE(errorOf([&] { lfd::openInputFile("a.bag", service); }).find("is relative"),
+            std::string::npos);
+  EXPECT_NE(errorOf([&] {
+              lfd::checkOutputFile("b.json", service, false, {}, anyKind());
+            }).find("is relative"),
+            std::string::npos);
+  EXPECT_NE(errorOf([&] { lfd::checkPathInRoots("c.bag", service); }).find("is relative"),
+            std::string::npos);
+  EXPECT_EQ(lfd::openInputFile("a.bag").resolved(), fs::canonical(file).string());  // a CLI's
+  fs::current_path(cwd);
 }
 
 // Issue 23: a bag replaced by another file of the same size and modification time looked the

@@ -250,6 +250,10 @@ class ExecutorAction(unittest.TestCase):
         case("library is empty", lambda x: setattr(x, "library", ""))
         case("missing.json", lambda x: setattr(x, "library", os.path.join(self.out, "missing.json")))
         case("~limits/max_name_length", lambda x: setattr(x, "library", "x" * 5000))
+        # Issue 23: a library path must be absolute (the node's working directory is not the
+        # caller's).
+        case("library: path 'libraries/grasp.json' is relative",
+             lambda x: setattr(x, "library", "libraries/grasp.json"))
         old = os.path.join(self.out, "version1.json")
         with open(old, "w") as f:
             f.write('{"format": "lfd_skill_library", "version": 1, "segments": []}')

@@ -4,7 +4,7 @@
 paths outside ~allowed_roots or with '..' are refused), limits (~limits/max_num_basis,
 ~limits/max_bags), 150 seeded random requests of extreme values (seed 12, about 10 s), and a link
 swapped between a bag and a FIFO for 3 s while requests run (issue 23). Issue 23: overwrite
-replaces only a library lfd wrote."""
+replaces only a library lfd wrote; relative paths are refused."""
 import hashlib
 import math
 import os
@@ -143,6 +143,15 @@ class LearnerFuzz(unittest.TestCase):
         self.assertTrue(self.call(self.valid(out)).success)
         res = self.call(self.valid(out, overwrite=True, num_basis=20))
         self.assertTrue(res.success, res.error)
+
+    def test_9_relative_paths_are_refused_naming_the_field(self):
+        """Issue 23: a relative path resolved against the node's own working directory."""
+        self.assertRefused(self.call(self.valid("relative.json")),
+                           "output_path: path 'relative.json' is relative")
+        req = self.valid(os.path.join(self.dir, "rel.json"))
+        req.bag_paths[1] = "demo1.bag"
+        self.assertRefused(self.call(req), "bag_paths[1]: path 'demo1.bag' is relative")
+        self.assertFalse(os.path.exists(os.path.join(self.dir, "rel.json")))
 
     def test_7_link_swapped_to_fifo_never_hangs(self):
         """Issue 23 row 1: a link swapped between a bag and a FIFO while requests run (3 s) never

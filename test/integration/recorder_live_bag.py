@@ -1,6 +1,6 @@
 #!/usr/bin/python3
 """rostest (recorder_live_bag.test): a recorder never touches another recorder's live bag, and
-refuses bag paths with ".." or outside its allowed_roots."""
+refuses bag paths with ".." or outside its allowed_roots, and relative ones."""
 import os
 import unittest
 
@@ -68,6 +68,12 @@ class RecorderLiveBag(unittest.TestCase):
             self.assertIn(why, res.message)
             self.assertFalse(os.path.exists(path + ".active"))
         self.assertFalse(os.path.exists("/var/lib/lfd_recorder_live_bag"))
+
+    def test_4_relative_paths_are_refused_naming_the_field(self):
+        """Issue 23: a service request path must be absolute."""
+        res = self.start("recorder_b", "relative.bag")
+        self.assertFalse(res.success)
+        self.assertIn("bag_path: path 'relative.bag' is relative", res.message)
 
 
 if __name__ == "__main__":

@@ -2,8 +2,8 @@
 // be regular files (a FIFO or device would block open() forever), outputs are written atomically
 // next to their destination, an existing file is kept unless the caller asks to overwrite it and
 // it is an lfd product of the output's kind, an output never replaces one of the request's
-// inputs, and request paths stay inside configured roots. Every refusal is a
-// std::invalid_argument whose message names the path and the reason.
+// inputs, and request paths stay inside configured roots (and are absolute in services). Every
+// refusal is a std::invalid_argument whose message names the path and the reason.
 #pragma once
 
 #include <cstdint>
@@ -17,7 +17,15 @@ namespace lfd {
 struct PathPolicy {
   /// Absolute folders; a leading "~" is the caller's $HOME. With roots set, ".." is refused too.
   std::vector<std::string> allowed_roots;
+  /// Relative paths refused (services and actions): a node resolves them against its own working
+  /// directory, which its client neither sees nor chose. The CLIs accept them (the shell's).
+  bool require_absolute = false;
 };
+
+/// Refuses a request path the policy does not accept as written (relative under
+/// require_absolute): "<field>: path '...' is relative; ...". `field` names the request field
+/// ("bag_paths[2]"). Services call it on every path field before any work.
+void checkRequestPath(const std::string& field, const std::string& path, const PathPolicy& policy);
 
 /// What identifies a file's content without reading it, from the fstat of an open descriptor:
 /// device and inode (a file renamed over the path is another inode), size, and modification and
