@@ -259,6 +259,33 @@ TEST(DmpTool, RolloutOverwritesOnlyATrajectoryItWrote) {
   for (const auto& p : {csv, json, traj, other}) std::remove(p.c_str());
 }
 
+// Issue 23: a CSV saved with a UTF-8 byte-order mark named its first column "\xef\xbb\xbft"; UTF-16
+// is refused saying so.
+TEST(DmpTool, AUtf8ByteOrderMarkIsSkippedAndUtf16IsRefused) {
+  const std::string plain = writeDemoCsv("bom_plain.csv", 0.6, 100);
+  const std::string bom = tempPath("bom.csv");
+  std::ofstream(bom, std::ios::binary) << "\xEF\xBB\xBF" << fileText(plain);
+  const lfd_dmp::CsvTrajectory traj = lfd_dmp::readTrajectoryCsv(bom);
+  EXPECT_EQ(traj.position_names, (std::vector<std::string>{"x", "y", "z"}));
+  EXPECT_EQ(traj.demo.times.size(), 100);
+  EXPECT_NEAR(traj.demo.times(99), 2.0, 1e-9);  // the time column is t, not column 0 by chance
+  const std::string utf16 = tempPath("utf16.csv");
+  {
+    std::ofstream out(utf16, std::ios::binary);
+    out << "\xFE\xFF";
+    for (char c : std::string("t,x\n0,1\n")) out << '\0' << c;
+  }
+  try {
+    lfd_dmp::readTrajectoryCsv(utf16);
+    ADD_FAILURE() << "a UTF-16 CSV was read";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("UTF-16 is not supported, save it as UTF-8"),
+              std::string::npos)
+        << e.what();
+  }
+  for (const auto& p : {plain, bom, utf16}) std::remove(p.c_str());
+}
+
 TEST(DmpTool, NeverWritesOverItsInput) {
   const std::string csv = writeDemoCsv("self.csv", 0.6, 100);
   const std::string before = fileText(csv);

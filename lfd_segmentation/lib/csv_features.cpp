@@ -50,7 +50,8 @@ lfd::FeatureMatrix read_csv_features(const std::string& path, const std::string&
   std::string line;
   std::size_t line_number = 0;
   while (std::getline(in, line)) {
-    ++line_number;
+    // A spreadsheet's UTF-8 byte-order mark made the first column "\xef\xbb\xbftime": no time.
+    if (++line_number == 1) lfd::stripByteOrderMark(line, path);
     if (!trim(line).empty()) break;
   }
   if (trim(line).empty())

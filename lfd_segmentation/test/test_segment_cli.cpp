@@ -389,6 +389,40 @@ TEST(CsvFeatures, LimitsStopTheReadAndNameRowAndColumn) {
   }
 }
 
+// Issue 23: a CSV saved with a UTF-8 byte-order mark (as spreadsheet programs save it) gave "no
+// time column": the first column was named "\xef\xbb\xbftime". The mark is skipped; UTF-16 is
+// refused saying so.
+TEST(CsvFeatures, AUtf8ByteOrderMarkIsSkippedAndUtf16IsRefused) {
+  const fs::path dir = temp_dir();
+  const std::string plain = (dir / "plain_bom.csv").string();
+  write_demo_csv(plain, 300, 4);
+  std::ifstream plain_in(plain);
+  const std::string text((std::istreambuf_iterator<char>(plain_in)), {});
+  const std::string bom = (dir / "bom.csv").string();
+  std::ofstream(bom, std::ios::binary) << "\xEF\xBB\xBF" << text;
+  const lfd::FeatureMatrix m = lfd_segmentation::read_csv_features(bom);
+  EXPECT_EQ(m.names, (std::vector<std::string>{"gripper", "speed", "noise", "touch"}));
+  EXPECT_EQ(m.time.size(), 300u);
+  int status = -1;
+  const auto j = run_cli("--state-columns gripper,speed " + bom, &status);
+  EXPECT_EQ(status, 0) << j.dump();
+
+  const std::string utf16 = (dir / "utf16.csv").string();
+  {
+    std::ofstream out(utf16, std::ios::binary);
+    out << "\xFF\xFE";
+    for (char c : std::string("time,a\n0,1\n")) out << c << '\0';
+  }
+  try {
+    lfd_segmentation::read_csv_features(utf16);
+    ADD_FAILURE() << "a UTF-16 CSV was read";
+  } catch (const std::invalid_argument& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("utf16.csv"), std::string::npos) << what;
+    EXPECT_NE(what.find("UTF-16 is not supported, save it as UTF-8"), std::string::npos) << what;
+  }
+}
+
 // Issue 23: an output replaced any regular file. --output replaces a result file the CLI wrote
 // (scripts rerun into their folder), never another file: it is kept and the error says why.
 TEST(SegmentCli, OutputReplacesOnlyAResultFileItWrote) {

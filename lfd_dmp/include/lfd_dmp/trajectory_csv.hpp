@@ -30,8 +30,8 @@ constexpr const char* kTrajectoryCsvMarker = "# lfd trajectory (dmp_tool rollout
 lfd::OutputKind trajectoryCsvOutput();
 
 /// Throws std::runtime_error naming the file, line and column of the first problem (missing
-/// header, ragged row, non-numeric or non-finite value, partial quaternion columns). A first
-/// kTrajectoryCsvMarker line is skipped.
+/// header, ragged row, non-numeric or non-finite value, partial quaternion columns, UTF-16). A
+/// UTF-8 byte-order mark and a first kTrajectoryCsvMarker line are skipped.
 CsvTrajectory readTrajectoryCsv(const std::string& path, const CsvColumns& columns = {});
 
 /// Writes kTrajectoryCsvMarker, then t, the position columns, qw,qx,qy,qz (if any) and gripper (if
