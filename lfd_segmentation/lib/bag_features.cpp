@@ -13,6 +13,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "lfd_core/bag_errors.hpp"
 #include "lfd_core/input_budget.hpp"
 #include "lfd_core/ros_message_reader.hpp"
 #include "lfd_core/safe_paths.hpp"
@@ -54,6 +55,11 @@ std::string field_list(const rosmsg::MessageSchema& schema,
     out += "\n  " + f;
   return out;
 }
+
+// A message whose bytes do not fit its declared type, already described in full.
+struct MismatchedMessage : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
 
 // One configured topic across the parts of a demonstration. Its features (the configured fields,
 // "*" expanded) are fixed by the first message of the first part; every connection (message
@@ -161,6 +167,18 @@ lfd::InputFile open_part(const std::string& path, const lfd::PathPolicy& policy 
   }
 }
 
+// One message of a topic into its reader; bytes that do not fit the declared type (a lying
+// connection header, a truncated message: rosbag's "Buffer Overrun") are named in full.
+void read_message(const rosbag::MessageInstance& m, const std::vector<std::uint8_t>& bytes,
+                  std::size_t index, const std::string& name, TopicReader& reader) {
+  try {
+    reader.read(m, bytes);
+  } catch (const rosmsg::MessageError& e) {
+    throw MismatchedMessage(lfd::mismatchedMessageError(name, m.getTopic(), m.getDataType(), index,
+                                                        m.getTime().toSec(), e.what()));
+  }
+}
+
 std::string topics_in(rosbag::Bag& bag) {
   std::string available;
   rosbag::View all(bag);
@@ -186,14 +204,17 @@ void read_part(const lfd::InputFile& file, const std::string& path,
     }
     std::vector<std::uint8_t> bytes;
     for (std::size_t k = 0; k < topics.size(); ++k) {
+      std::size_t index = 0;
       for (const rosbag::MessageInstance& m :
            rosbag::View(bag, rosbag::TopicQuery(topics[k].topic))) {
         message_bytes(m, bytes);
-        readers[k].read(m, bytes);
+        read_message(m, bytes, index++, path, readers[k]);
       }
     }
   } catch (const std::invalid_argument& e) {
     throw std::invalid_argument("bag " + lfd::quoted(path) + ": " + e.what());
+  } catch (const MismatchedMessage&) {
+    throw;
   } catch (const std::exception& e) {
     throw std::runtime_error("cannot read bag " + lfd::quoted(path) +
                              " (truncated or corrupt?): " + e.what());
@@ -375,11 +396,19 @@ std::string describe_bag(const std::string& path) {
           continue;
         }
         std::vector<std::uint8_t> sample;
-        message_bytes(*view.begin(), sample);
+        const rosbag::MessageInstance first = *view.begin();
+        message_bytes(first, sample);
         const rosmsg::MessageSchema schema =
             rosmsg::MessageSchema::parse(connection->datatype, connection->msg_def);
-        out << field_list(schema, sample) << "\n";
+        try {
+          out << field_list(schema, sample) << "\n";
+        } catch (const rosmsg::MessageError& e) {
+          throw MismatchedMessage(lfd::mismatchedMessageError(part, topic, connection->datatype, 0,
+                                                              first.getTime().toSec(), e.what()));
+        }
       }
+    } catch (const MismatchedMessage&) {
+      throw;
     } catch (const std::exception& e) {
       throw std::runtime_error("cannot read bag " + lfd::quoted(part) + ": " + e.what());
     }

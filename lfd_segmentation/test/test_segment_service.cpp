@@ -155,6 +155,19 @@ TEST_F(SegmentService, RelativeBagPathsAreRefusedNamingTheField) {
   expect_error(r, "absolute path");
 }
 
+// Issue 23: a topic whose connection declares geometry_msgs/PoseStamped but whose message holds
+// other bytes read as "Buffer Overrun". The error names the file, the topic, the declared type,
+// the message's index and time, and says the bytes do not match; the service answers.
+TEST_F(SegmentService, MessageBytesThatDoNotMatchTheDeclaredTypeAreNamed) {
+  DemoBagOptions o;
+  o.pose_holds_a_twist = true;
+  const auto r = call({good_bags(1)[0], bag("pose_holds_a_twist", o)});
+  expect_error(r,
+               "pose_holds_a_twist.bag': message 400 on '/ee_pose' (declared "
+               "'geometry_msgs/PoseStamped') at t = 104.000 s: its bytes do not match the "
+               "declared message definition");
+}
+
 TEST_F(SegmentService, GoodRequestValidatesTheGraspChangepoint) {
   const auto bags = good_bags(3);
   const auto r = call(bags);

@@ -51,11 +51,12 @@ void check_request_budget(const std::vector<std::string>& entries, const Request
                           const lfd::PathPolicy& paths, const std::string& kind = "bag");
 
 /// Raw (not resampled) streams of the configured fields of one bag. Throws std::runtime_error for
-/// unreadable/truncated bags or messages that do not match their definition, and
-/// std::invalid_argument for a missing topic, a field that does not exist (listing the topic's
-/// numeric fields), a field no message carries, or the ground-truth topic. Each stream is in stamp
-/// order (lfd_core/stamp_order.hpp); `warnings` gets one line per topic whose stamps were out of
-/// order, duplicated or had a gap.
+/// unreadable/truncated bags or messages that do not match their definition (naming the file,
+/// topic, declared type and the message's index and time), and std::invalid_argument for a
+/// missing topic, a field that does not exist (listing the topic's numeric fields), a field no
+/// message carries, or the ground-truth topic. Each stream is in stamp order
+/// (lfd_core/stamp_order.hpp); `warnings` gets one line per topic whose stamps were out of order,
+/// duplicated or had a gap.
 std::vector<lfd::Stream> read_bag_streams(const DemoFiles& files,
                                           const std::vector<TopicConfig>& topics,
                                           std::vector<FeatureRole>* roles = nullptr,
