@@ -18,6 +18,7 @@
 #include <lfd_msgs/ExecuteTaskAction.h>
 #include <lfd_core/heap_trim.hpp>
 #include <lfd_core/robot_setup.hpp>
+#include <lfd_core/ros_request_strings.hpp>
 #include <lfd_core/safe_paths.hpp>
 
 #include <actionlib/server/simple_action_server.h>
@@ -200,6 +201,9 @@ class Executor {
     feedback_period_ = param(pnh, "feedback_period", feedback_period_);
     paths_.allowed_roots = param(pnh, "allowed_roots", paths_.allowed_roots);
     paths_.require_absolute = true;  // the node's working directory is not the caller's
+    strings_.max_bytes = static_cast<std::size_t>(std::max(
+        0, param(pnh, "limits/max_request_string_bytes", static_cast<int>(strings_.max_bytes))));
+    strings_.key = "~limits/max_request_string_bytes";
     limits_.min_duration_scale =
         param(pnh, "limits/min_duration_scale", limits_.min_duration_scale);
     limits_.max_duration_scale =
@@ -347,6 +351,7 @@ class Executor {
     const auto wall0 = Clock::now();
     lfd_msgs::ExecuteTaskResult result;
     try {
+      lfd::checkRequestStrings(goal, strings_);  // before any work: no 10 MB string echoed
       feedback_ = lfd_msgs::ExecuteTaskFeedback();
       feedback_.state = lfd_msgs::ExecuteTaskFeedback::PLANNING;
       goal_server_->publishFeedback(feedback_);
@@ -589,6 +594,7 @@ class Executor {
   std::string library_dir_;
   lfd::RobotSetup robot_;
   lfd::PathPolicy paths_;
+  lfd::StringBudget strings_;  // ~limits/max_request_string_bytes of every goal string
   lfd_dmp::ExecutorOptions options_;
   lfd_dmp::RequestLimits limits_;
   lfd_dmp::LibraryLimits library_limits_;

@@ -4,7 +4,8 @@
 // lfd_dmp::learnSkillLibrary / readDemoBag.
 // Private parameters (config/learner.yaml): ~pose_topic, ~gripper_topic, ~gripper_joint,
 // ~num_basis, ~smoothing_sigma, ~time_alignment/*, ~goal_frames/*, ~allowed_roots,
-// ~limits/{max_bags, max_total_bytes, max_num_basis, max_demo_seconds, max_samples_per_demo}.
+// ~limits/{max_bags, max_total_bytes, max_num_basis, max_demo_seconds, max_samples_per_demo,
+// max_request_string_bytes}.
 // Paths: absolute, bags must be regular files inside the roots, the library is written atomically,
 // never over a bag, and over an existing file only with overwrite and only when that file is a
 // skill library lfd wrote.
@@ -18,6 +19,7 @@
 
 #include <lfd_core/heap_trim.hpp>
 #include <lfd_core/input_budget.hpp>
+#include <lfd_core/ros_request_strings.hpp>
 #include <lfd_core/safe_paths.hpp>
 #include <lfd_core/time_alignment.hpp>
 
@@ -41,6 +43,10 @@ class Learner {
     readTimeAlignment(pnh);
     pnh.param("allowed_roots", paths_.allowed_roots, paths_.allowed_roots);
     paths_.require_absolute = true;  // the node's working directory is not the caller's
+    int max_string = static_cast<int>(strings_.max_bytes);
+    pnh.param("limits/max_request_string_bytes", max_string, max_string);
+    strings_.max_bytes = static_cast<std::size_t>(std::max(max_string, 0));
+    strings_.key = "~limits/max_request_string_bytes";
     pnh.param("limits/max_bags", max_bags_, max_bags_);
     pnh.param("limits/max_total_bytes", max_total_bytes_, max_total_bytes_);
     pnh.param("limits/max_num_basis", max_num_basis_, max_num_basis_);
@@ -59,6 +65,7 @@ class Learner {
     const lfd::TrimHeapOnExit trim;  // the demos read go back to the system once answered
     const auto t0 = std::chrono::steady_clock::now();
     try {
+      lfd::checkRequestStrings(req, strings_);  // before any work: no 10 MB string echoed
       if (req.output_path.empty()) throw std::invalid_argument("output_path is empty");
       lfd::checkRequestPath("output_path", req.output_path, paths_);
       checkCounts(req);
@@ -212,6 +219,7 @@ class Learner {
 
   lfd_dmp::DemoBagTopics topics_;
   lfd::PathPolicy paths_;
+  lfd::StringBudget strings_;
   int max_bags_ = 32;
   double max_total_bytes_ = 1e9;  // a double: ROS int parameters stop at 2^31
   int max_num_basis_ = 1000;

@@ -286,6 +286,24 @@ TEST(DmpTool, AUtf8ByteOrderMarkIsSkippedAndUtf16IsRefused) {
   for (const auto& p : {plain, bom, utf16}) std::remove(p.c_str());
 }
 
+// Issue 23: a library's strings are bounded when it is loaded (library_limits); one lfd writes
+// must load again, so a 10 kB task name is refused before anything is written.
+TEST(DmpTool, ALibraryThatCouldNotBeLoadedIsNeverWritten) {
+  const std::string csv = writeDemoCsv("long_task.csv", 0.6, 100);
+  const std::string json = tempPath("long_task.json");
+  std::string out, err;
+  EXPECT_EQ(
+      run({"learn", "--csv", csv, "--out", json, "--task", std::string(10000, 't')}, &out, &err),
+      1);
+  EXPECT_NE(err.find("skill library.task: a string of 10000 is over the limit of 4096 "
+                     "(library_limits/max_string_length)"),
+            std::string::npos)
+      << err.substr(0, 500);
+  EXPECT_LT(err.size(), 500u);
+  EXPECT_FALSE(std::ifstream(json).good());
+  std::remove(csv.c_str());
+}
+
 TEST(DmpTool, NeverWritesOverItsInput) {
   const std::string csv = writeDemoCsv("self.csv", 0.6, 100);
   const std::string before = fileText(csv);

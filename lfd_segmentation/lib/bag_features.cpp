@@ -61,12 +61,26 @@ struct MismatchedMessage : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+// The features of a demo against limits/max_features, counted as each topic's fields are
+// expanded: 10,000 columns took 1.1 GB before anything refused them.
+struct FeatureCount {
+  std::size_t used = 0;
+  std::size_t max = 0;  // 0 = no bound
+  void add(std::size_t n, const std::string& topic) {
+    used += n;
+    if (max > 0 && used > max)
+      throw std::invalid_argument("topic " + lfd::quoted(topic) + " brings the features to " +
+                                  std::to_string(used) + ", over the limit of " +
+                                  std::to_string(max) + " (limits/max_features)");
+  }
+};
+
 // One configured topic across the parts of a demonstration. Its features (the configured fields,
 // "*" expanded) are fixed by the first message of the first part; every connection (message
 // definition) on the topic gets a reader of those features.
 class TopicReader {
  public:
-  explicit TopicReader(const TopicConfig& cfg) : cfg_(cfg) {}
+  TopicReader(const TopicConfig& cfg, FeatureCount* count) : cfg_(cfg), count_(count) {}
 
   // One message of the topic, `bytes` its serialized form.
   void read(const rosbag::MessageInstance& m, const std::vector<std::uint8_t>& bytes) {
@@ -131,6 +145,7 @@ class TopicReader {
       throw std::invalid_argument("topic " + cfg_.topic + " (" + schema.root().name +
                                   "): " + e.what());
     }
+    count_->add(fields_.size(), cfg_.topic);
     for (const std::string& field : fields_) {
       lfd::Stream s;
       s.name = feature_name(cfg_.topic, field);
@@ -140,6 +155,7 @@ class TopicReader {
   }
 
   const TopicConfig& cfg_;
+  FeatureCount* count_;
   std::vector<std::string> fields_;
   std::vector<lfd::Stream> streams_;
   std::unique_ptr<rosmsg::MessageSchema> schema_;  // of the first message
@@ -299,14 +315,16 @@ DemoFiles open_demo_files(const std::string& path, const lfd::PathPolicy& policy
 std::vector<lfd::Stream> read_bag_streams(const std::string& path,
                                           const std::vector<TopicConfig>& topics,
                                           std::vector<FeatureRole>* roles,
-                                          std::vector<std::string>* warnings) {
-  return read_bag_streams(open_demo_files(path), topics, roles, warnings);
+                                          std::vector<std::string>* warnings,
+                                          std::size_t max_features) {
+  return read_bag_streams(open_demo_files(path), topics, roles, warnings, max_features);
 }
 
 std::vector<lfd::Stream> read_bag_streams(const DemoFiles& files,
                                           const std::vector<TopicConfig>& topics,
                                           std::vector<FeatureRole>* roles,
-                                          std::vector<std::string>* warnings) {
+                                          std::vector<std::string>* warnings,
+                                          std::size_t max_features) {
   const std::string& path = files.path;
   if (topics.empty()) throw std::invalid_argument("no topics configured for the features");
   for (const TopicConfig& cfg : topics) {
@@ -315,9 +333,10 @@ std::vector<lfd::Stream> read_bag_streams(const DemoFiles& files,
                                   " is ground truth and is never read by the segmenter");
     }
   }
+  FeatureCount count{0, max_features};
   std::vector<TopicReader> readers;
   readers.reserve(topics.size());
-  for (const TopicConfig& cfg : topics) readers.emplace_back(cfg);
+  for (const TopicConfig& cfg : topics) readers.emplace_back(cfg, &count);
   for (std::size_t k = 0; k < files.parts.size(); ++k)
     read_part(files.parts[k], files.names[k], topics, readers);
   std::vector<lfd::Stream> streams;
@@ -346,7 +365,8 @@ DemoFeatures read_bag_features(const DemoFiles& files, const std::vector<TopicCo
   const std::string& path = files.path;
   std::vector<FeatureRole> roles;
   std::vector<std::string> warnings;
-  const std::vector<lfd::Stream> streams = read_bag_streams(files, topics, &roles, &warnings);
+  const std::vector<lfd::Stream> streams =
+      read_bag_streams(files, topics, &roles, &warnings, limits.max_features);
   check_streams(streams, path, limits);
   double start = -INFINITY, end = INFINITY;  // the span resample() keeps: where all streams overlap
   for (const lfd::Stream& s : streams) {

@@ -76,6 +76,12 @@ lfd::FeatureMatrix read_csv_features(const std::string& path, const std::string&
   for (std::size_t c = 0; c < header.size(); ++c) {
     if (static_cast<int>(c) != time_index) m.names.push_back(header[c]);
   }
+  if (limits.max_features > 0 && m.names.size() > limits.max_features) {  // before any row
+    throw std::invalid_argument("CSV file " + lfd::quoted(path) + " has " +
+                                std::to_string(m.names.size()) +
+                                " feature columns, over the limit of " +
+                                std::to_string(limits.max_features) + " (limits/max_features)");
+  }
   if (m.names.empty())
     throw std::invalid_argument("CSV file " + lfd::quoted(path) + " has no feature column");
 

@@ -5,6 +5,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "lfd_core/ros_request_strings.hpp"
 #include "lfd_core/safe_paths.hpp"
 #include "lfd_segmentation/bag_features.hpp"
 
@@ -106,6 +107,11 @@ void handle_segment_request(const SegmentationParams& params,
   const auto start = std::chrono::steady_clock::now();
   response = lfd_msgs::Segment::Response();
   try {
+    // Every string within one bound before anything else: a 10 MB path is refused, not echoed.
+    lfd::StringBudget strings;
+    strings.max_bytes = params.limits.max_request_string_bytes;
+    strings.key = "limits/max_request_string_bytes";
+    lfd::checkRequestStrings(request, strings);
     if (request.bag_paths.empty()) {
       throw std::invalid_argument("empty request: give at least one bag path");
     }

@@ -423,6 +423,39 @@ TEST(CsvFeatures, AUtf8ByteOrderMarkIsSkippedAndUtf16IsRefused) {
   }
 }
 
+// Issue 23: 10,000 feature columns took 1.1 GB. The header is checked against
+// limits/max_features before any row is read.
+TEST(CsvFeatures, TooManyFeatureColumnsAreRefusedOnTheHeader) {
+  const std::string csv = (temp_dir() / "wide.csv").string();
+  {
+    std::ofstream out(csv);
+    out << "time";
+    for (int c = 0; c < 300; ++c) out << ",f" << c;
+    out << "\n";
+    for (int r = 0; r < 5; ++r) {
+      out << 0.01 * r;
+      for (int c = 0; c < 300; ++c) out << "," << r + c;
+      out << "\n";
+    }
+  }
+  lfd_segmentation::RequestLimits limits;
+  ASSERT_EQ(limits.max_features, 256u);
+  try {
+    lfd_segmentation::read_csv_features(csv, "", 0.0, limits);
+    ADD_FAILURE() << "300 feature columns read under a limit of 256";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("300 feature columns, over the limit of 256 "
+                                         "(limits/max_features)"),
+              std::string::npos)
+        << e.what();
+  }
+  int status = -1;
+  const auto j = run_cli(csv, &status);  // the CLI, with the shipped config
+  EXPECT_EQ(status, 1);
+  EXPECT_NE(j["error"].get<std::string>().find("limits/max_features"), std::string::npos)
+      << j.dump();
+}
+
 // Issue 23: an output replaced any regular file. --output replaces a result file the CLI wrote
 // (scripts rerun into their folder), never another file: it is kept and the error says why.
 TEST(SegmentCli, OutputReplacesOnlyAResultFileItWrote) {

@@ -155,6 +155,35 @@ TEST_F(SegmentService, RelativeBagPathsAreRefusedNamingTheField) {
   expect_error(r, "absolute path");
 }
 
+// Issue 23: every string of a request within limits/max_request_string_bytes, checked before any
+// work (a 10 MB string was echoed into errors and logs); the error quotes at most 200 characters.
+TEST_F(SegmentService, AnOverlongRequestStringIsRefusedBeforeAnyWork) {
+  lfd_msgs::Segment::Request request;
+  request.combination = std::string(10 << 20, 'c');
+  const auto r = call(good_bags(2), request);
+  expect_error(r,
+               "combination: a string of 10485760 bytes, over the limit of 262207 "
+               "(limits/max_request_string_bytes)");
+  EXPECT_LT(r.error.size(), 500u);
+  EXPECT_LT(r.elapsed, 1.0);
+  const auto paths = call({good_bags(1)[0], "/tmp/" + std::string(300000, 'p') + ".bag"});
+  expect_error(paths, "bag_paths[1]: a string of 300009 bytes");
+}
+
+// Issue 23: 10,000 feature columns took 1.1 GB. Features beyond limits/max_features are refused
+// as the topics' fields are expanded, before the bags are read whole and resampled.
+TEST_F(SegmentService, TooManyFeaturesAreRefusedBeforeResampling) {
+  lfd_segmentation::SegmentationParams few = params_;
+  few.limits.max_features = 10;
+  lfd_msgs::Segment::Request request;
+  request.bag_paths = good_bags(2);
+  lfd_msgs::Segment::Response r;
+  lfd_segmentation::handle_segment_request(few, request, r);
+  expect_error(r, "over the limit of 10 (limits/max_features)");
+  EXPECT_NE(r.error.find("good0.bag"), std::string::npos) << r.error;
+  EXPECT_EQ(params_.limits.max_features, 256u);  // the shipped bound takes these bags
+}
+
 // Issue 23: a topic whose connection declares geometry_msgs/PoseStamped but whose message holds
 // other bytes read as "Buffer Overrun". The error names the file, the topic, the declared type,
 // the message's index and time, and says the bytes do not match; the service answers.

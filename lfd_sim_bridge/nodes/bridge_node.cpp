@@ -45,6 +45,7 @@
 #include <utility>
 #include <vector>
 
+#include "lfd_core/ros_request_strings.hpp"
 #include "lfd_sim_bridge/workcell_sim.hpp"
 
 namespace {
@@ -240,6 +241,9 @@ class BridgeNode {
     clock_every_ = std::max<long>(1, std::lround(1.0 / (clock_rate * dt)));
     paused_ = param(pnh, "start_paused", false);
     max_steps_per_call_ = param(pnh, "max_steps_per_call", max_steps_per_call_);
+    strings_.max_bytes = static_cast<std::size_t>(std::max(
+        0, param(pnh, "limits/max_request_string_bytes", static_cast<int>(strings_.max_bytes))));
+    strings_.key = "~limits/max_request_string_bytes";
     rtf_report_period_ = param(pnh, "rtf_report_period", 30.0);
     if (!param(pnh, "headless", true)) {
       ROS_WARN(
@@ -516,6 +520,7 @@ class BridgeNode {
 
   bool onReset(lfd_msgs::ResetSim::Request& req, lfd_msgs::ResetSim::Response& res) {
     try {
+      lfd::checkRequestStrings(req, strings_);  // before any work: no 10 MB name echoed
       if (req.joint_names.size() != req.positions.size()) {
         throw std::invalid_argument("joint_names and positions differ in length");
       }
@@ -557,6 +562,7 @@ class BridgeNode {
 
   bool onSetScene(lfd_msgs::SetScene::Request& req, lfd_msgs::SetScene::Response& res) {
     try {
+      lfd::checkRequestStrings(req, strings_);  // before any work: no 10 MB name echoed
       if (req.object_names.size() != req.poses.size()) {
         throw std::invalid_argument("object_names and poses differ in length");
       }
@@ -623,6 +629,7 @@ class BridgeNode {
   long publish_every_ = 5, clock_every_ = 5;
   long step_count_ = 0;
   int max_steps_per_call_ = 10000;
+  lfd::StringBudget strings_;  // ~limits/max_request_string_bytes of every request string
   bool paused_ = false;
   ros::Time last_clock_, last_tf_;
   ThrottledErrors errors_;

@@ -26,6 +26,7 @@
 #include <rosgraph_msgs/Clock.h>
 #include <topic_tools/shape_shifter.h>
 
+#include <lfd_core/ros_request_strings.hpp>
 #include <lfd_core/safe_paths.hpp>
 
 #include "lfd_sim_bridge/bag_recorder.hpp"
@@ -78,6 +79,9 @@ class Recorder {
     max_unflushed_ = pnh.param("max_unflushed_seconds", max_unflushed_);
     paths_.allowed_roots = pnh.param("allowed_roots", paths_.allowed_roots);
     paths_.require_absolute = true;  // the node's working directory is not the caller's
+    strings_.max_bytes = static_cast<std::size_t>(std::max(
+        0, pnh.param("limits/max_request_string_bytes", static_cast<int>(strings_.max_bytes))));
+    strings_.key = "~limits/max_request_string_bytes";
     for (const std::string& folder : pnh.param("recovery_folders", std::vector<std::string>{}))
       reportRecovered(lfd_sim_bridge::recoverCrashedBags(folder));
     for (const TopicSpec& spec : topics_) {
@@ -264,6 +268,7 @@ class Recorder {
         req.metadata.header.stamp.isZero() ? ros::Time::now() : req.metadata.header.stamp;
     std::string recovered;
     try {
+      lfd::checkRequestStrings(req, strings_);  // before any work: no 10 MB path echoed
       lfd::checkRequestPath("bag_path", req.bag_path, paths_);
       lfd::checkPathInRoots(req.bag_path, paths_);
       // A crash may have left this very bag's `.active`: keep and reindex it. Only this path, and
@@ -378,6 +383,7 @@ class Recorder {
   double connect_timeout_ = 5.0;  // s of wall time: at start-up, and at each start
   double max_unflushed_ = 0.1;    // s of bag time a kill -9 may lose (chunk closed this often)
   lfd::PathPolicy paths_;         // ~allowed_roots of a start's bag_path
+  lfd::StringBudget strings_;     // ~limits/max_request_string_bytes of a start's strings
   ros::NodeHandle service_nh_;
   ros::CallbackQueue service_queue_;
   std::unique_ptr<ros::AsyncSpinner> service_spinner_;

@@ -254,6 +254,12 @@ class ExecutorAction(unittest.TestCase):
         # caller's).
         case("library: path 'libraries/grasp.json' is relative",
              lambda x: setattr(x, "library", "libraries/grasp.json"))
+        # Issue 23: every goal string within ~limits/max_request_string_bytes before any work,
+        # quoted short.
+        case("library: a string of 300000 bytes, over the limit of 262207 "
+             "(~limits/max_request_string_bytes)", lambda x: setattr(x, "library", "x" * 300000))
+        case("object_names[0]: a string of 300000 bytes",
+             lambda x: setattr(x, "object_names", ["s" * 300000]))
         old = os.path.join(self.out, "version1.json")
         with open(old, "w") as f:
             f.write('{"format": "lfd_skill_library", "version": 1, "segments": []}')

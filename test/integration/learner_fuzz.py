@@ -4,7 +4,7 @@
 paths outside ~allowed_roots or with '..' are refused), limits (~limits/max_num_basis,
 ~limits/max_bags), 150 seeded random requests of extreme values (seed 12, about 10 s), and a link
 swapped between a bag and a FIFO for 3 s while requests run (issue 23). Issue 23: overwrite
-replaces only a library lfd wrote; relative paths are refused."""
+replaces only a library lfd wrote; relative paths are refused; overlong strings are refused."""
 import hashlib
 import math
 import os
@@ -152,6 +152,19 @@ class LearnerFuzz(unittest.TestCase):
         req.bag_paths[1] = "demo1.bag"
         self.assertRefused(self.call(req), "bag_paths[1]: path 'demo1.bag' is relative")
         self.assertFalse(os.path.exists(os.path.join(self.dir, "rel.json")))
+
+    def test_9b_overlong_strings_are_refused_before_any_work(self):
+        """Issue 23: every request string within ~limits/max_request_string_bytes; the error
+        quotes at most 200 characters (a 10 MB string was echoed into errors and logs)."""
+        t0 = time.time()
+        res = self.call(self.valid(os.path.join(self.dir, "long.json"), task="x" * 300000))
+        self.assertRefused(res, "task: a string of 300000 bytes, over the limit of 262207 "
+                                "(~limits/max_request_string_bytes)")
+        self.assertLess(len(res.error), 500)
+        self.assertLess(time.time() - t0, 5.0)
+        req = self.valid(os.path.join(self.dir, "long.json"), segment_names=["a", "n" * 300000])
+        self.assertRefused(self.call(req), "segment_names[1]: a string of 300000 bytes")
+        self.assertFalse(os.path.exists(os.path.join(self.dir, "long.json")))
 
     def test_7_link_swapped_to_fifo_never_hangs(self):
         """Issue 23 row 1: a link swapped between a bag and a FIFO while requests run (3 s) never

@@ -117,8 +117,11 @@ lfd::OutputKind skillLibraryOutput();
 
 /// Writes pretty-printed JSON atomically (lfd::writeFileAtomically). An existing file is kept
 /// (std::invalid_argument) unless `overwrite`, and even then unless it is a skill library lfd
-/// wrote. Throws std::runtime_error on I/O errors.
-void saveSkillLibrary(const SkillLibrary& library, const std::string& path, bool overwrite);
+/// wrote. The library must load again within `limits` (its strings, lists and counts: a request's
+/// 200 KB task name would otherwise make a library no node can load): else std::runtime_error
+/// "<JSON location>: ..." and nothing is written. Throws std::runtime_error on I/O errors.
+void saveSkillLibrary(const SkillLibrary& library, const std::string& path, bool overwrite,
+                      const LibraryLimits& limits = {});
 /// Only regular files are read (a FIFO is refused, never opened), within `limits` (file size,
 /// sizes, durations: library_limits.hpp). Throws std::runtime_error with the file name and the
 /// JSON location of the problem.

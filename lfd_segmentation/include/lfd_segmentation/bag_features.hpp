@@ -54,20 +54,23 @@ void check_request_budget(const std::vector<std::string>& entries, const Request
 /// unreadable/truncated bags or messages that do not match their definition (naming the file,
 /// topic, declared type and the message's index and time), and std::invalid_argument for a
 /// missing topic, a field that does not exist (listing the topic's numeric fields), a field no
-/// message carries, or the ground-truth topic. Each stream is in stamp order
-/// (lfd_core/stamp_order.hpp); `warnings` gets one line per topic whose stamps were out of order,
-/// duplicated or had a gap.
+/// message carries, the ground-truth topic, or more features than `max_features` (0 = no bound;
+/// counted as the first message of each topic expands its fields, before the rest is read). Each
+/// stream is in stamp order (lfd_core/stamp_order.hpp); `warnings` gets one line per topic whose
+/// stamps were out of order, duplicated or had a gap.
 std::vector<lfd::Stream> read_bag_streams(const DemoFiles& files,
                                           const std::vector<TopicConfig>& topics,
                                           std::vector<FeatureRole>* roles = nullptr,
-                                          std::vector<std::string>* warnings = nullptr);
+                                          std::vector<std::string>* warnings = nullptr,
+                                          std::size_t max_features = 0);
 std::vector<lfd::Stream> read_bag_streams(const std::string& path,
                                           const std::vector<TopicConfig>& topics,
                                           std::vector<FeatureRole>* roles = nullptr,
-                                          std::vector<std::string>* warnings = nullptr);
+                                          std::vector<std::string>* warnings = nullptr,
+                                          std::size_t max_features = 0);
 
 /// read_bag_streams + resampling at `rate` Hz (errors name the bag). Streams over `limits`
-/// (time span, |value|) are refused before resampling (check_streams).
+/// (features, time span, |value|) are refused before resampling (check_streams).
 DemoFeatures read_bag_features(const DemoFiles& files, const std::vector<TopicConfig>& topics,
                                double rate, const RequestLimits& limits = RequestLimits());
 DemoFeatures read_bag_features(const std::string& path, const std::vector<TopicConfig>& topics,

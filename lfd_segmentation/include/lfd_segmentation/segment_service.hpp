@@ -29,8 +29,8 @@ struct PreparedCache {
 };
 
 /// Handles one request; always returns (success=false + error on failure). Before any work: every
-/// path absolute, the request budget. With a cache, a request on the bags of the previous one
-/// reuses their features and selection.
+/// string within limits/max_request_string_bytes, every path absolute, the request budget. With a
+/// cache, a request on the bags of the previous one reuses their features and selection.
 void handle_segment_request(const SegmentationParams& params,
                             const lfd_msgs::Segment::Request& request,
                             lfd_msgs::Segment::Response& response, PreparedCache* cache = nullptr);
