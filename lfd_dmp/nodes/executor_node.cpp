@@ -377,6 +377,10 @@ class Executor {
         return goal_server_->isPreemptRequested() || !ros::ok() || clock_reset_;
       });
       plan.warnings.insert(plan.warnings.begin(), warnings.begin(), warnings.end());
+      // What the driver would refuse is refused here, with the reason in the result.
+      lfd_dmp::checkTrajectoryVelocities(
+          lfd_dmp::toJointTrajectory(plan, ros::Time(0), trajectory_period_),
+          planner().chain().jointNames(), planner().chain().velocityLimits());
       describePlan(plan, wall0, &result);
       ROS_INFO("executor: planned %s: %zu segments, %.2f s, IK residual %.2f mm, %.2f s wall",
                library.task.c_str(), plan.segments.size(), plan.duration(),

@@ -473,6 +473,8 @@ class BridgeNode {
     }
   }
 
+  // Validated on receipt, whole (WorkcellSim::setTrajectory: sizes, finite values, times, each
+  // velocity within its joint's limit); a refused trajectory is logged and nothing moves.
   void onTrajectory(const trajectory_msgs::JointTrajectory::ConstPtr& msg) {
     lfd_sim::JointTrajectory traj;
     traj.joint_names = msg->joint_names;
@@ -481,9 +483,26 @@ class BridgeNode {
       traj.points.push_back({p.time_from_start.toSec(), p.positions, p.velocities});
     }
     try {
+      checkAccelerations(*msg);
       sim_->setTrajectory(traj, msg->header.stamp.toSec());
     } catch (const std::exception& e) {
       errors_.report("joint_trajectory", std::string("rejected /joint_trajectory: ") + e.what());
+    }
+  }
+
+  // The interpolation does not use accelerations, but a trajectory that carries wrong ones is a
+  // wrong trajectory: refused like a bad position or velocity.
+  static void checkAccelerations(const trajectory_msgs::JointTrajectory& msg) {
+    for (size_t k = 0; k < msg.points.size(); ++k) {
+      const std::vector<double>& a = msg.points[k].accelerations;
+      if (!a.empty() && a.size() != msg.joint_names.size())
+        throw std::invalid_argument("trajectory point " + std::to_string(k) + " has " +
+                                    std::to_string(a.size()) + " accelerations for " +
+                                    std::to_string(msg.joint_names.size()) + " joints");
+      for (double x : a)
+        if (!std::isfinite(x))
+          throw std::invalid_argument("trajectory point " + std::to_string(k) +
+                                      " has a NaN or infinite acceleration");
     }
   }
 
