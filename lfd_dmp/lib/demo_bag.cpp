@@ -1,8 +1,10 @@
 #include "lfd_dmp/demo_bag.hpp"
 #include "lfd_dmp/demo_scene.hpp"
 
+#include <lfd_core/ros_bag_message.hpp>
 #include <lfd_core/safe_paths.hpp>
 #include <lfd_core/stamp_order.hpp>
+#include <lfd_core/user_text.hpp>
 
 #include <geometry_msgs/PoseStamped.h>
 #include <lfd_msgs/DemoMetadata.h>
@@ -13,6 +15,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <stdexcept>
 #include <vector>
 
@@ -77,38 +80,35 @@ void orderByStamp(const std::string& topic, std::vector<double>& stamps, std::ve
   if (!warning.empty()) warnings->push_back(warning);
 }
 
-}  // namespace
-
-DemoRecording readDemoBag(const std::string& path, const DemoBagTopics& topics,
-                          const TransformLookup& fallback) {
-  rosbag::Bag bag;
-  try {
-    // Opened once through the file-access layer: a link swapped to a FIFO cannot hang open().
-    const lfd::InputFile file = lfd::openInputFile(path);
-    bag.open(file.readPath(), rosbag::bagmode::Read);
-  } catch (const std::exception& e) {
-    throw std::runtime_error("cannot open bag " + path + ": " + e.what());
-  }
+// What a demo bag holds for the learner, as read (before stamp order).
+struct BagContents {
   std::vector<double> t;
   std::vector<std::array<double, 7>> poses;
   std::vector<double> grip_t, grip_v;
   std::string frame, extra_json;
   StaticTransforms tf;
+};
+
+void readMessages(rosbag::Bag& bag, const std::string& path, const DemoBagTopics& topics,
+                  BagContents* c) {
+  std::map<std::string, std::size_t> seen;  // messages per topic, for errors
   rosbag::View view(bag, rosbag::TopicQuery(std::vector<std::string>{
                              topics.pose, topics.gripper, topics.metadata, topics.tf_static}));
   for (const rosbag::MessageInstance& m : view) {
+    const std::size_t index = seen[m.getTopic()]++;
     if (m.getTopic() == topics.metadata) {
-      if (const auto meta = m.instantiate<lfd_msgs::DemoMetadata>()) extra_json = meta->extra_json;
+      if (const auto meta = lfd::instantiateChecked<lfd_msgs::DemoMetadata>(m, index, path))
+        c->extra_json = meta->extra_json;
     } else if (m.getTopic() == topics.tf_static) {
-      if (const auto msg = m.instantiate<tf2_msgs::TFMessage>()) {
+      if (const auto msg = lfd::instantiateChecked<tf2_msgs::TFMessage>(m, index, path)) {
         try {
-          addTransforms(*msg, &tf);
+          addTransforms(*msg, &c->tf);
         } catch (const std::runtime_error& e) {
           throw std::runtime_error(path + ": " + topics.tf_static + ": " + e.what());
         }
       }
     } else if (m.getTopic() == topics.pose) {
-      const auto msg = m.instantiate<geometry_msgs::PoseStamped>();
+      const auto msg = lfd::instantiateChecked<geometry_msgs::PoseStamped>(m, index, path);
       if (!msg)
         throw std::runtime_error(path + ": " + topics.pose + " is not geometry_msgs/PoseStamped");
       const double stamp = msg->header.stamp.toSec();
@@ -121,62 +121,85 @@ DemoRecording readDemoBag(const std::string& path, const DemoBagTopics& topics,
                                    " at t = " + std::to_string(stamp));
         }
       }
-      if (t.empty()) frame = msg->header.frame_id;
-      t.push_back(stamp);
-      poses.push_back(row);
+      if (c->t.empty()) c->frame = msg->header.frame_id;
+      c->t.push_back(stamp);
+      c->poses.push_back(row);
     } else {
-      const auto msg = m.instantiate<sensor_msgs::JointState>();
+      const auto msg = lfd::instantiateChecked<sensor_msgs::JointState>(m, index, path);
       if (!msg) continue;
       const auto it = std::find(msg->name.begin(), msg->name.end(), topics.gripper_joint);
       if (it == msg->name.end()) continue;
       const size_t i = static_cast<size_t>(it - msg->name.begin());
       if (i >= msg->position.size() || !std::isfinite(msg->position[i])) continue;
-      grip_t.push_back(msg->header.stamp.toSec());
-      grip_v.push_back(msg->position[i]);
+      c->grip_t.push_back(msg->header.stamp.toSec());
+      c->grip_v.push_back(msg->position[i]);
     }
+  }
+}
+
+}  // namespace
+
+DemoRecording readDemoBag(const std::string& path, const DemoBagTopics& topics,
+                          const TransformLookup& fallback) {
+  rosbag::Bag bag;
+  try {
+    // Opened once through the file-access layer: a link swapped to a FIFO cannot hang open().
+    const lfd::InputFile file = lfd::openInputFile(path);
+    bag.open(file.readPath(), rosbag::bagmode::Read);
+  } catch (const std::exception& e) {
+    throw std::runtime_error("cannot open bag " + path + ": " + e.what());
+  }
+  BagContents c;
+  try {
+    readMessages(bag, path, topics, &c);
+  } catch (const lfd::MismatchedMessage&) {
+    throw;
+  } catch (const ros::Exception& e) {  // rosbag: a chunk or record that cannot be read
+    throw std::runtime_error("cannot read bag " + lfd::quoted(path) +
+                             " (truncated or corrupt?): " + e.what());
   }
   bag.close();
   DemoRecording rec;
-  orderByStamp(topics.pose, t, poses, &rec.warnings);
-  orderByStamp(topics.gripper, grip_t, grip_v, &rec.warnings);
+  orderByStamp(topics.pose, c.t, c.poses, &rec.warnings);
+  orderByStamp(topics.gripper, c.grip_t, c.grip_v, &rec.warnings);
   for (std::string& w : rec.warnings) w = path + ": " + w;
-  if (t.size() < static_cast<size_t>(lfd::kMinDmpSamples)) {
-    throw std::runtime_error(path + ": only " + std::to_string(t.size()) + " messages on " +
+  if (c.t.size() < static_cast<size_t>(lfd::kMinDmpSamples)) {
+    throw std::runtime_error(path + ": only " + std::to_string(c.t.size()) + " messages on " +
                              topics.pose);
   }
   rec.id = path;
-  rec.frame = frame;
-  if (!extra_json.empty()) {
+  rec.frame = c.frame;
+  if (!c.extra_json.empty()) {
     try {
-      rec.scene = sceneOf(path, extra_json, tf, frame, fallback);
+      rec.scene = sceneOf(path, c.extra_json, c.tf, c.frame, fallback);
     } catch (const std::runtime_error& e) {
       const std::string what = e.what();
       throw std::runtime_error(what.rfind(path, 0) == 0 ? what : path + ": " + what);
     }
   }
-  const Eigen::Index m = static_cast<Eigen::Index>(t.size());
-  rec.times = Eigen::Map<Eigen::VectorXd>(t.data(), m);
+  const Eigen::Index m = static_cast<Eigen::Index>(c.t.size());
+  rec.times = Eigen::Map<Eigen::VectorXd>(c.t.data(), m);
   rec.positions.resize(m, 3);
   rec.quaternions.resize(m, 4);
   for (Eigen::Index i = 0; i < m; ++i) {
-    const auto& r = poses[static_cast<size_t>(i)];
+    const auto& r = c.poses[static_cast<size_t>(i)];
     rec.positions.row(i) << r[0], r[1], r[2];
     rec.quaternions.row(i) << r[3], r[4], r[5], r[6];
   }
-  if (!grip_t.empty()) {
+  if (!c.grip_t.empty()) {
     // Linear interpolation onto the pose stamps, held constant outside the gripper's range.
     rec.gripper.resize(m);
     size_t j = 0;
     for (Eigen::Index i = 0; i < m; ++i) {
       const double ti = rec.times[i];
-      while (j + 1 < grip_t.size() && grip_t[j + 1] <= ti) ++j;
-      if (ti <= grip_t.front()) {
-        rec.gripper[i] = grip_v.front();
-      } else if (j + 1 >= grip_t.size()) {
-        rec.gripper[i] = grip_v.back();
+      while (j + 1 < c.grip_t.size() && c.grip_t[j + 1] <= ti) ++j;
+      if (ti <= c.grip_t.front()) {
+        rec.gripper[i] = c.grip_v.front();
+      } else if (j + 1 >= c.grip_t.size()) {
+        rec.gripper[i] = c.grip_v.back();
       } else {
-        const double a = (ti - grip_t[j]) / (grip_t[j + 1] - grip_t[j]);
-        rec.gripper[i] = (1 - a) * grip_v[j] + a * grip_v[j + 1];
+        const double a = (ti - c.grip_t[j]) / (c.grip_t[j + 1] - c.grip_t[j]);
+        rec.gripper[i] = (1 - a) * c.grip_v[j] + a * c.grip_v[j + 1];
       }
     }
   }

@@ -94,7 +94,8 @@ int learn(const std::vector<std::string>& args, std::ostream& out) {
             {"--overwrite"});
   const std::string csv = required(o, "--csv");
   const bool overwrite = o.count("--overwrite") > 0;
-  const std::string path = lfd::checkOutputFile(required(o, "--out"), {}, overwrite, {csv});
+  const std::string path =
+      lfd::checkOutputFile(required(o, "--out"), {}, overwrite, {csv}, skillLibraryOutput());
   CsvColumns cols;
   if (o.count("--time-column")) cols.time = o.at("--time-column");
   if (o.count("--gripper-column")) cols.gripper = o.at("--gripper-column");
@@ -143,8 +144,8 @@ int rollout(const std::vector<std::string>& args, std::ostream& out) {
                           {"--generalize", "--overwrite"});
   const std::string library_path = required(o, "--library");
   const bool overwrite = o.count("--overwrite") > 0;
-  const std::string path =
-      lfd::checkOutputFile(required(o, "--out"), {}, overwrite, {library_path});
+  const std::string path = lfd::checkOutputFile(required(o, "--out"), {}, overwrite, {library_path},
+                                                trajectoryCsvOutput());
   const SkillLibrary lib = loadSkillLibrary(library_path);
   const int seg_index = static_cast<int>(optNumber(o, "--segment").value_or(0));
   if (seg_index < 0 || seg_index >= static_cast<int>(lib.segments.size())) {

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <sstream>
+#include <stdexcept>
 
 namespace lfd_dmp {
 
@@ -30,6 +32,30 @@ trajectory_msgs::JointTrajectory toJointTrajectory(const ExecutionPlan& plan,
     msg.points.push_back(std::move(p));
   }
   return msg;
+}
+
+void checkTrajectoryVelocities(const trajectory_msgs::JointTrajectory& trajectory,
+                               const std::vector<std::string>& joint_names,
+                               const Eigen::VectorXd& limits) {
+  std::vector<double> limit(trajectory.joint_names.size(), 0.0);
+  for (size_t j = 0; j < limit.size(); ++j) {
+    const auto it = std::find(joint_names.begin(), joint_names.end(), trajectory.joint_names[j]);
+    const auto k = static_cast<Eigen::Index>(it - joint_names.begin());
+    if (it != joint_names.end() && k < limits.size()) limit[j] = limits[k];
+  }
+  for (const trajectory_msgs::JointTrajectoryPoint& p : trajectory.points) {
+    for (size_t j = 0; j < p.velocities.size() && j < limit.size(); ++j) {
+      if (!(limit[j] > 0.0) || !std::isfinite(limit[j]) || std::abs(p.velocities[j]) <= limit[j])
+        continue;
+      std::ostringstream msg;
+      msg << "the planned motion moves joint " << trajectory.joint_names[j] << " at "
+          << std::abs(p.velocities[j]) << " rad/s at t = " << p.time_from_start.toSec()
+          << " s, over its velocity limit of " << limit[j]
+          << " rad/s (the robot's URDF): the driver would refuse it; a larger duration_scale "
+             "plans it slower";
+      throw std::invalid_argument(msg.str());
+    }
+  }
 }
 
 trajectory_msgs::JointTrajectory holdTrajectory(const std::vector<std::string>& joints,

@@ -465,11 +465,18 @@ SkillLibrary skillLibraryFromJson(const json& j) {
   return lib;
 }
 
-void saveSkillLibrary(const SkillLibrary& library, const std::string& path, bool overwrite) {
+lfd::OutputKind skillLibraryOutput() {
+  return lfd::jsonOutput("skill library", kSkillLibraryFormat);
+}
+
+void saveSkillLibrary(const SkillLibrary& library, const std::string& path, bool overwrite,
+                      const LibraryLimits& limits) {
+  const json j = toJson(library);
+  checkLibrarySizes(j, limits);  // a library lfd writes is one it loads again
   // Demo ids and segment names come from requests and file names: invalid UTF-8 is written as
   // U+FFFD rather than throwing nlohmann's type_error 316 at the end of a whole learning run.
-  const std::string text = toJson(library).dump(2, ' ', false, json::error_handler_t::replace);
-  lfd::writeTextAtomically(path, overwrite, text + "\n");
+  const std::string text = j.dump(2, ' ', false, json::error_handler_t::replace);
+  lfd::writeTextAtomically(path, overwrite, skillLibraryOutput(), text + "\n");
 }
 
 SkillLibrary loadSkillLibrary(const std::string& path, const LibraryLimits& limits) {

@@ -1,6 +1,7 @@
 #include "lfd_dmp/trajectory_csv.hpp"
 
 #include <lfd_core/safe_paths.hpp>
+#include <lfd_core/user_text.hpp>
 
 #include <algorithm>
 #include <cerrno>
@@ -50,7 +51,15 @@ CsvTrajectory readTrajectoryCsv(const std::string& path, const CsvColumns& colum
   size_t line_no = 0;
   std::vector<std::string> header;
   while (std::getline(in, line)) {
-    ++line_no;
+    if (++line_no == 1) {
+      // A spreadsheet's UTF-8 byte-order mark would name the first column "\xef\xbb\xbft".
+      try {
+        lfd::stripByteOrderMark(line, path);
+      } catch (const std::invalid_argument& e) {
+        throw std::runtime_error(e.what());
+      }
+      if (trim(line) == kTrajectoryCsvMarker) continue;  // lfd's own first line
+    }
     if (!trim(line).empty()) {
       header = splitCsv(line);
       break;
@@ -151,6 +160,7 @@ void writeTrajectoryCsv(const std::string& path, const lfd::SegmentTrajectory& t
                              " position columns");
   }
   std::ostringstream out;
+  out << kTrajectoryCsvMarker << "\n";
   out << "t";
   for (const auto& n : position_names) out << "," << n;
   const bool quat = traj.quaternions.cols() == 4;
@@ -167,7 +177,11 @@ void writeTrajectoryCsv(const std::string& path, const lfd::SegmentTrajectory& t
     if (grip) out << "," << traj.gripper[k];
     out << "\n";
   }
-  lfd::writeTextAtomically(path, overwrite, out.str());
+  lfd::writeTextAtomically(path, overwrite, trajectoryCsvOutput(), out.str());
+}
+
+lfd::OutputKind trajectoryCsvOutput() {
+  return lfd::textOutput("trajectory CSV", kTrajectoryCsvMarker);
 }
 
 }  // namespace lfd_dmp

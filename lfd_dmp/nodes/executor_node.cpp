@@ -18,6 +18,7 @@
 #include <lfd_msgs/ExecuteTaskAction.h>
 #include <lfd_core/heap_trim.hpp>
 #include <lfd_core/robot_setup.hpp>
+#include <lfd_core/ros_request_strings.hpp>
 #include <lfd_core/safe_paths.hpp>
 #include <lfd_ros/master_watch.hpp>
 
@@ -200,6 +201,10 @@ class Executor {
     trajectory_period_ = param(pnh, "trajectory_period", trajectory_period_);
     feedback_period_ = param(pnh, "feedback_period", feedback_period_);
     paths_.allowed_roots = param(pnh, "allowed_roots", paths_.allowed_roots);
+    paths_.require_absolute = true;  // the node's working directory is not the caller's
+    strings_.max_bytes = static_cast<std::size_t>(std::max(
+        0, param(pnh, "limits/max_request_string_bytes", static_cast<int>(strings_.max_bytes))));
+    strings_.key = "~limits/max_request_string_bytes";
     limits_.min_duration_scale =
         param(pnh, "limits/min_duration_scale", limits_.min_duration_scale);
     limits_.max_duration_scale =
@@ -259,8 +264,10 @@ class Executor {
   std::string libraryPath(const std::string& s) const {
     lfd_dmp::checkNameLength(s, "library", limits_);
     if (s.empty()) throw std::invalid_argument("library is empty (a path or a name)");
-    if (s.find('/') != std::string::npos || (s.size() > 5 && s.substr(s.size() - 5) == ".json"))
+    if (s.find('/') != std::string::npos || (s.size() > 5 && s.substr(s.size() - 5) == ".json")) {
+      lfd::checkRequestPath("library", s, paths_);
       return lfd::checkInputFile(s, paths_);
+    }
     if (library_dir_.empty() || s == "." || s == "..")
       throw std::invalid_argument("'" + s + "' is not a path and ~library_dir is not set");
     return lfd::checkInputFile(library_dir_ + "/" + s + ".json", paths_);
@@ -345,6 +352,7 @@ class Executor {
     const auto wall0 = Clock::now();
     lfd_msgs::ExecuteTaskResult result;
     try {
+      lfd::checkRequestStrings(goal, strings_);  // before any work: no 10 MB string echoed
       feedback_ = lfd_msgs::ExecuteTaskFeedback();
       feedback_.state = lfd_msgs::ExecuteTaskFeedback::PLANNING;
       goal_server_->publishFeedback(feedback_);
@@ -370,6 +378,10 @@ class Executor {
         return goal_server_->isPreemptRequested() || !ros::ok() || clock_reset_;
       });
       plan.warnings.insert(plan.warnings.begin(), warnings.begin(), warnings.end());
+      // What the driver would refuse is refused here, with the reason in the result.
+      lfd_dmp::checkTrajectoryVelocities(
+          lfd_dmp::toJointTrajectory(plan, ros::Time(0), trajectory_period_),
+          planner().chain().jointNames(), planner().chain().velocityLimits());
       describePlan(plan, wall0, &result);
       ROS_INFO("executor: planned %s: %zu segments, %.2f s, IK residual %.2f mm, %.2f s wall",
                library.task.c_str(), plan.segments.size(), plan.duration(),
@@ -596,6 +608,7 @@ class Executor {
   std::string library_dir_;
   lfd::RobotSetup robot_;
   lfd::PathPolicy paths_;
+  lfd::StringBudget strings_;  // ~limits/max_request_string_bytes of every goal string
   lfd_dmp::ExecutorOptions options_;
   lfd_dmp::RequestLimits limits_;
   lfd_dmp::LibraryLimits library_limits_;

@@ -4,9 +4,11 @@
 // lfd_dmp::learnSkillLibrary / readDemoBag.
 // Private parameters (config/learner.yaml): ~pose_topic, ~gripper_topic, ~gripper_joint,
 // ~num_basis, ~smoothing_sigma, ~time_alignment/*, ~goal_frames/*, ~allowed_roots,
-// ~limits/{max_bags, max_total_bytes, max_num_basis, max_demo_seconds, max_samples_per_demo}.
-// Paths: bags must be regular files inside the roots, the library is written atomically, never over
-// a bag, and over an existing file only with overwrite.
+// ~limits/{max_bags, max_total_bytes, max_num_basis, max_demo_seconds, max_samples_per_demo,
+// max_request_string_bytes}.
+// Paths: absolute, bags must be regular files inside the roots, the library is written atomically,
+// never over a bag, and over an existing file only with overwrite and only when that file is a
+// skill library lfd wrote.
 #include "lfd_dmp/demo_bag.hpp"
 #include "lfd_dmp/skill_learner.hpp"
 
@@ -17,6 +19,7 @@
 
 #include <lfd_core/heap_trim.hpp>
 #include <lfd_core/input_budget.hpp>
+#include <lfd_core/ros_request_strings.hpp>
 #include <lfd_core/safe_paths.hpp>
 #include <lfd_core/time_alignment.hpp>
 #include <lfd_ros/master_watch.hpp>
@@ -40,6 +43,11 @@ class Learner {
     }
     readTimeAlignment(pnh);
     pnh.param("allowed_roots", paths_.allowed_roots, paths_.allowed_roots);
+    paths_.require_absolute = true;  // the node's working directory is not the caller's
+    int max_string = static_cast<int>(strings_.max_bytes);
+    pnh.param("limits/max_request_string_bytes", max_string, max_string);
+    strings_.max_bytes = static_cast<std::size_t>(std::max(max_string, 0));
+    strings_.key = "~limits/max_request_string_bytes";
     pnh.param("limits/max_bags", max_bags_, max_bags_);
     pnh.param("limits/max_total_bytes", max_total_bytes_, max_total_bytes_);
     pnh.param("limits/max_num_basis", max_num_basis_, max_num_basis_);
@@ -58,12 +66,17 @@ class Learner {
     const lfd::TrimHeapOnExit trim;  // the demos read go back to the system once answered
     const auto t0 = std::chrono::steady_clock::now();
     try {
+      lfd::checkRequestStrings(req, strings_);  // before any work: no 10 MB string echoed
       if (req.output_path.empty()) throw std::invalid_argument("output_path is empty");
+      lfd::checkRequestPath("output_path", req.output_path, paths_);
       checkCounts(req);
       std::vector<std::string> bags;
       std::vector<std::vector<double>> cps;
       if (!req.segmentations.empty()) {
-        for (const auto& s : req.segmentations) {
+        for (size_t i = 0; i < req.segmentations.size(); ++i) {
+          const auto& s = req.segmentations[i];
+          lfd::checkRequestPath("segmentations[" + std::to_string(i) + "].source", s.source,
+                                paths_);
           bags.push_back(s.source);
           cps.push_back(s.changepoint_times);
         }
@@ -73,6 +86,7 @@ class Learner {
         }
         size_t k = 0;
         for (size_t i = 0; i < req.bag_paths.size(); ++i) {
+          lfd::checkRequestPath("bag_paths[" + std::to_string(i) + "]", req.bag_paths[i], paths_);
           bags.push_back(req.bag_paths[i]);
           std::vector<double> c;
           for (uint32_t j = 0; j < req.changepoint_counts[i]; ++j) {
@@ -89,7 +103,8 @@ class Learner {
       }
       if (bags.empty()) throw std::invalid_argument("no demonstrations given");
       checkBudget(bags);
-      const std::string output = lfd::checkOutputFile(req.output_path, paths_, req.overwrite, bags);
+      const std::string output = lfd::checkOutputFile(req.output_path, paths_, req.overwrite, bags,
+                                                      lfd_dmp::skillLibraryOutput());
       std::vector<lfd_dmp::DemoRecording> demos;
       for (const auto& b : bags) {
         demos.push_back(lfd_dmp::readDemoBag(
@@ -205,6 +220,7 @@ class Learner {
 
   lfd_dmp::DemoBagTopics topics_;
   lfd::PathPolicy paths_;
+  lfd::StringBudget strings_;
   int max_bags_ = 32;
   double max_total_bytes_ = 1e9;  // a double: ROS int parameters stop at 2^31
   int max_num_basis_ = 1000;

@@ -222,9 +222,86 @@ TEST(DmpTool, KeepsAnExistingOutputUnlessOverwrite) {
   EXPECT_EQ(run({"learn", "--csv", csv, "--out", json}, &out, &err), 1);
   EXPECT_NE(err.find("exists; set overwrite"), std::string::npos) << err;
   EXPECT_EQ(fileText(json), "precious\n");
-  ASSERT_EQ(run({"learn", "--csv", csv, "--out", json, "--overwrite"}, &out, &err), 0) << err;
-  EXPECT_EQ(lfd_dmp::loadSkillLibrary(json).segments.size(), 1u);
+  // Issue 23: --overwrite replaced any file; it replaces only a skill library lfd wrote.
+  EXPECT_EQ(run({"learn", "--csv", csv, "--out", json, "--overwrite"}, &out, &err), 1);
+  EXPECT_NE(err.find("keep.json"), std::string::npos) << err;
+  EXPECT_NE(err.find("was not written by lfd as a skill library"), std::string::npos) << err;
+  EXPECT_EQ(fileText(json), "precious\n");
+  std::remove(json.c_str());
+  ASSERT_EQ(run({"learn", "--csv", csv, "--out", json}, &out, &err), 0) << err;
+  ASSERT_EQ(
+      run({"learn", "--csv", csv, "--out", json, "--overwrite", "--task", "again"}, &out, &err), 0)
+      << err;
+  EXPECT_EQ(lfd_dmp::loadSkillLibrary(json).task, "again");
   for (const auto& p : {csv, json}) std::remove(p.c_str());
+}
+
+// Issue 23: a rollout's --overwrite replaces only a trajectory CSV dmp_tool wrote (its first line
+// marks it); a demonstration CSV or any other file of that name is kept.
+TEST(DmpTool, RolloutOverwritesOnlyATrajectoryItWrote) {
+  const std::string csv = writeDemoCsv("roll.csv", 0.6, 100);
+  const std::string json = tempPath("roll.json");
+  const std::string traj = tempPath("roll_traj.csv");
+  const std::string other = writeDemoCsv("roll_other.csv", 0.5, 50);  // a CSV lfd did not write
+  const std::string before = fileText(other);
+  std::string out, err;
+  ASSERT_EQ(run({"learn", "--csv", csv, "--out", json}, &out, &err), 0) << err;
+  EXPECT_EQ(run({"rollout", "--library", json, "--out", other, "--overwrite"}, &out, &err), 1);
+  EXPECT_NE(err.find("was not written by lfd as a trajectory CSV"), std::string::npos) << err;
+  EXPECT_EQ(fileText(other), before);
+  ASSERT_EQ(run({"rollout", "--library", json, "--out", traj}, &out, &err), 0) << err;
+  EXPECT_EQ(fileText(traj).rfind(std::string(lfd_dmp::kTrajectoryCsvMarker) + "\nt,x,y,z", 0), 0u);
+  ASSERT_EQ(
+      run({"rollout", "--library", json, "--out", traj, "--overwrite", "--tau", "3"}, &out, &err),
+      0)
+      << err;
+  EXPECT_NEAR(lfd_dmp::readTrajectoryCsv(traj).demo.times.tail(1)(0), 3.0, 0.01);
+  for (const auto& p : {csv, json, traj, other}) std::remove(p.c_str());
+}
+
+// Issue 23: a CSV saved with a UTF-8 byte-order mark named its first column "\xef\xbb\xbft"; UTF-16
+// is refused saying so.
+TEST(DmpTool, AUtf8ByteOrderMarkIsSkippedAndUtf16IsRefused) {
+  const std::string plain = writeDemoCsv("bom_plain.csv", 0.6, 100);
+  const std::string bom = tempPath("bom.csv");
+  std::ofstream(bom, std::ios::binary) << "\xEF\xBB\xBF" << fileText(plain);
+  const lfd_dmp::CsvTrajectory traj = lfd_dmp::readTrajectoryCsv(bom);
+  EXPECT_EQ(traj.position_names, (std::vector<std::string>{"x", "y", "z"}));
+  EXPECT_EQ(traj.demo.times.size(), 100);
+  EXPECT_NEAR(traj.demo.times(99), 2.0, 1e-9);  // the time column is t, not column 0 by chance
+  const std::string utf16 = tempPath("utf16.csv");
+  {
+    std::ofstream out(utf16, std::ios::binary);
+    out << "\xFE\xFF";
+    for (char c : std::string("t,x\n0,1\n")) out << '\0' << c;
+  }
+  try {
+    lfd_dmp::readTrajectoryCsv(utf16);
+    ADD_FAILURE() << "a UTF-16 CSV was read";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("UTF-16 is not supported, save it as UTF-8"),
+              std::string::npos)
+        << e.what();
+  }
+  for (const auto& p : {plain, bom, utf16}) std::remove(p.c_str());
+}
+
+// Issue 23: a library's strings are bounded when it is loaded (library_limits); one lfd writes
+// must load again, so a 10 kB task name is refused before anything is written.
+TEST(DmpTool, ALibraryThatCouldNotBeLoadedIsNeverWritten) {
+  const std::string csv = writeDemoCsv("long_task.csv", 0.6, 100);
+  const std::string json = tempPath("long_task.json");
+  std::string out, err;
+  EXPECT_EQ(
+      run({"learn", "--csv", csv, "--out", json, "--task", std::string(10000, 't')}, &out, &err),
+      1);
+  EXPECT_NE(err.find("skill library.task: a string of 10000 is over the limit of 4096 "
+                     "(library_limits/max_string_length)"),
+            std::string::npos)
+      << err.substr(0, 500);
+  EXPECT_LT(err.size(), 500u);
+  EXPECT_FALSE(std::ifstream(json).good());
+  std::remove(csv.c_str());
 }
 
 TEST(DmpTool, NeverWritesOverItsInput) {

@@ -1,6 +1,7 @@
 // Executor logic without ROS: segment goal rules, gripper thresholding, segment sequencing of the
 // planned path, and refusal of unreachable goals / mismatched libraries before anything moves.
 #include "lfd_dmp/executor.hpp"
+#include "lfd_dmp/plan_messages.hpp"
 #include "lfd_dmp/skill_learner.hpp"
 #include "strokes.hpp"
 
@@ -183,6 +184,30 @@ TEST_F(PlannerTest, SegmentsRunInSequenceFromTheCurrentPoseToEachNewGoal) {
   // Duration scale stretches the plan.
   opt.duration_scale = 1.5;
   EXPECT_NEAR(planner_.plan(lib_, targets(grasp, goal), q0_, 0.04, opt).duration(), 6.75, 0.05);
+}
+
+// Issue 23: the driver refuses a trajectory whose velocity is beyond a joint's limit; the
+// executor checks the trajectory it would send first, so the goal fails naming the joint. A
+// normal plan is within the limits.
+TEST_F(PlannerTest, ATrajectoryFasterThanAJointsLimitIsRefusedBeforeItIsSent) {
+  const Eigen::Vector3d grasp = home_.position + Eigen::Vector3d(0.02, 0.0, -0.045);
+  const Eigen::Vector3d goal = grasp + Eigen::Vector3d(-0.03, 0.05, 0.12);
+  lfd_dmp::ExecutorOptions opt;
+  opt.dt = 0.004;
+  const lfd_dmp::ExecutionPlan plan = planner_.plan(lib_, targets(grasp, goal), q0_, 0.04, opt);
+  trajectory_msgs::JointTrajectory msg = lfd_dmp::toJointTrajectory(plan, ros::Time(0), 0.01);
+  const Eigen::VectorXd& limits = chain_.velocityLimits();
+  EXPECT_NO_THROW(lfd_dmp::checkTrajectoryVelocities(msg, chain_.jointNames(), limits));
+  ASSERT_GT(limits[1], 0.0);
+  msg.points[5].velocities[1] = -1.5 * limits[1];
+  try {
+    lfd_dmp::checkTrajectoryVelocities(msg, chain_.jointNames(), limits);
+    ADD_FAILURE() << "a velocity over the limit passed";
+  } catch (const std::invalid_argument& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("joint " + chain_.jointNames()[1]), std::string::npos) << what;
+    EXPECT_NE(what.find("over its velocity limit"), std::string::npos) << what;
+  }
 }
 
 TEST_F(PlannerTest, RefusesUnreachableGoalsAndMismatchedLibraries) {

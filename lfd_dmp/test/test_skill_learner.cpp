@@ -11,6 +11,7 @@
 
 #include <gtest/gtest.h>
 
+#include "declared_type_bytes.hpp"
 #include "link_swap_race.hpp"
 
 #include <unistd.h>
@@ -311,6 +312,40 @@ TEST(DemoBag, ReadsPosesAndInterpolatesTheGripper) {
   EXPECT_FALSE(back.scene.has_value());  // no metadata: no scene (and no error)
   std::remove(path.c_str());
   EXPECT_THROW(lfd_dmp::readDemoBag(path), std::runtime_error);
+}
+
+// Issue 23: a topic declared geometry_msgs/PoseStamped whose message holds other bytes (here a
+// PoseStamped cut short) made roscpp throw "Buffer Overrun", which was all the learner said. The
+// error names the file, the topic, the declared type, the message's index and time.
+TEST(DemoBag, MessageBytesThatDoNotMatchTheDeclaredTypeAreNamed) {
+  const std::string path =
+      ::testing::TempDir() + "/lfd_dmp_mismatch_" + std::to_string(::getpid()) + ".bag";
+  const lfd_dmp::DemoRecording rec = recording(path, 0.6, 50.0);
+  writeBag(path, rec, "", false);
+  {
+    rosbag::Bag bag(path, rosbag::bagmode::Append);
+    geometry_msgs::PoseStamped p;
+    p.header.stamp = ros::Time(rec.times[3] + 0.001);
+    p.header.frame_id = "base_link";
+    std::vector<std::uint8_t> bytes = lfd_test::serializedBytes(p);
+    bytes.resize(bytes.size() - 20);  // the orientation cut off
+    lfd_test::writeAsDeclaredType<geometry_msgs::PoseStamped>(bag, "/ee_pose", p.header.stamp,
+                                                              bytes);
+  }
+  try {
+    lfd_dmp::readDemoBag(path);
+    ADD_FAILURE() << "a message cut short was read";
+  } catch (const std::runtime_error& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find(path), std::string::npos) << what;
+    EXPECT_NE(what.find("message 4 on '/ee_pose' (declared 'geometry_msgs/PoseStamped') at t = "),
+              std::string::npos)
+        << what;
+    EXPECT_NE(what.find("its bytes do not match the declared message definition"),
+              std::string::npos)
+        << what;
+  }
+  std::remove(path.c_str());
 }
 
 // Issue 23 row 1: a link swapped between a demo bag and a FIFO while the learner reads it never

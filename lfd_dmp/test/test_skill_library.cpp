@@ -294,7 +294,7 @@ TEST(SkillLibrary, ImplausibleDurationsAndSizesAreRefusedOnLoad) {
   j["segments"][0]["demos"][0]["demo_id"] = std::string(100000, 'x');
   error = loadError(j);
   EXPECT_NE(error.find("skill library.segments[0].demos[0].demo_id: a string of 100000 is over "
-                       "the limit of 1024 (library_limits/max_string_length)"),
+                       "the limit of 4096 (library_limits/max_string_length)"),
             std::string::npos)
       << error;
   EXPECT_LT(error.size(), 400u);

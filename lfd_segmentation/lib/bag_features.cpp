@@ -13,6 +13,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "lfd_core/bag_errors.hpp"
 #include "lfd_core/input_budget.hpp"
 #include "lfd_core/ros_message_reader.hpp"
 #include "lfd_core/safe_paths.hpp"
@@ -55,12 +56,31 @@ std::string field_list(const rosmsg::MessageSchema& schema,
   return out;
 }
 
+// A message whose bytes do not fit its declared type, already described in full.
+struct MismatchedMessage : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+// The features of a demo against limits/max_features, counted as each topic's fields are
+// expanded: 10,000 columns took 1.1 GB before anything refused them.
+struct FeatureCount {
+  std::size_t used = 0;
+  std::size_t max = 0;  // 0 = no bound
+  void add(std::size_t n, const std::string& topic) {
+    used += n;
+    if (max > 0 && used > max)
+      throw std::invalid_argument("topic " + lfd::quoted(topic) + " brings the features to " +
+                                  std::to_string(used) + ", over the limit of " +
+                                  std::to_string(max) + " (limits/max_features)");
+  }
+};
+
 // One configured topic across the parts of a demonstration. Its features (the configured fields,
 // "*" expanded) are fixed by the first message of the first part; every connection (message
 // definition) on the topic gets a reader of those features.
 class TopicReader {
  public:
-  explicit TopicReader(const TopicConfig& cfg) : cfg_(cfg) {}
+  TopicReader(const TopicConfig& cfg, FeatureCount* count) : cfg_(cfg), count_(count) {}
 
   // One message of the topic, `bytes` its serialized form.
   void read(const rosbag::MessageInstance& m, const std::vector<std::uint8_t>& bytes) {
@@ -125,6 +145,7 @@ class TopicReader {
       throw std::invalid_argument("topic " + cfg_.topic + " (" + schema.root().name +
                                   "): " + e.what());
     }
+    count_->add(fields_.size(), cfg_.topic);
     for (const std::string& field : fields_) {
       lfd::Stream s;
       s.name = feature_name(cfg_.topic, field);
@@ -134,6 +155,7 @@ class TopicReader {
   }
 
   const TopicConfig& cfg_;
+  FeatureCount* count_;
   std::vector<std::string> fields_;
   std::vector<lfd::Stream> streams_;
   std::unique_ptr<rosmsg::MessageSchema> schema_;  // of the first message
@@ -143,14 +165,33 @@ class TopicReader {
   rosmsg::FieldReader* last_reader_ = nullptr;
 };
 
-// Opens the bag through the file-access layer: rosbag reads the file that was checked, never what
-// the path names by then (a link swapped to a FIFO hung open()).
-void open_bag(rosbag::Bag& bag, const std::string& path) {
+// Opens the bag through the file-access layer's descriptor: rosbag reads the file that was checked,
+// never what the path names by then (a link swapped to a FIFO hung open()).
+void open_bag(rosbag::Bag& bag, const lfd::InputFile& file, const std::string& name) {
   try {
-    const lfd::InputFile file = lfd::openInputFile(path);
     bag.open(file.readPath(), rosbag::bagmode::Read);
   } catch (const std::exception& e) {
+    throw std::runtime_error("cannot open bag " + lfd::quoted(name) + ": " + e.what());
+  }
+}
+
+lfd::InputFile open_part(const std::string& path, const lfd::PathPolicy& policy = {}) {
+  try {
+    return lfd::openInputFile(path, policy);
+  } catch (const std::exception& e) {
     throw std::runtime_error("cannot open bag " + lfd::quoted(path) + ": " + e.what());
+  }
+}
+
+// One message of a topic into its reader; bytes that do not fit the declared type (a lying
+// connection header, a truncated message: rosbag's "Buffer Overrun") are named in full.
+void read_message(const rosbag::MessageInstance& m, const std::vector<std::uint8_t>& bytes,
+                  std::size_t index, const std::string& name, TopicReader& reader) {
+  try {
+    reader.read(m, bytes);
+  } catch (const rosmsg::MessageError& e) {
+    throw MismatchedMessage(lfd::mismatchedMessageError(name, m.getTopic(), m.getDataType(), index,
+                                                        m.getTime().toSec(), e.what()));
   }
 }
 
@@ -166,10 +207,10 @@ std::string topics_in(rosbag::Bag& bag) {
 // Reads every configured topic of one bag file into the readers, a view per topic as the typed
 // reader did (measured: one view over all topics saved no CPU, its connection merge costs as much
 // as rereading the cached chunks).
-void read_part(const std::string& path, const std::vector<TopicConfig>& topics,
-               std::vector<TopicReader>& readers) {
+void read_part(const lfd::InputFile& file, const std::string& path,
+               const std::vector<TopicConfig>& topics, std::vector<TopicReader>& readers) {
   rosbag::Bag bag;
-  open_bag(bag, path);
+  open_bag(bag, file, path);
   try {
     for (const TopicConfig& cfg : topics) {
       if (rosbag::View(bag, rosbag::TopicQuery(cfg.topic)).size() == 0) {
@@ -179,14 +220,17 @@ void read_part(const std::string& path, const std::vector<TopicConfig>& topics,
     }
     std::vector<std::uint8_t> bytes;
     for (std::size_t k = 0; k < topics.size(); ++k) {
+      std::size_t index = 0;
       for (const rosbag::MessageInstance& m :
            rosbag::View(bag, rosbag::TopicQuery(topics[k].topic))) {
         message_bytes(m, bytes);
-        readers[k].read(m, bytes);
+        read_message(m, bytes, index++, path, readers[k]);
       }
     }
   } catch (const std::invalid_argument& e) {
     throw std::invalid_argument("bag " + lfd::quoted(path) + ": " + e.what());
+  } catch (const MismatchedMessage&) {
+    throw;
   } catch (const std::exception& e) {
     throw std::runtime_error("cannot read bag " + lfd::quoted(path) +
                              " (truncated or corrupt?): " + e.what());
@@ -260,10 +304,28 @@ void check_request_budget(const std::vector<std::string>& entries, const Request
   }
 }
 
+DemoFiles open_demo_files(const std::string& path, const lfd::PathPolicy& policy) {
+  DemoFiles files;
+  files.path = path;
+  files.names = demo_parts(path);
+  for (const std::string& name : files.names) files.parts.push_back(open_part(name, policy));
+  return files;
+}
+
 std::vector<lfd::Stream> read_bag_streams(const std::string& path,
                                           const std::vector<TopicConfig>& topics,
                                           std::vector<FeatureRole>* roles,
-                                          std::vector<std::string>* warnings) {
+                                          std::vector<std::string>* warnings,
+                                          std::size_t max_features) {
+  return read_bag_streams(open_demo_files(path), topics, roles, warnings, max_features);
+}
+
+std::vector<lfd::Stream> read_bag_streams(const DemoFiles& files,
+                                          const std::vector<TopicConfig>& topics,
+                                          std::vector<FeatureRole>* roles,
+                                          std::vector<std::string>* warnings,
+                                          std::size_t max_features) {
+  const std::string& path = files.path;
   if (topics.empty()) throw std::invalid_argument("no topics configured for the features");
   for (const TopicConfig& cfg : topics) {
     if (cfg.topic == kGroundTruthTopic) {
@@ -271,10 +333,12 @@ std::vector<lfd::Stream> read_bag_streams(const std::string& path,
                                   " is ground truth and is never read by the segmenter");
     }
   }
+  FeatureCount count{0, max_features};
   std::vector<TopicReader> readers;
   readers.reserve(topics.size());
-  for (const TopicConfig& cfg : topics) readers.emplace_back(cfg);
-  for (const std::string& part : demo_parts(path)) read_part(part, topics, readers);
+  for (const TopicConfig& cfg : topics) readers.emplace_back(cfg, &count);
+  for (std::size_t k = 0; k < files.parts.size(); ++k)
+    read_part(files.parts[k], files.names[k], topics, readers);
   std::vector<lfd::Stream> streams;
   if (roles) roles->clear();
   for (std::size_t k = 0; k < topics.size(); ++k) {
@@ -293,9 +357,16 @@ std::vector<lfd::Stream> read_bag_streams(const std::string& path,
 
 DemoFeatures read_bag_features(const std::string& path, const std::vector<TopicConfig>& topics,
                                double rate, const RequestLimits& limits) {
+  return read_bag_features(open_demo_files(path), topics, rate, limits);
+}
+
+DemoFeatures read_bag_features(const DemoFiles& files, const std::vector<TopicConfig>& topics,
+                               double rate, const RequestLimits& limits) {
+  const std::string& path = files.path;
   std::vector<FeatureRole> roles;
   std::vector<std::string> warnings;
-  const std::vector<lfd::Stream> streams = read_bag_streams(path, topics, &roles, &warnings);
+  const std::vector<lfd::Stream> streams =
+      read_bag_streams(files, topics, &roles, &warnings, limits.max_features);
   check_streams(streams, path, limits);
   double start = -INFINITY, end = INFINITY;  // the span resample() keeps: where all streams overlap
   for (const lfd::Stream& s : streams) {
@@ -330,7 +401,8 @@ std::string describe_bag(const std::string& path) {
   std::ostringstream out;
   for (const std::string& part : demo_parts(path)) {
     rosbag::Bag bag;
-    open_bag(bag, part);
+    const lfd::InputFile file = open_part(part);
+    open_bag(bag, file, part);
     out << part << "\n";
     try {
       rosbag::View all(bag);
@@ -344,11 +416,19 @@ std::string describe_bag(const std::string& path) {
           continue;
         }
         std::vector<std::uint8_t> sample;
-        message_bytes(*view.begin(), sample);
+        const rosbag::MessageInstance first = *view.begin();
+        message_bytes(first, sample);
         const rosmsg::MessageSchema schema =
             rosmsg::MessageSchema::parse(connection->datatype, connection->msg_def);
-        out << field_list(schema, sample) << "\n";
+        try {
+          out << field_list(schema, sample) << "\n";
+        } catch (const rosmsg::MessageError& e) {
+          throw MismatchedMessage(lfd::mismatchedMessageError(part, topic, connection->datatype, 0,
+                                                              first.getTime().toSec(), e.what()));
+        }
       }
+    } catch (const MismatchedMessage&) {
+      throw;
     } catch (const std::exception& e) {
       throw std::runtime_error("cannot read bag " + lfd::quoted(part) + ": " + e.what());
     }

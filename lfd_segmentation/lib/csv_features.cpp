@@ -50,7 +50,8 @@ lfd::FeatureMatrix read_csv_features(const std::string& path, const std::string&
   std::string line;
   std::size_t line_number = 0;
   while (std::getline(in, line)) {
-    ++line_number;
+    // A spreadsheet's UTF-8 byte-order mark made the first column "\xef\xbb\xbftime": no time.
+    if (++line_number == 1) lfd::stripByteOrderMark(line, path);
     if (!trim(line).empty()) break;
   }
   if (trim(line).empty())
@@ -74,6 +75,12 @@ lfd::FeatureMatrix read_csv_features(const std::string& path, const std::string&
   lfd::FeatureMatrix m;
   for (std::size_t c = 0; c < header.size(); ++c) {
     if (static_cast<int>(c) != time_index) m.names.push_back(header[c]);
+  }
+  if (limits.max_features > 0 && m.names.size() > limits.max_features) {  // before any row
+    throw std::invalid_argument("CSV file " + lfd::quoted(path) + " has " +
+                                std::to_string(m.names.size()) +
+                                " feature columns, over the limit of " +
+                                std::to_string(limits.max_features) + " (limits/max_features)");
   }
   if (m.names.empty())
     throw std::invalid_argument("CSV file " + lfd::quoted(path) + " has no feature column");

@@ -1,12 +1,11 @@
 #include "lfd_segmentation/segment_service.hpp"
 
-#include <sys/stat.h>
-
 #include <chrono>
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
 
+#include "lfd_core/ros_request_strings.hpp"
 #include "lfd_core/safe_paths.hpp"
 #include "lfd_segmentation/bag_features.hpp"
 
@@ -44,21 +43,28 @@ SegmentationParams apply_overrides(const SegmentationParams& params,
 
 namespace {
 
-// PreparedCache's key: what the bags' features and their selection depend on.
-std::string cache_key(const std::vector<std::string>& paths, const SegmentationParams& p) {
+// PreparedCache's key: what the bags' features and their selection depend on. Each file is named by
+// the identity of the descriptor that is read (device, inode, size, mtime and ctime in ns): a bag
+// replaced by a same-size file with the old mtime (touch -r; mv) is another file, never the cache.
+std::string cache_key(const std::vector<DemoFiles>& demos, const SegmentationParams& p) {
   std::ostringstream key;
   key.precision(17);
   key << "T=" << p.pipeline.relevance.threshold;
-  for (const std::string& path : paths) {
-    for (const std::string& part : demo_parts(path)) {
-      struct stat st {};
-      if (::stat(part.c_str(), &st) != 0) return "";  // not cacheable: read (and fail) afresh
-      key << "|" << part << ":" << st.st_size << ":" << st.st_mtim.tv_sec << "."
-          << st.st_mtim.tv_nsec;
-    }
+  for (const DemoFiles& demo : demos) {
+    for (std::size_t k = 0; k < demo.parts.size(); ++k)
+      key << "|" << demo.names[k] << ":" << demo.parts[k].identity().key();
     key << ";";
   }
   return key.str();
+}
+
+// Service requests name absolute paths (the node's working directory is not the caller's), every
+// part of a demo written as "a.bag,b.bag" too; the error names the field.
+void check_request_paths(const std::vector<std::string>& bag_paths, const lfd::PathPolicy& policy) {
+  for (std::size_t i = 0; i < bag_paths.size(); ++i) {
+    for (const std::string& part : demo_parts(bag_paths[i]))
+      lfd::checkRequestPath("bag_paths[" + std::to_string(i) + "]", part, policy);
+  }
 }
 
 lfd_msgs::DemoSegmentation demo_message(const DemoFeatures& demo,
@@ -101,6 +107,11 @@ void handle_segment_request(const SegmentationParams& params,
   const auto start = std::chrono::steady_clock::now();
   response = lfd_msgs::Segment::Response();
   try {
+    // Every string within one bound before anything else: a 10 MB path is refused, not echoed.
+    lfd::StringBudget strings;
+    strings.max_bytes = params.limits.max_request_string_bytes;
+    strings.key = "limits/max_request_string_bytes";
+    lfd::checkRequestStrings(request, strings);
     if (request.bag_paths.empty()) {
       throw std::invalid_argument("empty request: give at least one bag path");
     }
@@ -110,15 +121,20 @@ void handle_segment_request(const SegmentationParams& params,
                                   std::to_string(params.limits.max_bags) + " (limits/max_bags)");
     }
     const SegmentationParams p = apply_overrides(params, request);
-    check_request_budget(request.bag_paths, p.limits, p.paths);  // the expanded work, up front
-    const std::string key = cache_key(request.bag_paths, p);
-    PreparedCache local;  // a request that cannot be cached (no cache, a file not stat-able)
-    PreparedCache& used = cache && !key.empty() ? *cache : local;
+    lfd::PathPolicy paths = p.paths;
+    paths.require_absolute = true;  // a service: the CLI takes relative paths, the node does not
+    check_request_paths(request.bag_paths, paths);
+    check_request_budget(request.bag_paths, p.limits, paths);  // the expanded work, up front
+    std::vector<DemoFiles> files;  // opened once: the cache key names what is read
+    for (const std::string& path : request.bag_paths) files.push_back(open_demo_files(path, paths));
+    const std::string key = cache_key(files, p);
+    PreparedCache local;  // without a cache
+    PreparedCache& used = cache ? *cache : local;
     const lfd::SegmentationPipelineConfig config = p.pipeline_config();
     if (used.key.empty() || used.key != key) {
       used = PreparedCache{};  // the stale entry goes before anything is read
-      for (const std::string& path : request.bag_paths) {
-        used.demos.push_back(read_bag_features(path, p.topics, p.rate, p.limits));
+      for (const DemoFiles& demo : files) {
+        used.demos.push_back(read_bag_features(demo, p.topics, p.rate, p.limits));
         used.matrices.push_back(used.demos.back().matrix);
       }
       check_demos_fit(p, used.matrices, request.bag_paths);

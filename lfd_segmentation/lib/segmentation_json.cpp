@@ -235,6 +235,16 @@ json feature_matrices_json(const std::vector<lfd::FeatureMatrix>& demos,
   return out;
 }
 
+lfd::OutputKind segmentation_result_output() {
+  const lfd::OutputKind success_mode =
+      lfd::jsonOutput("segmentation result", kSegmentationResultFormat, {"success", "mode"});
+  const lfd::OutputKind success_error =
+      lfd::jsonOutput("segmentation result", kSegmentationResultFormat, {"success", "error"});
+  return {"segmentation result", [=](const lfd::InputFile& file) {
+            return success_mode.written_by_lfd(file) || success_error.written_by_lfd(file);
+          }};
+}
+
 std::string dump_json(const json& j) {
   std::string out;
   dump_indented(j, 0, out);

@@ -282,6 +282,9 @@ SegmentationParams params_from_yaml(const YAML::Node& root) {
   lim.max_csv_rows = get<std::size_t>(limits, "max_csv_rows", lim.max_csv_rows);
   lim.max_abs_value =
       positive(get<double>(limits, "max_abs_value", lim.max_abs_value), "limits/max_abs_value");
+  lim.max_features = get<std::size_t>(limits, "max_features", lim.max_features);
+  lim.max_request_string_bytes =
+      get<std::size_t>(limits, "max_request_string_bytes", lim.max_request_string_bytes);
   p.paths.allowed_roots = get<std::vector<std::string>>(root, "allowed_roots", {});
 
   const YAML::Node topics = root["topics"];

@@ -357,13 +357,15 @@ int main(int argc, char** argv) {
     for (int k = 1; options.output.empty() && k + 1 < argc; ++k)
       if (std::string(argv[k]) == "--output") options.output = argv[k + 1];
   }
+  out["format"] = lfd_segmentation::kSegmentationResultFormat;
   const std::string text = lfd_segmentation::dump_json(out);
   if (!options.output.empty()) {
-    // A result file: replaced on every run (scripts rerun into their folder), but atomically and
-    // never over one of the inputs.
+    // A result file: replaced on every run (scripts rerun into their folder), but atomically,
+    // never over one of the inputs and only over a result file of its own.
     try {
-      lfd::writeTextAtomically(lfd::checkOutputFile(options.output, {}, true, options.files), true,
-                               text + "\n");
+      const lfd::OutputKind kind = lfd_segmentation::segmentation_result_output();
+      lfd::writeTextAtomically(lfd::checkOutputFile(options.output, {}, true, options.files, kind),
+                               true, kind, text + "\n");
     } catch (const std::exception& e) {
       std::cerr << "segment: cannot write the output: " << e.what() << "\n";
       return 1;

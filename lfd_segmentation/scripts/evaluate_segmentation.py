@@ -113,6 +113,9 @@ class CliSegmenter(object):
 
 
 def call_service(segment, bags, method):
+    # The service takes absolute paths only (its working directory is not ours); each part of a
+    # demo recorded in several bags ("a.bag,b.bag") too.
+    bags = [",".join(os.path.abspath(p) for p in b.split(",")) for b in bags]
     res = segment(SegmentRequest(bag_paths=bags, combination=method))
     if not res.success:
         raise RuntimeError("segmentation failed: %s" % res.error)

@@ -18,6 +18,8 @@
 #include <random>
 #include <string>
 
+#include "../../src/test/support/declared_type_bytes.hpp"
+
 namespace lfd_segmentation_test {
 
 struct DemoBagOptions {
@@ -33,6 +35,7 @@ struct DemoBagOptions {
   double late_twist_seconds = 0;  ///< > 0: one more /ee_twist stamped this long after the end
   double huge_twist = 0;          ///< != 0: one /ee_twist sample with this (finite) value
   double late_pose_seconds = 0;   ///< > 0: the /ee_pose at a quarter is stamped this late, in place
+  bool pose_holds_a_twist = false;  ///< the /ee_pose at half: declared PoseStamped, a twist's bytes
   std::string touch_name = "r_touch_left";
 };
 
@@ -83,7 +86,12 @@ inline void write_demo_bag(const std::string& path, const DemoBagOptions& o = {}
     pose.pose.orientation.w = 1.0;
     if (o.late_pose_seconds > 0 && i == samples / 4)
       pose.header.stamp = ros::Time(t + o.late_pose_seconds);
-    bag.write("/ee_pose", stamp, pose);
+    if (o.pose_holds_a_twist && i == samples / 2) {
+      lfd_test::writeAsDeclaredType<geometry_msgs::PoseStamped>(bag, "/ee_pose", stamp,
+                                                                lfd_test::serializedBytes(twist));
+    } else {
+      bag.write("/ee_pose", stamp, pose);
+    }
 
     sensor_msgs::JointState gripper;
     gripper.header.stamp = stamp;

@@ -389,6 +389,107 @@ TEST(CsvFeatures, LimitsStopTheReadAndNameRowAndColumn) {
   }
 }
 
+// Issue 23: a CSV saved with a UTF-8 byte-order mark (as spreadsheet programs save it) gave "no
+// time column": the first column was named "\xef\xbb\xbftime". The mark is skipped; UTF-16 is
+// refused saying so.
+TEST(CsvFeatures, AUtf8ByteOrderMarkIsSkippedAndUtf16IsRefused) {
+  const fs::path dir = temp_dir();
+  const std::string plain = (dir / "plain_bom.csv").string();
+  write_demo_csv(plain, 300, 4);
+  std::ifstream plain_in(plain);
+  const std::string text((std::istreambuf_iterator<char>(plain_in)), {});
+  const std::string bom = (dir / "bom.csv").string();
+  std::ofstream(bom, std::ios::binary) << "\xEF\xBB\xBF" << text;
+  const lfd::FeatureMatrix m = lfd_segmentation::read_csv_features(bom);
+  EXPECT_EQ(m.names, (std::vector<std::string>{"gripper", "speed", "noise", "touch"}));
+  EXPECT_EQ(m.time.size(), 300u);
+  int status = -1;
+  const auto j = run_cli("--state-columns gripper,speed " + bom, &status);
+  EXPECT_EQ(status, 0) << j.dump();
+
+  const std::string utf16 = (dir / "utf16.csv").string();
+  {
+    std::ofstream out(utf16, std::ios::binary);
+    out << "\xFF\xFE";
+    for (char c : std::string("time,a\n0,1\n")) out << c << '\0';
+  }
+  try {
+    lfd_segmentation::read_csv_features(utf16);
+    ADD_FAILURE() << "a UTF-16 CSV was read";
+  } catch (const std::invalid_argument& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("utf16.csv"), std::string::npos) << what;
+    EXPECT_NE(what.find("UTF-16 is not supported, save it as UTF-8"), std::string::npos) << what;
+  }
+}
+
+// Issue 23: 10,000 feature columns took 1.1 GB. The header is checked against
+// limits/max_features before any row is read.
+TEST(CsvFeatures, TooManyFeatureColumnsAreRefusedOnTheHeader) {
+  const std::string csv = (temp_dir() / "wide.csv").string();
+  {
+    std::ofstream out(csv);
+    out << "time";
+    for (int c = 0; c < 300; ++c) out << ",f" << c;
+    out << "\n";
+    for (int r = 0; r < 5; ++r) {
+      out << 0.01 * r;
+      for (int c = 0; c < 300; ++c) out << "," << r + c;
+      out << "\n";
+    }
+  }
+  lfd_segmentation::RequestLimits limits;
+  ASSERT_EQ(limits.max_features, 256u);
+  try {
+    lfd_segmentation::read_csv_features(csv, "", 0.0, limits);
+    ADD_FAILURE() << "300 feature columns read under a limit of 256";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("300 feature columns, over the limit of 256 "
+                                         "(limits/max_features)"),
+              std::string::npos)
+        << e.what();
+  }
+  int status = -1;
+  const auto j = run_cli(csv, &status);  // the CLI, with the shipped config
+  EXPECT_EQ(status, 1);
+  EXPECT_NE(j["error"].get<std::string>().find("limits/max_features"), std::string::npos)
+      << j.dump();
+}
+
+// Issue 23: an output replaced any regular file. --output replaces a result file the CLI wrote
+// (scripts rerun into their folder), never another file: it is kept and the error says why.
+TEST(SegmentCli, OutputReplacesOnlyAResultFileItWrote) {
+  const fs::path dir = temp_dir();
+  const std::string csv = (dir / "output_demo.csv").string();
+  write_demo_csv(csv, 300, 6);
+  const std::string bashrc = (dir / ".bashrc").string();
+  std::ofstream(bashrc) << "export PATH=$HOME/bin:$PATH\n";
+  const std::string err = (dir / "stderr.txt").string();
+  const std::string cmd =
+      std::string(SEGMENT_CLI) + " " + csv + " --output " + bashrc + " 2>" + err;
+  EXPECT_EQ(WEXITSTATUS(std::system(cmd.c_str())), 1);
+  std::ifstream kept(bashrc);
+  EXPECT_EQ(std::string((std::istreambuf_iterator<char>(kept)), {}),
+            "export PATH=$HOME/bin:$PATH\n");
+  std::ifstream err_in(err);
+  const std::string message((std::istreambuf_iterator<char>(err_in)), {});
+  EXPECT_NE(message.find(".bashrc"), std::string::npos) << message;
+  EXPECT_NE(message.find("was not written by lfd"), std::string::npos) << message;
+  // Its own result is replaced, run after run (also one written before the format marker).
+  int status = -1;
+  auto j = run_cli(csv, &status);
+  EXPECT_EQ(status, 0);
+  EXPECT_EQ(j["format"], "lfd_segmentation_result");
+  const std::string out = (dir / "result.json").string();
+  std::ofstream(out) << R"({"mode": "clasp", "success": true})";
+  const std::string again =
+      std::string(SEGMENT_CLI) + " " + csv + " --output " + out + " 2>/dev/null";
+  EXPECT_EQ(WEXITSTATUS(std::system(again.c_str())), 0);
+  EXPECT_EQ(WEXITSTATUS(std::system(again.c_str())), 0);
+  std::ifstream result(out);
+  EXPECT_EQ(nlohmann::json::parse(result)["format"], "lfd_segmentation_result");
+}
+
 TEST(SegmentCli, RefusesAPipeAndNeverWritesOverAnInput) {
   const fs::path dir = temp_dir();
   const std::string fifo = (dir / "pipe.csv").string();

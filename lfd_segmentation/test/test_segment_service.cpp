@@ -101,6 +101,102 @@ TEST_F(SegmentService, ACachedSelectionGivesTheUncachedAnswer) {
   fs::remove(bags[1]);  // good1 is written afresh by the next test that needs it
 }
 
+// Issue 23: a bag replaced by a corrupt file of the same size and modification time (touch -r
+// old new; mv new bag) still got the cached success: the cache was keyed by path, size and mtime.
+// Keyed by the identity of the descriptor read (inode, ctime...), the request reads the new file
+// and fails naming it.
+TEST_F(SegmentService, ABagReplacedBySameSizeSameTimeCorruptFileIsNotTheCachedOne) {
+  const std::vector<std::string> bags = good_bags(2);
+  std::vector<std::string> request_bags;
+  for (std::size_t d = 0; d < bags.size(); ++d) {  // copies: the other tests keep their bags
+    request_bags.push_back((dir_ / ("stale" + std::to_string(d) + ".bag")).string());
+    fs::copy_file(bags[d], request_bags.back(), fs::copy_options::overwrite_existing);
+  }
+  lfd_segmentation::PreparedCache cache;
+  lfd_msgs::Segment::Request request;
+  request.bag_paths = request_bags;
+  lfd_msgs::Segment::Response first;
+  lfd_segmentation::handle_segment_request(params_, request, first, &cache);
+  ASSERT_TRUE(first.success) << first.error;
+
+  const std::string& victim = request_bags[1];
+  struct stat old {};
+  ASSERT_EQ(::stat(victim.c_str(), &old), 0);
+  const std::string fake = (dir_ / "fake.bag").string();
+  std::ofstream(fake, std::ios::binary) << std::string(static_cast<std::size_t>(old.st_size), 'x');
+  const struct timespec times[2] = {old.st_atim, old.st_mtim};
+  ASSERT_EQ(::utimensat(AT_FDCWD, fake.c_str(), times, 0), 0);  // touch -r old new
+  fs::rename(fake, victim);                                     // mv new bag
+  struct stat now {};
+  ASSERT_EQ(::stat(victim.c_str(), &now), 0);
+  ASSERT_EQ(now.st_size, old.st_size);
+  ASSERT_EQ(now.st_mtim.tv_sec, old.st_mtim.tv_sec);
+  ASSERT_EQ(now.st_mtim.tv_nsec, old.st_mtim.tv_nsec);
+
+  lfd_msgs::Segment::Response again;
+  lfd_segmentation::handle_segment_request(params_, request, again, &cache);
+  EXPECT_FALSE(again.success) << "the cached success answered for a corrupt bag";
+  EXPECT_NE(again.error.find("cannot open bag"), std::string::npos) << again.error;
+  EXPECT_NE(again.error.find("stale1.bag"), std::string::npos) << again.error;
+  for (const std::string& b : request_bags) fs::remove(b);
+}
+
+// Issue 23: a service resolves a relative path against its own working directory, which the
+// client neither sees nor chose. Every bag path (every part of one) must be absolute; the error
+// names the field.
+TEST_F(SegmentService, RelativeBagPathsAreRefusedNamingTheField) {
+  const std::vector<std::string> bags = good_bags(2);
+  const fs::path cwd = fs::current_path();
+  fs::current_path(dir_);  // where the relative names would resolve: they exist there
+  const auto r = call({bags[0], fs::path(bags[1]).filename().string()});
+  expect_error(r, "bag_paths[1]: path 'good1.bag' is relative");
+  expect_error(call({bags[0], bags[1] + ",good0.bag"}), "bag_paths[1]: path 'good0.bag'");
+  fs::current_path(cwd);
+  expect_error(r, "absolute path");
+}
+
+// Issue 23: every string of a request within limits/max_request_string_bytes, checked before any
+// work (a 10 MB string was echoed into errors and logs); the error quotes at most 200 characters.
+TEST_F(SegmentService, AnOverlongRequestStringIsRefusedBeforeAnyWork) {
+  lfd_msgs::Segment::Request request;
+  request.combination = std::string(10 << 20, 'c');
+  const auto r = call(good_bags(2), request);
+  expect_error(r,
+               "combination: a string of 10485760 bytes, over the limit of 262207 "
+               "(limits/max_request_string_bytes)");
+  EXPECT_LT(r.error.size(), 500u);
+  EXPECT_LT(r.elapsed, 1.0);
+  const auto paths = call({good_bags(1)[0], "/tmp/" + std::string(300000, 'p') + ".bag"});
+  expect_error(paths, "bag_paths[1]: a string of 300009 bytes");
+}
+
+// Issue 23: 10,000 feature columns took 1.1 GB. Features beyond limits/max_features are refused
+// as the topics' fields are expanded, before the bags are read whole and resampled.
+TEST_F(SegmentService, TooManyFeaturesAreRefusedBeforeResampling) {
+  lfd_segmentation::SegmentationParams few = params_;
+  few.limits.max_features = 10;
+  lfd_msgs::Segment::Request request;
+  request.bag_paths = good_bags(2);
+  lfd_msgs::Segment::Response r;
+  lfd_segmentation::handle_segment_request(few, request, r);
+  expect_error(r, "over the limit of 10 (limits/max_features)");
+  EXPECT_NE(r.error.find("good0.bag"), std::string::npos) << r.error;
+  EXPECT_EQ(params_.limits.max_features, 256u);  // the shipped bound takes these bags
+}
+
+// Issue 23: a topic whose connection declares geometry_msgs/PoseStamped but whose message holds
+// other bytes read as "Buffer Overrun". The error names the file, the topic, the declared type,
+// the message's index and time, and says the bytes do not match; the service answers.
+TEST_F(SegmentService, MessageBytesThatDoNotMatchTheDeclaredTypeAreNamed) {
+  DemoBagOptions o;
+  o.pose_holds_a_twist = true;
+  const auto r = call({good_bags(1)[0], bag("pose_holds_a_twist", o)});
+  expect_error(r,
+               "pose_holds_a_twist.bag': message 400 on '/ee_pose' (declared "
+               "'geometry_msgs/PoseStamped') at t = 104.000 s: its bytes do not match the "
+               "declared message definition");
+}
+
 TEST_F(SegmentService, GoodRequestValidatesTheGraspChangepoint) {
   const auto bags = good_bags(3);
   const auto r = call(bags);

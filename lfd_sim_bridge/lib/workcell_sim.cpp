@@ -24,7 +24,6 @@ struct WorkcellSim::Actuated {
   double command = 0.0;     // target after velocity limiting, what the PD tracks
   double command_velocity = 0.0;
   bool warned_out_of_range = false;
-  bool warned_velocity = false;
   bool effort_from_config = false, velocity_from_config = false;
 };
 
@@ -345,6 +344,26 @@ void WorkcellSim::setJointTargets(const std::vector<std::string>& names,
   }
 }
 
+// Issue 23: velocities of 1.7e308, clamped to the limit, still made the Hermite segments overshoot
+// both waypoints of a 0.1 rad move by 0.6 rad, with nothing logged (the clamp warned once per
+// joint). A waypoint velocity beyond the joint's limit is a wrong trajectory: refused whole.
+void WorkcellSim::checkTrajectoryVelocities(const JointTrajectory& trajectory,
+                                            const std::vector<int>& index) const {
+  for (size_t k = 0; k < trajectory.points.size(); ++k) {
+    const std::vector<double>& v = trajectory.points[k].velocities;
+    for (size_t j = 0; j < v.size(); ++j) {
+      const Actuated& a = actuated_[index[j]];
+      if (std::abs(v[j]) <= a.limit.velocity) continue;
+      std::ostringstream msg;
+      msg << "trajectory point " << k << ", joint " << a.name << ": velocity " << v[j]
+          << " is beyond the joint's limit of " << a.limit.velocity
+          << " (rad/s or m/s: ~velocity_limits, else the URDF's <limit velocity>, else "
+             "~default_velocity_limit); the trajectory is refused";
+      throw std::invalid_argument(msg.str());
+    }
+  }
+}
+
 void WorkcellSim::setTrajectory(const JointTrajectory& trajectory, double start_time) {
   validateTrajectory(trajectory);
   if (trajectory_ && start_time > 0.0 && start_time == last_trajectory_stamp_ &&
@@ -361,23 +380,9 @@ void WorkcellSim::setTrajectory(const JointTrajectory& trajectory, double start_
     }
     start[j] = actuated_[index[j]].command;
   }
+  checkTrajectoryVelocities(trajectory, index);
   const double t0 = std::max(start_time, d_->time);
-  JointTrajectory limited = trajectory;
-  for (TrajectoryPoint& p : limited.points) {
-    for (size_t j = 0; j < p.velocities.size(); ++j) {
-      Actuated& a = actuated_[index[j]];
-      const double v = std::clamp(p.velocities[j], -a.limit.velocity, a.limit.velocity);
-      if (v != p.velocities[j] && !a.warned_velocity) {
-        a.warned_velocity = true;
-        std::ostringstream msg;
-        msg << "trajectory velocity " << p.velocities[j] << " for joint " << a.name
-            << " is beyond its limit " << a.limit.velocity << "; clamping (warned once per joint)";
-        log(LogLevel::kWarn, msg.str());
-      }
-      p.velocities[j] = v;
-    }
-  }
-  trajectory_ = std::make_unique<TrajectoryInterpolator>(limited, t0, start);
+  trajectory_ = std::make_unique<TrajectoryInterpolator>(trajectory, t0, start);
   trajectory_to_actuated_ = index;
   last_trajectory_ = trajectory;
   last_trajectory_stamp_ = start_time;

@@ -46,6 +46,7 @@
 #include <vector>
 
 #include "lfd_ros/master_watch.hpp"
+#include "lfd_core/ros_request_strings.hpp"
 #include "lfd_sim_bridge/workcell_sim.hpp"
 
 namespace {
@@ -241,6 +242,9 @@ class BridgeNode {
     clock_every_ = std::max<long>(1, std::lround(1.0 / (clock_rate * dt)));
     paused_ = param(pnh, "start_paused", false);
     max_steps_per_call_ = param(pnh, "max_steps_per_call", max_steps_per_call_);
+    strings_.max_bytes = static_cast<std::size_t>(std::max(
+        0, param(pnh, "limits/max_request_string_bytes", static_cast<int>(strings_.max_bytes))));
+    strings_.key = "~limits/max_request_string_bytes";
     rtf_report_period_ = param(pnh, "rtf_report_period", 30.0);
     if (!param(pnh, "headless", true)) {
       ROS_WARN(
@@ -470,6 +474,8 @@ class BridgeNode {
     }
   }
 
+  // Validated on receipt, whole (WorkcellSim::setTrajectory: sizes, finite values, times, each
+  // velocity within its joint's limit); a refused trajectory is logged and nothing moves.
   void onTrajectory(const trajectory_msgs::JointTrajectory::ConstPtr& msg) {
     lfd_sim::JointTrajectory traj;
     traj.joint_names = msg->joint_names;
@@ -478,9 +484,26 @@ class BridgeNode {
       traj.points.push_back({p.time_from_start.toSec(), p.positions, p.velocities});
     }
     try {
+      checkAccelerations(*msg);
       sim_->setTrajectory(traj, msg->header.stamp.toSec());
     } catch (const std::exception& e) {
       errors_.report("joint_trajectory", std::string("rejected /joint_trajectory: ") + e.what());
+    }
+  }
+
+  // The interpolation does not use accelerations, but a trajectory that carries wrong ones is a
+  // wrong trajectory: refused like a bad position or velocity.
+  static void checkAccelerations(const trajectory_msgs::JointTrajectory& msg) {
+    for (size_t k = 0; k < msg.points.size(); ++k) {
+      const std::vector<double>& a = msg.points[k].accelerations;
+      if (!a.empty() && a.size() != msg.joint_names.size())
+        throw std::invalid_argument("trajectory point " + std::to_string(k) + " has " +
+                                    std::to_string(a.size()) + " accelerations for " +
+                                    std::to_string(msg.joint_names.size()) + " joints");
+      for (double x : a)
+        if (!std::isfinite(x))
+          throw std::invalid_argument("trajectory point " + std::to_string(k) +
+                                      " has a NaN or infinite acceleration");
     }
   }
 
@@ -517,6 +540,7 @@ class BridgeNode {
 
   bool onReset(lfd_msgs::ResetSim::Request& req, lfd_msgs::ResetSim::Response& res) {
     try {
+      lfd::checkRequestStrings(req, strings_);  // before any work: no 10 MB name echoed
       if (req.joint_names.size() != req.positions.size()) {
         throw std::invalid_argument("joint_names and positions differ in length");
       }
@@ -558,6 +582,7 @@ class BridgeNode {
 
   bool onSetScene(lfd_msgs::SetScene::Request& req, lfd_msgs::SetScene::Response& res) {
     try {
+      lfd::checkRequestStrings(req, strings_);  // before any work: no 10 MB name echoed
       if (req.object_names.size() != req.poses.size()) {
         throw std::invalid_argument("object_names and poses differ in length");
       }
@@ -624,6 +649,7 @@ class BridgeNode {
   long publish_every_ = 5, clock_every_ = 5;
   long step_count_ = 0;
   int max_steps_per_call_ = 10000;
+  lfd::StringBudget strings_;  // ~limits/max_request_string_bytes of every request string
   bool paused_ = false;
   ros::Time last_clock_, last_tf_;
   ThrottledErrors errors_;

@@ -27,6 +27,7 @@
 #include <topic_tools/shape_shifter.h>
 
 #include <lfd_core/heap_trim.hpp>
+#include <lfd_core/ros_request_strings.hpp>
 #include <lfd_core/safe_paths.hpp>
 
 #include "lfd_ros/master_watch.hpp"
@@ -79,6 +80,10 @@ class Recorder {
     connect_timeout_ = pnh.param("connect_timeout", 5.0);
     max_unflushed_ = pnh.param("max_unflushed_seconds", max_unflushed_);
     paths_.allowed_roots = pnh.param("allowed_roots", paths_.allowed_roots);
+    paths_.require_absolute = true;  // the node's working directory is not the caller's
+    strings_.max_bytes = static_cast<std::size_t>(std::max(
+        0, pnh.param("limits/max_request_string_bytes", static_cast<int>(strings_.max_bytes))));
+    strings_.key = "~limits/max_request_string_bytes";
     for (const std::string& folder : pnh.param("recovery_folders", std::vector<std::string>{}))
       reportRecovered(lfd_sim_bridge::recoverCrashedBags(folder));
     for (const TopicSpec& spec : topics_) {
@@ -265,6 +270,8 @@ class Recorder {
         req.metadata.header.stamp.isZero() ? ros::Time::now() : req.metadata.header.stamp;
     std::string recovered;
     try {
+      lfd::checkRequestStrings(req, strings_);  // before any work: no 10 MB path echoed
+      lfd::checkRequestPath("bag_path", req.bag_path, paths_);
       lfd::checkPathInRoots(req.bag_path, paths_);
       // A crash may have left this very bag's `.active`: keep and reindex it. Only this path, and
       // only when no live recorder holds it (another recorder may be recording next to it).
@@ -379,6 +386,7 @@ class Recorder {
   double connect_timeout_ = 5.0;  // s of wall time: at start-up, and at each start
   double max_unflushed_ = 0.1;    // s of bag time a kill -9 may lose (chunk closed this often)
   lfd::PathPolicy paths_;         // ~allowed_roots of a start's bag_path
+  lfd::StringBudget strings_;     // ~limits/max_request_string_bytes of a start's strings
   ros::NodeHandle service_nh_;
   ros::CallbackQueue service_queue_;
   std::unique_ptr<ros::AsyncSpinner> service_spinner_;

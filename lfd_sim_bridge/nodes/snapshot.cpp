@@ -20,6 +20,7 @@
 #include <rosbag/view.h>
 
 #include <geometry_msgs/PoseStamped.h>
+#include <lfd_core/ros_bag_message.hpp>
 #include <lfd_msgs/Phase.h>
 #include <sensor_msgs/JointState.h>
 #include <algorithm>
@@ -162,19 +163,25 @@ Recording read_recording(const std::string& path) {
   r.end = view.getEndTime().toSec();
   std::string phase;
   double phase_time = 0;
+  std::map<std::string, std::size_t> seen;  // messages per topic, for errors
   for (const rosbag::MessageInstance& m : view) {
     const std::string& topic = m.getTopic();
     double t = m.getTime().toSec();
+    const std::size_t k = seen[topic]++;
+    // Bytes that do not fit the declared type are named (file, topic, type, index, time), not
+    // roscpp's "Buffer Overrun".
     if (topic == "/joint_states") {
-      if (auto js = m.instantiate<sensor_msgs::JointState>()) r.joints.push_back({t, *js});
+      if (auto js = lfd::instantiateChecked<sensor_msgs::JointState>(m, k, path))
+        r.joints.push_back({t, *js});
     } else if (topic == "/objects/joint_states") {
-      if (auto js = m.instantiate<sensor_msgs::JointState>()) r.object_joints.push_back({t, *js});
+      if (auto js = lfd::instantiateChecked<sensor_msgs::JointState>(m, k, path))
+        r.object_joints.push_back({t, *js});
     } else if (topic.rfind("/objects/", 0) == 0 && topic.size() > 14 &&
                topic.compare(topic.size() - 5, 5, "/pose") == 0) {
-      if (auto p = m.instantiate<geometry_msgs::PoseStamped>())
+      if (auto p = lfd::instantiateChecked<geometry_msgs::PoseStamped>(m, k, path))
         r.objects[topic.substr(9, topic.size() - 14)].push_back({t, *p});
     } else if (topic == "/lfd/phase") {
-      if (auto p = m.instantiate<lfd_msgs::Phase>()) {
+      if (auto p = lfd::instantiateChecked<lfd_msgs::Phase>(m, k, path)) {
         if (!phase.empty() && p->name != phase) r.segment_ends.push_back(phase_time);
         phase = p->name;
         phase_time = t;

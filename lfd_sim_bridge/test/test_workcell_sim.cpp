@@ -363,29 +363,49 @@ TEST(WorkcellSim, ObjectPosesOutsideTheWorkspaceOrNonUnitAreRefused) {
   EXPECT_EQ(sim.divergenceCount(), 0);
 }
 
-// Issue 12: /joint_trajectory velocities of 1.7e308 swung the elbow between its limits.
-TEST(WorkcellSim, TrajectoryVelocitiesAreClampedToTheJointLimit) {
-  LogCounter logs;
-  lfd_sim::WorkcellSim sim(kModel, readyConfig(), logs.sink());
+// Issue 12: /joint_trajectory velocities of 1.7e308 swung the elbow between its limits; issue 23:
+// clamped to the limit, they still made the elbow overshoot both waypoints by 0.6 rad, with
+// nothing logged. A velocity beyond the joint's limit refuses the trajectory (nothing moves); one
+// within it is followed through its waypoints.
+TEST(WorkcellSim, TrajectoryVelocitiesBeyondTheJointLimitAreRefused) {
+  lfd_sim::WorkcellSim sim(kModel, readyConfig());
   sim.step(200);
   const double q0 = sim.jointTarget("R_ELBOW_P");
+  const double limit = sim.jointLimit("R_ELBOW_P").velocity;
   lfd_sim::JointTrajectory traj;
   traj.joint_names = {"R_ELBOW_P"};
-  traj.points = {{0.5, {q0 + 0.1}, {1.7e308}}, {1.0, {q0 + 0.2}, {-1.7e308}}};
+  traj.points = {{0.5, {q0 + 0.05}, {1.7e308}}, {1.0, {q0 + 0.1}, {-1.7e308}}};
+  std::string error;
+  try {
+    sim.setTrajectory(traj);
+  } catch (const std::invalid_argument& e) {
+    error = e.what();
+  }
+  EXPECT_NE(error.find("trajectory point 0, joint R_ELBOW_P: velocity 1.7e+308 is beyond the "
+                       "joint's limit"),
+            std::string::npos)
+      << error;
+  EXPECT_NE(error.find("refused"), std::string::npos) << error;
+  EXPECT_FALSE(sim.trajectoryActive());
+  // Just over the limit is over it too.
+  traj.points = {{0.5, {q0 + 0.05}, {limit * 1.01}}, {1.0, {q0 + 0.1}, {0.0}}};
+  EXPECT_THROW(sim.setTrajectory(traj), std::invalid_argument);
+  sim.step(1000);
+  EXPECT_NEAR(sim.jointTarget("R_ELBOW_P"), q0, 1e-12);  // nothing moved
+
+  // A normal trajectory with velocities within the limit is taken and passes its waypoints.
+  traj.points = {{0.5, {q0 + 0.05}, {0.1}}, {1.0, {q0 + 0.1}, {0.0}}};
   sim.setTrajectory(traj);
-  EXPECT_GE(logs.warnings, 1);
-  EXPECT_NE(logs.last.find("clamping"), std::string::npos) << logs.last;
+  EXPECT_TRUE(sim.trajectoryActive());
   double lo = q0, hi = q0;
   for (int k = 0; k < 1500; ++k) {
     sim.step();
     lo = std::min(lo, sim.jointTarget("R_ELBOW_P"));
     hi = std::max(hi, sim.jointTarget("R_ELBOW_P"));
   }
-  // Hermite segments with the clamped 2 rad/s overshoot the 0.2 rad move by a fraction of it, not
-  // by a swing to the joint limits.
-  EXPECT_GT(lo, q0 - 0.3);
-  EXPECT_LT(hi, q0 + 0.5);
-  EXPECT_NEAR(sim.jointTarget("R_ELBOW_P"), q0 + 0.2, 1e-9);
+  EXPECT_GT(lo, q0 - 0.01);
+  EXPECT_LT(hi, q0 + 0.11);
+  EXPECT_NEAR(sim.jointTarget("R_ELBOW_P"), q0 + 0.1, 1e-9);
 }
 
 TEST(WorkcellSim, RecoversFromDivergenceWithoutCrashing) {

@@ -2,6 +2,9 @@
 
 #include <stdexcept>
 
+#include "lfd_core/ros_message_reader.hpp"
+#include "lfd_core/user_text.hpp"
+
 namespace lfd {
 
 std::uint64_t checkInputBudget(const std::vector<std::string>& files, const InputBudget& budget,
@@ -21,6 +24,23 @@ std::uint64_t checkInputBudget(const std::vector<std::string>& files, const Inpu
     }
   }
   return total;
+}
+
+void checkRequestString(const std::string& field, std::string_view value,
+                        const StringBudget& budget) {
+  if (budget.max_bytes == 0 || value.size() <= budget.max_bytes) return;
+  // Only the quoted head is copied: the whole value may be hundreds of megabytes.
+  const std::string head(value.substr(0, kMaxQuotedChars));
+  throw std::invalid_argument(field + ": a string of " + std::to_string(value.size()) +
+                              " bytes, over the limit of " + std::to_string(budget.max_bytes) +
+                              " (" + budget.key + "): " + quoted(head) + "...");
+}
+
+void checkMessageStrings(const rosmsg::MessageSchema& schema, const std::uint8_t* data,
+                         std::size_t size, const StringBudget& budget) {
+  rosmsg::for_each_string(schema, data, size, [&](const std::string& path, std::string_view value) {
+    checkRequestString(path, value, budget);
+  });
 }
 
 }  // namespace lfd

@@ -60,8 +60,14 @@ void checkRoots(const std::string& path, const fs::path& resolved, const PathPol
   refuse(path, "outside the allowed roots (allowed_roots: " + roots + ")");
 }
 
-// Checked first: a request path with ".." is refused whether or not its target exists.
+constexpr const char* kRelativeWhy =
+    "is relative; a service request needs an absolute path (the node resolves a relative one "
+    "against its own working directory, not the caller's)";
+
+// Checked first: a relative request path, or one with "..", is refused whether or not its target
+// exists.
 void checkParentReferences(const std::string& path, const PathPolicy& policy) {
+  if (policy.require_absolute && !fs::path(path).is_absolute()) refuse(path, kRelativeWhy);
   if (!policy.allowed_roots.empty() && hasParentReference(path))
     refuse(path, "'..' is not allowed in request paths");
 }
@@ -90,22 +96,60 @@ std::string descriptorPath(int fd) {
   return ec ? std::string() : target.string();
 }
 
+FileIdentity identityOf(const struct stat& st) {
+  FileIdentity id;
+  id.device = static_cast<std::uint64_t>(st.st_dev);
+  id.inode = static_cast<std::uint64_t>(st.st_ino);
+  id.size = static_cast<std::uint64_t>(st.st_size);
+  id.mtime_sec = st.st_mtim.tv_sec;
+  id.mtime_nsec = st.st_mtim.tv_nsec;
+  id.ctime_sec = st.st_ctim.tv_sec;
+  id.ctime_nsec = st.st_ctim.tv_nsec;
+  return id;
+}
+
+// An existing output may be replaced only when its kind recognises it as lfd's own product.
+void checkReplaceable(const std::string& path, const std::string& resolved,
+                      const OutputKind& kind) {
+  bool ours = false;
+  try {
+    ours = kind.written_by_lfd && kind.written_by_lfd(openInputFile(resolved));
+  } catch (const std::exception& e) {
+    refuse(path, "exists and cannot be checked (" + std::string(e.what()) + "); it is kept");
+  }
+  if (!ours) {
+    refuse(path, "exists and was not written by lfd as a " + kind.name +
+                     "; it is kept (overwrite replaces only lfd's own " + kind.name +
+                     " files): remove it or choose another path");
+  }
+}
+
 }  // namespace
 
-InputFile::InputFile(int fd, std::string resolved, std::uint64_t size)
-    : fd_(fd), resolved_(std::move(resolved)), size_(size) {}
+void checkRequestPath(const std::string& field, const std::string& path, const PathPolicy& policy) {
+  if (policy.require_absolute && !fs::path(path).is_absolute())
+    throw std::invalid_argument(field + ": path " + lfd::quoted(path) + " " + kRelativeWhy);
+}
+
+std::string FileIdentity::key() const {
+  return std::to_string(device) + ":" + std::to_string(inode) + ":" + std::to_string(size) + ":" +
+         std::to_string(mtime_sec) + "." + std::to_string(mtime_nsec) + ":" +
+         std::to_string(ctime_sec) + "." + std::to_string(ctime_nsec);
+}
+
+InputFile::InputFile(int fd, std::string resolved) : fd_(fd), resolved_(std::move(resolved)) {}
 
 InputFile::InputFile(InputFile&& other) noexcept
     : fd_(std::exchange(other.fd_, -1)),
       resolved_(std::move(other.resolved_)),
-      size_(other.size_) {}
+      identity_(other.identity_) {}
 
 InputFile& InputFile::operator=(InputFile&& other) noexcept {
   if (this != &other) {
     if (fd_ >= 0) ::close(fd_);
     fd_ = std::exchange(other.fd_, -1);
     resolved_ = std::move(other.resolved_);
-    size_ = other.size_;
+    identity_ = other.identity_;
   }
   return *this;
 }
@@ -132,7 +176,7 @@ InputFile openInputFile(const std::string& path, const PathPolicy& policy,
   const int fd = ::open(resolved.c_str(), O_RDONLY | O_NOFOLLOW | O_NONBLOCK | O_CLOEXEC);
   if (fd < 0)
     refuse(path, errno == ELOOP ? "changed into a link while opening it" : std::strerror(errno));
-  InputFile file(fd, resolved, 0);  // closes the descriptor on every refusal below
+  InputFile file(fd, resolved);  // closes the descriptor on every refusal below
   if (::fstat(fd, &st) != 0) refuse(path, std::strerror(errno));
   if (!S_ISREG(st.st_mode))
     refuse(path, std::string(typeName(st.st_mode)) + ", not a regular file");
@@ -144,7 +188,7 @@ InputFile openInputFile(const std::string& path, const PathPolicy& policy,
   }
   // Readers block as usual on a regular file; O_NONBLOCK was only for the open itself.
   ::fcntl(fd, F_SETFL, ::fcntl(fd, F_GETFL) & ~O_NONBLOCK);
-  file.size_ = size;
+  file.identity_ = identityOf(st);
   return file;
 }
 
@@ -153,7 +197,7 @@ std::string checkInputFile(const std::string& path, const PathPolicy& policy) {
 }
 
 std::string checkOutputFile(const std::string& path, const PathPolicy& policy, bool overwrite,
-                            const std::vector<std::string>& inputs) {
+                            const std::vector<std::string>& inputs, const OutputKind& kind) {
   if (path.empty()) throw std::invalid_argument("empty output path");
   checkParentReferences(path, policy);
   const fs::path absolute = fs::absolute(path);
@@ -181,6 +225,7 @@ std::string checkOutputFile(const std::string& path, const PathPolicy& policy, b
   if (exists && !S_ISREG(out.st_mode))
     refuse(path, std::string("exists and is ") + typeName(out.st_mode));
   if (exists && !overwrite) refuse(path, "exists; set overwrite to replace it");
+  if (exists) checkReplaceable(path, resolved.string(), kind);
   return resolved.string();
 }
 
@@ -192,7 +237,7 @@ std::string checkPathInRoots(const std::string& path, const PathPolicy& policy) 
   return resolved.string();
 }
 
-void writeFileAtomically(const std::string& path, bool overwrite,
+void writeFileAtomically(const std::string& path, bool overwrite, const OutputKind& kind,
                          const std::function<void(const std::string& temp_path)>& write) {
   const fs::path target = fs::absolute(path);
   std::string temp =
@@ -209,6 +254,13 @@ void writeFileAtomically(const std::string& path, bool overwrite,
       ::close(sync_fd);
     }
     int rc = 0;
+    struct stat existing {};
+    if (overwrite && ::stat(target.c_str(), &existing) == 0) {
+      // Checked again as late as possible: what the rename replaces must be lfd's own.
+      if (!S_ISREG(existing.st_mode))
+        refuse(path, std::string("exists and is ") + typeName(existing.st_mode));
+      checkReplaceable(path, target.string(), kind);
+    }
     if (overwrite) {
       rc = ::rename(temp.c_str(), target.c_str());
     } else {
@@ -230,8 +282,9 @@ void writeFileAtomically(const std::string& path, bool overwrite,
   }
 }
 
-void writeTextAtomically(const std::string& path, bool overwrite, const std::string& text) {
-  writeFileAtomically(path, overwrite, [&](const std::string& temp) {
+void writeTextAtomically(const std::string& path, bool overwrite, const OutputKind& kind,
+                         const std::string& text) {
+  writeFileAtomically(path, overwrite, kind, [&](const std::string& temp) {
     FILE* f = std::fopen(temp.c_str(), "w");
     if (!f) refuse(path, std::string("cannot write: ") + std::strerror(errno));
     const bool ok = std::fwrite(text.data(), 1, text.size(), f) == text.size();

@@ -1,6 +1,7 @@
 #include "lfd_core/user_text.hpp"
 
 #include <cstdio>
+#include <stdexcept>
 
 namespace lfd {
 
@@ -24,6 +25,20 @@ std::string printable(const std::string& text, std::size_t max_chars) {
 
 std::string quoted(const std::string& text, std::size_t max_chars) {
   return "'" + printable(text, max_chars) + "'";
+}
+
+void stripByteOrderMark(std::string& first_line, const std::string& path) {
+  static const std::string kUtf8 = "\xEF\xBB\xBF";
+  if (first_line.compare(0, kUtf8.size(), kUtf8) == 0) {
+    first_line.erase(0, kUtf8.size());
+    return;
+  }
+  const bool le = first_line.compare(0, 2, "\xFF\xFE") == 0;
+  if (le || first_line.compare(0, 2, "\xFE\xFF") == 0) {
+    throw std::invalid_argument(
+        "file " + quoted(path) + " is UTF-16 (it starts with the byte-order mark " +
+        (le ? "FF FE" : "FE FF") + "): UTF-16 is not supported, save it as UTF-8");
+  }
 }
 
 }  // namespace lfd

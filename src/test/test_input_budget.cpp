@@ -1,5 +1,6 @@
 // The request budget (issue 23 row 2): the files a request expands to, and their bytes, are
-// refused before any work, naming the config key; a FIFO among them is refused at once.
+// refused before any work, naming the config key; a FIFO among them is refused at once. Every
+// string of a request within one bound (issue 23).
 #include "lfd_core/input_budget.hpp"
 
 #include <gtest/gtest.h>
@@ -11,6 +12,7 @@
 #include <functional>
 #include <stdexcept>
 
+#include "ros_serialized_bytes.hpp"
 #include "support/error_of.hpp"
 
 namespace {
@@ -68,3 +70,76 @@ TEST_F(InputBudgetTest, ANamedPipeAmongTheFilesIsRefused) {
 }
 
 }  // namespace
+
+// Issue 23: one bound for every string of a request; the refusal names the field and the key and
+// quotes at most 200 characters (a 10 MB string was echoed whole into errors, logs, feedback).
+TEST(RequestStrings, AStringOverTheBudgetIsRefusedNamingTheFieldAndKey) {
+  lfd::StringBudget budget;
+  budget.max_bytes = 100;
+  budget.key = "limits/max_request_string_bytes";
+  EXPECT_EQ(errorOf([&] { lfd::checkRequestString("task", std::string(100, 'a'), budget); }), "");
+  const std::string huge(10 << 20, 'x');
+  const std::string error = errorOf([&] { lfd::checkRequestString("task", huge, budget); });
+  EXPECT_EQ(error.rfind("task: a string of 10485760 bytes, over the limit of 100 "
+                        "(limits/max_request_string_bytes): 'xxx",
+                        0),
+            0u)
+      << error.substr(0, 300);
+  EXPECT_LT(error.size(), 400u);
+  EXPECT_EQ(lfd::kDefaultMaxRequestStringBytes, 64u * 4096u + 63u);
+}
+
+// Every string of a serialized request, at any depth and in every array, named by its path.
+TEST(RequestStrings, EveryStringOfAMessageIsCheckedByItsPath) {
+  const lfd::rosmsg::MessageSchema schema =
+      lfd::rosmsg::MessageSchema::parse("p/Req", R"(string task
+string[] bag_paths
+float64[] numbers
+Meta metadata
+Meta[] more
+================================================================================
+MSG: p/Meta
+Header header
+string note
+================================================================================
+MSG: std_msgs/Header
+uint32 seq
+time stamp
+string frame_id
+)");
+  auto message = [](const std::string& path, const std::string& frame) {
+    Bytes b;
+    b.str("grasp");
+    b.put<std::uint32_t>(2).str("/tmp/a.bag").str(path);
+    b.put<std::uint32_t>(3).put(1.0).put(2.0).put(3.0);
+    b.header(1, 2).str("note");
+    b.put<std::uint32_t>(1).put<std::uint32_t>(0).put<std::uint32_t>(0).put<std::uint32_t>(0);
+    b.str(frame).str("");
+    return b;
+  };
+  lfd::StringBudget budget;
+  budget.max_bytes = 64;
+  budget.key = "~limits/max_request_string_bytes";
+  const Bytes fine = message("/tmp/b.bag", "world");
+  EXPECT_EQ(errorOf([&] {
+              lfd::checkMessageStrings(schema, fine.data.data(), fine.data.size(), budget);
+            }),
+            "");
+  const Bytes long_path = message(std::string(65, 'p'), "world");
+  EXPECT_EQ(errorOf([&] {
+              lfd::checkMessageStrings(schema, long_path.data.data(), long_path.data.size(),
+                                       budget);
+            }).rfind("bag_paths[1]: a string of 65 bytes", 0),
+            0u);
+  const Bytes long_frame = message("/tmp/b.bag", std::string(1000, 'f'));
+  EXPECT_EQ(errorOf([&] {
+              lfd::checkMessageStrings(schema, long_frame.data.data(), long_frame.data.size(),
+                                       budget);
+            }).rfind("more[0].header.frame_id: a string of 1000 bytes", 0),
+            0u);
+  // Bytes that are no message of the schema are an error, never a read past the buffer.
+  Bytes cut = fine;
+  cut.data.resize(cut.data.size() - 3);
+  EXPECT_THROW(lfd::checkMessageStrings(schema, cut.data.data(), cut.data.size(), budget),
+               lfd::rosmsg::MessageError);
+}

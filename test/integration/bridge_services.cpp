@@ -227,6 +227,28 @@ TEST_F(BridgeServices, ResetSelectsTheNoiseProfile) {
   EXPECT_NE(unknown.response.message.find("no_such_profile"), std::string::npos);
 }
 
+// Issue 23: every request string within ~limits/max_request_string_bytes, checked before any
+// work; the error names the field and quotes at most 200 characters (a 10 MB name was echoed).
+TEST_F(BridgeServices, OverlongRequestStringsAreRefusedBeforeAnyWork) {
+  lfd_msgs::ResetSim reset;
+  reset.request.noise_profile = std::string(300000, 'n');
+  ASSERT_TRUE(call("/bridge/reset", &reset));
+  EXPECT_FALSE(reset.response.success);
+  EXPECT_EQ(reset.response.message.rfind("noise_profile: a string of 300000 bytes, over the limit "
+                                         "of 262207 (~limits/max_request_string_bytes)",
+                                         0),
+            0u)
+      << reset.response.message.substr(0, 300);
+  EXPECT_LT(reset.response.message.size(), 500u);
+  lfd_msgs::SetScene scene;
+  scene.request.object_names = {"stick", std::string(300000, 'o')};
+  scene.request.poses.resize(2);
+  ASSERT_TRUE(call("/bridge/set_scene", &scene));
+  EXPECT_FALSE(scene.response.success);
+  EXPECT_EQ(scene.response.message.rfind("object_names[1]: a string of 300000 bytes", 0), 0u)
+      << scene.response.message.substr(0, 300);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {

@@ -250,6 +250,16 @@ class ExecutorAction(unittest.TestCase):
         case("library is empty", lambda x: setattr(x, "library", ""))
         case("missing.json", lambda x: setattr(x, "library", os.path.join(self.out, "missing.json")))
         case("~limits/max_name_length", lambda x: setattr(x, "library", "x" * 5000))
+        # Issue 23: a library path must be absolute (the node's working directory is not the
+        # caller's).
+        case("library: path 'libraries/grasp.json' is relative",
+             lambda x: setattr(x, "library", "libraries/grasp.json"))
+        # Issue 23: every goal string within ~limits/max_request_string_bytes before any work,
+        # quoted short.
+        case("library: a string of 300000 bytes, over the limit of 262207 "
+             "(~limits/max_request_string_bytes)", lambda x: setattr(x, "library", "x" * 300000))
+        case("object_names[0]: a string of 300000 bytes",
+             lambda x: setattr(x, "object_names", ["s" * 300000]))
         old = os.path.join(self.out, "version1.json")
         with open(old, "w") as f:
             f.write('{"format": "lfd_skill_library", "version": 1, "segments": []}')

@@ -3,7 +3,8 @@
 (a bag is never overwritten, an existing library only with overwrite, a FIFO is refused at once,
 paths outside ~allowed_roots or with '..' are refused), limits (~limits/max_num_basis,
 ~limits/max_bags), 150 seeded random requests of extreme values (seed 12, about 10 s), and a link
-swapped between a bag and a FIFO for 3 s while requests run (issue 23)."""
+swapped between a bag and a FIFO for 3 s while requests run (issue 23). Issue 23: overwrite
+replaces only a library lfd wrote; relative paths are refused; overlong strings are refused."""
 import hashlib
 import math
 import os
@@ -127,6 +128,43 @@ class LearnerFuzz(unittest.TestCase):
                          changepoint_counts=[1] * 60,
                          changepoint_times=[START + DURATION / 2] * 60)
         self.assertRefused(self.call(req), "limits/max_bags")
+
+    def test_8_overwrite_replaces_only_a_library_lfd_wrote(self):
+        """Issue 23: overwrite: true replaced any regular file under the roots (a test .bashrc)."""
+        bashrc = os.path.join(self.dir, ".bashrc")
+        with open(bashrc, "w") as f:
+            f.write("export PATH=$HOME/bin:$PATH\n")
+        before = digest(bashrc)
+        res = self.call(self.valid(bashrc, overwrite=True))
+        self.assertRefused(res, "was not written by lfd as a skill library")
+        self.assertIn(".bashrc", res.error)
+        self.assertEqual(digest(bashrc), before)
+        out = os.path.join(self.dir, "own.json")
+        self.assertTrue(self.call(self.valid(out)).success)
+        res = self.call(self.valid(out, overwrite=True, num_basis=20))
+        self.assertTrue(res.success, res.error)
+
+    def test_9_relative_paths_are_refused_naming_the_field(self):
+        """Issue 23: a relative path resolved against the node's own working directory."""
+        self.assertRefused(self.call(self.valid("relative.json")),
+                           "output_path: path 'relative.json' is relative")
+        req = self.valid(os.path.join(self.dir, "rel.json"))
+        req.bag_paths[1] = "demo1.bag"
+        self.assertRefused(self.call(req), "bag_paths[1]: path 'demo1.bag' is relative")
+        self.assertFalse(os.path.exists(os.path.join(self.dir, "rel.json")))
+
+    def test_9b_overlong_strings_are_refused_before_any_work(self):
+        """Issue 23: every request string within ~limits/max_request_string_bytes; the error
+        quotes at most 200 characters (a 10 MB string was echoed into errors and logs)."""
+        t0 = time.time()
+        res = self.call(self.valid(os.path.join(self.dir, "long.json"), task="x" * 300000))
+        self.assertRefused(res, "task: a string of 300000 bytes, over the limit of 262207 "
+                                "(~limits/max_request_string_bytes)")
+        self.assertLess(len(res.error), 500)
+        self.assertLess(time.time() - t0, 5.0)
+        req = self.valid(os.path.join(self.dir, "long.json"), segment_names=["a", "n" * 300000])
+        self.assertRefused(self.call(req), "segment_names[1]: a string of 300000 bytes")
+        self.assertFalse(os.path.exists(os.path.join(self.dir, "long.json")))
 
     def test_7_link_swapped_to_fifo_never_hangs(self):
         """Issue 23 row 1: a link swapped between a bag and a FIFO while requests run (3 s) never

@@ -1,6 +1,6 @@
 #!/usr/bin/python3
 """rostest (recorder_live_bag.test): a recorder never touches another recorder's live bag, and
-refuses bag paths with ".." or outside its allowed_roots."""
+refuses bag paths with ".." or outside its allowed_roots, relative ones, and overlong strings."""
 import os
 import unittest
 
@@ -68,6 +68,29 @@ class RecorderLiveBag(unittest.TestCase):
             self.assertIn(why, res.message)
             self.assertFalse(os.path.exists(path + ".active"))
         self.assertFalse(os.path.exists("/var/lib/lfd_recorder_live_bag"))
+
+    def test_4_relative_paths_are_refused_naming_the_field(self):
+        """Issue 23: a service request path must be absolute."""
+        res = self.start("recorder_b", "relative.bag")
+        self.assertFalse(res.success)
+        self.assertIn("bag_path: path 'relative.bag' is relative", res.message)
+
+    def test_5_overlong_strings_are_refused_naming_the_field(self):
+        """Issue 23: every request string is within ~limits/max_request_string_bytes (the error
+        quotes it short)."""
+        long_path = os.path.join(self.dir, "x" * 300000 + ".bag")
+        res = self.start("recorder_b", long_path)
+        self.assertFalse(res.success)
+        self.assertIn("bag_path: a string of %d bytes, over the limit of 262207 "
+                      "(~limits/max_request_string_bytes)" % len(long_path), res.message)
+        self.assertLess(len(res.message), 500)
+        meta = DemoMetadata(task="t" * 300000, extra_json="{}")
+        meta.header.stamp = rospy.Time.now()
+        res = rospy.ServiceProxy("/recorder_b/start", StartRecording)(
+            bag_path=os.path.join(self.dir, "long_task.bag"), metadata=meta)
+        self.assertFalse(res.success)
+        self.assertIn("metadata.task: a string of 300000 bytes", res.message)
+        self.assertFalse(os.path.exists(os.path.join(self.dir, "long_task.bag.active")))
 
 
 if __name__ == "__main__":

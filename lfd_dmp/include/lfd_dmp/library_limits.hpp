@@ -22,7 +22,7 @@ struct LibraryLimits {
   std::size_t max_demos = 256;           ///< per segment, and demo scenes (learner: 32 bags)
   int max_num_basis = 1000;              ///< learner.yaml limits/max_num_basis
   std::size_t max_list_length = 1000;    ///< any JSON array: the longest is num_basis weights
-  std::size_t max_string_length = 1024;  ///< any JSON string or key: names and bag file names
+  std::size_t max_string_length = 4096;  ///< any JSON string or key: demo ids are bag paths
   std::uintmax_t max_file_bytes = 64u << 20;  ///< learned libraries are 0.1-1 MB
 };
 

@@ -27,6 +27,14 @@ using lfd_msgs::toPoseMsg;
 trajectory_msgs::JointTrajectory toJointTrajectory(const ExecutionPlan& plan,
                                                    const ros::Time& start, double period);
 
+/// Refuses a trajectory that moves a joint faster than its limit (`limits` by `joint_names`;
+/// a joint without a positive finite limit is not checked): the driver refuses it whole (a
+/// velocity beyond the limit made its Hermite segments overshoot), so the goal fails here, naming
+/// the time, the joint, the speed and the limit. Throws std::invalid_argument.
+void checkTrajectoryVelocities(const trajectory_msgs::JointTrajectory& trajectory,
+                               const std::vector<std::string>& joint_names,
+                               const Eigen::VectorXd& limits);
+
 /// A trajectory of one point that holds `q` from `stamp` on (a stop).
 trajectory_msgs::JointTrajectory holdTrajectory(const std::vector<std::string>& joints,
                                                 const Eigen::VectorXd& q, const ros::Time& stamp);

@@ -46,6 +46,8 @@
 
 #include "lfd_dmp/library_limits.hpp"
 
+#include <lfd_core/safe_paths.hpp>
+
 #include <nlohmann/json.hpp>
 
 #include <map>
@@ -109,9 +111,17 @@ lfd::SegmentDmp segmentDmpFromJson(const nlohmann::json& j, const lfd::DmpParame
 /// Throws std::runtime_error naming the JSON location on any problem.
 SkillLibrary skillLibraryFromJson(const nlohmann::json& j);
 
+/// What a skill library file is, for outputs: a JSON object whose "format" is kSkillLibraryFormat
+/// (every library lfd ever wrote has it). `overwrite` replaces only such a file.
+lfd::OutputKind skillLibraryOutput();
+
 /// Writes pretty-printed JSON atomically (lfd::writeFileAtomically). An existing file is kept
-/// (std::invalid_argument) unless `overwrite`. Throws std::runtime_error on I/O errors.
-void saveSkillLibrary(const SkillLibrary& library, const std::string& path, bool overwrite);
+/// (std::invalid_argument) unless `overwrite`, and even then unless it is a skill library lfd
+/// wrote. The library must load again within `limits` (its strings, lists and counts: a request's
+/// 200 KB task name would otherwise make a library no node can load): else std::runtime_error
+/// "<JSON location>: ..." and nothing is written. Throws std::runtime_error on I/O errors.
+void saveSkillLibrary(const SkillLibrary& library, const std::string& path, bool overwrite,
+                      const LibraryLimits& limits = {});
 /// Only regular files are read (a FIFO is refused, never opened), within `limits` (file size,
 /// sizes, durations: library_limits.hpp). Throws std::runtime_error with the file name and the
 /// JSON location of the problem.

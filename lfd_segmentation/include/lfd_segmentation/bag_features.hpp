@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "lfd_core/safe_paths.hpp"
 #include "lfd_core/time_series.hpp"
 #include "lfd_segmentation/segmentation_params.hpp"
 
@@ -29,6 +30,18 @@ struct DemoFeatures {
 /// of that very name exists).
 std::vector<std::string> demo_parts(const std::string& path);
 
+/// One demonstration's bag files, each opened once by the file-access layer: the reader reads
+/// these descriptors, and their identities (lfd::FileIdentity) key the service's cache, so a key
+/// always describes the very files that were read.
+struct DemoFiles {
+  std::string path;                ///< as the request gave it
+  std::vector<std::string> names;  ///< demo_parts(path), for messages
+  std::vector<lfd::InputFile> parts;
+};
+
+/// Opens the parts of `path` under `policy`. Throws std::runtime_error "cannot open bag ...: why".
+DemoFiles open_demo_files(const std::string& path, const lfd::PathPolicy& policy = {});
+
 /// The request budget of the segmentation (service and CLI), checked before anything is read:
 /// `entries` (bag paths or CSV files) within limits/max_bags, the files they expand to (demo
 /// parts) within limits/max_bag_files, their total size within limits/max_total_bytes, and each
@@ -38,18 +51,28 @@ void check_request_budget(const std::vector<std::string>& entries, const Request
                           const lfd::PathPolicy& paths, const std::string& kind = "bag");
 
 /// Raw (not resampled) streams of the configured fields of one bag. Throws std::runtime_error for
-/// unreadable/truncated bags or messages that do not match their definition, and
-/// std::invalid_argument for a missing topic, a field that does not exist (listing the topic's
-/// numeric fields), a field no message carries, or the ground-truth topic. Each stream is in stamp
-/// order (lfd_core/stamp_order.hpp); `warnings` gets one line per topic whose stamps were out of
-/// order, duplicated or had a gap.
+/// unreadable/truncated bags or messages that do not match their definition (naming the file,
+/// topic, declared type and the message's index and time), and std::invalid_argument for a
+/// missing topic, a field that does not exist (listing the topic's numeric fields), a field no
+/// message carries, the ground-truth topic, or more features than `max_features` (0 = no bound;
+/// counted as the first message of each topic expands its fields, before the rest is read). Each
+/// stream is in stamp order (lfd_core/stamp_order.hpp); `warnings` gets one line per topic whose
+/// stamps were out of order, duplicated or had a gap.
+std::vector<lfd::Stream> read_bag_streams(const DemoFiles& files,
+                                          const std::vector<TopicConfig>& topics,
+                                          std::vector<FeatureRole>* roles = nullptr,
+                                          std::vector<std::string>* warnings = nullptr,
+                                          std::size_t max_features = 0);
 std::vector<lfd::Stream> read_bag_streams(const std::string& path,
                                           const std::vector<TopicConfig>& topics,
                                           std::vector<FeatureRole>* roles = nullptr,
-                                          std::vector<std::string>* warnings = nullptr);
+                                          std::vector<std::string>* warnings = nullptr,
+                                          std::size_t max_features = 0);
 
 /// read_bag_streams + resampling at `rate` Hz (errors name the bag). Streams over `limits`
-/// (time span, |value|) are refused before resampling (check_streams).
+/// (features, time span, |value|) are refused before resampling (check_streams).
+DemoFeatures read_bag_features(const DemoFiles& files, const std::vector<TopicConfig>& topics,
+                               double rate, const RequestLimits& limits = RequestLimits());
 DemoFeatures read_bag_features(const std::string& path, const std::vector<TopicConfig>& topics,
                                double rate, const RequestLimits& limits = RequestLimits());
 

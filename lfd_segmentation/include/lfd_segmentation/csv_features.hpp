@@ -13,9 +13,10 @@ namespace lfd_segmentation {
 /// `time_column`: a column name, or "" to use a column named time, t, timestamp or stamp when
 /// present. Throws std::invalid_argument (file, line and column named) for an unreadable file,
 /// a missing header, ragged rows, unparsable cells or a missing time column that was asked for.
-/// NaN/Inf cells are kept so that the pipeline can report them by feature. Over `limits` (data
-/// rows, finite |values| whose squares would overflow the distances) the read stops at once with
-/// the limit's key, the line and the column.
+/// NaN/Inf cells are kept so that the pipeline can report them by feature. Over `limits` (feature
+/// columns, checked on the header; data rows; finite |values| whose squares would overflow the
+/// distances) the read stops at once with the limit's key, the line and the column. A UTF-8
+/// byte-order mark is skipped; a UTF-16 file is refused ("save it as UTF-8").
 lfd::FeatureMatrix read_csv_features(const std::string& path, const std::string& time_column = "",
                                      double rate = 0.0,
                                      const RequestLimits& limits = RequestLimits());

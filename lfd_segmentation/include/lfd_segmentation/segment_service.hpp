@@ -18,8 +18,9 @@ SegmentationParams apply_overrides(const SegmentationParams& params,
 
 /// The last request's bags read and features selected (II-B), for the next request on the same
 /// bags: an evaluation asks for every combination method in turn, and neither the bags nor the
-/// selection depend on the method. Keyed by the bag paths, each file's size and modification
-/// time, and the relevance threshold; anything else may differ between the requests.
+/// selection depend on the method. Keyed by the bag paths, each file's identity as read (device,
+/// inode, size, mtime and ctime in ns: lfd::FileIdentity), and the relevance threshold; anything
+/// else may differ between the requests.
 struct PreparedCache {
   std::string key;
   std::vector<DemoFeatures> demos;
@@ -27,8 +28,9 @@ struct PreparedCache {
   lfd::PreparedSegmentation prepared;
 };
 
-/// Handles one request; always returns (success=false + error on failure). With a cache, a
-/// request on the bags of the previous one reuses their features and selection.
+/// Handles one request; always returns (success=false + error on failure). Before any work: every
+/// string within limits/max_request_string_bytes, every path absolute, the request budget. With a
+/// cache, a request on the bags of the previous one reuses their features and selection.
 void handle_segment_request(const SegmentationParams& params,
                             const lfd_msgs::Segment::Request& request,
                             lfd_msgs::Segment::Response& response, PreparedCache* cache = nullptr);

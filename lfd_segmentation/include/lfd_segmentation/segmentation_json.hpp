@@ -9,9 +9,16 @@
 #include <string>
 #include <vector>
 
+#include "lfd_core/safe_paths.hpp"
 #include "lfd_core/segmentation_pipeline.hpp"
 
 namespace lfd_segmentation {
+
+/// The `segment` CLI's result file: "format" marks it as lfd's (its --output replaces only such a
+/// file); files written before the marker are recognised by their top-level "success" and "mode"
+/// or "error".
+constexpr const char* kSegmentationResultFormat = "lfd_segmentation_result";
+lfd::OutputKind segmentation_result_output();
 
 struct JsonOptions {
   bool profiles = true;           ///< combined profile (raw and Kaiser-penalized) per demo

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "lfd_core/input_budget.hpp"
 #include "lfd_core/safe_paths.hpp"
 #include "lfd_core/segmentation_pipeline.hpp"
 #include "lfd_core/time_series.hpp"
@@ -36,6 +37,9 @@ struct RequestLimits {
   std::size_t max_total_samples = 60000;       ///< rows summed over the request's demos
   std::size_t max_csv_rows = 100000;           ///< data rows of one CSV file
   double max_abs_value = 1e100;                ///< |feature value|; squares must not overflow
+  std::size_t max_features = 256;              ///< feature columns of a demo (bag fields, CSV)
+  /// Bytes of any string of a request (lfd_core input_budget.hpp).
+  std::size_t max_request_string_bytes = lfd::kDefaultMaxRequestStringBytes;
 };
 
 struct SegmentationParams {

@@ -136,8 +136,9 @@ class WorkcellSim {
   // Streamed targets; cancels any running trajectory.
   void setJointTargets(const std::vector<std::string>& names, const std::vector<double>& positions);
   // Replaces the current trajectory. It starts at max(start_time, now) (start_time <= 0 = now).
-  // Waypoint velocities beyond a joint's velocity limit are clamped to it (warned once per joint):
-  // a Hermite segment with 1e308 rad/s would swing the joint between its position limits.
+  // A waypoint velocity beyond its joint's velocity limit refuses the whole trajectory (the error
+  // names the point, the joint, the value and the limit): a Hermite segment with 1e308 rad/s,
+  // even clamped to the limit, overshot both waypoints of a 0.1 rad move by 0.6 rad.
   // A repeat of the running trajectory with the same start_time > 0 is ignored, so senders may
   // resend a stamped trajectory (ROS can drop the first messages of a new connection).
   void setTrajectory(const JointTrajectory& trajectory, double start_time = 0.0);
@@ -186,6 +187,8 @@ class WorkcellSim {
   void injectNaNForTest();
 
  private:
+  void checkTrajectoryVelocities(const JointTrajectory& trajectory,
+                                 const std::vector<int>& index) const;
   struct Actuated;
   void configureActuators();
   void computeControls();

@@ -24,6 +24,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <string>
 #include <string_view>
@@ -90,5 +91,19 @@ std::size_t array_length(const MessageSchema& schema, const std::uint8_t* sample
 /// The string (one element) or string[] at `path` in `sample`.
 std::vector<std::string> string_values(const MessageSchema& schema, const std::uint8_t* sample,
                                        std::size_t size, const std::string& path);
+
+/// Gets each string of a message with its field path: "task", "bag_paths[2]",
+/// "metadata.header.frame_id", "segmentations[0].source". `value` points into the message bytes.
+using StringVisitor = std::function<void(const std::string& path, std::string_view value)>;
+
+/// Walks every field of one serialized message (any depth, every array element) and calls
+/// `visit` for each string. Throws MessageError, naming the field, when the bytes do not match
+/// the schema (a length past the end, bytes left over).
+void for_each_string(const MessageSchema& schema, const std::uint8_t* data, std::size_t size,
+                     const StringVisitor& visit);
+
+/// Whether the bytes are a message of the schema at all: every length within the buffer and
+/// nothing left over (for_each_string without a visitor). Throws MessageError naming the field.
+void check_message_bytes(const MessageSchema& schema, const std::uint8_t* data, std::size_t size);
 
 }  // namespace lfd::rosmsg

@@ -19,4 +19,10 @@ std::string printable(const std::string& text, std::size_t max_chars = kMaxQuote
 /// printable() in single quotes: "'" + printable(text) + "'".
 std::string quoted(const std::string& text, std::size_t max_chars = kMaxQuotedChars);
 
+/// The first line of a text file (CSV) as its reader wants it: a UTF-8 byte-order mark
+/// (EF BB BF, which spreadsheet programs write) is removed, so the first column keeps its name
+/// (it read as "no time column"). UTF-16 (a first FF FE or FE FF) is refused: std::invalid_argument
+/// naming `path` and saying to save it as UTF-8.
+void stripByteOrderMark(std::string& first_line, const std::string& path);
+
 }  // namespace lfd
