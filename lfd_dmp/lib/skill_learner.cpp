@@ -161,6 +161,44 @@ void learnSegment(const std::vector<UsedDemo>& used, size_t s, const LearnOption
   }
 }
 
+// The demos' sensations per segment (lfd_core/sensory_signature.hpp), cut where their DMPs were.
+// Demos without the same sensors are left out of it, with a warning; fewer than two: none.
+void learnSignature(const std::vector<UsedDemo>& used, const lfd::SignatureOptions& options,
+                    LearnOutcome* out) {
+  std::vector<lfd::SegmentedRecording> recordings;
+  const DemoRecording* first = nullptr;
+  for (const UsedDemo& u : used) {
+    const DemoRecording& rec = u.rec;
+    if (rec.sensors.rows() < 2) continue;
+    if (first && rec.sensors.names != first->sensors.names) {
+      out->warnings.push_back("demo " + rec.id +
+                              " left out of the sensory signature: its sensors "
+                              "differ from demo " +
+                              first->id + "'s");
+      continue;
+    }
+    if (!first) first = &rec;
+    lfd::SegmentedRecording r;
+    r.features = rec.sensors;
+    for (std::size_t k = 1; k + 1 < u.bounds.size(); ++k)  // the inner bounds: the changepoints
+      r.boundaries.push_back(rec.times[u.bounds[k]] - rec.sensors.time_at(0));
+    recordings.push_back(std::move(r));
+  }
+  if (recordings.size() < 2) {
+    out->warnings.push_back("no sensory signature: " + std::to_string(recordings.size()) +
+                            " demo(s) with sensors, 2 needed; reproductions are not monitored");
+    return;
+  }
+  try {
+    lfd::SensorySignature sig = lfd::learn_signature(recordings, first->sensors.names, options);
+    sig.sources = first->sensor_sources;
+    if (!sig.sources.empty() && sig.sources.size() != sig.channels.size()) sig.sources.clear();
+    out->library.sensory_signature = std::move(sig);
+  } catch (const std::invalid_argument& e) {
+    out->warnings.push_back(std::string("no sensory signature: ") + e.what());
+  }
+}
+
 }  // namespace
 
 LearnOutcome learnSkillLibrary(const std::vector<DemoRecording>& demos,
@@ -238,6 +276,7 @@ LearnOutcome learnSkillLibrary(const std::vector<DemoRecording>& demos,
   if (outcome.demos_used == 0) {
     throw std::invalid_argument("learnSkillLibrary: no demonstration could be used");
   }
+  if (options.signature) learnSignature(used, *options.signature, &outcome);
   if (with_scenes)
     learnGoals(ends, options.frames, &lib);
   else

@@ -1,5 +1,8 @@
 #include "lfd_dmp/skill_library.hpp"
 
+#include "json_fields.hpp"
+#include "lfd_dmp/signature_json.hpp"
+
 #include <lfd_core/safe_paths.hpp>
 #include <lfd_core/user_text.hpp>
 
@@ -16,14 +19,7 @@ namespace lfd_dmp {
 namespace {
 
 using nlohmann::json;
-
-[[noreturn]] void fail(const std::string& where, const std::string& what) {
-  throw std::runtime_error(where + ": " + what);
-}
-
-json vectorJson(const Eigen::VectorXd& v) {
-  return json(std::vector<double>(v.data(), v.data() + v.size()));
-}
+using namespace json_fields;
 
 json quaternionJson(const Eigen::Quaterniond& q) {
   return json::array({q.w(), q.x(), q.y(), q.z()});
@@ -34,37 +30,6 @@ json weightsJson(const Eigen::MatrixXd& w) {
   json out = json::array();
   for (Eigen::Index d = 0; d < w.cols(); ++d) out.push_back(vectorJson(w.col(d)));
   return out;
-}
-
-const json& member(const json& j, const char* key, const std::string& where) {
-  if (!j.is_object()) fail(where, "expected an object");
-  const auto it = j.find(key);
-  if (it == j.end()) fail(where, std::string("missing field \"") + key + "\"");
-  return *it;
-}
-
-double number(const json& j, const std::string& where) {
-  if (!j.is_number()) fail(where, "expected a number, got " + std::string(j.type_name()));
-  const double v = j.get<double>();
-  if (!std::isfinite(v)) fail(where, "number is not finite");
-  return v;
-}
-
-std::string text(const json& j, const std::string& where) {
-  if (!j.is_string()) fail(where, "expected a string, got " + std::string(j.type_name()));
-  return j.get<std::string>();
-}
-
-Eigen::VectorXd vector(const json& j, const std::string& where, long expected = -1) {
-  if (!j.is_array()) fail(where, "expected an array of numbers, got " + std::string(j.type_name()));
-  if (expected >= 0 && static_cast<long>(j.size()) != expected) {
-    fail(where,
-         "expected " + std::to_string(expected) + " numbers, got " + std::to_string(j.size()));
-  }
-  Eigen::VectorXd v(static_cast<Eigen::Index>(j.size()));
-  for (size_t i = 0; i < j.size(); ++i)
-    v[static_cast<Eigen::Index>(i)] = number(j[i], where + "[" + std::to_string(i) + "]");
-  return v;
 }
 
 // Finite is not enough: a rollout of a huge number overflows to inf/NaN downstream (IK, the
@@ -294,6 +259,7 @@ json toJson(const SkillLibrary& lib) {
            {"cartesian_frame", lib.cartesian_frame},
            {"demo_scenes", scenes},
            {"segments", segments}};
+  if (lib.sensory_signature) out["sensory_signature"] = toJson(*lib.sensory_signature);
   if (lib.time_alignment) {
     const lfd::TimeAlignmentOptions& a = *lib.time_alignment;
     out["time_alignment"] = json{{"sample_seconds", a.sample_seconds},
@@ -461,6 +427,13 @@ SkillLibrary skillLibraryFromJson(const json& j) {
       seg.demos.push_back(std::move(demo));
     }
     lib.segments.push_back(std::move(seg));
+  }
+  if (j.contains("sensory_signature")) {
+    lib.sensory_signature = signatureFromJson(j["sensory_signature"], "sensory_signature");
+    if (lib.sensory_signature->segments.size() != lib.segments.size())
+      fail("sensory_signature.segments",
+           "has " + std::to_string(lib.sensory_signature->segments.size()) +
+               " segments, the library " + std::to_string(lib.segments.size()));
   }
   return lib;
 }

@@ -11,6 +11,7 @@
 // a preemption or cancel is served at any moment (planning, moving, settling).
 // The logic is lfd_dmp::TaskPlanner (lib/executor.cpp); this file is ROS I/O and monitoring.
 // Parameters: config/executor.yaml (loaded by launch/reproduce.launch).
+#include "lfd_dmp/execution_monitor.hpp"
 #include "lfd_dmp/execution_request.hpp"
 #include "lfd_dmp/executor.hpp"
 #include "lfd_dmp/plan_messages.hpp"
@@ -193,6 +194,8 @@ class Executor {
         param(pnh, "generalization/min_range_margin", options_.min_range_margin);
     options_.min_range_angle =
         param(pnh, "generalization/min_range_angle", options_.min_range_angle);
+    monitoring_ = param(pnh, "monitoring/enabled", monitoring_);
+    stop_on_alarm_ = param(pnh, "monitoring/stop_on_alarm", stop_on_alarm_);
     settle_time_ = param(pnh, "settle_time", settle_time_);
     clock_timeout_ = param(pnh, "clock_timeout", clock_timeout_);
     motion_lead_ = param(pnh, "motion_lead", motion_lead_);
@@ -383,6 +386,7 @@ class Executor {
           lfd_dmp::toJointTrajectory(plan, ros::Time(0), trajectory_period_),
           planner().chain().jointNames(), planner().chain().velocityLimits());
       describePlan(plan, wall0, &result);
+      startMonitor(library, &result);
       ROS_INFO("executor: planned %s: %zu segments, %.2f s, IK residual %.2f mm, %.2f s wall",
                library.task.c_str(), plan.segments.size(), plan.duration(),
                plan.max_ik_position_error * 1e3, result.planning_time);
@@ -410,6 +414,7 @@ class Executor {
     executed_ = nav_msgs::Path();
     feedback_ = lfd_msgs::ExecuteTaskFeedback();
     tracked_stamp_ = ros::Time();
+    monitor_.reset();  // its subscriptions end with the goal
   }
 
   void finish(lfd_msgs::ExecuteTaskResult* result, const std::string& error, bool preempted) {
@@ -466,6 +471,7 @@ class Executor {
       gripper_pub_.publish(lfd_dmp::gripperCommand(e.close, robot_.gripper,
                                                    t0 + ros::Duration(plan.times[e.sample])));
     result->motion_start = t0;
+    if (monitor_) monitor_->start(plan, t0);
     executed_ = nav_msgs::Path();
     feedback_.motion_start = t0;
     feedback_.planned_duration = plan.duration();
@@ -479,6 +485,7 @@ class Executor {
       if (goal_server_->isPreemptRequested() || !ros::ok()) stop(plan, t0, now);
       watch.check(now);
       const ros::Time measured = track(plan, t0);
+      checkMonitor(plan, t0, now, result);
       if (now >= t_end) {
         if (feedback_.state != lfd_msgs::ExecuteTaskFeedback::SETTLING)
           setState(lfd_msgs::ExecuteTaskFeedback::SETTLING, plan);
@@ -496,6 +503,7 @@ class Executor {
           "the TCP did not come within the IK tolerance of its final pose "
           "in ~settle_time");
     }
+    endMonitor(result);
     result->execution_time = (reached - t0).toSec();
     result->final_position_error = feedback_.tcp_position_error;
     result->final_orientation_error = feedback_.tcp_orientation_error;
@@ -509,6 +517,57 @@ class Executor {
   // stamped command would still fire otherwise), then ends the goal as preempted.
   [[noreturn]] void stop(const lfd_dmp::ExecutionPlan& plan, const ros::Time& t0,
                          const ros::Time& now) {
+    const size_t k = hold(plan, t0, now);
+    throw Preempted("preempted at t=" + std::to_string((now - t0).toSec()) +
+                    " s of the motion, in segment '" + segmentAt(plan, k).name +
+                    "'; the arm holds there");
+  }
+
+  // ---- execution monitoring (lfd_dmp/execution_monitor.hpp) -----------------------------------
+  // A library with a sensory signature is monitored when ~monitoring/enabled; a signature whose
+  // sensors cannot be subscribed is a warning, not a failure (the motion runs unmonitored).
+  void startMonitor(const lfd_dmp::SkillLibrary& library, lfd_msgs::ExecuteTaskResult* result) {
+    monitor_.reset();
+    if (!monitoring_ || !library.sensory_signature) return;
+    try {
+      monitor_ = std::make_unique<lfd_dmp::ExecutionMonitor>(nh_, *library.sensory_signature);
+      result->monitored = true;
+    } catch (const std::invalid_argument& e) {
+      result->warnings.push_back(std::string("not monitored: ") + e.what());
+    }
+  }
+
+  void checkMonitor(const lfd_dmp::ExecutionPlan& plan, const ros::Time& t0, const ros::Time& now,
+                    lfd_msgs::ExecuteTaskResult* result) {
+    if (!monitor_) return;
+    feedback_.anomaly_score = monitor_->worst().score;
+    const std::optional<lfd::Deviation> alarm = monitor_->alarm();
+    if (!alarm || !feedback_.monitor_alarm.empty()) return;
+    feedback_.monitor_alarm = result->monitor_alarm = lfd_dmp::describeAlarm(*alarm, plan.segments);
+    result->max_anomaly_score = feedback_.anomaly_score;
+    publishFeedback();
+    if (!stop_on_alarm_) {
+      ROS_WARN("executor: monitor: %s", result->monitor_alarm.c_str());
+      return;
+    }
+    hold(plan, t0, now);
+    monitor_->stop();
+    throw std::runtime_error("stopped by the execution monitor: " + result->monitor_alarm +
+                             "; the arm holds there");
+  }
+
+  void endMonitor(lfd_msgs::ExecuteTaskResult* result) {
+    if (!monitor_) return;
+    monitor_->stop();
+    result->max_anomaly_score = monitor_->worst().score;
+    if (!monitor_->problem().empty())
+      result->warnings.push_back("monitor: sensor data not read: " + monitor_->problem());
+    ROS_INFO("executor: monitored, worst anomaly score %.2f", result->max_anomaly_score);
+  }
+
+  // Holds the arm where the plan is at `now`, and the gripper as the plan has it then; returns the
+  // plan's sample there.
+  size_t hold(const lfd_dmp::ExecutionPlan& plan, const ros::Time& t0, const ros::Time& now) {
     const size_t k = sampleAt(plan, t0, now);
     trajectory_pub_.publish(lfd_dmp::holdTrajectory(plan.joint_names, plan.joints[k], now));
     const lfd_dmp::GripperEvent* last = nullptr;
@@ -516,9 +575,7 @@ class Executor {
       if (!last || e.sample <= k) last = &e;
     if (last) gripper_pub_.publish(lfd_dmp::gripperCommand(last->close, robot_.gripper, now));
     executed_pub_.publish(executed_);
-    throw Preempted("preempted at t=" + std::to_string((now - t0).toSec()) +
-                    " s of the motion, in segment '" + segmentAt(plan, k).name +
-                    "'; the arm holds there");
+    return k;
   }
 
   static size_t sampleAt(const lfd_dmp::ExecutionPlan& plan, const ros::Time& t0,
@@ -616,6 +673,8 @@ class Executor {
   double tf_timeout_ = 1.0;
   double trajectory_period_ = 0.01, feedback_period_ = 0.05;
   std::unique_ptr<lfd_dmp::TaskPlanner> planner_;
+  bool monitoring_ = true, stop_on_alarm_ = false;
+  std::unique_ptr<lfd_dmp::ExecutionMonitor> monitor_;  // the current goal's
   tf2_ros::Buffer tf_buffer_;
   tf2_ros::TransformListener tf_listener_;
   ros::Publisher trajectory_pub_, gripper_pub_, planned_pub_, executed_pub_, marker_pub_;

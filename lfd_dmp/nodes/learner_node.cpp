@@ -10,6 +10,7 @@
 // never over a bag, and over an existing file only with overwrite and only when that file is a
 // skill library lfd wrote.
 #include "lfd_dmp/demo_bag.hpp"
+#include "lfd_dmp/demo_sensors.hpp"
 #include "lfd_dmp/skill_learner.hpp"
 
 #include <lfd_msgs/LearnSkills.h>
@@ -60,6 +61,7 @@ class Learner {
     pnh.param("goal_frames/min_motion_length", frames_.min_motion_length,
               frames_.min_motion_length);
     pnh.param("tf_timeout", tf_timeout_, tf_timeout_);
+    readSignature(pnh);
   }
 
   bool learn(lfd_msgs::LearnSkills::Request& req, lfd_msgs::LearnSkills::Response& res) {
@@ -112,6 +114,7 @@ class Learner {
               return liveTransform(target, source);
             }));
         checkDemoSize(demos.back(), b);
+        if (signature_) lfd_dmp::readDemoSensors(b, sensors_, &demos.back());
       }
       std::vector<std::string> read_warnings;  // stamps the readers put in order, per demo
       for (const auto& d : demos)
@@ -124,6 +127,7 @@ class Learner {
       opt.smoothing_sigma = smoothing_sigma_;
       opt.time_alignment = time_alignment_;
       opt.frames = frames_;
+      opt.signature = signature_;
       const lfd_dmp::LearnOutcome out = lfd_dmp::learnSkillLibrary(demos, cps, opt);
       lfd_dmp::saveSkillLibrary(out.library, output, req.overwrite);
       res.success = true;
@@ -218,7 +222,39 @@ class Learner {
     time_alignment_ = a;
   }
 
+  // ~signature/{enabled, topics_file, phase_bins, ...}: what each segment's sensors showed; a bad
+  // value turns it off, loudly (the library is still learned, its reproductions not monitored).
+  void readSignature(ros::NodeHandle& pnh) {
+    bool enabled = false;
+    std::string file;
+    pnh.param("signature/enabled", enabled, enabled);
+    pnh.param("signature/topics_file", file, file);
+    if (!enabled) return;
+    lfd::SignatureOptions o;
+    int bins = static_cast<int>(o.phase_bins);
+    pnh.param("signature/phase_bins", bins, bins);
+    o.phase_bins = static_cast<std::size_t>(std::max(bins, 0));
+    pnh.param("signature/phase_slack", o.phase_slack, o.phase_slack);
+    pnh.param("signature/persistence_seconds", o.persistence, o.persistence);
+    pnh.param("signature/min_spread_fraction", o.min_spread_fraction, o.min_spread_fraction);
+    pnh.param("signature/noise_sigmas", o.noise_sigmas, o.noise_sigmas);
+    pnh.param("signature/threshold_margin", o.threshold_margin, o.threshold_margin);
+    pnh.param("signature/min_threshold", o.min_threshold, o.min_threshold);
+    try {
+      lfd::check_signature_options(o);
+      sensors_ = lfd_dmp::loadMonitoredSensors(file);
+    } catch (const std::exception& e) {
+      ROS_WARN("learner: ~signature: %s: no sensory signatures", e.what());
+      return;
+    }
+    signature_ = o;
+    ROS_INFO("learner: sensory signatures from %zu monitored topic(s) of %s",
+             sensors_.topics.size(), file.c_str());
+  }
+
   lfd_dmp::DemoBagTopics topics_;
+  std::optional<lfd::SignatureOptions> signature_;
+  lfd_dmp::MonitoredSensors sensors_;
   lfd::PathPolicy paths_;
   lfd::StringBudget strings_;
   int max_bags_ = 32;

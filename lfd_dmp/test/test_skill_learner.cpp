@@ -514,6 +514,56 @@ TEST(DemoScene, StaticTransformsChainedLookupsEqualTheProducts) {
   EXPECT_THROW(tf.add("world", "c", bad), std::runtime_error);
 }
 
+// The touch pads of recording(): loaded while the stick is held (2..4 s), on the demo's clock.
+lfd::FeatureMatrix touchOf(const lfd_dmp::DemoRecording& rec, double level, const char* name) {
+  lfd::FeatureMatrix m;
+  m.names = {name};
+  m.data.resize(rec.times.size(), 1);
+  for (Eigen::Index i = 0; i < rec.times.size(); ++i) {
+    const double t = rec.times[i] - rec.times[0];
+    m.time.push_back(rec.times[i]);
+    m.data(i, 0) = (t > 2.05 && t < 3.95 ? level : 0.0) + 0.01 * std::sin(37.0 * t);
+  }
+  return m;
+}
+
+TEST(SkillLearner, LearnsTheSensorySignatureOfEachSegment) {
+  std::vector<lfd_dmp::DemoRecording> demos;
+  for (double x : {0.6, 0.65, 0.7}) {
+    demos.push_back(recording("d" + std::to_string(x) + ".bag", x));
+    demos.back().sensors = touchOf(demos.back(), 4.0 + 10 * (x - 0.6), "/touch/values/0");
+    demos.back().sensor_sources = {"/touch"};
+  }
+  demos.push_back(recording("other.bag", 0.62));
+  demos.back().sensors = touchOf(demos.back(), 4.0, "/pads/left");
+  const std::vector<std::vector<double>> cps(demos.size(), {12.0, 14.0});
+  lfd_dmp::LearnOptions opt;
+  opt.task = "grasp";
+  opt.signature = lfd::SignatureOptions();
+  const auto out = lfd_dmp::learnSkillLibrary(demos, cps, opt);
+  ASSERT_TRUE(out.library.sensory_signature.has_value());
+  const lfd::SensorySignature& sig = *out.library.sensory_signature;
+  EXPECT_EQ(sig.demonstrations, 3u);  // other.bag's sensor differs: left out, and said so
+  bool said = false;
+  for (const auto& w : out.warnings)
+    said = said || w.find("other.bag left out") != std::string::npos;
+  EXPECT_TRUE(said);
+  EXPECT_EQ(sig.channels, std::vector<std::string>{"/touch/values/0"});
+  EXPECT_EQ(sig.sources, std::vector<std::string>{"/touch"});
+  ASSERT_EQ(sig.segments.size(), 3u);
+  EXPECT_NEAR(sig.segments[1].duration_mean, 2.0, 0.02);
+  EXPECT_NEAR(sig.segments[1].channels[0].mean[25], 4.5, 0.1);   // held: the pads loaded
+  EXPECT_NEAR(sig.segments[0].channels[0].mean[25], 0.0, 0.05);  // approach: nothing touched
+
+  for (auto& d : demos) d.sensors = lfd::FeatureMatrix();
+  const auto none = lfd_dmp::learnSkillLibrary(demos, cps, opt);
+  EXPECT_FALSE(none.library.sensory_signature.has_value());
+  said = false;
+  for (const auto& w : none.warnings)
+    said = said || w.find("no sensory signature") != std::string::npos;
+  EXPECT_TRUE(said);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <functional>
 #include <limits>
 
 namespace {
@@ -320,4 +321,74 @@ TEST(SkillLibrary, ImplausibleDurationsAndSizesAreRefusedOnLoad) {
 int main(int argc, char** argv) {
   ::testing::InitGoogleTest(&argc, argv);
   return RUN_ALL_TESTS();
+}
+
+// A signature of two segments and two channels, as the learner would store it.
+lfd::SensorySignature makeSignature() {
+  lfd::SensorySignature sig;
+  sig.channels = {"/touch/values/0", "/wrist_ft/wrench/force/z"};
+  sig.sources = {"/touch", "/wrist_ft"};
+  sig.demonstrations = 5;
+  sig.options.phase_bins = 4;
+  for (int s = 0; s < 2; ++s) {
+    lfd::SegmentSignature seg;
+    seg.duration_mean = 1.5 + s;
+    seg.duration_spread = 0.1;
+    for (int c = 0; c < 2; ++c) {
+      lfd::ChannelSignature ch;
+      ch.mean = Eigen::Vector4d(0.0, 1.0 + s, 2.5, 0.25 * c);
+      ch.spread = Eigen::Vector4d(0.1, 0.2, 0.3, 0.4);
+      ch.threshold = 3.0 + c;
+      ch.nominal_score = 1.25;
+      seg.channels.push_back(ch);
+    }
+    sig.segments.push_back(seg);
+  }
+  return sig;
+}
+
+TEST(SkillLibrary, TheSensorySignatureTravelsWithTheLibrary) {
+  SkillLibrary lib = makeLibrary();
+  lib.sensory_signature = makeSignature();
+  const std::string path = tempPath("sig.json");
+  lfd_dmp::saveSkillLibrary(lib, path, false);
+  const SkillLibrary back = lfd_dmp::loadSkillLibrary(path);
+  std::remove(path.c_str());
+  ASSERT_TRUE(back.sensory_signature.has_value());
+  EXPECT_EQ(lfd_dmp::toJson(back), lfd_dmp::toJson(lib));
+  EXPECT_EQ(back.sensory_signature->sources, lib.sensory_signature->sources);
+  EXPECT_EQ(back.sensory_signature->segments[1].channels[1].mean,
+            lib.sensory_signature->segments[1].channels[1].mean);
+  EXPECT_EQ(back.sensory_signature->options.phase_bins, 4u);
+}
+
+TEST(SkillLibrary, ABrokenSignatureIsRefusedWithItsLocation) {
+  SkillLibrary lib = makeLibrary();
+  lib.sensory_signature = makeSignature();
+  const nlohmann::json good = lfd_dmp::toJson(lib);
+  auto broken = [&](const std::function<void(nlohmann::json&)>& edit) {
+    nlohmann::json j = good;
+    edit(j);
+    return loadError(j);
+  };
+  EXPECT_NE(broken([](auto& j) {
+              j["sensory_signature"]["segments"].erase(1);
+            }).find("sensory_signature.segments"),
+            std::string::npos);
+  EXPECT_NE(broken([](auto& j) {
+              j["sensory_signature"]["segments"][0]["channels"][1]["spread"][2] = 0.0;
+            }).find("segments[0].channels[1].spread"),
+            std::string::npos);
+  EXPECT_NE(broken([](auto& j) {
+              j["sensory_signature"]["segments"][1]["channels"][0]["mean"].erase(0);
+            }).find("expected 4 numbers"),
+            std::string::npos);
+  EXPECT_NE(broken([](auto& j) {
+              j["sensory_signature"]["sources"].erase(0);
+            }).find("one source per channel"),
+            std::string::npos);
+  EXPECT_NE(broken([](auto& j) {
+              j["sensory_signature"]["segments"][0]["channels"][0]["threshold"] = -1;
+            }).find("threshold"),
+            std::string::npos);
 }

@@ -70,6 +70,7 @@ TopicConfig parse_topic(const YAML::Node& node, std::size_t index) {
     throw std::invalid_argument(where + ": role must be 'state', 'sensor' or 'context', got " +
                                 lfd::quoted(role));
   }
+  topic.monitor = get<bool>(node, "monitor", topic.role != FeatureRole::kState);
   const std::string interpolation = get<std::string>(node, "interpolation", "linear");
   if (interpolation == "linear") {
     topic.interpolation = lfd::Interpolation::kLinear;

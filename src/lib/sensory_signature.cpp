@@ -223,6 +223,23 @@ void set_thresholds(const std::vector<SegmentedRecording>& demos, const ChannelF
 
 }  // namespace
 
+void check_signature_options(const SignatureOptions& o) {
+  if (o.phase_bins < 2 || o.phase_bins > 1000)
+    throw std::invalid_argument("phase_bins must be in [2, 1000], got " +
+                                std::to_string(o.phase_bins));
+  const std::pair<const char*, double> at_least_zero[] = {
+      {"phase_slack", o.phase_slack},
+      {"persistence", o.persistence},
+      {"min_spread_fraction", o.min_spread_fraction},
+      {"noise_sigmas", o.noise_sigmas}};
+  for (const auto& [name, v] : at_least_zero)
+    if (!(v >= 0) || !std::isfinite(v))
+      throw std::invalid_argument(std::string(name) + " must be finite and >= 0");
+  if (!(o.threshold_margin > 0) || !std::isfinite(o.threshold_margin) || !(o.min_threshold > 0) ||
+      !std::isfinite(o.min_threshold))
+    throw std::invalid_argument("threshold_margin and min_threshold must be finite and > 0");
+}
+
 SensorySignature learn_signature(const std::vector<SegmentedRecording>& demos,
                                  const std::vector<std::string>& channels,
                                  const SignatureOptions& options) {
@@ -230,8 +247,7 @@ SensorySignature learn_signature(const std::vector<SegmentedRecording>& demos,
     throw std::invalid_argument("a sensory signature needs at least 2 demonstrations, got " +
                                 std::to_string(demos.size()));
   if (channels.empty()) throw std::invalid_argument("a sensory signature needs a channel");
-  if (options.phase_bins < 2 || !(options.phase_slack >= 0) || !(options.persistence >= 0))
-    throw std::invalid_argument("signature options: phase_bins >= 2, slack and persistence >= 0");
+  check_signature_options(options);
   for (std::size_t d = 0; d < demos.size(); ++d)
     check_recording(demos[d], demos.front().boundaries.size(), channels,
                     "demonstration " + std::to_string(d));

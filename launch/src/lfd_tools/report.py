@@ -67,6 +67,9 @@ def goal_record(goal_id, response=None, outcome=None, error="", demo_duration=No
          "extrapolation_distance_m": response.extrapolation_distance if response is not None else None,
          "extrapolation_angle_rad": response.extrapolation_angle if response is not None else None,
          "outside_demo_range": bool(response.outside_demo_range) if response is not None else None,
+         "monitored": bool(response.monitored) if response is not None else False,
+         "max_anomaly_score": response.max_anomaly_score if response is not None else None,
+         "monitor_alarm": response.monitor_alarm if response is not None else "",
          "wall_time_s": wall_time}
     g["time_ratio"] = g["execution_time_s"] / demo_duration if executed and demo_duration else None
     g["overhead_ratio"] = (g["execution_time_s"] / g["planned_duration_s"]

@@ -3,6 +3,8 @@
 // ROS-free apart from the bag reader (demo_bag.hpp), so it is unit-tested without a master.
 #pragma once
 
+#include "lfd_core/sensory_signature.hpp"
+#include "lfd_core/time_series.hpp"
 #include "lfd_dmp/skill_library.hpp"
 
 #include <optional>
@@ -21,6 +23,10 @@ struct DemoRecording {
   std::string frame;                  ///< frame of the poses ("" = not recorded)
   std::optional<lfd::Scene> scene;    ///< the demo's scene in that frame (none recorded: empty)
   std::vector<std::string> warnings;  ///< what reading it found (stamps out of order, gaps)
+  /// The sensors the demo recorded (feature names, on the same clock as `times`), for the
+  /// sensory signature; empty: none read.
+  lfd::FeatureMatrix sensors;
+  std::vector<std::string> sensor_sources;  ///< per sensor column, its topic (optional)
 };
 
 struct LearnOptions {
@@ -39,6 +45,8 @@ struct LearnOptions {
   std::optional<lfd::TimeAlignmentOptions> time_alignment;
   /// How each segment's goal frame is chosen from the demos' scenes (lfd_core task_frames).
   lfd::FrameSelectionOptions frames;
+  /// Learn each segment's sensory signature from the demos' `sensors` (none: not learned).
+  std::optional<lfd::SignatureOptions> signature;
 };
 
 struct LearnOutcome {

@@ -41,6 +41,7 @@
 #pragma once
 
 #include <lfd_core/segment_dmp.hpp>
+#include <lfd_core/sensory_signature.hpp>
 #include <lfd_core/task_frames.hpp>
 #include <lfd_core/time_alignment.hpp>
 
@@ -98,6 +99,9 @@ struct SkillLibrary {
   std::string cartesian_frame = "base_link";     ///< frame of the poses (DMPs, scenes, goals)
   std::map<std::string, DemoScene> demo_scenes;  ///< by demo_id
   std::vector<SegmentSkills> segments;
+  /// What each segment's sensors showed in the demos (none: learned without sensors, or by an
+  /// older learner); the executor monitors a reproduction against it.
+  std::optional<lfd::SensorySignature> sensory_signature;
 };
 
 nlohmann::json toJson(const lfd::DmpParameters& params);

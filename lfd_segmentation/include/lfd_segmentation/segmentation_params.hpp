@@ -24,6 +24,9 @@ struct TopicConfig {
   FeatureRole role = FeatureRole::kState;
   std::vector<std::string> fields;  ///< a field ending in "/*" expands to every name
   lfd::Interpolation interpolation = lfd::Interpolation::kLinear;
+  /// Its fields go into each skill's sensory signature (the executor's monitor); YAML `monitor`,
+  /// default: every role but state (a gripper's opening, a state, says `monitor: true`).
+  bool monitor = false;
 };
 
 /// Bounds on one request (config `limits:`): whatever a client sends, a request takes bounded

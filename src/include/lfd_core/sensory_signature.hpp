@@ -33,6 +33,10 @@ struct SignatureOptions {
   double min_threshold = 3.0;         ///< ... and never below this many spreads
 };
 
+/// Throws std::invalid_argument naming the option that is out of range (phase_bins in [2, 1000],
+/// the others finite and >= 0, threshold_margin and min_threshold > 0).
+void check_signature_options(const SignatureOptions& options);
+
 /// One channel's expectation along one segment.
 struct ChannelSignature {
   Eigen::VectorXd mean;        ///< expected level per phase bin
@@ -49,6 +53,7 @@ struct SegmentSignature {
 
 struct SensorySignature {
   std::vector<std::string> channels;  ///< feature names, e.g. /wrench/wrench/force/z
+  std::vector<std::string> sources;   ///< per channel, where it is read live (a topic); optional
   std::vector<SegmentSignature> segments;
   SignatureOptions options;
   std::size_t demonstrations = 0;

@@ -1,0 +1,85 @@
+#include "lfd_dmp/sensor_channels.hpp"
+
+#include <algorithm>
+
+#include "lfd_core/ros_message_schema.hpp"
+
+namespace lfd_dmp {
+
+SensorChannels::SensorChannels(ros::NodeHandle& nh, const lfd::SensorySignature& signature,
+                               Callback callback)
+    : callback_(std::move(callback)),
+      latest_(Eigen::VectorXd::Zero(static_cast<Eigen::Index>(signature.channels.size()))),
+      seen_(signature.channels.size(), false) {
+  if (signature.sources.size() != signature.channels.size())
+    throw std::invalid_argument(
+        "the sensory signature does not say which topic each channel is on");
+  std::map<std::string, Source*> by_topic;
+  for (std::size_t c = 0; c < signature.channels.size(); ++c) {
+    const std::string& topic = signature.sources[c];
+    const std::string& name = signature.channels[c];
+    if (topic.empty() || name.rfind(topic + "/", 0) != 0)
+      throw std::invalid_argument("channel " + name + " is not a field of its topic '" + topic +
+                                  "'");
+    Source*& s = by_topic[topic];
+    if (!s) {
+      sources_.push_back(std::make_unique<Source>());
+      s = sources_.back().get();
+      s->topic = topic;
+    }
+    s->fields.push_back(name.substr(topic.size() + 1));
+    s->channels.push_back(c);
+  }
+  for (auto& s : sources_) {
+    Source* source = s.get();
+    s->subscriber = nh.subscribe<topic_tools::ShapeShifter>(
+        source->topic, 20,
+        [this, source](const topic_tools::ShapeShifter::ConstPtr& m) { onMessage(source, m); },
+        ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay());
+  }
+}
+
+std::string SensorChannels::problem() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return problem_;
+}
+
+void SensorChannels::readMessage(Source* s, const topic_tools::ShapeShifter& msg) {
+  const std::string key = msg.getDataType() + " " + msg.getMD5Sum();
+  if (key != s->reader_key) {
+    const auto schema =
+        lfd::rosmsg::MessageSchema::parse(msg.getDataType(), msg.getMessageDefinition());
+    s->reader = std::make_unique<lfd::rosmsg::FieldReader>(schema, s->fields);
+    s->reader_key = key;
+  }
+  std::vector<std::uint8_t> bytes(msg.size());
+  ros::serialization::OStream stream(bytes.data(), static_cast<uint32_t>(bytes.size()));
+  msg.write(stream);
+  s->reader->read(bytes.data(), bytes.size());
+}
+
+void SensorChannels::onMessage(Source* s, const topic_tools::ShapeShifter::ConstPtr& msg) {
+  Eigen::VectorXd values;
+  ros::Time stamp;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    try {
+      readMessage(s, *msg);
+    } catch (const std::exception& e) {
+      problem_ = s->topic + ": " + e.what();
+      return;
+    }
+    for (std::size_t k = 0; k < s->fields.size(); ++k) {
+      if (!s->reader->present(k)) continue;
+      latest_[static_cast<Eigen::Index>(s->channels[k])] = s->reader->value(k);
+      seen_[s->channels[k]] = true;
+    }
+    if (std::find(seen_.begin(), seen_.end(), false) != seen_.end()) return;
+    const double header = s->reader->header_stamp();
+    stamp = header > 0 ? ros::Time(header) : ros::Time::now();
+    values = latest_;
+  }
+  callback_(stamp, values);
+}
+
+}  // namespace lfd_dmp

@@ -1,0 +1,101 @@
+#include "lfd_dmp/signature_json.hpp"
+
+#include "json_fields.hpp"
+
+namespace lfd_dmp {
+namespace {
+
+using nlohmann::json;
+using namespace json_fields;
+
+json optionsJson(const lfd::SignatureOptions& o) {
+  return {{"phase_bins", o.phase_bins},      {"phase_slack", o.phase_slack},
+          {"persistence", o.persistence},    {"min_spread_fraction", o.min_spread_fraction},
+          {"noise_sigmas", o.noise_sigmas},  {"threshold_margin", o.threshold_margin},
+          {"min_threshold", o.min_threshold}};
+}
+
+double nonNegative(const json& j, const char* key, const std::string& where) {
+  const double v = number(member(j, key, where), where + "." + key);
+  if (v < 0) fail(where + "." + key, "must be >= 0");
+  return v;
+}
+
+lfd::SignatureOptions optionsFromJson(const json& j, const std::string& w) {
+  lfd::SignatureOptions o;
+  const double bins = number(member(j, "phase_bins", w), w + ".phase_bins");
+  if (!(bins >= 2 && bins <= 1000) || bins != std::floor(bins))
+    fail(w + ".phase_bins", "must be a whole number in [2, 1000]");
+  o.phase_bins = static_cast<std::size_t>(bins);
+  o.phase_slack = nonNegative(j, "phase_slack", w);
+  o.persistence = nonNegative(j, "persistence", w);
+  o.min_spread_fraction = nonNegative(j, "min_spread_fraction", w);
+  o.noise_sigmas = nonNegative(j, "noise_sigmas", w);
+  o.threshold_margin = nonNegative(j, "threshold_margin", w);
+  o.min_threshold = nonNegative(j, "min_threshold", w);
+  return o;
+}
+
+lfd::ChannelSignature channelFromJson(const json& j, std::size_t bins, const std::string& w) {
+  lfd::ChannelSignature c;
+  c.mean = vector(member(j, "mean", w), w + ".mean", static_cast<long>(bins));
+  c.spread = vector(member(j, "spread", w), w + ".spread", static_cast<long>(bins));
+  if (!(c.spread.minCoeff() > 0)) fail(w + ".spread", "every spread must be > 0");
+  c.threshold = number(member(j, "threshold", w), w + ".threshold");
+  if (!(c.threshold > 0)) fail(w + ".threshold", "must be > 0");
+  c.nominal_score = nonNegative(j, "nominal_score", w);
+  return c;
+}
+
+}  // namespace
+
+json toJson(const lfd::SensorySignature& signature) {
+  json segments = json::array();
+  for (const lfd::SegmentSignature& s : signature.segments) {
+    json channels = json::array();
+    for (const lfd::ChannelSignature& c : s.channels)
+      channels.push_back({{"mean", vectorJson(c.mean)},
+                          {"spread", vectorJson(c.spread)},
+                          {"threshold", c.threshold},
+                          {"nominal_score", c.nominal_score}});
+    segments.push_back({{"duration_mean", s.duration_mean},
+                        {"duration_spread", s.duration_spread},
+                        {"channels", channels}});
+  }
+  return {{"channels", signature.channels},
+          {"sources", signature.sources},
+          {"demonstrations", signature.demonstrations},
+          {"options", optionsJson(signature.options)},
+          {"segments", segments}};
+}
+
+lfd::SensorySignature signatureFromJson(const json& j, const std::string& where) {
+  lfd::SensorySignature sig;
+  sig.channels = texts(member(j, "channels", where), where + ".channels");
+  if (sig.channels.empty()) fail(where + ".channels", "needs at least one channel");
+  sig.sources = texts(member(j, "sources", where), where + ".sources");
+  if (!sig.sources.empty() && sig.sources.size() != sig.channels.size())
+    fail(where + ".sources", "one source per channel (or none)");
+  sig.demonstrations = static_cast<std::size_t>(nonNegative(j, "demonstrations", where));
+  sig.options = optionsFromJson(member(j, "options", where), where + ".options");
+  const json& segments = member(j, "segments", where);
+  if (!segments.is_array() || segments.empty())
+    fail(where + ".segments", "expected a non-empty array");
+  for (std::size_t s = 0; s < segments.size(); ++s) {
+    const std::string ws = where + ".segments[" + std::to_string(s) + "]";
+    lfd::SegmentSignature seg;
+    seg.duration_mean = nonNegative(segments[s], "duration_mean", ws);
+    seg.duration_spread = nonNegative(segments[s], "duration_spread", ws);
+    const json& channels = member(segments[s], "channels", ws);
+    if (!channels.is_array() || channels.size() != sig.channels.size())
+      fail(ws + ".channels",
+           "expected one entry per channel (" + std::to_string(sig.channels.size()) + ")");
+    for (std::size_t c = 0; c < channels.size(); ++c)
+      seg.channels.push_back(channelFromJson(channels[c], sig.options.phase_bins,
+                                             ws + ".channels[" + std::to_string(c) + "]"));
+    sig.segments.push_back(std::move(seg));
+  }
+  return sig;
+}
+
+}  // namespace lfd_dmp
