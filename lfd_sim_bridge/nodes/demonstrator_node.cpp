@@ -183,7 +183,13 @@ class Demonstrator {
     phase_pub_ = nh.advertise<lfd_msgs::Phase>("/lfd/phase", 100);
     const auto hints = ros::TransportHints().tcpNoDelay();
     joint_sub_ = nh.subscribe("/joint_states", 5, &Demonstrator::onJoints, this, hints);
-    touch_sub_ = nh.subscribe("/touch", 5, &Demonstrator::onTouch, this, hints);
+    // The pads the grasps and guarded moves feel: the robot file's touch row.
+    const lfd::SensorEntry* touch = lfd::findSensorOfType(robot_, "lfd_msgs/Touch");
+    if (!touch)
+      throw std::runtime_error(
+          "the robot file has no lfd_msgs/Touch row in its sensor table; "
+          "grasps and guarded moves need one");
+    touch_sub_ = nh.subscribe(touch->topic, 5, &Demonstrator::onTouch, this, hints);
     for (const std::string& object : objects)
       object_subs_.push_back(nh.subscribe<geometry_msgs::PoseStamped>(
           "/objects/" + object + "/pose", 5,

@@ -55,6 +55,15 @@ TEST(RobotSetup, RepositoryFileDescribesTheWaistAndRightArm) {
   EXPECT_GT(s.joint_costs.at("WAIST_R"), s.joint_costs.at("WAIST_Y"));
   EXPECT_EQ(s.gripper.joint, "R_GRIPPER");
   EXPECT_GT(s.gripper.open_opening, s.gripper.close_opening);
+  // The sensor table, rows and fields in the file's order (the order readings are taken in).
+  ASSERT_EQ(s.sensors.size(), 3u);
+  EXPECT_EQ(s.sensors[0].topic, "/wrist_ft");
+  EXPECT_EQ(s.sensors[0].fields.front().first, "force");
+  const lfd::SensorEntry* touch = lfd::findSensorOfType(s, "lfd_msgs/Touch");
+  ASSERT_NE(touch, nullptr);
+  EXPECT_EQ(touch->fields.at(0).second,
+            (std::vector<std::string>{"r_touch_left", "r_touch_right"}));
+  EXPECT_EQ(lfd::findSensorOfType(s, "no_msgs/Nothing"), nullptr);
   const lfd::CartesianToJoints ik = repositoryIk();
   EXPECT_EQ(ik.chain().dof(), 10);  // waist 3 + arm 7
 }
@@ -77,6 +86,20 @@ TEST(RobotSetup, BadFilesAreClearErrors) {
   expectError("ik: {tip_link: t}\ngripper: {open_opening: 0.0, close_opening: 0.05}\n",
               "open_opening");
   expectError("ik: [1, 2\n", "cannot be read");
+  const std::string ik = "ik: {tip_link: t}\n";
+  expectError(ik + "sensors: {a: 1}\n", "sensors must be a list");
+  expectError(ik + "sensors: [{topic: /f, type: T, fields: {force: s}}]\n", "sensors[0].frame");
+  expectError(ik + "sensors: [{topic: /f, type: T, frame: f, fields: {}}]\n", "sensors[0].fields");
+  expectError(ik + "sensors: [{topic: /f, type: T, frame: f, fields: {values: []}}]\n",
+              "sensors[0].fields.values");
+  expectError(ik + "sensors: [{topic: /f, type: T, frame: f, rate: 3, fields: {a: s}}]\n",
+              "unknown key 'rate'");
+  expectError(ik + "sensors: [{topic: /f, type: T, frame: f, fields: {a: s}},\n"
+                   "          {topic: /f, type: U, frame: g, fields: {b: t}}]\n",
+              "topic /f appears twice");
+  expectError(ik + "sensors: [{topic: /f, type: T, frame: f, fields: {a: s}},\n"
+                   "          {topic: /g, type: U, frame: g, fields: {b: [t, s]}}]\n",
+              "sensor 's' is read twice (/f and /g)");
   EXPECT_THROW(lfd::loadRobotSetup("/nonexistent/robot.yaml"), std::runtime_error);
 }
 
