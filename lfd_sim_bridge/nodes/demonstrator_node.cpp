@@ -256,7 +256,7 @@ class Demonstrator {
     std::string urdf;
     if (!nh_.getParam("/robot_description", urdf))
       throw std::runtime_error("/robot_description is not set (launch sim.launch)");
-    // The IK of config/robot.yaml (chain, costs, posture) for poses in base_link; base_link's
+    // The IK of the robot file (chain, costs, posture) for poses in base_link; base_link's
     // pose in the world comes from /tf_static.
     converter_ = std::make_unique<lfd::CartesianToJoints>(lfd::makeCartesianToJoints(urdf, robot_));
     const geometry_msgs::TransformStamped w =

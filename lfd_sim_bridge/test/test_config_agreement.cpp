@@ -13,7 +13,7 @@
 
 namespace {
 
-const std::string kConfig = std::string(LFD_SIM_MODEL_DIR) + "/../../config/";
+const std::string kConfig = std::string(LFD_CONFIG_DIR) + "/";
 
 // What the recorder records (recorder_node): recorder.yaml's topics and the sensor table's rows
 // at sensor_rate; topic -> rate.
@@ -22,7 +22,7 @@ std::map<std::string, double> recordedTopics() {
   std::map<std::string, double> topics;
   for (const YAML::Node& t : config["topics"])
     topics[t["name"].as<std::string>()] = t["rate"].as<double>();
-  for (const lfd::SensorEntry& row : lfd::loadRobotSetup(kConfig + "robot.yaml").sensors)
+  for (const lfd::SensorEntry& row : lfd::loadRobotSetup(LFD_ROBOT_FILE).sensors)
     topics[row.topic] = config["sensor_rate"].as<double>();
   return topics;
 }
@@ -31,7 +31,7 @@ TEST(ConfigAgreement, SensorRowsAreRecordedOnceAtThePublishRate) {
   const YAML::Node recorder = YAML::LoadFile(kConfig + "recorder.yaml");
   const double publish_rate = YAML::LoadFile(kConfig + "bridge.yaml")["publish_rate"].as<double>();
   EXPECT_EQ(recorder["sensor_rate"].as<double>(), publish_rate);
-  const lfd::RobotSetup robot = lfd::loadRobotSetup(kConfig + "robot.yaml");
+  const lfd::RobotSetup robot = lfd::loadRobotSetup(LFD_ROBOT_FILE);
   ASSERT_FALSE(robot.sensors.empty());
   for (const YAML::Node& t : recorder["topics"])
     for (const lfd::SensorEntry& row : robot.sensors)
@@ -39,7 +39,7 @@ TEST(ConfigAgreement, SensorRowsAreRecordedOnceAtThePublishRate) {
 }
 
 TEST(ConfigAgreement, TheSegmentationReadsRecordedTopicsAndTheRobotsGripper) {
-  const lfd::RobotSetup robot = lfd::loadRobotSetup(kConfig + "robot.yaml");
+  const lfd::RobotSetup robot = lfd::loadRobotSetup(LFD_ROBOT_FILE);
   const std::map<std::string, double> recorded = recordedTopics();
   const YAML::Node topics = YAML::LoadFile(kConfig + "segmentation.yaml")["topics"];
   ASSERT_TRUE(topics && topics.size() > 0);

@@ -30,9 +30,9 @@ namespace {
 
 const std::string kModelDir = LFD_SIM_MODEL_DIR;
 const std::string kUrdfPath = kModelDir + "/jvrc1_like.urdf";
-const std::string kSceneFile = kModelDir + "/../../config/scene.yaml";
+const std::string kSceneFile = std::string(LFD_CONFIG_DIR) + "/scene.yaml";
 const std::string kScenePath = kModelDir + "/workcell.xml";
-const std::string kRobotFile = kModelDir + "/../../config/robot.yaml";
+const std::string kRobotFile = LFD_ROBOT_FILE;
 
 struct MjModelDeleter {
   void operator()(mjModel* m) const { mj_deleteModel(m); }

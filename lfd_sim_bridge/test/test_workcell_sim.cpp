@@ -18,7 +18,7 @@
 namespace {
 
 const std::string kModel = std::string(LFD_SIM_MODEL_DIR) + "/workcell.xml";
-const std::string kRobotFile = std::string(LFD_SIM_MODEL_DIR) + "/../../config/robot.yaml";
+const std::string kRobotFile = LFD_ROBOT_FILE;
 
 // The robot's part as the bridge configures it: from the shipped robot file.
 lfd_sim::WorkcellConfig robotConfig() {

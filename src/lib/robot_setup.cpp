@@ -51,10 +51,16 @@ void readIk(const YAML::Node& ik, const std::string& path, RobotSetup* setup) {
   }
 }
 
+std::string text(const YAML::Node& node, const std::string& path, const std::string& key) {
+  if (!node || !node.IsScalar() || node.as<std::string>().empty())
+    fail(path, key + " must be a non-empty string");
+  return node.as<std::string>();
+}
+
 void readGripper(const YAML::Node& g, const std::string& path, GripperSetup* gripper) {
   if (!g) return;
   if (!g.IsMap()) fail(path, "gripper must be a mapping");
-  if (g["joint"]) gripper->joint = g["joint"].as<std::string>();
+  gripper->joint = text(g["joint"], path, "gripper.joint");  // no default: it names the robot's
   if (g["open_opening"]) gripper->open_opening = g["open_opening"].as<double>();
   if (g["close_opening"]) gripper->close_opening = g["close_opening"].as<double>();
   if (g["close_effort"])
@@ -62,12 +68,6 @@ void readGripper(const YAML::Node& g, const std::string& path, GripperSetup* gri
   if (!std::isfinite(gripper->open_opening) || !std::isfinite(gripper->close_opening) ||
       gripper->open_opening < gripper->close_opening)
     fail(path, "gripper.open_opening must be finite and >= close_opening");
-}
-
-std::string text(const YAML::Node& node, const std::string& path, const std::string& key) {
-  if (!node || !node.IsScalar() || node.as<std::string>().empty())
-    fail(path, key + " must be a non-empty string");
-  return node.as<std::string>();
 }
 
 // A field's device sensors: one name, or a list of names (e.g. the touch pads).

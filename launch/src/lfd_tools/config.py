@@ -21,8 +21,10 @@ def config_path(name):
 
 
 def robot_file():
-    """The robot file (lfd::loadRobotSetup's; its sensor table names the topics it publishes)."""
-    return config_path("robot.yaml")
+    """The robot file (lfd::loadRobotSetup's; its sensor table names the topics it publishes): the
+    robot description package's config/robot.yaml."""
+    import rospkg
+    return os.path.join(rospkg.RosPack().get_path("jvrc1_description"), "config", "robot.yaml")
 
 
 @functools.lru_cache(maxsize=None)

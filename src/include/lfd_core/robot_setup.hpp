@@ -1,8 +1,8 @@
-// The robot as the learn-and-reproduce half needs it, read from one file (config/robot.yaml) by
-// the demonstrator, the executor and the bridge alike: the IK chain (base and tip links of the
-// URDF), its motion costs, null-space posture and accepted residual, the gripper's joint and
-// commands, and the sensor table. Nothing here knows a simulator or ROS: a real robot is described
-// by its own robot.yaml, and its driver publishes what the table says.
+// The robot as the learn-and-reproduce half needs it, read from one file (the robot description
+// package's config/robot.yaml) by the demonstrator, the executor and the bridge alike: the IK chain
+// (base and tip links of the URDF), its motion costs, null-space posture and accepted residual, the
+// gripper's joint and commands, and the sensor table. Nothing here knows a simulator or ROS: a real
+// robot is described by its own robot.yaml, and its driver publishes what the table says.
 #pragma once
 
 #include <map>
@@ -15,10 +15,10 @@
 namespace lfd {
 
 struct GripperSetup {
-  std::string joint = "R_GRIPPER";  // joint whose position the gripper state reports
-  double open_opening = 0.08;       // m between the pads when opened
-  double close_opening = 0.0;       // m commanded to close (the effort limit stops it on an object)
-  double close_effort = 20.0;       // N
+  std::string joint;           // joint whose position the gripper state reports (required)
+  double open_opening = 0.08;  // m between the pads when opened
+  double close_opening = 0.0;  // m commanded to close (the effort limit stops it on an object)
+  double close_effort = 20.0;  // N
 };
 
 // One row of the sensor table, the way ros_control's hardware interfaces describe a sensor: which
