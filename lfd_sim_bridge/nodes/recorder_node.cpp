@@ -123,12 +123,13 @@ class Recorder {
     // Services run on their own thread so /recorder/stop can wait for in-flight messages while the
     // main thread keeps writing them.
     service_nh_.setCallbackQueue(&service_queue_);
-    start_srv_ = service_nh_.advertiseService("/recorder/start", &Recorder::onStart, this);
+    start_srv_ = service_nh_.advertiseService("recorder/start", &Recorder::onStart, this);
     // The newest sim time, read on the service thread: ros::Time::now() is updated on the main
     // queue, behind any backlog of messages, and would stop a bag too early.
+    // Relative service names (remappable); /clock is the master-wide sim time.
     clock_sub_ = service_nh_.subscribe("/clock", 10, &Recorder::onClock, this,
                                        ros::TransportHints().tcpNoDelay());
-    stop_srv_ = service_nh_.advertiseService("/recorder/stop", &Recorder::onStop, this);
+    stop_srv_ = service_nh_.advertiseService("recorder/stop", &Recorder::onStop, this);
     service_spinner_ = std::make_unique<ros::AsyncSpinner>(1, &service_queue_);
     service_spinner_->start();
     ROS_INFO("recorder: %zu topics, queue %d, services /recorder/start and /recorder/stop",
