@@ -11,7 +11,7 @@
 
 namespace {
 
-const std::string kUrdf = std::string(LFD_REPO_DIR) + "/lfd_sim_bridge/models/jvrc1_like.urdf";
+const std::string kUrdf = std::string(LFD_ROBOT_DIR) + "/models/jvrc1_like.urdf";
 
 lfd::KinematicChain armChain(const char* base) {
   return lfd::KinematicChain::fromUrdfFile(kUrdf, base, "r_gripper_tcp");

@@ -4,8 +4,9 @@
 //             feed-forward, divergence checks
 //   +sensors  workcell plus readState() at the bridge's publish rate (every 5 steps = 200 Hz)
 //   +traj     as +sensors while a trajectory sweeps the right arm (contacts-free motion)
-// Usage: bench_realtime_factor [sim_seconds=10] [repeats=3] [model=LFD_SIM_MODEL_DIR/workcell.xml]
-// Prints the best of `repeats` runs per variant (least disturbed by other processes).
+// Usage: bench_realtime_factor [sim_seconds=10] [repeats=3] [model=LFD_SIM_MODEL_DIR/workcell.xml,
+// jvrc1_description] Prints the best of `repeats` runs per variant (least disturbed by other
+// processes).
 #include <mujoco/mujoco.h>
 
 #include <chrono>

@@ -111,20 +111,21 @@ class Executor {
  public:
   Executor(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh), tf_listener_(tf_buffer_) {
     loadParameters(pnh);
-    trajectory_pub_ = nh.advertise<trajectory_msgs::JointTrajectory>("/joint_trajectory", 10);
-    gripper_pub_ = nh.advertise<lfd_msgs::GripperCommand>("/gripper/command", 10);
-    planned_pub_ = nh.advertise<nav_msgs::Path>("/executor/planned_path", 1, true);
-    executed_pub_ = nh.advertise<nav_msgs::Path>("/executor/executed_path", 1, true);
+    trajectory_pub_ = nh.advertise<trajectory_msgs::JointTrajectory>("joint_trajectory", 10);
+    gripper_pub_ = nh.advertise<lfd_msgs::GripperCommand>("gripper/command", 10);
+    planned_pub_ = nh.advertise<nav_msgs::Path>("executor/planned_path", 1, true);
+    executed_pub_ = nh.advertise<nav_msgs::Path>("executor/executed_path", 1, true);
     marker_pub_ =
-        nh.advertise<visualization_msgs::MarkerArray>("/executor/segment_markers", 1, true);
+        nh.advertise<visualization_msgs::MarkerArray>("executor/segment_markers", 1, true);
     const auto hints = ros::TransportHints().tcpNoDelay();
-    joint_sub_ = nh.subscribe("/joint_states", 5, &Executor::onJoints, this, hints);
-    gripper_sub_ = nh.subscribe("/gripper/state", 5, &Executor::onGripper, this, hints);
+    joint_sub_ = nh.subscribe("joint_states", 5, &Executor::onJoints, this, hints);
+    gripper_sub_ = nh.subscribe("gripper/state", 5, &Executor::onGripper, this, hints);
     pnh_ = pnh;
     startServer();
     // A simulator restart takes sim time back to 0: the action server would drop every goal
     // stamped before its last one (RECALLED, no error text) until sim time caught up.
     if (ros::Time::isSimTime())
+      // Relative names elsewhere (remappable); /clock is the master-wide sim time.
       clock_sub_ = nh.subscribe("/clock", 10, &Executor::onClock, this, hints);
     ROS_INFO("executor: ready (action %s/execute, dt %.4f s)", pnh.getNamespace().c_str(),
              options_.dt);

@@ -279,7 +279,7 @@ int main(int argc, char** argv) {
   ros::NodeHandle pnh("~");
   const lfd_ros::MasterWatch master_watch;  // a restarted master: the node ends, to be respawned
   Learner learner(pnh);
-  ros::ServiceServer srv = nh.advertiseService("/learner/learn", &Learner::learn, &learner);
+  ros::ServiceServer srv = nh.advertiseService("learner/learn", &Learner::learn, &learner);
   ROS_INFO("learner: ready on /learner/learn");
   ros::spin();  // tf arrives on the listener's own thread while a request waits for it
   return master_watch.exitCode();

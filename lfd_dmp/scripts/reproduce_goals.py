@@ -57,8 +57,9 @@ class BagRecording(object):
 
     def __init__(self, path, objects):
         self.path = path
-        topics = ["/joint_states", "/objects/joint_states", "/ee_pose", "/gripper/state", "/touch",
-                  "/executor/planned_path", "/executor/executed_path", "/executor/segment_markers"]
+        topics = ["/joint_states", "/objects/joint_states", "/ee_pose", "/gripper/state",
+                  bags.touch_topic(), "/executor/planned_path", "/executor/executed_path",
+                  "/executor/segment_markers"]
         topics += ["/objects/%s/pose" % o for o in objects]
         self.proc = subprocess.Popen(["rosbag", "record", "-q", "-O", path] + topics,
                                      stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,

@@ -14,13 +14,13 @@
 namespace {
 
 // From CMake, not __FILE__: ccache (CCACHE_BASEDIR) makes __FILE__ relative to the build tree.
-const std::string kUrdf = std::string(LFD_REPO_DIR) + "/lfd_sim_bridge/models/jvrc1_like.urdf";
+const std::string kUrdf = std::string(LFD_ROBOT_DIR) + "/models/jvrc1_like.urdf";
 
 lfd::KinematicChain chain() {
   return lfd::KinematicChain::fromUrdfFile(kUrdf, "base_link", "r_gripper_tcp");
 }
 
-// config/robot.yaml preferred posture (TCP fingers-down above the workspace centre).
+// robot.yaml (jvrc1_description) preferred posture (TCP fingers-down above the workspace centre).
 Eigen::VectorXd homePosture(const lfd::KinematicChain& c) {
   const std::map<std::string, double> p = {
       {"WAIST_Y", 0.08},       {"WAIST_P", 0.24},       {"R_SHOULDER_P", -0.72},

@@ -64,9 +64,31 @@ bool allFinite(const mjtNum* v, int n) {
   return true;
 }
 
-int sensorAddress(const mjModel* m, const char* name) {
-  const int id = mj_name2id(m, mjOBJ_SENSOR, name);
-  return id < 0 ? -1 : m->sensor_adr[id];
+// The readings noise of a sensor's kind; nullptr = read exactly (a frame orientation, ...).
+const double SensorNoise::*noiseOfKind(int type) {
+  switch (type) {
+    case mjSENS_FORCE:
+      return &SensorNoise::force;
+    case mjSENS_TORQUE:
+      return &SensorNoise::torque;
+    case mjSENS_TOUCH:
+      return &SensorNoise::touch;
+    case mjSENS_GYRO:
+      return &SensorNoise::gyro;
+    case mjSENS_ACCELEROMETER:
+      return &SensorNoise::accel;
+    default:
+      return nullptr;
+  }
+}
+
+std::string sensorNames(const mjModel* m) {
+  std::string names;
+  for (int i = 0; i < m->nsensor; ++i) {
+    const char* name = mj_id2name(m, mjOBJ_SENSOR, i);
+    names += (names.empty() ? "" : ", ") + std::string(name ? name : "(unnamed)");
+  }
+  return names.empty() ? "none" : names;
 }
 
 std::string jointName(const mjModel* m, int joint) {
@@ -116,7 +138,8 @@ WorkcellSim::WorkcellSim(const std::string& mjcf_path, const WorkcellConfig& con
   }
   configureActuators();
 
-  base_body_ = mj_name2id(m_, mjOBJ_BODY, config_.base_body.c_str());
+  base_body_ =
+      config_.base_body.empty() ? -1 : mj_name2id(m_, mjOBJ_BODY, config_.base_body.c_str());
   if (base_body_ < 0) {
     // Fall back to the robot's root: the first child of the world that is not a free object.
     for (int b = 1; b < m_->nbody && base_body_ < 0; ++b) {
@@ -126,37 +149,27 @@ WorkcellSim::WorkcellSim(const std::string& mjcf_path, const WorkcellConfig& con
       }
     }
     if (base_body_ < 0) base_body_ = 0;
-    this->log(LogLevel::kWarn, "no body '" + config_.base_body + "'; using body '" +
-                                   mj_id2name(m_, mjOBJ_BODY, base_body_) + "' as base_link");
+    if (!config_.base_body.empty())
+      this->log(LogLevel::kWarn, "no body '" + config_.base_body + "'; using body '" +
+                                     mj_id2name(m_, mjOBJ_BODY, base_body_) + "' as the base");
   }
   // A joint belongs to the robot when its body hangs from the same world child as base_link;
   // any other (the drawer's slide) is a scene object's.
   for (int j : joint_ids_)
     object_joint_.push_back(m_->body_rootid[m_->jnt_bodyid[j]] != m_->body_rootid[base_body_]);
   ee_site_ = mj_name2id(m_, mjOBJ_SITE, config_.ee_site.c_str());
-  if (ee_site_ < 0) this->log(LogLevel::kWarn, "no site '" + config_.ee_site + "' in the model");
+  if (ee_site_ < 0 && !config_.ee_site.empty())
+    this->log(LogLevel::kWarn, "no site '" + config_.ee_site + "' in the model");
   gripper_ = actuatedIndex(config_.gripper_joint);
-  if (gripper_ < 0) {
+  if (gripper_ < 0 && !config_.gripper_joint.empty())
     this->log(LogLevel::kWarn, "no actuated gripper joint '" + config_.gripper_joint + "'");
-  }
 
-  force_adr_ = sensorAddress(m_, "r_wrist_force");
-  torque_adr_ = sensorAddress(m_, "r_wrist_torque");
-  gyro_adr_ = sensorAddress(m_, "imu_gyro");
-  accel_adr_ = sensorAddress(m_, "imu_accel");
-  quat_adr_ = sensorAddress(m_, "imu_quat");
-  for (const char* name : {"r_touch_left", "r_touch_right"}) {
-    const int adr = sensorAddress(m_, name);
-    if (adr >= 0) touch_adr_.emplace_back(name, adr);
-  }
-  touch_filtered_.assign(touch_adr_.size(), 0.0);
-  const std::pair<const char*, int> expected[] = {{"r_wrist_force", force_adr_},
-                                                  {"r_wrist_torque", torque_adr_},
-                                                  {"imu_gyro", gyro_adr_},
-                                                  {"imu_accel", accel_adr_},
-                                                  {"imu_quat", quat_adr_}};
-  for (const auto& [name, adr] : expected) {
-    if (adr < 0) this->log(LogLevel::kWarn, std::string("no sensor '") + name + "'; reads zero");
+  try {
+    configureSensors();
+  } catch (...) {  // the destructor does not run for a constructor that throws
+    mj_deleteData(d_);
+    mj_deleteModel(m_);
+    throw;
   }
 
   for (const std::string& name : config_.objects) {
@@ -462,11 +475,78 @@ void WorkcellSim::step(int n) {
   }
 }
 
+WorkcellSim::SensorSlot WorkcellSim::sensorSlot(const std::string& group,
+                                                const std::string& sensor) {
+  const int id = mj_name2id(m_, mjOBJ_SENSOR, sensor.c_str());
+  if (id < 0)
+    throw std::invalid_argument(
+        "sensor table row " + group + " names sensor '" + sensor +
+        "', which the model does not have (its sensors: " + sensorNames(m_) + ")");
+  SensorSlot slot;
+  slot.adr = m_->sensor_adr[id];
+  slot.dim = m_->sensor_dim[id];
+  slot.noise = noiseOfKind(m_->sensor_type[id]);
+  if (m_->sensor_type[id] == mjSENS_TOUCH) {
+    slot.touch_slot = static_cast<int>(touch_adr_.size());
+    touch_adr_.push_back(slot.adr);
+  }
+  return slot;
+}
+
+// Every sensor the groups name, looked up once: a missing one is an error naming it.
+void WorkcellSim::configureSensors() {
+  for (const SensorGroup& group : config_.sensors) {
+    std::vector<SensorSlot> slots;
+    for (const std::string& sensor : group.sensors) slots.push_back(sensorSlot(group.name, sensor));
+    sensor_slots_.push_back(std::move(slots));
+  }
+  touch_filtered_.assign(touch_adr_.size(), 0.0);
+}
+
+int WorkcellSim::sensorDimension(const std::string& sensor) const {
+  const int id = mj_name2id(m_, mjOBJ_SENSOR, sensor.c_str());
+  if (id < 0)
+    throw std::invalid_argument("the model has no sensor '" + sensor +
+                                "' (its sensors: " + sensorNames(m_) + ")");
+  return m_->sensor_dim[id];
+}
+
 void WorkcellSim::updateTouch() {
   const double tau = config_.touch_time_constant;
   const double alpha = tau > 0.0 ? 1.0 - std::exp(-m_->opt.timestep / tau) : 1.0;
   for (size_t i = 0; i < touch_adr_.size(); ++i)
-    touch_filtered_[i] += alpha * (d_->sensordata[touch_adr_[i].second] - touch_filtered_[i]);
+    touch_filtered_[i] += alpha * (d_->sensordata[touch_adr_[i]] - touch_filtered_[i]);
+}
+
+// Group by group, sensor by sensor: the order the noise is drawn in. A touch sensor reports its
+// filtered normal force, which noise must not make negative.
+void WorkcellSim::readSensors(WorkcellState* s) {
+  s->sensors.resize(config_.sensors.size());
+  for (size_t g = 0; g < config_.sensors.size(); ++g) {
+    SensorReading& r = s->sensors[g];
+    r.name = config_.sensors[g].name;
+    r.sensors = config_.sensors[g].sensors;
+    r.values.resize(sensor_slots_[g].size());
+    for (size_t k = 0; k < sensor_slots_[g].size(); ++k) {
+      const SensorSlot& slot = sensor_slots_[g][k];
+      const double std = slot.noise ? config_.noise.*slot.noise : 0.0;
+      std::vector<double>& v = r.values[k];
+      v.resize(slot.dim);
+      for (int i = 0; i < slot.dim; ++i) {
+        if (slot.touch_slot >= 0) {
+          v[i] = std::max(0.0, touch_filtered_[slot.touch_slot] + noise(std));
+        } else {
+          v[i] = d_->sensordata[slot.adr + i] + (noisy_ ? noise(std) : 0.0);
+        }
+      }
+    }
+  }
+}
+
+const SensorReading* WorkcellState::sensor(const std::string& group) const {
+  for (const SensorReading& r : sensors)
+    if (r.name == group) return &r;
+  return nullptr;
 }
 
 std::array<int, 4> WorkcellSim::badNumberWarnings() const {
@@ -715,26 +795,7 @@ void WorkcellSim::readState(WorkcellState* s) {
       s->joint_efforts[k] += noise(n.joint_effort);
     }
   }
-  auto read3 = [&](int adr, double std, std::array<double, 3>* out) {
-    for (int i = 0; i < 3; ++i) {
-      (*out)[i] = adr < 0 ? 0.0 : d_->sensordata[adr + i];
-      if (noisy_) (*out)[i] += noise(std);
-    }
-  };
-  read3(force_adr_, n.force, &s->wrist_force);
-  read3(torque_adr_, n.torque, &s->wrist_torque);
-  read3(gyro_adr_, n.gyro, &s->imu_gyro);
-  read3(accel_adr_, n.accel, &s->imu_accel);
-  if (quat_adr_ >= 0) {
-    for (int i = 0; i < 4; ++i) s->imu_orientation[i] = d_->sensordata[quat_adr_ + i];
-  }
-  s->touch_names.resize(touch_adr_.size());
-  s->touch_values.resize(touch_adr_.size());
-  for (size_t i = 0; i < touch_adr_.size(); ++i) {
-    s->touch_names[i] = touch_adr_[i].first;
-    // Touch is a non-negative normal force; noise must not make it negative.
-    s->touch_values[i] = std::max(0.0, touch_filtered_[i] + noise(n.touch));
-  }
+  readSensors(s);
   if (gripper_ >= 0) {
     const Actuated& g = actuated_[gripper_];
     s->gripper_opening = config_.gripper_opening_scale * d_->qpos[g.qpos_adr] + noise(n.gripper);
@@ -742,8 +803,8 @@ void WorkcellSim::readState(WorkcellState* s) {
     s->gripper_effort = d_->actuator_force[g.actuator];
   }
 
-  // End effector in base_link: p = R_b^T (p_s - p_b), R = R_b^T R_s; base_link is fixed in the
-  // world, so the world-frame site velocity rotated into base_link is its velocity there.
+  // End effector in the base body: p = R_b^T (p_s - p_b), R = R_b^T R_s; the base is fixed in the
+  // world, so the world-frame site velocity rotated into the base is its velocity there.
   if (ee_site_ >= 0) {
     const mjtNum* Rb = d_->xmat + 9 * base_body_;
     const mjtNum* pb = d_->xpos + 3 * base_body_;

@@ -7,6 +7,10 @@
 //
 // Private parameters (config/bridge.yaml):
 //   model_path            MJCF scene (required; sim.launch passes models/workcell.xml)
+//   robot_file            the robot file (required; lfd::loadRobotSetup): the gripper joint, the
+//                         end-effector site (ik tip_link) and its frame (the Cartesian frame), and
+//                         the sensor table, one topic per row (sensor_publishers.hpp)
+//   world_frame           the fixed frame of the object poses and of the base's static transform
 //   real_time_factor      <= 0: as fast as possible; else sim seconds per wall second
 //   publish_rate          Hz (sim time) of joint states, sensors, ee pose/twist, objects, tf
 //   clock_rate            Hz (sim time) of /clock; also how often commands are polled
@@ -20,16 +24,13 @@
 #include <geometry_msgs/PoseStamped.h>
 #include <geometry_msgs/TransformStamped.h>
 #include <geometry_msgs/TwistStamped.h>
-#include <geometry_msgs/WrenchStamped.h>
 #include <lfd_msgs/GripperCommand.h>
 #include <lfd_msgs/ResetSim.h>
 #include <lfd_msgs/SetScene.h>
 #include <lfd_msgs/StepSim.h>
-#include <lfd_msgs/Touch.h>
 #include <ros/callback_queue.h>
 #include <ros/ros.h>
 #include <rosgraph_msgs/Clock.h>
-#include <sensor_msgs/Imu.h>
 #include <sensor_msgs/JointState.h>
 #include <std_srvs/SetBool.h>
 #include <tf2_msgs/TFMessage.h>
@@ -45,8 +46,11 @@
 #include <utility>
 #include <vector>
 
-#include "lfd_ros/master_watch.hpp"
+#include "lfd_core/robot_setup.hpp"
 #include "lfd_core/ros_request_strings.hpp"
+#include "lfd_ros/master_watch.hpp"
+#include "lfd_sim_bridge/sensor_publishers.hpp"
+#include "lfd_sim_bridge/sensor_table.hpp"
 #include "lfd_sim_bridge/workcell_sim.hpp"
 
 namespace {
@@ -121,8 +125,14 @@ std::map<std::string, NoiseProfile> loadNoiseProfiles(ros::NodeHandle& pnh) {
   return profiles;
 }
 
-lfd_sim::WorkcellConfig loadConfig(ros::NodeHandle& pnh) {
+// The robot's part of the workcell comes from its robot file, the rest from ~ parameters.
+lfd_sim::WorkcellConfig loadConfig(ros::NodeHandle& pnh, const lfd::RobotSetup& robot,
+                                   const std::vector<lfd_sim::SensorBinding>& sensors) {
   lfd_sim::WorkcellConfig c;
+  c.gripper_joint = robot.gripper.joint;
+  c.base_body = robot.cartesian_frame.empty() ? robot.base_link : robot.cartesian_frame;
+  c.ee_site = robot.tip_link;
+  c.sensors = lfd_sim::sensorGroups(sensors);
   c.initial_posture = mapParam(pnh, "initial_posture");
   c.kp = mapParam(pnh, "kp");
   c.kd = mapParam(pnh, "kd");
@@ -133,10 +143,7 @@ lfd_sim::WorkcellConfig loadConfig(ros::NodeHandle& pnh) {
   c.default_velocity_limit = param(pnh, "default_velocity_limit", c.default_velocity_limit);
   c.default_effort_limit = param(pnh, "default_effort_limit", c.default_effort_limit);
   c.gravity_compensation = param(pnh, "gravity_compensation", c.gravity_compensation);
-  c.gripper_joint = param(pnh, "gripper_joint", c.gripper_joint);
   c.gripper_opening_scale = param(pnh, "gripper_opening_scale", c.gripper_opening_scale);
-  c.base_body = param(pnh, "base_body", c.base_body);
-  c.ee_site = param(pnh, "ee_site", c.ee_site);
   c.objects = param(pnh, "objects", c.objects);
   c.max_abs_velocity = param(pnh, "max_abs_velocity", c.max_abs_velocity);
   c.touch_time_constant = param(pnh, "touch_time_constant", c.touch_time_constant);
@@ -218,11 +225,19 @@ class BridgeNode {
     const std::string model_path = param<std::string>(pnh, "model_path", "");
     if (model_path.empty()) throw std::runtime_error("~model_path is not set");
     noise_profiles_ = loadNoiseProfiles(pnh);
-    lfd_sim::WorkcellConfig config = loadConfig(pnh);
+    const lfd::RobotSetup robot = lfd::loadRobotSetup(param<std::string>(pnh, "robot_file", ""));
+    const std::vector<lfd_sim::SensorBinding> sensors = lfd_sim::bindSensorTable(robot.sensors);
+    lfd_sim::WorkcellConfig config = loadConfig(pnh, robot, sensors);
+    gripper_joint_ = config.gripper_joint;
+    base_frame_ = config.base_body;
+    world_frame_ = param<std::string>(pnh, "world_frame", "");
+    if (world_frame_.empty()) throw std::runtime_error("~world_frame is not set");
     const NoiseProfile& start = noiseProfile(param<std::string>(pnh, "noise_profile", ""));
     config.noise = start.noise;
     config.noise_seed = start.seed;
     sim_ = std::make_unique<lfd_sim::WorkcellSim>(model_path, config, rosLogSink);
+    lfd_sim::checkSensorDimensions(
+        sensors, [this](const std::string& name) { return sim_->sensorDimension(name); });
     if (param(pnh, "use_urdf_limits", true)) {
       std::string urdf;
       if (nh.getParam("robot_description", urdf)) {
@@ -252,34 +267,33 @@ class BridgeNode {
           "(robot, tf and object poses are all published)");
     }
 
+    // Names are relative (the node's namespace, remappable), except the master-wide /clock, which
+    // every sim-time node reads by that name, and the tf tree /tf.
     clock_pub_ = nh.advertise<rosgraph_msgs::Clock>("/clock", 10);
-    joint_state_pub_ = nh.advertise<sensor_msgs::JointState>("/joint_states", kSensorQueue);
-    object_joint_pub_ =
-        nh.advertise<sensor_msgs::JointState>("/objects/joint_states", kSensorQueue);
-    gripper_state_pub_ = nh.advertise<sensor_msgs::JointState>("/gripper/state", kSensorQueue);
-    wrench_pub_ = nh.advertise<geometry_msgs::WrenchStamped>("/wrist_ft", kSensorQueue);
-    touch_pub_ = nh.advertise<lfd_msgs::Touch>("/touch", kSensorQueue);
-    imu_pub_ = nh.advertise<sensor_msgs::Imu>("/imu", kSensorQueue);
-    ee_pose_pub_ = nh.advertise<geometry_msgs::PoseStamped>("/ee_pose", kSensorQueue);
-    ee_twist_pub_ = nh.advertise<geometry_msgs::TwistStamped>("/ee_twist", kSensorQueue);
+    joint_state_pub_ = nh.advertise<sensor_msgs::JointState>("joint_states", kSensorQueue);
+    object_joint_pub_ = nh.advertise<sensor_msgs::JointState>("objects/joint_states", kSensorQueue);
+    gripper_state_pub_ = nh.advertise<sensor_msgs::JointState>("gripper/state", kSensorQueue);
+    sensor_pubs_ = lfd_sim_bridge::makeSensorPublishers(nh, sensors, kSensorQueue);
+    ee_pose_pub_ = nh.advertise<geometry_msgs::PoseStamped>("ee_pose", kSensorQueue);
+    ee_twist_pub_ = nh.advertise<geometry_msgs::TwistStamped>("ee_twist", kSensorQueue);
     tf_pub_ = nh.advertise<tf2_msgs::TFMessage>("/tf", 100);
     sim_->readState(&state_);
     for (const std::string& name : state_.object_names) {
       object_pubs_.push_back(
-          nh.advertise<geometry_msgs::PoseStamped>("/objects/" + name + "/pose", kSensorQueue));
+          nh.advertise<geometry_msgs::PoseStamped>("objects/" + name + "/pose", kSensorQueue));
     }
     static_tf_.sendTransform(
-        toTransform(sim_->basePoseInWorld(), ros::Time(0), "world", "base_link"));
+        toTransform(sim_->basePoseInWorld(), ros::Time(0), world_frame_, base_frame_));
 
     ros::TransportHints hints = ros::TransportHints().tcpNoDelay();
     joint_command_sub_ =
-        nh.subscribe("/joint_command", 10, &BridgeNode::onJointCommand, this, hints);
-    trajectory_sub_ = nh.subscribe("/joint_trajectory", 10, &BridgeNode::onTrajectory, this, hints);
-    gripper_sub_ = nh.subscribe("/gripper/command", 10, &BridgeNode::onGripper, this, hints);
-    reset_srv_ = nh.advertiseService("/bridge/reset", &BridgeNode::onReset, this);
-    scene_srv_ = nh.advertiseService("/bridge/set_scene", &BridgeNode::onSetScene, this);
-    pause_srv_ = nh.advertiseService("/bridge/pause", &BridgeNode::onPause, this);
-    step_srv_ = nh.advertiseService("/bridge/step", &BridgeNode::onStep, this);
+        nh.subscribe("joint_command", 10, &BridgeNode::onJointCommand, this, hints);
+    trajectory_sub_ = nh.subscribe("joint_trajectory", 10, &BridgeNode::onTrajectory, this, hints);
+    gripper_sub_ = nh.subscribe("gripper/command", 10, &BridgeNode::onGripper, this, hints);
+    reset_srv_ = nh.advertiseService("bridge/reset", &BridgeNode::onReset, this);
+    scene_srv_ = nh.advertiseService("bridge/set_scene", &BridgeNode::onSetScene, this);
+    pause_srv_ = nh.advertiseService("bridge/pause", &BridgeNode::onPause, this);
+    step_srv_ = nh.advertiseService("bridge/step", &BridgeNode::onStep, this);
 
     ROS_INFO(
         "bridge: %zu actuated joints, dt %.4f s, /clock every %ld steps, sensors every %ld "
@@ -399,51 +413,25 @@ class BridgeNode {
     if (gripper_state_pub_.getNumSubscribers() > 0) {
       sensor_msgs::JointState gs;
       gs.header.stamp = stamp;
-      gs.name = {"R_GRIPPER"};
+      gs.name = {gripper_joint_};
       gs.position = {state_.gripper_opening};
       gs.velocity = {state_.gripper_velocity};
       gs.effort = {state_.gripper_effort};
       gripper_state_pub_.publish(gs);
     }
-    if (wrench_pub_.getNumSubscribers() > 0) {
-      geometry_msgs::WrenchStamped w;
-      w.header.stamp = stamp;
-      w.header.frame_id = "r_wrist_ft";
-      toMsg(state_.wrist_force, &w.wrench.force);
-      toMsg(state_.wrist_torque, &w.wrench.torque);
-      wrench_pub_.publish(w);
-    }
-    if (touch_pub_.getNumSubscribers() > 0) {
-      lfd_msgs::Touch t;
-      t.header.stamp = stamp;
-      t.header.frame_id = "r_gripper_palm";
-      t.names = state_.touch_names;
-      t.values = state_.touch_values;
-      touch_pub_.publish(t);
-    }
-    if (imu_pub_.getNumSubscribers() > 0) {
-      sensor_msgs::Imu imu;
-      imu.header.stamp = stamp;
-      imu.header.frame_id = "imu";
-      imu.orientation.w = state_.imu_orientation[0];
-      imu.orientation.x = state_.imu_orientation[1];
-      imu.orientation.y = state_.imu_orientation[2];
-      imu.orientation.z = state_.imu_orientation[3];
-      toMsg(state_.imu_gyro, &imu.angular_velocity);
-      toMsg(state_.imu_accel, &imu.linear_acceleration);
-      imu_pub_.publish(imu);
-    }
+    for (size_t i = 0; i < sensor_pubs_.size(); ++i)
+      sensor_pubs_[i]->publish(state_.sensors[i], stamp);
     if (ee_pose_pub_.getNumSubscribers() > 0) {
       geometry_msgs::PoseStamped p;
       p.header.stamp = stamp;
-      p.header.frame_id = "base_link";
+      p.header.frame_id = base_frame_;
       toMsg(state_.ee_pose, &p.pose);
       ee_pose_pub_.publish(p);
     }
     if (ee_twist_pub_.getNumSubscribers() > 0) {
       geometry_msgs::TwistStamped tw;
       tw.header.stamp = stamp;
-      tw.header.frame_id = "base_link";
+      tw.header.frame_id = base_frame_;
       toMsg(state_.ee_linear_velocity, &tw.twist.linear);
       toMsg(state_.ee_angular_velocity, &tw.twist.angular);
       ee_twist_pub_.publish(tw);
@@ -453,12 +441,12 @@ class BridgeNode {
       if (object_pubs_[i].getNumSubscribers() > 0) {
         geometry_msgs::PoseStamped p;
         p.header.stamp = stamp;
-        p.header.frame_id = "world";
+        p.header.frame_id = world_frame_;
         toMsg(state_.object_poses[i], &p.pose);
         object_pubs_[i].publish(p);
       }
       tf.transforms.push_back(
-          toTransform(state_.object_poses[i], stamp, "world", state_.object_names[i]));
+          toTransform(state_.object_poses[i], stamp, world_frame_, state_.object_names[i]));
     }
     if (tf_pub_.getNumSubscribers() > 0 && stamp > last_tf_) {
       tf_pub_.publish(tf);
@@ -655,8 +643,10 @@ class BridgeNode {
   ThrottledErrors errors_;
   static constexpr size_t kMaxPendingGripper = 1000;
   std::deque<lfd_msgs::GripperCommand> pending_gripper_;  // stamped ahead, by stamp
-  ros::Publisher clock_pub_, joint_state_pub_, object_joint_pub_, gripper_state_pub_, wrench_pub_,
-      touch_pub_, imu_pub_, ee_pose_pub_, ee_twist_pub_, tf_pub_;
+  ros::Publisher clock_pub_, joint_state_pub_, object_joint_pub_, gripper_state_pub_, ee_pose_pub_,
+      ee_twist_pub_, tf_pub_;
+  std::vector<std::unique_ptr<lfd_sim_bridge::SensorPublisher>> sensor_pubs_;  // per table row
+  std::string gripper_joint_, base_frame_, world_frame_;  // robot file, ~world_frame
   std::vector<ros::Publisher> object_pubs_;
   tf2_ros::StaticTransformBroadcaster static_tf_;
   ros::Subscriber joint_command_sub_, trajectory_sub_, gripper_sub_;

@@ -178,26 +178,32 @@ class Demonstrator {
     publish_period_ = 1.0 / nh.param("/bridge/publish_rate", 200.0);
     opening_scale_ = nh.param("/bridge/gripper_opening_scale", 2.0);
 
-    trajectory_pub_ = nh.advertise<trajectory_msgs::JointTrajectory>("/joint_trajectory", 10);
-    gripper_pub_ = nh.advertise<lfd_msgs::GripperCommand>("/gripper/command", 10);
-    phase_pub_ = nh.advertise<lfd_msgs::Phase>("/lfd/phase", 100);
+    trajectory_pub_ = nh.advertise<trajectory_msgs::JointTrajectory>("joint_trajectory", 10);
+    gripper_pub_ = nh.advertise<lfd_msgs::GripperCommand>("gripper/command", 10);
+    phase_pub_ = nh.advertise<lfd_msgs::Phase>("lfd/phase", 100);
     const auto hints = ros::TransportHints().tcpNoDelay();
-    joint_sub_ = nh.subscribe("/joint_states", 5, &Demonstrator::onJoints, this, hints);
-    touch_sub_ = nh.subscribe("/touch", 5, &Demonstrator::onTouch, this, hints);
+    joint_sub_ = nh.subscribe("joint_states", 5, &Demonstrator::onJoints, this, hints);
+    // The pads the grasps and guarded moves feel: the robot file's touch row.
+    const lfd::SensorEntry* touch = lfd::findSensorOfType(robot_, "lfd_msgs/Touch");
+    if (!touch)
+      throw std::runtime_error(
+          "the robot file has no lfd_msgs/Touch row in its sensor table; "
+          "grasps and guarded moves need one");
+    touch_sub_ = nh.subscribe(touch->topic, 5, &Demonstrator::onTouch, this, hints);
     for (const std::string& object : objects)
       object_subs_.push_back(nh.subscribe<geometry_msgs::PoseStamped>(
-          "/objects/" + object + "/pose", 5,
+          "objects/" + object + "/pose", 5,
           [this, object](const geometry_msgs::PoseStamped::ConstPtr& m) {
             std::lock_guard<std::mutex> lock(mutex_);
             object_poses_[object] = fromMsg(m->pose);
           },
           ros::VoidConstPtr(), hints));
-    reset_client_ = nh.serviceClient<lfd_msgs::ResetSim>("/bridge/reset");
-    scene_client_ = nh.serviceClient<lfd_msgs::SetScene>("/bridge/set_scene");
-    start_client_ = nh.serviceClient<lfd_msgs::StartRecording>("/recorder/start");
-    stop_client_ = nh.serviceClient<lfd_msgs::StopRecording>("/recorder/stop");
-    pause_client_ = nh.serviceClient<std_srvs::SetBool>("/bridge/pause");
-    step_client_ = nh.serviceClient<lfd_msgs::StepSim>("/bridge/step", true);
+    reset_client_ = nh.serviceClient<lfd_msgs::ResetSim>("bridge/reset");
+    scene_client_ = nh.serviceClient<lfd_msgs::SetScene>("bridge/set_scene");
+    start_client_ = nh.serviceClient<lfd_msgs::StartRecording>("recorder/start");
+    stop_client_ = nh.serviceClient<lfd_msgs::StopRecording>("recorder/stop");
+    pause_client_ = nh.serviceClient<std_srvs::SetBool>("bridge/pause");
+    step_client_ = nh.serviceClient<lfd_msgs::StepSim>("bridge/step", true);
   }
 
   // Runs every selected demonstration of every dataset; returns how many were recorded.
@@ -250,7 +256,7 @@ class Demonstrator {
     std::string urdf;
     if (!nh_.getParam("/robot_description", urdf))
       throw std::runtime_error("/robot_description is not set (launch sim.launch)");
-    // The IK of config/robot.yaml (chain, costs, posture) for poses in base_link; base_link's
+    // The IK of the robot file (chain, costs, posture) for poses in base_link; base_link's
     // pose in the world comes from /tf_static.
     converter_ = std::make_unique<lfd::CartesianToJoints>(lfd::makeCartesianToJoints(urdf, robot_));
     const geometry_msgs::TransformStamped w =
@@ -282,7 +288,7 @@ class Demonstrator {
       if (!pause_client_.waitForExistence(ros::Duration(30.0)) ||
           !step_client_.waitForExistence(ros::Duration(30.0)))
         throw std::runtime_error("lockstep needs /bridge/pause and /bridge/step");
-      step_client_ = nh_.serviceClient<lfd_msgs::StepSim>("/bridge/step", true);
+      step_client_ = nh_.serviceClient<lfd_msgs::StepSim>("bridge/step", true);
       setPaused(true);
       lfd_msgs::StepSim step;  // zero steps: read the paused sim time
       if (!step_client_.call(step) || !step.response.success)

@@ -1,5 +1,6 @@
 // recorder_node: one bag per demonstration. Subscribes generically (ShapeShifter) to the topics of
-// config/recorder.yaml from startup, so no subscription latency is paid when a demo starts, and
+// config/recorder.yaml and to the robot's sensor topics (the rows of ~robot_file's sensor table,
+// at ~sensor_rate) from startup, so no subscription latency is paid when a demo starts, and
 // writes them while a recording is active, stamped with their header time (sim time).
 //   /recorder/start (lfd_msgs/StartRecording): open <bag_path>.active (inside ~allowed_roots, no
 //                   ".."), write metadata first, answer once every topic is linked to each of
@@ -27,6 +28,7 @@
 #include <topic_tools/shape_shifter.h>
 
 #include <lfd_core/heap_trim.hpp>
+#include <lfd_core/robot_setup.hpp>
 #include <lfd_core/ros_request_strings.hpp>
 #include <lfd_core/safe_paths.hpp>
 
@@ -71,10 +73,28 @@ std::vector<TopicSpec> loadTopics(ros::NodeHandle& pnh) {
   return topics;
 }
 
+// The robot's sensor topics, named once, in its robot file (~robot_file; "" = none): each row
+// of the sensor table at ~sensor_rate, the rate its driver publishes them at.
+void addSensorTopics(ros::NodeHandle& pnh, std::vector<TopicSpec>* topics) {
+  const std::string robot_file = pnh.param<std::string>("robot_file", "");
+  if (robot_file.empty()) return;
+  double rate = 0.0;
+  if (!pnh.getParam("sensor_rate", rate) || !(rate >= 0.0))
+    throw std::runtime_error("~sensor_rate (Hz of the sensor table's topics, >= 0) is not set");
+  for (const lfd::SensorEntry& row : lfd::loadRobotSetup(robot_file).sensors) {
+    for (const TopicSpec& spec : *topics)
+      if (spec.name == row.topic)
+        throw std::runtime_error("~topics lists " + row.topic + ", a row of the sensor table of " +
+                                 robot_file + ": name it once");
+    topics->push_back({row.topic, rate});
+  }
+}
+
 class Recorder {
  public:
   Recorder(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
     topics_ = loadTopics(pnh);
+    addSensorTopics(pnh, &topics_);
     const int queue_size = pnh.param("queue_size", 100000);
     settle_timeout_ = pnh.param("settle_timeout", 1.0);
     connect_timeout_ = pnh.param("connect_timeout", 5.0);
@@ -103,12 +123,13 @@ class Recorder {
     // Services run on their own thread so /recorder/stop can wait for in-flight messages while the
     // main thread keeps writing them.
     service_nh_.setCallbackQueue(&service_queue_);
-    start_srv_ = service_nh_.advertiseService("/recorder/start", &Recorder::onStart, this);
+    start_srv_ = service_nh_.advertiseService("recorder/start", &Recorder::onStart, this);
     // The newest sim time, read on the service thread: ros::Time::now() is updated on the main
     // queue, behind any backlog of messages, and would stop a bag too early.
+    // Relative service names (remappable); /clock is the master-wide sim time.
     clock_sub_ = service_nh_.subscribe("/clock", 10, &Recorder::onClock, this,
                                        ros::TransportHints().tcpNoDelay());
-    stop_srv_ = service_nh_.advertiseService("/recorder/stop", &Recorder::onStop, this);
+    stop_srv_ = service_nh_.advertiseService("recorder/stop", &Recorder::onStop, this);
     service_spinner_ = std::make_unique<ros::AsyncSpinner>(1, &service_queue_);
     service_spinner_->start();
     ROS_INFO("recorder: %zu topics, queue %d, services /recorder/start and /recorder/stop",

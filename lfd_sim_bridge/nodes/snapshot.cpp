@@ -20,7 +20,6 @@
 #include <rosbag/view.h>
 
 #include <geometry_msgs/PoseStamped.h>
-#include <lfd_core/ros_bag_message.hpp>
 #include <lfd_msgs/Phase.h>
 #include <sensor_msgs/JointState.h>
 #include <algorithm>
@@ -31,6 +30,7 @@
 #include <cstring>
 #include <filesystem>
 #include <iostream>
+#include <lfd_core/ros_bag_message.hpp>
 #include <map>
 #include <memory>
 #include <sstream>
@@ -45,7 +45,7 @@ namespace {
 struct Options {
   std::string bag;
   std::string out;
-  // The package's own scene (LFD_SIM_MODEL_DIR: <package>/models, set by CMake).
+  // The robot's scene (LFD_SIM_MODEL_DIR: jvrc1_description's models, set by CMake).
   std::string model = (std::filesystem::path(LFD_SIM_MODEL_DIR) / "workcell.xml").string();
   std::string times;  // empty: segment ends
   bool relative = false;

@@ -30,15 +30,15 @@ Eigen::VectorXd readyPosture(const lfd::KinematicChain& chain) {
 
 }  // namespace
 
-// Configured like the demonstrator node: the IK of config/robot.yaml, a configuration of the
+// Configured like the demonstrator node: the IK of the robot file, a configuration of the
 // simulated grasp dataset, base_link 0.85 m above the world origin.
 TEST(CartesianToJoints, GraspDemoIsTrackedByTheJointPath) {
-  const std::string config = std::string(LFD_SIM_MODEL_DIR) + "/../../config/";
+  const std::string config = std::string(LFD_CONFIG_DIR) + "/";
   const task::Scene scene = task::loadScene(config + "scene.yaml");
   const task::TaskDefinition grasp = task::loadTask(config + "tasks/grasp.yaml", scene);
   std::ifstream urdf_file(std::string(LFD_SIM_MODEL_DIR) + "/jvrc1_like.urdf");
   const std::string urdf((std::istreambuf_iterator<char>(urdf_file)), {});
-  const lfd::RobotSetup robot = lfd::loadRobotSetup(config + "robot.yaml");
+  const lfd::RobotSetup robot = lfd::loadRobotSetup(LFD_ROBOT_FILE);
   lfd::CartesianToJoints converter = lfd::makeCartesianToJoints(urdf, robot);
   const lfd::KinematicChain& chain = converter.chain();
   const Eigen::VectorXd q0 = readyPosture(chain);

@@ -16,7 +16,7 @@ namespace task = lfd_sim_bridge::task;
 
 namespace {
 
-const std::string kConfig = std::string(LFD_SIM_MODEL_DIR) + "/../../config/";
+const std::string kConfig = std::string(LFD_CONFIG_DIR) + "/";
 
 task::Pose pose(double x, double y, double z, double qw, double qx, double qy, double qz) {
   task::Pose p;

@@ -15,7 +15,7 @@ namespace task = lfd_sim_bridge::task;
 
 namespace {
 
-const std::string kConfig = std::string(LFD_SIM_MODEL_DIR) + "/../../config/";
+const std::string kConfig = std::string(LFD_CONFIG_DIR) + "/";
 
 demo::Pose pose(double x, double y, double z, double yaw = 0.0) {
   demo::Pose p;

@@ -20,6 +20,8 @@
 #include <iterator>
 
 #include "lfd_core/kinematic_chain.hpp"
+#include "lfd_core/robot_setup.hpp"
+#include "lfd_sim_bridge/sensor_table.hpp"
 #include "lfd_sim_bridge/task_file.hpp"
 
 namespace task = lfd_sim_bridge::task;
@@ -28,8 +30,9 @@ namespace {
 
 const std::string kModelDir = LFD_SIM_MODEL_DIR;
 const std::string kUrdfPath = kModelDir + "/jvrc1_like.urdf";
-const std::string kSceneFile = kModelDir + "/../../config/scene.yaml";
+const std::string kSceneFile = std::string(LFD_CONFIG_DIR) + "/scene.yaml";
 const std::string kScenePath = kModelDir + "/workcell.xml";
+const std::string kRobotFile = LFD_ROBOT_FILE;
 
 struct MjModelDeleter {
   void operator()(mjModel* m) const { mj_deleteModel(m); }
@@ -191,6 +194,30 @@ TEST(ModelConsistency, SensorsSitesAndMassesMatchTheContract) {
   EXPECT_NEAR(m->body_subtreemass[base], urdf_total, 1e-9);
   EXPECT_GT(urdf_total, 55.0);
   EXPECT_LT(urdf_total, 70.0);
+}
+
+// The shipped robot file describes this model: every sensor table row binds to its message type,
+// names sensors the model has with its fields' dimensions, in a frame the model has (a site or a
+// body), and the gripper joint and end effector exist.
+TEST(ModelConsistency, TheRobotFileMatchesTheModel) {
+  const ModelPtr m = loadScene();
+  ASSERT_TRUE(m);
+  const lfd::RobotSetup robot = lfd::loadRobotSetup(kRobotFile);
+  ASSERT_FALSE(robot.sensors.empty());
+  const auto dimension = [&](const std::string& sensor) {
+    const int id = mj_name2id(m.get(), mjOBJ_SENSOR, sensor.c_str());
+    if (id < 0) ADD_FAILURE() << "the sensor table names '" << sensor << "', not in the model";
+    return id < 0 ? -1 : m->sensor_dim[id];
+  };
+  const auto bindings = lfd_sim::bindSensorTable(robot.sensors);
+  EXPECT_NO_THROW(lfd_sim::checkSensorDimensions(bindings, dimension));
+  for (const lfd::SensorEntry& row : robot.sensors)
+    EXPECT_TRUE(mj_name2id(m.get(), mjOBJ_SITE, row.frame.c_str()) >= 0 ||
+                mj_name2id(m.get(), mjOBJ_BODY, row.frame.c_str()) >= 0)
+        << row.topic << ": frame " << row.frame << " is neither a site nor a body";
+  EXPECT_GE(mj_name2id(m.get(), mjOBJ_ACTUATOR, robot.gripper.joint.c_str()), 0);
+  EXPECT_GE(mj_name2id(m.get(), mjOBJ_SITE, robot.tip_link.c_str()), 0);
+  EXPECT_GE(mj_name2id(m.get(), mjOBJ_BODY, robot.base_link.c_str()), 0);
 }
 
 TEST(ModelConsistency, ToolPoseAgreesWithUrdfKinematics) {

@@ -13,7 +13,7 @@ namespace task = lfd_sim_bridge::task;
 
 namespace {
 
-const std::string kConfig = std::string(LFD_SIM_MODEL_DIR) + "/../../config/";
+const std::string kConfig = std::string(LFD_CONFIG_DIR) + "/";
 const char* const kTasks[] = {"grasp", "push", "place", "wipe", "drawer"};
 
 task::Scene scene() {

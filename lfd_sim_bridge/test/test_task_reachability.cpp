@@ -1,8 +1,9 @@
 // Every task file (config/tasks/*.yaml) follows the protocol -- counts, unseen goals inside the
 // demonstrated range and different from every demonstration, parked objects out of the way -- and
 // every path the demonstrator plans for any of its scenes, demonstrated or unseen, sim or teleop,
-// whatever the per-demo variation draws, is reachable by the IK of config/robot.yaml along a
-// continuous branch with margin from the joint limits (as the demonstrator converts it).
+// whatever the per-demo variation draws, is reachable by the IK of the robot file
+// (jvrc1_description) along a continuous branch with margin from the joint limits (as the
+// demonstrator converts it).
 #include <gtest/gtest.h>
 
 #include <dirent.h>
@@ -26,7 +27,7 @@ namespace task = lfd_sim_bridge::task;
 namespace {
 
 const std::string kModelDir = LFD_SIM_MODEL_DIR;
-const std::string kConfig = kModelDir + "/../../config/";
+const std::string kConfig = std::string(LFD_CONFIG_DIR) + "/";
 
 std::vector<std::string> taskNames() {
   std::vector<std::string> names;
@@ -46,10 +47,11 @@ class TaskFiles : public ::testing::Test {
  protected:
   void SetUp() override {
     scene_ = task::loadScene(kConfig + "scene.yaml");
-    robot_ = lfd::loadRobotSetup(kConfig + "robot.yaml");
+    robot_ = lfd::loadRobotSetup(std::string(LFD_ROBOT_FILE));
     std::ifstream f(kModelDir + "/jvrc1_like.urdf");
     urdf_.assign(std::istreambuf_iterator<char>(f), {});
-    min_margin_ = YAML::LoadFile(kConfig + "robot.yaml")["ik"]["min_limit_margin"].as<double>();
+    min_margin_ =
+        YAML::LoadFile(std::string(LFD_ROBOT_FILE))["ik"]["min_limit_margin"].as<double>();
     world_from_base_.translation() = scene_.base_in_world;
   }
 

@@ -10,16 +10,38 @@
 #include <string>
 #include <vector>
 
+#include "lfd_core/robot_setup.hpp"
+#include "lfd_sim_bridge/sensor_table.hpp"
 #include "lfd_sim_bridge/trajectory_interpolator.hpp"
 #include "lfd_sim_bridge/workcell_sim.hpp"
 
 namespace {
 
 const std::string kModel = std::string(LFD_SIM_MODEL_DIR) + "/workcell.xml";
+const std::string kRobotFile = LFD_ROBOT_FILE;
+
+// The robot's part as the bridge configures it: from the shipped robot file.
+lfd_sim::WorkcellConfig robotConfig() {
+  const lfd::RobotSetup robot = lfd::loadRobotSetup(kRobotFile);
+  lfd_sim::WorkcellConfig c;
+  c.gripper_joint = robot.gripper.joint;
+  c.base_body = robot.base_link;
+  c.ee_site = robot.tip_link;
+  c.sensors = lfd_sim::sensorGroups(lfd_sim::bindSensorTable(robot.sensors));
+  return c;
+}
+
+// Readings of the table row `topic`'s sensor `k` (1-D sensors: its value).
+const std::vector<double>& reading(const lfd_sim::WorkcellState& s, const std::string& topic,
+                                   size_t k) {
+  const lfd_sim::SensorReading* r = s.sensor(topic);
+  if (!r) throw std::runtime_error("no sensor row " + topic);
+  return r->values.at(k);
+}
 
 // Arm bent over the table (as config/bridge.yaml), so arm joints move without hitting anything.
 lfd_sim::WorkcellConfig readyConfig() {
-  lfd_sim::WorkcellConfig c;
+  lfd_sim::WorkcellConfig c = robotConfig();
   c.initial_posture = {
       {"R_SHOULDER_P", -0.3}, {"R_ELBOW_P", -1.3}, {"R_WRIST_Y", 1.4}, {"R_GRIPPER", 0.03}};
   return c;
@@ -46,8 +68,73 @@ TEST(WorkcellSim, LoadsTheContractScene) {
   const lfd_sim::WorkcellState s = sim.readState();
   ASSERT_EQ(s.object_names.size(), 2u);
   EXPECT_EQ(s.object_names[0], "stick");
-  EXPECT_EQ(s.touch_names.size(), 2u);
-  EXPECT_NEAR(s.imu_orientation[0], 1.0, 1e-9);  // pelvis fixed upright
+  ASSERT_NE(s.sensor("/touch"), nullptr);
+  EXPECT_EQ(s.sensor("/touch")->sensors,
+            (std::vector<std::string>{"r_touch_left", "r_touch_right"}));
+  EXPECT_NEAR(reading(s, "/imu", 0).at(0), 1.0, 1e-9);  // orientation w: pelvis fixed upright
+  EXPECT_EQ(reading(s, "/wrist_ft", 0).size(), 3u);     // a force
+}
+
+// Readings are keyed by table row, in the rows' order, each sensor as the model defines it.
+TEST(WorkcellSim, ReadsTheSensorsTheTableNames) {
+  lfd_sim::WorkcellConfig c = readyConfig();
+  c.sensors = {{"/pads", {"r_touch_right"}}, {"/spin", {"imu_gyro", "imu_quat"}}};
+  lfd_sim::WorkcellSim sim(kModel, c);
+  const lfd_sim::WorkcellState s = sim.readState();
+  ASSERT_EQ(s.sensors.size(), 2u);
+  EXPECT_EQ(s.sensors[0].name, "/pads");
+  EXPECT_EQ(s.sensors[0].values.at(0).size(), 1u);
+  EXPECT_EQ(s.sensors[1].values.at(0).size(), 3u);
+  EXPECT_EQ(s.sensors[1].values.at(1).size(), 4u);
+  EXPECT_EQ(s.sensor("/wrist_ft"), nullptr);  // not in this table: not read
+}
+
+// A row naming a sensor the model lacks is refused at start-up, naming the row and the sensor.
+TEST(WorkcellSim, ATableSensorTheModelLacksIsAClearError) {
+  lfd_sim::WorkcellConfig c = readyConfig();
+  c.sensors.push_back({"/elbow_ft", {"r_elbow_force"}});
+  try {
+    lfd_sim::WorkcellSim sim(kModel, c);
+    FAIL() << "a missing sensor was accepted";
+  } catch (const std::invalid_argument& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("/elbow_ft"), std::string::npos) << what;
+    EXPECT_NE(what.find("'r_elbow_force'"), std::string::npos) << what;
+    EXPECT_NE(what.find("r_wrist_force"), std::string::npos) << what;  // lists what there is
+  }
+}
+
+// The table bound to the message types: fields in the message's order, dimensions checked.
+TEST(SensorTable, BindsRowsAndRefusesWrongOnes) {
+  const lfd::RobotSetup robot = lfd::loadRobotSetup(kRobotFile);
+  lfd_sim::WorkcellSim sim(kModel, readyConfig());
+  const auto dim = [&](const std::string& n) { return sim.sensorDimension(n); };
+  const auto bindings = lfd_sim::bindSensorTable(robot.sensors);
+  EXPECT_NO_THROW(lfd_sim::checkSensorDimensions(bindings, dim));
+  const auto expectError = [&](const lfd::SensorEntry& row, const std::string& needle) {
+    try {
+      lfd_sim::checkSensorDimensions(lfd_sim::bindSensorTable({row}), dim);
+      ADD_FAILURE() << "accepted a row with " << needle;
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("/x"), std::string::npos) << e.what();
+    }
+  };
+  expectError({"/x", "geometry_msgs/Wrench", "f", {{"force", {"r_wrist_force"}}}},
+              "unknown message type");
+  expectError({"/x", "geometry_msgs/WrenchStamped", "f", {{"forces", {"r_wrist_force"}}}},
+              "no field 'forces'");
+  expectError({"/x", "geometry_msgs/WrenchStamped", "f", {{"force", {"r_touch_left"}}}},
+              "dimension 3; 'r_touch_left' has 1");
+  expectError({"/x", "sensor_msgs/Imu", "f", {{"angular_velocity", {"imu_gyro", "imu_accel"}}}},
+              "takes one sensor, not 2");
+  // Fields are read in the message's order, whatever the file's.
+  const auto imu = lfd_sim::bindSensorTable(
+      {{"/x",
+        "sensor_msgs/Imu",
+        "f",
+        {{"linear_acceleration", {"imu_accel"}}, {"orientation", {"imu_quat"}}}}});
+  EXPECT_EQ(imu[0].group.sensors, (std::vector<std::string>{"imu_quat", "imu_accel"}));
 }
 
 TEST(WorkcellSim, BadModelPathGivesMuJoCoMessage) {
@@ -248,8 +335,8 @@ TEST(WorkcellSim, TouchPadsRespondWithTheirTimeConstant) {
   for (int k = 0; k < 1500; ++k) {  // 1.5 s at 1 kHz
     raw.step();
     pad.step();
-    raw_left.push_back(raw.readState().touch_values.at(0));
-    pad_left.push_back(pad.readState().touch_values.at(0));
+    raw_left.push_back(reading(raw.readState(), "/touch", 0).at(0));
+    pad_left.push_back(reading(pad.readState(), "/touch", 0).at(0));
   }
   const auto onset =
       std::find_if(raw_left.begin(), raw_left.end(), [](double v) { return v > 1.0; });
@@ -513,7 +600,7 @@ TEST(WorkcellSim, SetNoiseSwitchesAndReseeds) {
   quiet.setNoise(teleop, 7);
   const lfd_sim::WorkcellState a = noisy.readState(), b = quiet.readState();
   EXPECT_EQ(a.joint_positions, b.joint_positions);
-  EXPECT_EQ(a.touch_values, b.touch_values);
+  EXPECT_EQ(a.sensor("/touch")->values, b.sensor("/touch")->values);
   EXPECT_EQ(noisy.sensorNoise().touch, 0.8);
   noisy.setNoise(lfd_sim::SensorNoise(), 7);  // back to exact readings
   const lfd_sim::WorkcellState exact = noisy.readState();

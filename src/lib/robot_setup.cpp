@@ -51,10 +51,16 @@ void readIk(const YAML::Node& ik, const std::string& path, RobotSetup* setup) {
   }
 }
 
+std::string text(const YAML::Node& node, const std::string& path, const std::string& key) {
+  if (!node || !node.IsScalar() || node.as<std::string>().empty())
+    fail(path, key + " must be a non-empty string");
+  return node.as<std::string>();
+}
+
 void readGripper(const YAML::Node& g, const std::string& path, GripperSetup* gripper) {
   if (!g) return;
   if (!g.IsMap()) fail(path, "gripper must be a mapping");
-  if (g["joint"]) gripper->joint = g["joint"].as<std::string>();
+  gripper->joint = text(g["joint"], path, "gripper.joint");  // no default: it names the robot's
   if (g["open_opening"]) gripper->open_opening = g["open_opening"].as<double>();
   if (g["close_opening"]) gripper->close_opening = g["close_opening"].as<double>();
   if (g["close_effort"])
@@ -64,7 +70,71 @@ void readGripper(const YAML::Node& g, const std::string& path, GripperSetup* gri
     fail(path, "gripper.open_opening must be finite and >= close_opening");
 }
 
+// A field's device sensors: one name, or a list of names (e.g. the touch pads).
+std::vector<std::string> sensorNames(const YAML::Node& node, const std::string& path,
+                                     const std::string& key) {
+  if (node.IsScalar()) return {text(node, path, key)};
+  if (!node.IsSequence() || node.size() == 0)
+    fail(path, key + " must name a sensor or a non-empty list of sensors");
+  std::vector<std::string> names;
+  for (std::size_t i = 0; i < node.size(); ++i)
+    names.push_back(text(node[i], path, key + "[" + std::to_string(i) + "]"));
+  return names;
+}
+
+SensorEntry readSensor(const YAML::Node& row, const std::string& path, const std::string& key) {
+  if (!row.IsMap()) fail(path, key + " must be a mapping (topic, type, frame, fields)");
+  for (const auto& item : row) {
+    const std::string k = item.first.as<std::string>();
+    if (k != "topic" && k != "type" && k != "frame" && k != "fields")
+      fail(path, key + " has an unknown key '" + k + "' (topic, type, frame, fields)");
+  }
+  SensorEntry entry;
+  entry.topic = text(row["topic"], path, key + ".topic");
+  entry.type = text(row["type"], path, key + ".type");
+  entry.frame = text(row["frame"], path, key + ".frame");
+  const YAML::Node fields = row["fields"];
+  if (!fields || !fields.IsMap() || fields.size() == 0)
+    fail(path, key + ".fields must map message fields to device sensors");
+  for (const auto& item : fields) {
+    const std::string field = item.first.as<std::string>();
+    entry.fields.emplace_back(field, sensorNames(item.second, path, key + ".fields." + field));
+  }
+  return entry;
+}
+
+// Each topic once, and each device sensor in one place: a sensor read twice would draw its noise
+// twice and publish two different readings of one measurement.
+void checkUnique(const std::vector<SensorEntry>& table, const std::string& path) {
+  std::map<std::string, std::string> topic_of_sensor;
+  std::map<std::string, int> topics;
+  for (const SensorEntry& entry : table) {
+    if (topics[entry.topic]++) fail(path, "sensors: topic " + entry.topic + " appears twice");
+    for (const auto& [field, names] : entry.fields)
+      for (const std::string& name : names) {
+        auto [it, fresh] = topic_of_sensor.emplace(name, entry.topic);
+        if (!fresh)
+          fail(path, "sensors: sensor '" + name + "' is read twice (" + it->second + " and " +
+                         entry.topic + ")");
+      }
+  }
+}
+
+void readSensors(const YAML::Node& node, const std::string& path, RobotSetup* setup) {
+  if (!node) return;
+  if (!node.IsSequence()) fail(path, "sensors must be a list of sensor table rows");
+  for (std::size_t i = 0; i < node.size(); ++i)
+    setup->sensors.push_back(readSensor(node[i], path, "sensors[" + std::to_string(i) + "]"));
+  checkUnique(setup->sensors, path);
+}
+
 }  // namespace
+
+const SensorEntry* findSensorOfType(const RobotSetup& setup, const std::string& type) {
+  for (const SensorEntry& entry : setup.sensors)
+    if (entry.type == type) return &entry;
+  return nullptr;
+}
 
 RobotSetup loadRobotSetup(const std::string& path) {
   YAML::Node root;
@@ -79,6 +149,7 @@ RobotSetup loadRobotSetup(const std::string& path) {
   try {
     readIk(root["ik"], path, &setup);
     readGripper(root["gripper"], path, &setup.gripper);
+    readSensors(root["sensors"], path, &setup);
   } catch (const YAML::Exception& e) {
     fail(path, std::string("invalid value: ") + e.what());
   }

@@ -1,5 +1,6 @@
 // Cartesian path -> joint path (the IK shared by the demonstrator and the executor) and the robot
-// description file that configures it, on the repository's robot model and config/robot.yaml.
+// description file that configures it, on the robot model of jvrc1_description and its
+// config/robot.yaml.
 #include <cstdio>
 #include <fstream>
 #include <iterator>
@@ -12,8 +13,8 @@
 
 namespace {
 
-const std::string kRepo = LFD_REPO_DIR;
-const std::string kUrdfPath = kRepo + "/lfd_sim_bridge/models/jvrc1_like.urdf";
+const std::string kRobotFile = std::string(LFD_ROBOT_DIR) + "/config/robot.yaml";
+const std::string kUrdfPath = std::string(LFD_ROBOT_DIR) + "/models/jvrc1_like.urdf";
 
 std::string readFile(const std::string& path) {
   std::ifstream in(path);
@@ -31,13 +32,12 @@ std::string writeTemp(const std::string& text) {
 }
 
 lfd::CartesianToJoints repositoryIk() {
-  return lfd::makeCartesianToJoints(readFile(kUrdfPath),
-                                    lfd::loadRobotSetup(kRepo + "/config/robot.yaml"));
+  return lfd::makeCartesianToJoints(readFile(kUrdfPath), lfd::loadRobotSetup(kRobotFile));
 }
 
 // The robot.yaml posture: the null-space equilibrium the demonstrator starts from.
 Eigen::VectorXd home(const lfd::CartesianToJoints& ik) {
-  const lfd::RobotSetup setup = lfd::loadRobotSetup(kRepo + "/config/robot.yaml");
+  const lfd::RobotSetup setup = lfd::loadRobotSetup(kRobotFile);
   Eigen::VectorXd q = Eigen::VectorXd::Zero(ik.chain().dof());
   for (int i = 0; i < q.size(); ++i) {
     const auto it = setup.preferred_posture.find(ik.chain().jointNames()[i]);
@@ -49,12 +49,21 @@ Eigen::VectorXd home(const lfd::CartesianToJoints& ik) {
 }  // namespace
 
 TEST(RobotSetup, RepositoryFileDescribesTheWaistAndRightArm) {
-  const lfd::RobotSetup s = lfd::loadRobotSetup(kRepo + "/config/robot.yaml");
+  const lfd::RobotSetup s = lfd::loadRobotSetup(kRobotFile);
   EXPECT_EQ(s.base_link, "base_link");
   EXPECT_EQ(s.tip_link, "r_gripper_tcp");
   EXPECT_GT(s.joint_costs.at("WAIST_R"), s.joint_costs.at("WAIST_Y"));
   EXPECT_EQ(s.gripper.joint, "R_GRIPPER");
   EXPECT_GT(s.gripper.open_opening, s.gripper.close_opening);
+  // The sensor table, rows and fields in the file's order (the order readings are taken in).
+  ASSERT_EQ(s.sensors.size(), 3u);
+  EXPECT_EQ(s.sensors[0].topic, "/wrist_ft");
+  EXPECT_EQ(s.sensors[0].fields.front().first, "force");
+  const lfd::SensorEntry* touch = lfd::findSensorOfType(s, "lfd_msgs/Touch");
+  ASSERT_NE(touch, nullptr);
+  EXPECT_EQ(touch->fields.at(0).second,
+            (std::vector<std::string>{"r_touch_left", "r_touch_right"}));
+  EXPECT_EQ(lfd::findSensorOfType(s, "no_msgs/Nothing"), nullptr);
   const lfd::CartesianToJoints ik = repositoryIk();
   EXPECT_EQ(ik.chain().dof(), 10);  // waist 3 + arm 7
 }
@@ -74,9 +83,24 @@ TEST(RobotSetup, BadFilesAreClearErrors) {
   expectError("ik: {base_link: a}\n", "tip_link");
   expectError("ik: {tip_link: t, joint_costs: {J: -1}}\n", "joint_costs.J");
   expectError("ik: {tip_link: t, tolerance: {position: 0}}\n", "tolerance.position");
-  expectError("ik: {tip_link: t}\ngripper: {open_opening: 0.0, close_opening: 0.05}\n",
+  expectError("ik: {tip_link: t}\ngripper: {joint: G, open_opening: 0.0, close_opening: 0.05}\n",
               "open_opening");
   expectError("ik: [1, 2\n", "cannot be read");
+  expectError("ik: {tip_link: t}\ngripper: {close_effort: 5}\n", "gripper.joint");
+  const std::string ik = "ik: {tip_link: t}\n";
+  expectError(ik + "sensors: {a: 1}\n", "sensors must be a list");
+  expectError(ik + "sensors: [{topic: /f, type: T, fields: {force: s}}]\n", "sensors[0].frame");
+  expectError(ik + "sensors: [{topic: /f, type: T, frame: f, fields: {}}]\n", "sensors[0].fields");
+  expectError(ik + "sensors: [{topic: /f, type: T, frame: f, fields: {values: []}}]\n",
+              "sensors[0].fields.values");
+  expectError(ik + "sensors: [{topic: /f, type: T, frame: f, rate: 3, fields: {a: s}}]\n",
+              "unknown key 'rate'");
+  expectError(ik + "sensors: [{topic: /f, type: T, frame: f, fields: {a: s}},\n"
+                   "          {topic: /f, type: U, frame: g, fields: {b: t}}]\n",
+              "topic /f appears twice");
+  expectError(ik + "sensors: [{topic: /f, type: T, frame: f, fields: {a: s}},\n"
+                   "          {topic: /g, type: U, frame: g, fields: {b: [t, s]}}]\n",
+              "sensor 's' is read twice (/f and /g)");
   EXPECT_THROW(lfd::loadRobotSetup("/nonexistent/robot.yaml"), std::runtime_error);
 }
 

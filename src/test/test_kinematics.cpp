@@ -13,7 +13,7 @@
 
 namespace {
 
-const std::string kRobotUrdf = std::string(LFD_REPO_DIR) + "/lfd_sim_bridge/models/jvrc1_like.urdf";
+const std::string kRobotUrdf = std::string(LFD_ROBOT_DIR) + "/models/jvrc1_like.urdf";
 
 // base -> (fixed, rotated) -> revolute z -> prismatic x -> fixed tip.
 const char* kSmallUrdf = R"(<?xml version="1.0"?>
@@ -280,8 +280,8 @@ TEST(InverseKinematics, OverflowingTargetIsAClearFailureNeverAnEmptyResult) {
 TEST(InverseKinematics, NonFiniteTargetIsRefused) {
   const auto chain = taskChain();
   lfd::InverseKinematics ik(chain);
-  for (double bad : {std::numeric_limits<double>::quiet_NaN(),
-                     std::numeric_limits<double>::infinity()}) {
+  for (double bad :
+       {std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity()}) {
     Eigen::Isometry3d target = chain.forward(chain.midRange());
     target.translation().x() = bad;
     EXPECT_THROW(ik.reach(target, chain.midRange()), std::invalid_argument);

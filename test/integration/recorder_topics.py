@@ -28,6 +28,12 @@ class RecorderTopics(unittest.TestCase):
         cls.output_dir = rospy.get_param("recorder_test/output_dir")
         with open(rospy.get_param("recorder_test/recorder_config")) as f:
             cls.config = yaml.safe_load(f)
+        # The recorder adds the robot's sensor topics, the rows of its robot file's sensor table.
+        cls.robot_file = rospy.get_param("/recorder/robot_file")
+        with open(cls.robot_file) as f:
+            rows = yaml.safe_load(f)["sensors"]
+        cls.topics = cls.config["topics"] + [{"name": r["topic"], "rate": cls.config["sensor_rate"]}
+                                             for r in rows]
 
     def wait_for_file(self, path, timeout):
         deadline = time.time() + timeout
@@ -38,6 +44,8 @@ class RecorderTopics(unittest.TestCase):
     def spawn_recorder(self, name, **params):
         """A second recorder node, `name`, with the shipped topics and services under /<name>/."""
         rospy.set_param("/%s/topics" % name, self.config["topics"])
+        rospy.set_param("/%s/robot_file" % name, self.robot_file)
+        rospy.set_param("/%s/sensor_rate" % name, self.config["sensor_rate"])
         for key, value in params.items():
             rospy.set_param("/%s/%s" % (name, key), value)
         return subprocess.Popen(["rosrun", "lfd_sim_bridge", "recorder_node", "__name:=" + name,
@@ -56,7 +64,7 @@ class RecorderTopics(unittest.TestCase):
             start, end = bag.get_start_time(), bag.get_end_time()
             self.assertAlmostEqual(start, first.message.header.stamp.to_sec(), places=6)
             self.assertGreater(end - start, 3.0)
-            for spec in self.config["topics"]:
+            for spec in self.topics:
                 name, rate = spec["name"], float(spec.get("rate", 0.0))
                 stamps = topic_stamps(bag, name)
                 # An event-driven topic (rate 0, e.g. the latched /tf_static) may come once.
@@ -112,7 +120,7 @@ class RecorderTopics(unittest.TestCase):
             joints = topic_stamps(bag, "/joint_states")
             # Everything received before the signal is in the bag, up to the frozen sim time
             # (two publishing periods of slack), and at the configured rate.
-            rate = next(float(t["rate"]) for t in self.config["topics"] if t["name"] == "/joint_states")
+            rate = next(float(t["rate"]) for t in self.topics if t["name"] == "/joint_states")
             self.assertGreaterEqual(joints[-1], interrupted_at - 2.0 / rate - 1e-3)
             self.assertLessEqual(joints[0], recording_by + 2.0 / rate + 1e-3)
             self.assertGreaterEqual(len(joints), 0.9 * rate * (interrupted_at - recording_by))
@@ -151,7 +159,7 @@ class RecorderTopics(unittest.TestCase):
                 proc.wait()
         start = meta.header.stamp.to_sec()
         with rosbag.Bag(bag_path) as bag:
-            for spec in self.config["topics"]:
+            for spec in self.topics:
                 rate = float(spec.get("rate", 0.0))
                 if rate <= 0.0 or spec["name"] == "/lfd/phase":  # the demonstrator's, not running
                     continue

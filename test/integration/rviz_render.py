@@ -121,7 +121,7 @@ class RvizRender(unittest.TestCase):
         self.workdir = tempfile.mkdtemp(prefix="lfd_rviz_render_")
         self.passed = False
         self.addCleanup(self.remove_workdir)  # runs last: after rviz and Xvfb are stopped
-        urdf = os.path.join(rospkg.RosPack().get_path("lfd_sim_bridge"), "models",
+        urdf = os.path.join(rospkg.RosPack().get_path("jvrc1_description"), "models",
                             "jvrc1_like.urdf")
         self.bag = os.path.join(self.workdir, "grasp_sim_00.bag")
         write_synthetic_bag(self.bag, urdf, drop)

@@ -88,7 +88,7 @@ class SnapshotRender(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
         cls.workdir = tempfile.mkdtemp(prefix="lfd_snapshot_")
-        urdf = os.path.join(rospkg.RosPack().get_path("lfd_sim_bridge"), "models",
+        urdf = os.path.join(rospkg.RosPack().get_path("jvrc1_description"), "models",
                             "jvrc1_like.urdf")
         cls.bag = os.path.join(cls.workdir, "push_sim_00.bag")
         write_bag(cls.bag, urdf_joint_names(urdf))

@@ -102,10 +102,15 @@ def truth_from_labels(path, runs=None):
 
 # ---- a recording's physical outcome -------------------------------------------------------------
 
-TOUCH_TOPIC, EE_TOPIC = "/touch", "/ee_pose"
+EE_TOPIC = "/ee_pose"
 # A scene object's joint (the drawer's slide) is on /objects/joint_states; bags recorded before
 # the bridge split it from the robot's carry it on /joint_states.
 JOINT_TOPICS = ("/objects/joint_states", "/joint_states")
+
+
+def touch_topic():
+    """The pads' topic: the robot file's lfd_msgs/Touch sensor row."""
+    return config.sensor_topic("lfd_msgs/Touch")
 
 
 def topics_for(criterion):
@@ -117,7 +122,7 @@ def topics_for(criterion):
         if rule["rule"] == "joint":
             topics.update(JOINT_TOPICS)
         if rule["rule"] == "contact_path":
-            topics.update((TOUCH_TOPIC, EE_TOPIC))
+            topics.update((touch_topic(), EE_TOPIC))
     return sorted(topics)
 
 
@@ -141,7 +146,7 @@ def measure(bag, criterion, base_in_world):
             for name, value in zip(msg.name, msg.position):
                 if name in joint_names:
                     out["joints"][name] = value
-        elif topic == TOUCH_TOPIC and msg.values:
+        elif topic == touch_topic() and msg.values:
             touch[round(stamp, 4)] = sum(msg.values) / len(msg.values)
         elif topic == EE_TOPIC:
             p = msg.pose.position

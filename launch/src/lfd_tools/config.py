@@ -20,6 +20,23 @@ def config_path(name):
     return os.path.join(config_dir(), name)
 
 
+def robot_file():
+    """The robot file (lfd::loadRobotSetup's; its sensor table names the topics it publishes): the
+    robot description package's config/robot.yaml."""
+    import rospkg
+    return os.path.join(rospkg.RosPack().get_path("jvrc1_description"), "config", "robot.yaml")
+
+
+@functools.lru_cache(maxsize=None)
+def sensor_topic(message_type):
+    """The topic of the robot file's first sensor table row publishing `message_type` (e.g.
+    lfd_msgs/Touch, the pads the judge's contact rules read). Raises RuntimeError without one."""
+    for row in load_yaml(robot_file()).get("sensors") or []:
+        if row.get("type") == message_type:
+            return row["topic"]
+    raise RuntimeError("robot file %s has no %s row in its sensor table" % (robot_file(), message_type))
+
+
 def load_yaml(path):
     with open(path) as f:
         return yaml.safe_load(f)

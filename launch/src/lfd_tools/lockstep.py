@@ -33,7 +33,9 @@ def message_type(topic):
     from geometry_msgs.msg import PoseStamped
     from lfd_msgs.msg import Touch
     from sensor_msgs.msg import JointState
-    types = {"/joint_states": JointState, "/objects/joint_states": JointState, "/touch": Touch}
+    from lfd_tools import config
+    types = {"/joint_states": JointState, "/objects/joint_states": JointState,
+             config.sensor_topic("lfd_msgs/Touch"): Touch}
     if topic in types:
         return types[topic]
     if topic.startswith("/objects/") or topic == "/ee_pose":  # /objects/<body>/pose

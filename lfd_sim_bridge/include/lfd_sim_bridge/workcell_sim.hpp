@@ -40,6 +40,14 @@ struct SensorNoise {
   double object_position = 0.0;  // m
 };
 
+// Model sensors read together: one row of the robot's sensor table (lfd::SensorEntry), keyed by
+// its name (the row's topic). Each sensor's noise follows its kind (force, torque, touch, gyro,
+// accelerometer; others exact), and touch sensors respond with touch_time_constant.
+struct SensorGroup {
+  std::string name;
+  std::vector<std::string> sensors;  // MJCF sensor names
+};
+
 struct WorkcellConfig {
   // Proportional gain per actuated joint. Joints not listed keep the MJCF position actuator's kp,
   // or default_kp if the actuator has none.
@@ -61,12 +69,16 @@ struct WorkcellConfig {
   bool gravity_compensation = true;
   // Initial posture used by reset(); joints not listed start at the model's qpos0.
   std::map<std::string, double> initial_posture;
-  // Gripper: actuated joint name, opening between the fingers = scale * joint position.
-  std::string gripper_joint = "R_GRIPPER";
+  // Gripper: actuated joint name ("" = none), opening between the fingers = scale * position.
+  std::string gripper_joint;
   double gripper_opening_scale = 2.0;
-  // Frames of the contract.
-  std::string base_body = "base_link";
-  std::string ee_site = "r_gripper_tcp";
+  // The robot's frames (its robot file: the Cartesian frame and the IK tip): the body every
+  // end-effector pose is expressed in ("" = the robot's root body) and the end-effector site.
+  std::string base_body;
+  std::string ee_site;
+  // The sensors read into WorkcellState::sensors, one group per sensor table row, in this order
+  // (readings and their noise are drawn in it). A name the model lacks is an error naming it.
+  std::vector<SensorGroup> sensors;
   // Bodies reported as objects (world poses). Free bodies and mocap bodies (fixed objects such as
   // a cabinet) can be placed by setObjectPose; any other body (a drawer's handle) is reported only.
   std::vector<std::string> objects = {"stick", "box"};
@@ -99,6 +111,13 @@ struct JointLimit {
   double effort = 0.0;    // max |actuator force|
 };
 
+// The readings of one SensorGroup.
+struct SensorReading {
+  std::string name;                         // the group's
+  std::vector<std::string> sensors;         // its sensors
+  std::vector<std::vector<double>> values;  // per sensor, its MuJoCo dimension
+};
+
 // One snapshot of everything the bridge publishes, at sim time `time`.
 struct WorkcellState {
   double time = 0.0;
@@ -107,14 +126,13 @@ struct WorkcellState {
   // Parallel to joint_names: true for a joint of a scene object (a drawer's slide), whose body is
   // not in the robot's tree. The bridge keeps these off the robot's /joint_states.
   std::vector<bool> object_joint;
-  std::array<double, 3> wrist_force{}, wrist_torque{};  // in the r_wrist_ft site frame
-  std::vector<std::string> touch_names;
-  std::vector<double> touch_values;
-  std::array<double, 3> imu_gyro{}, imu_accel{};      // in the imu site frame
-  std::array<double, 4> imu_orientation{1, 0, 0, 0};  // w, x, y, z, world frame
+  // Per WorkcellConfig::sensors group, in its order: each sensor's reading, as MuJoCo gives it
+  // (in its site's frame; a quaternion w, x, y, z).
+  std::vector<SensorReading> sensors;
+  const SensorReading* sensor(const std::string& group) const;
   double gripper_opening = 0.0, gripper_velocity = 0.0, gripper_effort = 0.0;
-  Pose ee_pose;                                                       // r_gripper_tcp in base_link
-  std::array<double, 3> ee_linear_velocity{}, ee_angular_velocity{};  // in base_link axes
+  Pose ee_pose;                                                       // ee_site in base_body
+  std::array<double, 3> ee_linear_velocity{}, ee_angular_velocity{};  // in base_body axes
   std::vector<std::string> object_names;
   std::vector<Pose> object_poses;  // world
 };
@@ -173,6 +191,9 @@ class WorkcellSim {
   // --- introspection ---
   const std::vector<std::string>& actuatedJoints() const { return actuated_names_; }
   const std::vector<std::string>& jointNames() const { return joint_names_; }
+  // The dimension of a model sensor (3 for a force, 1 for a touch pad); throws naming it if the
+  // model has none of that name.
+  int sensorDimension(const std::string& sensor) const;
   bool hasJoint(const std::string& name) const;
   JointLimit jointLimit(const std::string& actuated_joint) const;
   double jointPosition(const std::string& name) const;
@@ -218,10 +239,19 @@ class WorkcellSim {
   double last_trajectory_stamp_ = 0.0;
   std::vector<double> traj_pos_, traj_vel_;
   int base_body_ = -1, ee_site_ = -1, gripper_ = -1;
-  int force_adr_ = -1, torque_adr_ = -1, gyro_adr_ = -1, accel_adr_ = -1, quat_adr_ = -1;
-  std::vector<std::pair<std::string, int>> touch_adr_;
+  // One read sensor: its sensordata address, dimension and noise; touch_slot indexes
+  // touch_filtered_ for a touch sensor (-1 otherwise).
+  struct SensorSlot {
+    int adr = -1, dim = 0, touch_slot = -1;
+    const double SensorNoise::*noise = nullptr;  // the kind's noise; nullptr = exact
+  };
+  std::vector<std::vector<SensorSlot>> sensor_slots_;  // parallel to config_.sensors
+  void configureSensors();
+  SensorSlot sensorSlot(const std::string& group, const std::string& sensor);
+  std::vector<int> touch_adr_;          // sensordata address of each touch sensor read
   std::vector<double> touch_filtered_;  // the pads' response (touch_time_constant)
   void updateTouch();
+  void readSensors(WorkcellState* state);
   std::vector<std::pair<std::string, int>> objects_;  // name, body id
   std::vector<double> initial_qpos_;                  // model qpos0: initial object poses
   std::vector<double> scene_qpos_;   // object poses last set (divergence recovery restores them)

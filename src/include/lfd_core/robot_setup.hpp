@@ -1,21 +1,35 @@
-// The robot as the learn-and-reproduce half needs it, read from one file (config/robot.yaml) by
-// the demonstrator and the executor alike: the IK chain (base and tip links of the URDF), its
-// motion costs, null-space posture and accepted residual, and the gripper's joint and commands.
-// Nothing here knows a simulator: a real robot is described by its own robot.yaml.
+// The robot as the learn-and-reproduce half needs it, read from one file (the robot description
+// package's config/robot.yaml) by the demonstrator, the executor and the bridge alike: the IK chain
+// (base and tip links of the URDF), its motion costs, null-space posture and accepted residual, the
+// gripper's joint and commands, and the sensor table. Nothing here knows a simulator or ROS: a real
+// robot is described by its own robot.yaml, and its driver publishes what the table says.
 #pragma once
 
 #include <map>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "lfd_core/cartesian_path.hpp"
 
 namespace lfd {
 
 struct GripperSetup {
-  std::string joint = "R_GRIPPER";  // joint whose position the gripper state reports
-  double open_opening = 0.08;       // m between the pads when opened
-  double close_opening = 0.0;       // m commanded to close (the effort limit stops it on an object)
-  double close_effort = 20.0;       // N
+  std::string joint;           // joint whose position the gripper state reports (required)
+  double open_opening = 0.08;  // m between the pads when opened
+  double close_opening = 0.0;  // m commanded to close (the effort limit stops it on an object)
+  double close_effort = 20.0;  // N
+};
+
+// One row of the sensor table, the way ros_control's hardware interfaces describe a sensor: which
+// device sensors (by their name in the robot's model, e.g. MJCF) make up one message of a standard
+// type, published on `topic` with header.frame_id `frame`. The topic is the row's key.
+struct SensorEntry {
+  std::string topic;  // e.g. /wrist_ft
+  std::string type;   // ROS message type, e.g. geometry_msgs/WrenchStamped
+  std::string frame;  // tf frame of the readings
+  // Message field -> device sensors feeding it, in the file's order (a force, or a list of pads).
+  std::vector<std::pair<std::string, std::vector<std::string>>> fields;
 };
 
 struct RobotSetup {
@@ -27,7 +41,11 @@ struct RobotSetup {
   std::map<std::string, double> preferred_posture;  // rad; unlisted joints: 0
   IkTolerance ik_tolerance;
   GripperSetup gripper;
+  std::vector<SensorEntry> sensors;  // the sensor table, in the file's order
 };
+
+// The row of `setup.sensors` publishing `type` (the first one), or nullptr.
+const SensorEntry* findSensorOfType(const RobotSetup& setup, const std::string& type);
 
 // Throws std::runtime_error naming the file and the missing or invalid key.
 RobotSetup loadRobotSetup(const std::string& path);

@@ -17,7 +17,10 @@ Conventions: every joint frame is aligned with its parent (no rotation offsets),
 about y, "R" about x, "Y" about z. In the zero pose the robot stands upright with the arms hanging
 and the gripper fingers pointing down. R_GRIPPER is the distance (m) of each finger pad from the
 gripper centre plane: 0 = closed, 0.045 = fully open (gap = 2 * R_GRIPPER).
-Run: /usr/bin/python3 lfd_sim_bridge/models/generate_models.py
+The robot's files and the scene it stands in are generated together because the scene includes the
+robot (a relative MJCF <include>) and pairs its finger pads with the table; a second robot has its
+own description package and its own scene of the same config/scene.yaml.
+Run: /usr/bin/python3 jvrc1_description/models/generate_models.py
 """
 
 import math
@@ -27,6 +30,8 @@ import sys
 import yaml
 
 HERE = os.path.dirname(os.path.abspath(__file__))
+# lfd_config's scene.yaml, beside this package in the source tree (the generator is a developer's
+# tool, run there; the installed package ships only its output).
 SCENE_FILE = os.path.join(HERE, '..', '..', 'config', 'scene.yaml')
 
 
