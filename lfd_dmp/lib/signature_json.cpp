@@ -9,7 +9,7 @@ using nlohmann::json;
 using namespace json_fields;
 
 json optionsJson(const lfd::SignatureOptions& o) {
-  return {{"phase_bins", o.phase_bins},      {"phase_slack", o.phase_slack},
+  return {{"phase_bins", o.phase_bins},      {"phase_slack", o.phase_slack}, {"time_slack", o.time_slack},
           {"persistence", o.persistence},    {"min_spread_fraction", o.min_spread_fraction},
           {"noise_sigmas", o.noise_sigmas},  {"threshold_margin", o.threshold_margin},
           {"min_threshold", o.min_threshold}};
@@ -28,6 +28,7 @@ lfd::SignatureOptions optionsFromJson(const json& j, const std::string& w) {
     fail(w + ".phase_bins", "must be a whole number in [2, 1000]");
   o.phase_bins = static_cast<std::size_t>(bins);
   o.phase_slack = nonNegative(j, "phase_slack", w);
+  o.time_slack = nonNegative(j, "time_slack", w);
   o.persistence = nonNegative(j, "persistence", w);
   o.min_spread_fraction = nonNegative(j, "min_spread_fraction", w);
   o.noise_sigmas = nonNegative(j, "noise_sigmas", w);

@@ -235,6 +235,7 @@ class Learner {
     pnh.param("signature/phase_bins", bins, bins);
     o.phase_bins = static_cast<std::size_t>(std::max(bins, 0));
     pnh.param("signature/phase_slack", o.phase_slack, o.phase_slack);
+    pnh.param("signature/time_slack_seconds", o.time_slack, o.time_slack);
     pnh.param("signature/persistence_seconds", o.persistence, o.persistence);
     pnh.param("signature/min_spread_fraction", o.min_spread_fraction, o.min_spread_fraction);
     pnh.param("signature/noise_sigmas", o.noise_sigmas, o.noise_sigmas);

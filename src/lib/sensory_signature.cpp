@@ -95,8 +95,9 @@ double task_range(const std::vector<SegmentedRecording>& demos, int column) {
   return hi - lo;
 }
 
-std::size_t slack_bins(const SignatureOptions& o) {
-  return static_cast<std::size_t>(std::ceil(o.phase_slack * static_cast<double>(o.phase_bins)));
+std::size_t slack_bins(const SignatureOptions& o, const SegmentSignature& segment) {
+  return static_cast<std::size_t>(
+      std::ceil(segment_slack(o, segment) * static_cast<double>(o.phase_bins)));
 }
 
 // Mean and spread per bin from the profiles of the demonstrations; the variance is pooled over
@@ -159,7 +160,7 @@ std::vector<SegmentSignature> expectations(const std::vector<SegmentedRecording>
         const std::vector<double> e = segment_edges(r);
         profiles.push_back(phase_profile(r, floors.columns[c], e[s], e[s + 1], o.phase_bins));
       }
-      out[s].channels.push_back(expectation(profiles, floors.floors[c], slack_bins(o)));
+      out[s].channels.push_back(expectation(profiles, floors.floors[c], slack_bins(o, out[s])));
     }
   }
   return out;
@@ -182,6 +183,7 @@ RawScores raw_scores(const std::vector<SegmentSignature>& segments,
     const int column = run.features.require(channels[c]);
     for (std::size_t s = 0; s < segments.size(); ++s) {
       SustainedDeviation sustained(o.persistence);
+      const double slack = segment_slack(o, segments[s]);
       const ChannelSignature& sig = segments[s].channels[c];
       for (Eigen::Index i = 0; i < run.features.rows(); ++i) {
         const double t = run.features.time_at(i) - t0;
@@ -189,7 +191,7 @@ RawScores raw_scores(const std::vector<SegmentSignature>& segments,
         const double phase = (t - edges[s]) / (edges[s + 1] - edges[s]);
         const double value = run.features.data(i, column);
         const double d =
-            sustained.push(t, deviation_at(sig, o.phase_bins, o.phase_slack, phase, value));
+            sustained.push(t, deviation_at(sig, o.phase_bins, slack, phase, value));
         if (d <= out.scores[s][c]) continue;
         out.scores[s][c] = d;
         const auto bin = std::min<Eigen::Index>(static_cast<Eigen::Index>(phase * o.phase_bins),
@@ -229,6 +231,7 @@ void check_signature_options(const SignatureOptions& o) {
                                 std::to_string(o.phase_bins));
   const std::pair<const char*, double> at_least_zero[] = {
       {"phase_slack", o.phase_slack},
+      {"time_slack", o.time_slack},
       {"persistence", o.persistence},
       {"min_spread_fraction", o.min_spread_fraction},
       {"noise_sigmas", o.noise_sigmas}};
@@ -259,6 +262,12 @@ SensorySignature learn_signature(const std::vector<SegmentedRecording>& demos,
   signature.segments = expectations(demos, floors, options);
   set_thresholds(demos, floors, channels, &signature);
   return signature;
+}
+
+double segment_slack(const SignatureOptions& options, const SegmentSignature& segment) {
+  return segment.duration_mean > 0
+             ? std::max(options.phase_slack, options.time_slack / segment.duration_mean)
+             : options.phase_slack;
 }
 
 double deviation_at(const ChannelSignature& channel, std::size_t phase_bins, double phase_slack,
@@ -309,9 +318,10 @@ Deviation SignatureMonitor::observe(std::size_t segment, double phase, double ti
   segment_ = segment;
   const SignatureOptions& o = signature_.options;
   Deviation worst;
+  const double slack = segment_slack(o, signature_.segments[segment]);
   for (std::size_t c = 0; c < recent_.size(); ++c) {
     const ChannelSignature& sig = signature_.segments[segment].channels[c];
-    const double d = deviation_at(sig, o.phase_bins, o.phase_slack, phase, values[c]);
+    const double d = deviation_at(sig, o.phase_bins, slack, phase, values[c]);
     const double score = recent_[c].push(time, d) / sig.threshold;
     if (c > 0 && score <= worst.score) continue;
     const auto bin = std::min<Eigen::Index>(

@@ -25,7 +25,8 @@ namespace lfd {
 
 struct SignatureOptions {
   std::size_t phase_bins = 50;        ///< resolution of the expected level along a segment
-  double phase_slack = 0.1;           ///< fraction of a segment: timing differences tolerated
+  double phase_slack = 0.1;           ///< fraction of a segment: timing differences tolerated ...
+  double time_slack = 0.5;            ///< ... and at least this many s (a boundary's placement)
   double persistence = 0.1;           ///< s a deviation must last (one noisy sample is no alarm)
   double min_spread_fraction = 0.05;  ///< spread >= this x the channel's range over the task
   double noise_sigmas = 3.0;          ///< spread >= this x the channel's measurement noise
@@ -72,6 +73,10 @@ struct SegmentedRecording {
 SensorySignature learn_signature(const std::vector<SegmentedRecording>& demos,
                                  const std::vector<std::string>& channels,
                                  const SignatureOptions& options = {});
+
+/// The phase slack of one segment: options.phase_slack, at least options.time_slack over the
+/// segment's mean duration (a boundary placed 0.3 s off shifts every event near it by 0.3 s).
+double segment_slack(const SignatureOptions& options, const SegmentSignature& segment);
 
 /// The worst sustained deviation of one channel's reading at `phase` of a segment, in spreads.
 double deviation_at(const ChannelSignature& channel, std::size_t phase_bins, double phase_slack,
