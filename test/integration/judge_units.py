@@ -430,6 +430,7 @@ class Response(object):
         self.segment_frames = ["object:stick / object:stick", "goal / goal"]
         self.segment_slope_ridges = [0.001, -1.0]
         self.extrapolation_distance, self.extrapolation_angle, self.outside_demo_range = 0.0, 0.0, False
+        self.monitored, self.max_anomaly_score, self.monitor_alarm = True, 0.4, ""
 
 
 class Records(unittest.TestCase):
@@ -438,6 +439,7 @@ class Records(unittest.TestCase):
         self.assertTrue(good["success"])
         self.assertAlmostEqual(good["time_ratio"], 1.5)
         self.assertAlmostEqual(good["overhead_ratio"], 1.2)
+        self.assertEqual((good["monitored"], good["max_anomaly_score"], good["monitor_alarm"]), (True, 0.4, ""))
         refused = report.goal_record(101, Response(success=False, error="unreachable"),
                                      {"success": True, "distance_m": 0.0})  # the object happened to be there
         self.assertFalse(refused["success"])
