@@ -52,10 +52,10 @@ void SensorChannels::readMessage(Source* s, const topic_tools::ShapeShifter& msg
     s->reader = std::make_unique<lfd::rosmsg::FieldReader>(schema, s->fields);
     s->reader_key = key;
   }
-  std::vector<std::uint8_t> bytes(msg.size());
-  ros::serialization::OStream stream(bytes.data(), static_cast<uint32_t>(bytes.size()));
+  s->bytes.resize(msg.size());
+  ros::serialization::OStream stream(s->bytes.data(), static_cast<uint32_t>(s->bytes.size()));
   msg.write(stream);
-  s->reader->read(bytes.data(), bytes.size());
+  s->reader->read(s->bytes.data(), s->bytes.size());
 }
 
 void SensorChannels::onMessage(Source* s, const topic_tools::ShapeShifter::ConstPtr& msg) {

@@ -9,9 +9,13 @@ using nlohmann::json;
 using namespace json_fields;
 
 json optionsJson(const lfd::SignatureOptions& o) {
-  return {{"phase_bins", o.phase_bins},      {"phase_slack", o.phase_slack}, {"time_slack", o.time_slack},
-          {"persistence", o.persistence},    {"min_spread_fraction", o.min_spread_fraction},
-          {"noise_sigmas", o.noise_sigmas},  {"threshold_margin", o.threshold_margin},
+  return {{"phase_bins", o.phase_bins},
+          {"phase_slack", o.phase_slack},
+          {"time_slack", o.time_slack},
+          {"persistence", o.persistence},
+          {"min_spread_fraction", o.min_spread_fraction},
+          {"noise_sigmas", o.noise_sigmas},
+          {"threshold_margin", o.threshold_margin},
           {"min_threshold", o.min_threshold}};
 }
 
@@ -24,16 +28,21 @@ double nonNegative(const json& j, const char* key, const std::string& where) {
 lfd::SignatureOptions optionsFromJson(const json& j, const std::string& w) {
   lfd::SignatureOptions o;
   const double bins = number(member(j, "phase_bins", w), w + ".phase_bins");
-  if (!(bins >= 2 && bins <= 1000) || bins != std::floor(bins))
-    fail(w + ".phase_bins", "must be a whole number in [2, 1000]");
+  if (bins != std::floor(bins) || !(bins >= 0 && bins <= 1e6))
+    fail(w + ".phase_bins", "must be a whole number");
   o.phase_bins = static_cast<std::size_t>(bins);
-  o.phase_slack = nonNegative(j, "phase_slack", w);
-  o.time_slack = nonNegative(j, "time_slack", w);
-  o.persistence = nonNegative(j, "persistence", w);
-  o.min_spread_fraction = nonNegative(j, "min_spread_fraction", w);
-  o.noise_sigmas = nonNegative(j, "noise_sigmas", w);
-  o.threshold_margin = nonNegative(j, "threshold_margin", w);
-  o.min_threshold = nonNegative(j, "min_threshold", w);
+  o.phase_slack = number(member(j, "phase_slack", w), w + ".phase_slack");
+  o.time_slack = number(member(j, "time_slack", w), w + ".time_slack");
+  o.persistence = number(member(j, "persistence", w), w + ".persistence");
+  o.min_spread_fraction = number(member(j, "min_spread_fraction", w), w + ".min_spread_fraction");
+  o.noise_sigmas = number(member(j, "noise_sigmas", w), w + ".noise_sigmas");
+  o.threshold_margin = number(member(j, "threshold_margin", w), w + ".threshold_margin");
+  o.min_threshold = number(member(j, "min_threshold", w), w + ".min_threshold");
+  try {
+    lfd::check_signature_options(o);  // the learner's own rule, one place
+  } catch (const std::invalid_argument& e) {
+    fail(w, e.what());
+  }
   return o;
 }
 

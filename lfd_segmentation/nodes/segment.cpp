@@ -15,6 +15,7 @@
 #include "lfd_core/safe_paths.hpp"
 #include "lfd_core/user_text.hpp"
 #include "lfd_segmentation/bag_features.hpp"
+#include "lfd_segmentation/cli_args.hpp"
 #include "lfd_segmentation/csv_features.hpp"
 #include "lfd_segmentation/segmentation_json.hpp"
 #include "lfd_segmentation/segmentation_params.hpp"
@@ -24,6 +25,9 @@
 #endif
 
 namespace {
+
+using lfd_segmentation::ends_with;
+using lfd_segmentation::split_list;
 
 const char* kUsage = R"(usage: segment [options] FILE...
   FILE                      demonstration bags (*.bag) or CSV files (header row, one row per sample);
@@ -60,22 +64,6 @@ const char* kUsage = R"(usage: segment [options] FILE...
   --output PATH             write the JSON there instead of stdout
 )";
 
-std::vector<std::string> split_list(const std::string& s) {
-  std::vector<std::string> out;
-  std::stringstream in(s);
-  std::string item;
-  while (std::getline(in, item, ',')) {
-    if (!item.empty()) out.push_back(item);
-  }
-  return out;
-}
-
-bool ends_with(const std::string& s, const std::string& suffix) {
-  return s.size() >= suffix.size() &&
-         s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
-}
-
-// --combination: empty = the config's, "all" = every method, else a comma list.
 std::vector<lfd::ProfileCombination> parse_combinations(const std::string& list) {
   std::vector<lfd::ProfileCombination> out;
   if (list == "all") {
@@ -112,10 +100,7 @@ Options parse_args(int argc, char** argv) {
   Options o;
   for (int k = 1; k < argc; ++k) {
     const std::string arg = argv[k];
-    auto value = [&]() -> std::string {
-      if (k + 1 >= argc) throw std::invalid_argument(arg + " needs a value");
-      return argv[++k];
-    };
+    auto value = [&] { return lfd_segmentation::option_value(argc, argv, &k); };
     auto number = [&]() -> double {
       const std::string v = value();
       try {

@@ -13,6 +13,7 @@
 #include "lfd_core/sensory_signature.hpp"
 #include "lfd_core/user_text.hpp"
 #include "lfd_segmentation/bag_features.hpp"
+#include "lfd_segmentation/cli_args.hpp"
 #include "lfd_segmentation/csv_features.hpp"
 #include "lfd_segmentation/segmentation_params.hpp"
 
@@ -21,6 +22,8 @@
 #endif
 
 namespace {
+
+using lfd_segmentation::split_list;
 
 const char* kUsage =
     R"(usage: signature [options] --demo FILE --boundaries LIST ... --run FILE --boundaries LIST ...
@@ -52,17 +55,6 @@ struct Options {
   std::vector<Recording> recordings;
 };
 
-std::vector<std::string> split_list(const std::string& s) {
-  std::vector<std::string> out;
-  std::size_t start = 0;
-  while (start <= s.size()) {
-    const std::size_t end = std::min(s.find(',', start), s.size());
-    if (end > start) out.push_back(s.substr(start, end - start));
-    start = end + 1;
-  }
-  return out;
-}
-
 std::vector<double> parse_times(const std::string& list) {
   std::vector<double> out;
   for (const std::string& item : split_list(list)) {
@@ -84,10 +76,7 @@ Options parse_args(int argc, char** argv) {
   Options o;
   for (int k = 1; k < argc; ++k) {
     const std::string arg = argv[k];
-    auto value = [&]() -> std::string {
-      if (k + 1 >= argc) throw std::invalid_argument(arg + " needs a value");
-      return argv[++k];
-    };
+    auto value = [&] { return lfd_segmentation::option_value(argc, argv, &k); };
     if (arg == "-h" || arg == "--help") {
       std::cout << kUsage;
       std::exit(0);
@@ -130,7 +119,7 @@ nlohmann::json run(const Options& o) {
   for (const Recording& r : o.recordings) {
     lfd::SegmentedRecording rec;
     rec.boundaries = r.boundaries;
-    if (is_bag(r.file)) {
+    if (lfd_segmentation::ends_with(r.file, ".bag")) {
       auto features =
           lfd_segmentation::read_bag_features(r.file, params.topics, params.rate, params.limits);
       if (channels.empty()) channels = features.sensor_features;

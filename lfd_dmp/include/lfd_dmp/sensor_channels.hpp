@@ -42,6 +42,7 @@ class SensorChannels {
     std::vector<std::size_t> channels;  ///< index in the signature of each field
     std::string reader_key;             ///< type + md5 the reader was made for
     std::unique_ptr<lfd::rosmsg::FieldReader> reader;
+    std::vector<std::uint8_t> bytes;  ///< the last message, serialized (reused: 200 Hz each)
     ros::Subscriber subscriber;
   };
   void onMessage(Source* source, const topic_tools::ShapeShifter::ConstPtr& msg);
