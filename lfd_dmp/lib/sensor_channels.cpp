@@ -39,6 +39,12 @@ SensorChannels::SensorChannels(ros::NodeHandle& nh, const lfd::SensorySignature&
   }
 }
 
+SensorChannels::~SensorChannels() {
+  // shutdown() waits for a callback of that subscription that is running; once all are shut
+  // down, no callback can touch the buffers destroyed after this body.
+  for (auto& s : sources_) s->subscriber.shutdown();
+}
+
 std::string SensorChannels::problem() const {
   std::lock_guard<std::mutex> lock(mutex_);
   return problem_;

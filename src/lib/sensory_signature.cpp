@@ -183,7 +183,6 @@ RawScores raw_scores(const std::vector<SegmentSignature>& segments,
     const int column = run.features.require(channels[c]);
     for (std::size_t s = 0; s < segments.size(); ++s) {
       SustainedDeviation sustained(o.persistence);
-      const double slack = segment_slack(o, segments[s]);
       const ChannelSignature& sig = segments[s].channels[c];
       for (Eigen::Index i = 0; i < run.features.rows(); ++i) {
         const double t = run.features.time_at(i) - t0;
@@ -191,7 +190,7 @@ RawScores raw_scores(const std::vector<SegmentSignature>& segments,
         const double phase = (t - edges[s]) / (edges[s + 1] - edges[s]);
         const double value = run.features.data(i, column);
         const double d =
-            sustained.push(t, deviation_at(sig, o.phase_bins, slack, phase, value));
+            sustained.push(t, deviation_at(segments, o, s, c, phase, value));
         if (d <= out.scores[s][c]) continue;
         out.scores[s][c] = d;
         const auto bin = std::min<Eigen::Index>(static_cast<Eigen::Index>(phase * o.phase_bins),
@@ -270,17 +269,44 @@ double segment_slack(const SignatureOptions& options, const SegmentSignature& se
              : options.phase_slack;
 }
 
-double deviation_at(const ChannelSignature& channel, std::size_t phase_bins, double phase_slack,
-                    double phase, double value) {
-  const double p = std::clamp(phase, 0.0, 1.0);
+namespace {
+
+// The smallest distance to the expected level over the phase bins [from, to] of one segment.
+double deviation_over(const ChannelSignature& channel, std::size_t phase_bins, double from,
+                      double to, double value) {
   const auto last = static_cast<long>(channel.mean.size()) - 1;
-  const auto lo =
-      std::clamp(static_cast<long>(std::floor((p - phase_slack) * phase_bins)), 0L, last);
-  const auto hi =
-      std::clamp(static_cast<long>(std::floor((p + phase_slack) * phase_bins)), 0L, last);
+  const auto bin = [&](double p) {
+    return std::clamp(static_cast<long>(std::floor(std::clamp(p, 0.0, 1.0) * phase_bins)), 0L,
+                      last);
+  };
   double best = std::numeric_limits<double>::infinity();
-  for (long b = lo; b <= hi; ++b)
+  for (long b = bin(from); b <= bin(to); ++b)
     best = std::min(best, std::abs(value - channel.mean[b]) / channel.spread[b]);
+  return best;
+}
+
+}  // namespace
+
+double deviation_at(const std::vector<SegmentSignature>& segments, const SignatureOptions& options,
+                    std::size_t segment, std::size_t channel, double phase, double value) {
+  const SegmentSignature& here = segments[segment];
+  const double slack = segment_slack(options, here);
+  const double p = std::clamp(phase, 0.0, 1.0);
+  double best = deviation_over(here.channels[channel], options.phase_bins, p - slack, p + slack,
+                               value);
+  // The part of the slack beyond this segment's edge, in seconds, then in the neighbour's phase.
+  const double before = (slack - p) * here.duration_mean;
+  if (before > 0 && segment > 0 && segments[segment - 1].duration_mean > 0) {
+    const SegmentSignature& previous = segments[segment - 1];
+    best = std::min(best, deviation_over(previous.channels[channel], options.phase_bins,
+                                         1.0 - before / previous.duration_mean, 1.0, value));
+  }
+  const double after = (p + slack - 1.0) * here.duration_mean;
+  if (after > 0 && segment + 1 < segments.size() && segments[segment + 1].duration_mean > 0) {
+    const SegmentSignature& next = segments[segment + 1];
+    best = std::min(best, deviation_over(next.channels[channel], options.phase_bins, 0.0,
+                                         after / next.duration_mean, value));
+  }
   return best;
 }
 
@@ -318,10 +344,9 @@ Deviation SignatureMonitor::observe(std::size_t segment, double phase, double ti
   segment_ = segment;
   const SignatureOptions& o = signature_.options;
   Deviation worst;
-  const double slack = segment_slack(o, signature_.segments[segment]);
   for (std::size_t c = 0; c < recent_.size(); ++c) {
     const ChannelSignature& sig = signature_.segments[segment].channels[c];
-    const double d = deviation_at(sig, o.phase_bins, slack, phase, values[c]);
+    const double d = deviation_at(signature_.segments, o, segment, c, phase, values[c]);
     const double score = recent_[c].push(time, d) / sig.threshold;
     if (c > 0 && score <= worst.score) continue;
     const auto bin = std::min<Eigen::Index>(

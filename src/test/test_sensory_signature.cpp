@@ -72,6 +72,29 @@ TEST(SensorySignature, NominalRunsRaiseNoAlarm) {
   }
 }
 
+// The segmentation validates a boundary at a sensory event, so a segment may start at full force.
+// Live, the segment's start comes from the plan: contact 0.4 s later than planned shows the
+// approach's level in the press segment, which the slack must accept across the boundary.
+TEST(SensorySignature, AnEventLateByLessThanTheTimeSlackAtABoundaryIsNoAlarm) {
+  std::vector<lfd::SegmentedRecording> demos;
+  for (unsigned k = 0; k < 5; ++k) {
+    demos.push_back(press_run(varied(k), 1000 + k));
+    for (double& b : demos.back().boundaries) b += 0.3;  // after the ramp: at full force / rest
+  }
+  const lfd::SensorySignature sig = lfd::learn_signature(demos, {"force_z", "gripper"});
+  ASSERT_GE(sig.options.time_slack, 0.45);
+  for (unsigned k = 0; k < 10; ++k) {
+    lfd::SegmentedRecording run = press_run(varied(60 + k), 6000 + k);
+    for (double& b : run.boundaries) b += 0.3 - 0.4;  // the plan's boundary, 0.4 s early
+    EXPECT_LT(worst_score(lfd::score_recording(sig, run)), 1.0) << "run " << k;
+    Press missed = varied(60 + k);
+    missed.level = 0.0;
+    lfd::SegmentedRecording no_force = press_run(missed, 6000 + k);
+    for (double& b : no_force.boundaries) b += 0.3 - 0.4;
+    EXPECT_GT(lfd::score_recording(sig, no_force)[1][0], 1.0) << "run " << k;
+  }
+}
+
 TEST(SensorySignature, APressWithoutForceIsFlaggedInThePressSegment) {
   const lfd::SensorySignature sig = learned(5);
   Press p = varied(77);

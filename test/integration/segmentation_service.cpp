@@ -127,7 +127,11 @@ TEST(SegmentationService, LinkSwappedToFifoNeverHangsTheNode) {
       [](const std::string& link) {
         lfd_msgs::Segment srv;
         srv.request.bag_paths = {link};
-        if (!ros::service::call("/segmentation/segment", srv))
+        // ros::service::call opens a new connection per call; at ~500 calls/s on a loaded CI
+        // machine one connection in a few thousand can fail in transport. The node answered
+        // if a second try on a fresh connection does; a dead or hung node fails both.
+        if (!ros::service::call("/segmentation/segment", srv) &&
+            !ros::service::call("/segmentation/segment", srv))
           throw std::runtime_error("the node died");
       },
       3.0, 2.0);

@@ -32,6 +32,12 @@ class SensorChannels {
   /// with "<source>/".
   SensorChannels(ros::NodeHandle& nh, const lfd::SensorySignature& signature, Callback callback);
 
+  /// Ends every subscription before any member goes: a message of one topic may be in its
+  /// callback while another topic's subscription ends (the executor's spinner has 4 threads).
+  ~SensorChannels();
+  SensorChannels(const SensorChannels&) = delete;
+  SensorChannels& operator=(const SensorChannels&) = delete;
+
   /// What could not be read so far (a message whose bytes or fields do not fit), "" = nothing.
   std::string problem() const;
 

@@ -78,9 +78,12 @@ SensorySignature learn_signature(const std::vector<SegmentedRecording>& demos,
 /// segment's mean duration (a boundary placed 0.3 s off shifts every event near it by 0.3 s).
 double segment_slack(const SignatureOptions& options, const SegmentSignature& segment);
 
-/// The worst sustained deviation of one channel's reading at `phase` of a segment, in spreads.
-double deviation_at(const ChannelSignature& channel, std::size_t phase_bins, double phase_slack,
-                    double phase, double value);
+/// How far one channel's reading at `phase` of `segment` is from what the demonstrations showed
+/// within the slack around it, in spreads. The slack reaches into the neighbouring segments: a
+/// boundary sits at a sensory event, so an event a little late in a run shows the previous
+/// segment's level just after the boundary.
+double deviation_at(const std::vector<SegmentSignature>& segments, const SignatureOptions& options,
+                    std::size_t segment, std::size_t channel, double phase, double value);
 
 /// A deviation that lasted: which segment and channel, when, expected versus measured.
 struct Deviation {

@@ -1,0 +1,130 @@
+// The executor's live sensor reader (lfd_dmp/sensor_channels.hpp) against a running master: any
+// message type read by field path, and a reader destroyed while messages of several topics arrive
+// on a multi-threaded spinner (the executor ends one per goal) never touches what it freed.
+#include <geometry_msgs/WrenchStamped.h>
+#include <gtest/gtest.h>
+#include <lfd_dmp/sensor_channels.hpp>
+#include <ros/ros.h>
+#include <std_msgs/Float64MultiArray.h>
+
+#include <atomic>
+#include <chrono>
+#include <mutex>
+#include <thread>
+
+namespace {
+
+constexpr double kForceZ = 7.5;
+constexpr double kLevel = -2.25;
+
+lfd::SensorySignature twoTopics() {
+  lfd::SensorySignature s;
+  s.channels = {"/channels_test/ft/wrench/force/z", "/channels_test/level/data/1"};
+  s.sources = {"/channels_test/ft", "/channels_test/level"};
+  return s;
+}
+
+// Publishes both topics at ~2 kHz each until destroyed.
+class Publishers {
+ public:
+  Publishers() {
+    ros::NodeHandle nh;
+    ft_ = nh.advertise<geometry_msgs::WrenchStamped>("/channels_test/ft", 100);
+    level_ = nh.advertise<std_msgs::Float64MultiArray>("/channels_test/level", 100);
+    thread_ = std::thread([this] {
+      geometry_msgs::WrenchStamped w;
+      w.wrench.force.z = kForceZ;
+      std_msgs::Float64MultiArray a;
+      a.data = {0.0, kLevel, 1.0};
+      while (!stop_) {
+        w.header.stamp = ros::Time::now();
+        ft_.publish(w);
+        level_.publish(a);
+        std::this_thread::sleep_for(std::chrono::microseconds(500));
+      }
+    });
+  }
+  ~Publishers() {
+    stop_ = true;
+    thread_.join();
+  }
+
+ private:
+  ros::Publisher ft_, level_;
+  std::atomic<bool> stop_{false};
+  std::thread thread_;
+};
+
+struct Readings {
+  std::mutex mutex;
+  int count = 0;
+  int wrong = 0;
+  void add(const Eigen::VectorXd& v) {
+    std::lock_guard<std::mutex> lock(mutex);
+    ++count;
+    if (v.size() != 2 || v[0] != kForceZ || v[1] != kLevel) ++wrong;
+  }
+};
+
+bool waitFor(const std::function<bool()>& condition, double seconds) {
+  const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
+  while (!condition()) {
+    if (std::chrono::steady_clock::now() > end) return false;
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  return true;
+}
+
+TEST(SensorChannels, ReadsEveryChannelOfAnyMessageTypeByItsFieldPath) {
+  Publishers publishers;
+  Readings readings;
+  ros::NodeHandle nh;
+  lfd_dmp::SensorChannels channels(nh, twoTopics(), [&](const ros::Time&, const Eigen::VectorXd& v) {
+    readings.add(v);
+  });
+  ASSERT_TRUE(waitFor(
+      [&] {
+        std::lock_guard<std::mutex> lock(readings.mutex);
+        return readings.count >= 20;
+      },
+      10.0));
+  EXPECT_EQ(readings.wrong, 0);
+  EXPECT_EQ(channels.problem(), "");
+}
+
+TEST(SensorChannels, DestroyedWhileMessagesArriveOnManyThreadsNeverTouchesWhatItFreed) {
+  Publishers publishers;
+  Readings readings;
+  ros::NodeHandle nh;
+  std::atomic<int> after_destruction{0};
+  for (int round = 0; round < 150; ++round) {
+    std::atomic<bool> destroyed{false};
+    {
+      lfd_dmp::SensorChannels channels(nh, twoTopics(),
+                                       [&](const ros::Time&, const Eigen::VectorXd& v) {
+                                         if (destroyed) ++after_destruction;
+                                         readings.add(v);
+                                         // a slow callback widens the window in which the other
+                                         // topic's subscription ends
+                                         std::this_thread::sleep_for(std::chrono::microseconds(300));
+                                       });
+      std::this_thread::sleep_for(std::chrono::milliseconds(10 + round % 7));
+    }
+    destroyed = true;
+  }
+  std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  EXPECT_EQ(after_destruction, 0);
+  EXPECT_GT(readings.count, 150);  // the rounds did read (each lives >= 10 ms at 2 kHz)
+  EXPECT_EQ(readings.wrong, 0);    // a freed buffer read back shows as a wrong value
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  testing::InitGoogleTest(&argc, argv);
+  ros::init(argc, argv, "sensor_channels_test");
+  ros::NodeHandle nh;
+  ros::AsyncSpinner spinner(4);  // as the executor: callbacks of different topics in parallel
+  spinner.start();
+  return RUN_ALL_TESTS();
+}
