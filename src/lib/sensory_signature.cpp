@@ -189,8 +189,7 @@ RawScores raw_scores(const std::vector<SegmentSignature>& segments,
         if (t < edges[s] || t > edges[s + 1]) continue;
         const double phase = (t - edges[s]) / (edges[s + 1] - edges[s]);
         const double value = run.features.data(i, column);
-        const double d =
-            sustained.push(t, deviation_at(segments, o, s, c, phase, value));
+        const double d = sustained.push(t, deviation_at(segments, o, s, c, phase, value));
         if (d <= out.scores[s][c]) continue;
         out.scores[s][c] = d;
         const auto bin = std::min<Eigen::Index>(static_cast<Eigen::Index>(phase * o.phase_bins),
@@ -292,8 +291,8 @@ double deviation_at(const std::vector<SegmentSignature>& segments, const Signatu
   const SegmentSignature& here = segments[segment];
   const double slack = segment_slack(options, here);
   const double p = std::clamp(phase, 0.0, 1.0);
-  double best = deviation_over(here.channels[channel], options.phase_bins, p - slack, p + slack,
-                               value);
+  double best =
+      deviation_over(here.channels[channel], options.phase_bins, p - slack, p + slack, value);
   // The part of the slack beyond this segment's edge, in seconds, then in the neighbour's phase.
   const double before = (slack - p) * here.duration_mean;
   if (before > 0 && segment > 0 && segments[segment - 1].duration_mean > 0) {

@@ -3,9 +3,9 @@
 // on a multi-threaded spinner (the executor ends one per goal) never touches what it freed.
 #include <geometry_msgs/WrenchStamped.h>
 #include <gtest/gtest.h>
-#include <lfd_dmp/sensor_channels.hpp>
 #include <ros/ros.h>
 #include <std_msgs/Float64MultiArray.h>
+#include <lfd_dmp/sensor_channels.hpp>
 
 #include <atomic>
 #include <chrono>
@@ -79,9 +79,8 @@ TEST(SensorChannels, ReadsEveryChannelOfAnyMessageTypeByItsFieldPath) {
   Publishers publishers;
   Readings readings;
   ros::NodeHandle nh;
-  lfd_dmp::SensorChannels channels(nh, twoTopics(), [&](const ros::Time&, const Eigen::VectorXd& v) {
-    readings.add(v);
-  });
+  lfd_dmp::SensorChannels channels(
+      nh, twoTopics(), [&](const ros::Time&, const Eigen::VectorXd& v) { readings.add(v); });
   ASSERT_TRUE(waitFor(
       [&] {
         std::lock_guard<std::mutex> lock(readings.mutex);
@@ -100,14 +99,14 @@ TEST(SensorChannels, DestroyedWhileMessagesArriveOnManyThreadsNeverTouchesWhatIt
   for (int round = 0; round < 150; ++round) {
     std::atomic<bool> destroyed{false};
     {
-      lfd_dmp::SensorChannels channels(nh, twoTopics(),
-                                       [&](const ros::Time&, const Eigen::VectorXd& v) {
-                                         if (destroyed) ++after_destruction;
-                                         readings.add(v);
-                                         // a slow callback widens the window in which the other
-                                         // topic's subscription ends
-                                         std::this_thread::sleep_for(std::chrono::microseconds(300));
-                                       });
+      lfd_dmp::SensorChannels channels(
+          nh, twoTopics(), [&](const ros::Time&, const Eigen::VectorXd& v) {
+            if (destroyed) ++after_destruction;
+            readings.add(v);
+            // a slow callback widens the window in which the other
+            // topic's subscription ends
+            std::this_thread::sleep_for(std::chrono::microseconds(300));
+          });
       std::this_thread::sleep_for(std::chrono::milliseconds(10 + round % 7));
     }
     destroyed = true;
