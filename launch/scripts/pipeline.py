@@ -403,16 +403,16 @@ def write_report(out, report):
         if not report.get(key):
             continue
         lines += ["## Reproduction toward unseen goals (%s)" % title, "",
-                  "| task | success | time ratio | mean object error | mean TCP error | note |",
-                  "| --- | --- | --- | --- | --- | --- |"]
+                  "| task | success | time ratio | mean object error | mean TCP error | monitor alarms | note |",
+                  "| --- | --- | --- | --- | --- | --- | --- |"]
         mm = lambda v: "-" if v is None else "%.1f mm" % (v * 1e3)  # noqa: E731
         for task, e in sorted(report[key].items()):
             goals = e.get("goals", [])
-            lines.append("| %s | %s | %s | %s | %s | %s |" % (
+            lines.append("| %s | %s | %s | %s | %s | %s | %s |" % (
                 task, "%d/%d" % (sum(g["success"] for g in goals), len(goals)) if goals else "-",
                 "-" if e.get("execution_time_ratio") is None else "%.2f" % e["execution_time_ratio"],
                 mm(e.get("mean_object_position_error_m")), mm(e.get("mean_tcp_position_error_m")),
-                (e.get("error") or "").replace("|", "/")))
+                records.monitor_summary(goals), (e.get("error") or "").replace("|", "/")))
         lines += ["", "Success (the task files): " + "; ".join(
             judge.describe_criteria(t, tasks.success_criterion(t)) for t in sorted(report[key]))
             + ". Time ratio: executed / mean demonstrated duration.", ""]
@@ -420,16 +420,18 @@ def write_report(out, report):
             if not e.get("goals"):
                 continue
             lines += ["%s, per goal%s:" % (task, records.ridges_note(e["goals"])), "",
-                      "| goal | result | object error | yaw error | TCP error | time ratio | planning | wall |",
-                      "| --- | --- | --- | --- | --- | --- | --- | --- |"]
+                      "| goal | result | object error | yaw error | TCP error | time ratio | planning | wall "
+                      "| anomaly score |",
+                      "| --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
             sec = lambda v: "-" if v is None else "%.2f s" % v  # noqa: E731
             for g in e["goals"]:
-                lines.append("| %d | %s | %s | %s | %s | %s | %s | %s |" % (
+                lines.append("| %d | %s | %s | %s | %s | %s | %s | %s | %s |" % (
                     g["id"], "ok" if g["success"] else "FAILED", mm(g["object_position_error_m"]),
                     "-" if g["object_yaw_error_rad"] is None else "%.3f rad" % g["object_yaw_error_rad"],
                     mm(g["tcp_position_error_m"]),
                     "-" if g["time_ratio"] is None else "%.3f" % g["time_ratio"],
-                    sec(g.get("planning_time_s")), sec(g.get("wall_time_s"))))
+                    sec(g.get("planning_time_s")), sec(g.get("wall_time_s")),
+                    "%.2f" % g["max_anomaly_score"] if g.get("monitored") else "-"))
             lines.append("")
     if report.get("figures"):
         lines += ["## Figures", ""]

@@ -98,6 +98,16 @@ def reproduction_record(library, library_summary, goals, error=None):
     return r
 
 
+def monitor_summary(goals):
+    """The execution monitor over a task's goals: "alarms/monitored (max score)", "-" when no goal
+    was monitored (monitoring off, or a library without a sensory signature)."""
+    monitored = [g for g in goals if g.get("monitored")]
+    if not monitored:
+        return "-"
+    return "%d/%d (max %.2f)" % (sum(bool(g.get("monitor_alarm")) for g in monitored), len(monitored),
+                                 max(g.get("max_anomaly_score", 0.0) for g in monitored))
+
+
 def reproduction_key(mode):
     """report.json's section of a mode's reproductions."""
     return "reproduction" if mode == "sim" else "reproduction_%s" % mode
