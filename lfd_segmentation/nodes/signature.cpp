@@ -102,10 +102,6 @@ Options parse_args(int argc, char** argv) {
   return o;
 }
 
-bool is_bag(const std::string& f) {
-  return f.size() > 4 && f.substr(f.size() - 4) == ".bag";
-}
-
 nlohmann::json deviation_json(const lfd::Deviation& d) {
   return {{"channel", d.channel_name}, {"time", d.time},         {"phase", d.phase},
           {"expected", d.expected},    {"measured", d.measured}, {"score", d.score}};

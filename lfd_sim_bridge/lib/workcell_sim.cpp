@@ -417,8 +417,15 @@ void WorkcellSim::setGripper(double opening, double max_effort) {
   }
   a.desired = clampTarget(a, opening / config_.gripper_opening_scale);
   a.effort_cap = max_effort > 0.0 ? std::min(max_effort, a.limit.effort) : a.limit.effort;
-  m_->actuator_forcerange[2 * a.actuator] = -a.effort_cap;
-  m_->actuator_forcerange[2 * a.actuator + 1] = a.effort_cap;
+  applyGripperEffort();
+}
+
+// The commanded force limit, times the grip a fault left (1 without one).
+void WorkcellSim::applyGripperEffort() {
+  if (gripper_ < 0) return;
+  const Actuated& a = actuated_[gripper_];
+  m_->actuator_forcerange[2 * a.actuator] = -a.effort_cap * grip_fraction_;
+  m_->actuator_forcerange[2 * a.actuator + 1] = a.effort_cap * grip_fraction_;
 }
 
 void WorkcellSim::computeControls() {
@@ -540,6 +547,8 @@ void WorkcellSim::readSensors(WorkcellState* s) {
         }
       }
     }
+    const auto frozen = frozen_readings_.find(g);
+    if (frozen != frozen_readings_.end()) r.values = frozen->second;
   }
 }
 
@@ -658,6 +667,7 @@ void WorkcellSim::reset(const std::map<std::string, double>& posture, bool reset
     }
   }
   applyPosture(posture);
+  clearFaults();
   d_->time = t;
   ActiveSimGuard guard(this, &log_);
   mj_forward(m_, d_);

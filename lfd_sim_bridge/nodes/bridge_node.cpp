@@ -25,6 +25,7 @@
 #include <geometry_msgs/TransformStamped.h>
 #include <geometry_msgs/TwistStamped.h>
 #include <lfd_msgs/GripperCommand.h>
+#include <lfd_msgs/InjectFault.h>
 #include <lfd_msgs/ResetSim.h>
 #include <lfd_msgs/SetScene.h>
 #include <lfd_msgs/StepSim.h>
@@ -42,6 +43,7 @@
 #include <deque>
 #include <map>
 #include <memory>
+#include <set>
 #include <string>
 #include <utility>
 #include <vector>
@@ -49,6 +51,7 @@
 #include "lfd_core/robot_setup.hpp"
 #include "lfd_core/ros_request_strings.hpp"
 #include "lfd_ros/master_watch.hpp"
+#include "lfd_sim_bridge/fault_schedule.hpp"
 #include "lfd_sim_bridge/sensor_publishers.hpp"
 #include "lfd_sim_bridge/sensor_table.hpp"
 #include "lfd_sim_bridge/workcell_sim.hpp"
@@ -294,6 +297,7 @@ class BridgeNode {
     scene_srv_ = nh.advertiseService("bridge/set_scene", &BridgeNode::onSetScene, this);
     pause_srv_ = nh.advertiseService("bridge/pause", &BridgeNode::onPause, this);
     step_srv_ = nh.advertiseService("bridge/step", &BridgeNode::onStep, this);
+    fault_srv_ = nh.advertiseService("bridge/inject_fault", &BridgeNode::onInjectFault, this);
 
     ROS_INFO(
         "bridge: %zu actuated joints, dt %.4f s, /clock every %ld steps, sensors every %ld "
@@ -348,6 +352,7 @@ class BridgeNode {
   void stepOnce() {
     applyDueGripperCommands();
     sim_->step();
+    applyDueFaults();
     ++step_count_;
     if (step_count_ % clock_every_ == 0) publishClock();
     if (step_count_ % publish_every_ == 0) publishState();
@@ -420,7 +425,8 @@ class BridgeNode {
       gripper_state_pub_.publish(gs);
     }
     for (size_t i = 0; i < sensor_pubs_.size(); ++i)
-      sensor_pubs_[i]->publish(state_.sensors[i], stamp);
+      if (!silenced_.count(state_.sensors[i].name))
+        sensor_pubs_[i]->publish(state_.sensors[i], stamp);
     if (ee_pose_pub_.getNumSubscribers() > 0) {
       geometry_msgs::PoseStamped p;
       p.header.stamp = stamp;
@@ -542,6 +548,8 @@ class BridgeNode {
       sim_->reset(posture, req.reset_objects);
       if (noise) sim_->setNoise(noise->noise, noise->seed);
       pending_gripper_.clear();  // a reset robot has no plan left
+      faults_.clear();           // and no fault (the workcell undid those in force)
+      silenced_.clear();
       publishState();
       res.success = true;
       res.message = "reset at t=" + std::to_string(sim_->time()) +
@@ -592,6 +600,43 @@ class BridgeNode {
       ROS_ERROR("/bridge/set_scene failed: %s", e.what());
     }
     return true;
+  }
+
+  // ---- fault injection (sim only; lfd_sim_bridge/fault_schedule.hpp) -------------------------
+  bool onInjectFault(lfd_msgs::InjectFault::Request& req, lfd_msgs::InjectFault::Response& res) {
+    try {
+      lfd::checkRequestStrings(req, strings_);
+      lfd_sim::Fault f;
+      f.kind = lfd_sim::faultKind(req.kind);
+      f.target = req.target;
+      f.at = req.at_time;
+      f.pose.position = {req.pose.position.x, req.pose.position.y, req.pose.position.z};
+      f.pose.orientation = {req.pose.orientation.w, req.pose.orientation.x, req.pose.orientation.y,
+                            req.pose.orientation.z};
+      f.value = req.value;
+      faults_.add(f, *sim_);
+      res.success = true;
+      res.message = "scheduled: " + lfd_sim::describeFault(f);
+    } catch (const std::exception& e) {
+      res.success = false;
+      res.message = e.what();
+      ROS_ERROR("/bridge/inject_fault failed: %s", e.what());
+    }
+    return true;
+  }
+
+  void applyDueFaults() {
+    for (const lfd_sim::Fault& f : faults_.takeDue(sim_->time())) {
+      try {
+        if (f.kind == lfd_sim::Fault::Kind::kSilenceSensor) silenced_.insert(f.target);
+        lfd_sim::applyFault(f, sim_.get());
+        ROS_WARN("bridge: fault injected at t=%.3f s: %s", sim_->time(),
+                 lfd_sim::describeFault(f).c_str());
+      } catch (const std::exception& e) {  // checked when scheduled; the scene may have changed
+        ROS_ERROR("bridge: fault not injected (%s): %s", lfd_sim::describeFault(f).c_str(),
+                  e.what());
+      }
+    }
   }
 
   bool onPause(std_srvs::SetBool::Request& req, std_srvs::SetBool::Response& res) {
@@ -650,7 +695,9 @@ class BridgeNode {
   std::vector<ros::Publisher> object_pubs_;
   tf2_ros::StaticTransformBroadcaster static_tf_;
   ros::Subscriber joint_command_sub_, trajectory_sub_, gripper_sub_;
-  ros::ServiceServer reset_srv_, scene_srv_, pause_srv_, step_srv_;
+  ros::ServiceServer reset_srv_, scene_srv_, pause_srv_, step_srv_, fault_srv_;
+  lfd_sim::FaultSchedule faults_;
+  std::set<std::string> silenced_;  // sensor table rows whose topic a fault stopped
   std::map<std::string, NoiseProfile> noise_profiles_;
 };
 

@@ -1,8 +1,11 @@
-// rostest: the bridge's services. Pause and step advance sim time by exactly steps x 1 ms and
-// announce it on /clock; set_scene places objects (read back on /objects/<name>/pose) and
+// rostest: the bridge's services (inject_fault: an object moved at its sim time, a sensor topic
+// silenced until a reset, a bad fault refused). Pause and step advance sim time by exactly steps x
+// 1 ms and announce it on /clock; set_scene places objects (read back on /objects/<name>/pose) and
 // rejects bad requests atomically; reset restores a posture and, on request, the objects, and
 // selects a noise profile.
+#include <geometry_msgs/WrenchStamped.h>
 #include <gtest/gtest.h>
+#include <lfd_msgs/InjectFault.h>
 #include <lfd_msgs/ResetSim.h>
 #include <lfd_msgs/SetScene.h>
 #include <lfd_msgs/StepSim.h>
@@ -10,6 +13,7 @@
 #include <sensor_msgs/JointState.h>
 #include <std_srvs/SetBool.h>
 
+#include <atomic>
 #include <cmath>
 
 #include "bridge_test_utils.hpp"
@@ -141,6 +145,72 @@ TEST_F(BridgeServices, SetScenePlacesObjects) {
   ASSERT_TRUE(waitFor(
       [&] { return probe_.objectPose("box", &box) && box.header.stamp.toSec() > t2; }, 10.0));
   EXPECT_NEAR(box.pose.position.x, 0.6, 0.005);
+}
+
+double stepBy(int steps) {
+  lfd_msgs::StepSim step;
+  step.request.steps = steps;
+  return call("/bridge/step", &step) && step.response.success ? step.response.sim_time : -1.0;
+}
+
+TEST_F(BridgeServices, InjectedFaultsHappenAtTheirSimTimeUntilAReset) {
+  std::atomic<double> last_wrench{-1.0};
+  const ros::Subscriber wrench = nh_.subscribe<geometry_msgs::WrenchStamped>(
+      "/wrist_ft", 10, [&](const geometry_msgs::WrenchStamped::ConstPtr& m) {
+        last_wrench = m->header.stamp.toSec();
+      });
+  ASSERT_TRUE(waitFor([&] { return last_wrench > 0; }, 10.0)) << "no /wrist_ft";
+  ASSERT_TRUE(setPaused(true));
+  lfd_msgs::SetScene scene;
+  scene.request.object_names = {"stick"};
+  scene.request.poses = {pose(0.45, -0.25, 0.815, 0.0)};
+  ASSERT_TRUE(call("/bridge/set_scene", &scene) && scene.response.success);
+  const double t0 = stepBy(0);
+  lfd_msgs::InjectFault move;
+  move.request.kind = "move_object";
+  move.request.target = "stick";
+  move.request.at_time = t0 + 0.1;
+  move.request.pose = pose(0.6, 0.2, 0.815, 0.0);
+  ASSERT_TRUE(call("/bridge/inject_fault", &move));
+  ASSERT_TRUE(move.response.success) << move.response.message;
+  geometry_msgs::PoseStamped stick;
+  const auto stick_at = [&](double stamp) {
+    return waitFor(
+        [&] {
+          return probe_.objectPose("stick", &stick) && stick.header.stamp.toSec() >= stamp - 1e-9;
+        },
+        10.0);
+  };
+  ASSERT_TRUE(stick_at(stepBy(50)));
+  EXPECT_NEAR(stick.pose.position.x, 0.45, 0.005);  // not yet
+  ASSERT_TRUE(stick_at(stepBy(100)));
+  EXPECT_NEAR(stick.pose.position.x, 0.6, 0.005);
+
+  lfd_msgs::InjectFault silence;
+  silence.request.kind = "silence_sensor";
+  silence.request.target = "/wrist_ft";
+  ASSERT_TRUE(call("/bridge/inject_fault", &silence) && silence.response.success);
+  const double silenced_at = stepBy(1);
+  ASSERT_TRUE(probe_.waitUntilSimTime(stepBy(200), 10.0));
+  ros::WallDuration(0.2).sleep();  // messages in flight
+  EXPECT_LE(last_wrench, silenced_at + 1e-9) << "/wrist_ft still published";
+
+  lfd_msgs::InjectFault bad;
+  bad.request.kind = "explode";
+  ASSERT_TRUE(call("/bridge/inject_fault", &bad));
+  EXPECT_FALSE(bad.response.success);
+  EXPECT_NE(bad.response.message.find("move_object"), std::string::npos) << bad.response.message;
+  bad.request.kind = "freeze_sensor";
+  bad.request.target = "/elbow_ft";
+  ASSERT_TRUE(call("/bridge/inject_fault", &bad));
+  EXPECT_FALSE(bad.response.success);
+  EXPECT_NE(bad.response.message.find("/elbow_ft"), std::string::npos) << bad.response.message;
+
+  lfd_msgs::ResetSim reset;
+  ASSERT_TRUE(call("/bridge/reset", &reset) && reset.response.success);
+  const double after_reset = stepBy(20);
+  EXPECT_TRUE(waitFor([&] { return last_wrench >= after_reset - 1e-9; }, 10.0))
+      << "/wrist_ft silent after the reset";
 }
 
 TEST_F(BridgeServices, ResetRestoresPostureAndObjects) {

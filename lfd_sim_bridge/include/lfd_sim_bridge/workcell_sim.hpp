@@ -178,6 +178,17 @@ class WorkcellSim {
   // pose is finite, inside the workspace and its quaternion unit within quaternion_tolerance.
   void checkObjectPose(const std::string& object, const Pose& pose_in_world) const;
 
+  // --- faults (sim only: tests and benchmarks of execution monitoring; lib/workcell_faults.cpp).
+  // reset() undoes every one. Each throws std::invalid_argument naming a bad target or value.
+  // The gripper's force limit becomes `fraction` (in [0, 1]) of the commanded one, from now on.
+  void weakenGrip(double fraction);
+  // The joint (e.g. the drawer's slide) stuck: under `holding_force` (N or N m, > 0) it creeps at
+  // 1 mm/s (1 mrad/s) at most. The model needs the Euler integrator (implicit damping).
+  void lockJoint(const std::string& joint, double holding_force);
+  // The sensor table row `group` repeats its current reading.
+  void freezeSensor(const std::string& group);
+  bool hasSensorGroup(const std::string& group) const;
+
   // --- readings ---
   WorkcellState readState();  // noisy if config.noise is non-zero
   // Replaces the readings noise and restarts its generator from `seed`: the noise that follows
@@ -259,6 +270,13 @@ class WorkcellSim {
   int freeJointOf(int body) const;   // the body's free joint, or -1
   void restoreMocap();
   int divergence_count_ = 0;
+  // Faults in force (undone by reset): the grip's fraction, the locked dofs' own damping,
+  // the frozen rows' readings (index in config_.sensors).
+  double grip_fraction_ = 1.0;
+  std::map<int, double> locked_dofs_;
+  std::map<std::size_t, std::vector<std::vector<double>>> frozen_readings_;
+  void applyGripperEffort();
+  void clearFaults();
   std::mt19937_64 rng_;
   bool noisy_ = false;
 };
