@@ -1,23 +1,49 @@
 #include "lfd_dmp/execution_monitor.hpp"
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
+#include <stdexcept>
 
 namespace lfd_dmp {
 
-std::string describeAlarm(const lfd::Deviation& d, const std::vector<PlannedSegment>& segments) {
-  char text[512];
-  const std::string segment =
-      d.segment < segments.size() ? segments[d.segment].name : std::to_string(d.segment);
+namespace {
+
+// "segment '<name>' at <phase>% (<t> s into the motion): " -- where every alarm happened.
+std::string where(std::size_t segment, double phase, double time,
+                  const std::vector<PlannedSegment>& segments) {
+  char text[256];
+  const std::string name =
+      segment < segments.size() ? segments[segment].name : std::to_string(segment);
   std::snprintf(text, sizeof(text),
-                "segment '%s' at %.0f%% (%.2f s into the motion): %s measured %.4g, the "
-                "demonstrations showed %.4g (anomaly score %.2f)",
-                segment.c_str(), 100.0 * d.phase, d.time, d.channel_name.c_str(), d.measured,
-                d.expected, d.score);
+                "segment '%s' at %.0f%% (%.2f s into the motion): ", name.c_str(), 100.0 * phase,
+                time);
   return text;
 }
 
-ExecutionMonitor::ExecutionMonitor(ros::NodeHandle& nh, lfd::SensorySignature signature)
-    : signature_(std::move(signature)), monitor_(signature_) {
+}  // namespace
+
+std::string describeAlarm(const lfd::Deviation& d, const std::vector<PlannedSegment>& segments) {
+  char text[384];
+  std::snprintf(text, sizeof(text),
+                "%s measured %.4g, the demonstrations showed %.4g (anomaly score %.2f)",
+                d.channel_name.c_str(), d.measured, d.expected, d.score);
+  return where(d.segment, d.phase, d.time, segments) + text;
+}
+
+std::string describeSilence(const Silence& s, const std::vector<PlannedSegment>& segments) {
+  char text[384];
+  std::snprintf(text, sizeof(text),
+                "%s silent for %.3f s (allowed %.3f s; its messages came every %.4f s)",
+                s.topic.c_str(), s.gap, s.allowed, s.period);
+  return where(s.segment, s.phase, s.time, segments) + text;
+}
+
+ExecutionMonitor::ExecutionMonitor(ros::NodeHandle& nh, lfd::SensorySignature signature,
+                                   double max_silence)
+    : signature_(std::move(signature)), max_silence_(max_silence), monitor_(signature_) {
+  if (!(max_silence > 0) || !std::isfinite(max_silence))
+    throw std::invalid_argument("max_silence must be finite and > 0");
   channels_ = std::make_unique<SensorChannels>(
       nh, signature_,
       [this](const ros::Time& stamp, const Eigen::VectorXd& values) { onReading(stamp, values); });
@@ -55,6 +81,32 @@ lfd::Deviation ExecutionMonitor::worst() const {
 std::optional<lfd::Deviation> ExecutionMonitor::alarm() const {
   std::lock_guard<std::mutex> lock(mutex_);
   return alarm_;
+}
+
+std::optional<Silence> ExecutionMonitor::silence(const ros::Time& now) const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (!active_ || now < t0_ || spans_.empty()) return std::nullopt;
+  const double t = (now - t0_).toSec();
+  if (t >= spans_.back().second) return std::nullopt;
+  // Ten periods: a stream may be late by a few messages (a lockstep chunk is 50 ms).
+  const double floor = max_silence_;
+  std::optional<Silence> worst;
+  for (const SensorChannels::Activity& a : channels_->activity()) {
+    Silence s;
+    s.topic = a.topic;
+    s.period = a.count > 1 ? (a.last - a.first).toSec() / static_cast<double>(a.count - 1) : 0.0;
+    s.allowed = std::max(floor, 10.0 * s.period);
+    const ros::Time since = a.count > 0 && a.last > t0_ ? a.last : t0_;
+    s.gap = (now - since).toSec();
+    if (a.count == 0) s.allowed = std::max(s.allowed, 2.0 * floor);  // no period known yet
+    if (s.gap <= s.allowed || (worst && s.gap / s.allowed <= worst->gap / worst->allowed)) continue;
+    s.time = t;
+    while (s.segment + 1 < spans_.size() && t >= spans_[s.segment].second) ++s.segment;
+    const auto [begin, end] = spans_[s.segment];
+    s.phase = (t - begin) / (end - begin);
+    worst = s;
+  }
+  return worst;
 }
 
 void ExecutionMonitor::onReading(const ros::Time& stamp, const Eigen::VectorXd& values) {

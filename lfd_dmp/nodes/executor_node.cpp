@@ -197,6 +197,9 @@ class Executor {
         param(pnh, "generalization/min_range_angle", options_.min_range_angle);
     monitoring_ = param(pnh, "monitoring/enabled", monitoring_);
     stop_on_alarm_ = param(pnh, "monitoring/stop_on_alarm", stop_on_alarm_);
+    max_silence_ = param(pnh, "monitoring/max_silence", max_silence_);
+    if (!(max_silence_ > 0.0))
+      throw std::runtime_error("executor: ~monitoring/max_silence must be > 0");
     settle_time_ = param(pnh, "settle_time", settle_time_);
     clock_timeout_ = param(pnh, "clock_timeout", clock_timeout_);
     motion_lead_ = param(pnh, "motion_lead", motion_lead_);
@@ -464,6 +467,7 @@ class Executor {
   void run(const lfd_dmp::ExecutionPlan& plan, lfd_msgs::ExecuteTaskResult* result) {
     waitForDriver(trajectory_pub_);
     if (!plan.gripper_events.empty()) waitForDriver(gripper_pub_);
+    waitForSensors(result);
     // The whole motion is sent ahead, stamped on the driver's clock: it runs at sim time whatever
     // the load, and a lockstep client only has to step.
     const ros::Time t0 = ros::Time::now() + ros::Duration(motion_lead_);
@@ -486,7 +490,7 @@ class Executor {
       if (goal_server_->isPreemptRequested() || !ros::ok()) stop(plan, t0, now);
       watch.check(now);
       const ros::Time measured = track(plan, t0);
-      checkMonitor(plan, t0, now, result);
+      checkMonitor(plan, t0, now, measured, result);
       if (now >= t_end) {
         if (feedback_.state != lfd_msgs::ExecuteTaskFeedback::SETTLING)
           setState(lfd_msgs::ExecuteTaskFeedback::SETTLING, plan);
@@ -531,20 +535,48 @@ class Executor {
     monitor_.reset();
     if (!monitoring_ || !library.sensory_signature) return;
     try {
-      monitor_ = std::make_unique<lfd_dmp::ExecutionMonitor>(nh_, *library.sensory_signature);
+      monitor_ = std::make_unique<lfd_dmp::ExecutionMonitor>(nh_, *library.sensory_signature,
+                                                             max_silence_);
       result->monitored = true;
     } catch (const std::invalid_argument& e) {
       result->warnings.push_back(std::string("not monitored: ") + e.what());
     }
   }
 
+  // `measured`: the latest joint state's stamp, the time the sensors' stamps are compared with.
+  // The monitor's topics connected before the motion starts (a lockstep client steps at once):
+  // else their first messages are lost and the sensor looks silent. A topic that no publisher
+  // serves within ~connect_timeout leaves the motion unmonitored, with a warning.
+  void waitForSensors(lfd_msgs::ExecuteTaskResult* result) {
+    const auto t0 = Clock::now();
+    while (monitor_ && !monitor_->unconnected().empty()) {
+      if (wallSince(t0) > connect_timeout_ || !ros::ok()) {
+        result->warnings.push_back("not monitored: no publisher of " +
+                                   monitor_->unconnected().front() + " within ~connect_timeout");
+        ROS_WARN("executor: %s", result->warnings.back().c_str());
+        monitor_.reset();
+        result->monitored = false;
+        return;
+      }
+      ros::WallDuration(0.01).sleep();
+    }
+  }
+
   void checkMonitor(const lfd_dmp::ExecutionPlan& plan, const ros::Time& t0, const ros::Time& now,
-                    lfd_msgs::ExecuteTaskResult* result) {
+                    const ros::Time& measured, lfd_msgs::ExecuteTaskResult* result) {
     if (!monitor_) return;
-    feedback_.anomaly_score = monitor_->worst().score;
-    const std::optional<lfd::Deviation> alarm = monitor_->alarm();
-    if (!alarm || !feedback_.monitor_alarm.empty()) return;
-    feedback_.monitor_alarm = result->monitor_alarm = lfd_dmp::describeAlarm(*alarm, plan.segments);
+    feedback_.anomaly_score = std::max(feedback_.anomaly_score, monitor_->worst().score);
+    if (!feedback_.monitor_alarm.empty()) return;
+    std::string text;
+    if (const std::optional<lfd::Deviation> alarm = monitor_->alarm()) {
+      text = lfd_dmp::describeAlarm(*alarm, plan.segments);
+    } else if (const std::optional<lfd_dmp::Silence> silent = monitor_->silence(measured)) {
+      text = lfd_dmp::describeSilence(*silent, plan.segments);
+      feedback_.anomaly_score = std::max(feedback_.anomaly_score, silent->gap / silent->allowed);
+    } else {
+      return;
+    }
+    feedback_.monitor_alarm = result->monitor_alarm = text;
     result->max_anomaly_score = feedback_.anomaly_score;
     publishFeedback();
     if (!stop_on_alarm_) {
@@ -560,7 +592,7 @@ class Executor {
   void endMonitor(lfd_msgs::ExecuteTaskResult* result) {
     if (!monitor_) return;
     monitor_->stop();
-    result->max_anomaly_score = monitor_->worst().score;
+    result->max_anomaly_score = std::max(feedback_.anomaly_score, monitor_->worst().score);
     if (!monitor_->problem().empty())
       result->warnings.push_back("monitor: sensor data not read: " + monitor_->problem());
     ROS_INFO("executor: monitored, worst anomaly score %.2f", result->max_anomaly_score);
@@ -675,6 +707,7 @@ class Executor {
   double trajectory_period_ = 0.01, feedback_period_ = 0.05;
   std::unique_ptr<lfd_dmp::TaskPlanner> planner_;
   bool monitoring_ = true, stop_on_alarm_ = false;
+  double max_silence_ = 2.0;                            // s (executor.yaml monitoring/max_silence)
   std::unique_ptr<lfd_dmp::ExecutionMonitor> monitor_;  // the current goal's
   tf2_ros::Buffer tf_buffer_;
   tf2_ros::TransformListener tf_listener_;

@@ -32,11 +32,7 @@ import subprocess
 import sys
 import time
 
-from lfd_tools import bags, judge, lockstep, master, report, tasks
-
-SETTLE_BEFORE_S = 0.3  # sim s after placing the objects, before executing
-SETTLE_AFTER_S = 1.0   # sim s for the objects to come to rest before they are judged
-
+from lfd_tools import bags, lockstep, master, report, reproduction, tasks
 
 def library_summary(path):
     """(mean demonstrated duration s, demos, segments) of a skill library."""
@@ -74,24 +70,18 @@ class BagRecording(object):
 def reproduce(cell, task, scene, library, demo_duration, args, record_path=None):
     """One unseen scene: a goal record (report.goal_record), judged with the task's success rules
     on what was measured during and after the motion (as a demonstration is judged)."""
-    criterion = tasks.success_criterion(task)
-    cell.set_scene(dict(tasks.parked(task), **scene["objects"]), SETTLE_BEFORE_S, scene.get("joints"))
-    recording = BagRecording(record_path, list(scene["objects"]) + list(tasks.parked(task))) \
-        if record_path else None
-    measured = cell.record(bags.topics_for(criterion))
+    recording = []
+
+    def start_recording():  # once the scene is placed: the bag shows the motion, not the reset
+        if record_path:
+            recording.append(BagRecording(record_path, list(scene["objects"]) + list(tasks.parked(task))))
+
     try:
-        res, wall = cell.execute(lockstep.execute_goal(library, scene, args.duration_scale,
-                                                       args.allow_extrapolation))
-        if res is None:
-            raise RuntimeError("the executor gave no result")
-        cell.advance(SETTLE_AFTER_S)
-        if not measured.wait_until(cell.now()):
-            raise RuntimeError("the final state was not published (%s)" % ", ".join(measured.messages))
+        res, wall, outcome = reproduction.execute_and_judge(
+            cell, task, scene, library, args.duration_scale, args.allow_extrapolation,
+            after_scene=start_recording)
     finally:
-        measured.close()
-        bag = recording.stop() if recording else None
-    outcome = judge.judge_rules(criterion, bags.measure(measured, criterion, tasks.base_in_world()),
-                                scene, tasks.table_top())
+        bag = recording[0].stop() if recording else None
     g = report.goal_record(scene["id"], res, outcome, demo_duration=demo_duration, wall_time=wall)
     if bag and res.success:  # sim times at which each segment ended (snapshots per segment)
         t = res.motion_start.to_sec()

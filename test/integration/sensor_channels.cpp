@@ -1,15 +1,18 @@
 // The executor's live sensor reader (lfd_dmp/sensor_channels.hpp) against a running master: any
 // message type read by field path, and a reader destroyed while messages of several topics arrive
-// on a multi-threaded spinner (the executor ends one per goal) never touches what it freed.
+// on a multi-threaded spinner (the executor ends one per goal) never touches what it freed. The
+// monitor (execution_monitor.hpp) names a source topic that stops during the motion.
 #include <geometry_msgs/WrenchStamped.h>
 #include <gtest/gtest.h>
 #include <ros/ros.h>
 #include <std_msgs/Float64MultiArray.h>
+#include <lfd_dmp/execution_monitor.hpp>
 #include <lfd_dmp/sensor_channels.hpp>
 
 #include <atomic>
 #include <chrono>
 #include <mutex>
+#include <optional>
 #include <thread>
 
 namespace {
@@ -27,6 +30,7 @@ lfd::SensorySignature twoTopics() {
 // Publishes both topics at ~2 kHz each until destroyed.
 class Publishers {
  public:
+  std::atomic<bool> level_on{true};
   Publishers() {
     ros::NodeHandle nh;
     ft_ = nh.advertise<geometry_msgs::WrenchStamped>("/channels_test/ft", 100);
@@ -39,7 +43,7 @@ class Publishers {
       while (!stop_) {
         w.header.stamp = ros::Time::now();
         ft_.publish(w);
-        level_.publish(a);
+        if (level_on) level_.publish(a);
         std::this_thread::sleep_for(std::chrono::microseconds(500));
       }
     });
@@ -115,6 +119,50 @@ TEST(SensorChannels, DestroyedWhileMessagesArriveOnManyThreadsNeverTouchesWhatIt
   EXPECT_EQ(after_destruction, 0);
   EXPECT_GT(readings.count, 150);  // the rounds did read (each lives >= 10 ms at 2 kHz)
   EXPECT_EQ(readings.wrong, 0);    // a freed buffer read back shows as a wrong value
+}
+
+// A signature of one 2 s segment whose levels are what Publishers sends: nothing deviates.
+lfd::SensorySignature quietSignature() {
+  lfd::SensorySignature s = twoTopics();
+  lfd::SegmentSignature segment;
+  segment.duration_mean = 2.0;
+  for (const double level : {kForceZ, kLevel}) {
+    lfd::ChannelSignature c;
+    c.mean = Eigen::VectorXd::Constant(50, level);
+    c.spread = Eigen::VectorXd::Ones(50);
+    c.threshold = 3.0;
+    segment.channels.push_back(c);
+  }
+  s.segments = {segment};
+  return s;
+}
+
+TEST(ExecutionMonitor, ATopicThatStopsDuringTheMotionIsNamedOnceSilentForMaxSilence) {
+  Publishers publishers;
+  ros::NodeHandle nh;
+  lfd_dmp::ExecutionMonitor monitor(nh, quietSignature(), 0.3);
+  lfd_dmp::ExecutionPlan plan;
+  plan.segments.resize(1);
+  plan.segments[0].name = "press";
+  plan.segments[0].duration = 3.0;
+  const ros::Time t0 = ros::Time::now();
+  monitor.start(plan, t0);
+  ros::WallDuration(0.5).sleep();
+  EXPECT_FALSE(monitor.silence(ros::Time::now())) << "both topics publish";
+  EXPECT_FALSE(monitor.alarm());
+  publishers.level_on = false;
+  const ros::Time stopped = ros::Time::now();
+  std::optional<lfd_dmp::Silence> silent;
+  ASSERT_TRUE(
+      waitFor([&] { return (silent = monitor.silence(ros::Time::now())).has_value(); }, 2.0));
+  EXPECT_EQ(silent->topic, "/channels_test/level");
+  EXPECT_LE((ros::Time::now() - stopped).toSec(), 0.4);
+  EXPECT_NEAR(silent->allowed, 0.3, 1e-9);  // 10 periods of ~0.5 ms are less than 0.3 s
+  const std::string text = lfd_dmp::describeSilence(*silent, plan.segments);
+  EXPECT_NE(text.find("'press'"), std::string::npos) << text;
+  EXPECT_NE(text.find("/channels_test/level silent"), std::string::npos) << text;
+  monitor.stop();
+  EXPECT_FALSE(monitor.silence(ros::Time::now())) << "a stopped monitor judges nothing";
 }
 
 }  // namespace

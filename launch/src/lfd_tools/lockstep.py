@@ -210,11 +210,15 @@ class Cell(object):
         gh, self.goal_handle = self.goal_handle, None
         return gh.get_result(), gh.get_goal_status()
 
-    def execute(self, goal, timeout=GOAL_TIMEOUT_S):
-        """Sends the goal and drives it to its end: (result, wall s); cancelled after `timeout`."""
+    def execute(self, goal, timeout=GOAL_TIMEOUT_S, on_moving=None):
+        """Sends the goal and drives it to its end: (result, wall s); cancelled after `timeout`.
+        on_moving(feedback): called once the motion is sent (feedback.motion_start), before any
+        of it is stepped (e.g. to schedule faults on its clock)."""
         started = time.time()
         self.send(goal)
-        if not self.drive(timeout=timeout):
+        if on_moving and self.drive(until=self.moving, timeout=timeout) and not self.done():
+            on_moving(next(f for f in self.feedback if f.state != f.PLANNING))
+        if not self.drive(timeout=max(1.0, timeout - (time.time() - started))):
             self.cancel()
             raise RuntimeError("the goal took over %.0f s of wall time; cancelled" % (time.time() - started))
         return self.result()[0], time.time() - started

@@ -22,11 +22,23 @@ namespace lfd_dmp {
 /// The alarm as one line: segment, sensor, expected versus measured, when.
 std::string describeAlarm(const lfd::Deviation& d, const std::vector<PlannedSegment>& segments);
 
+/// A source topic that stopped: no message for longer than it may be silent.
+struct Silence {
+  std::string topic;
+  double gap = 0.0;      ///< s since its last message (since the motion start if none came)
+  double allowed = 0.0;  ///< s: 10 of its mean periods, at least max_silence
+  double period = 0.0;   ///< s between its messages so far (0: fewer than 2)
+  std::size_t segment = 0;
+  double phase = 0.0, time = 0.0;  ///< where the motion is (s since its start)
+};
+std::string describeSilence(const Silence& s, const std::vector<PlannedSegment>& segments);
+
 class ExecutionMonitor {
  public:
   /// Subscribes to the signature's sources. Throws std::invalid_argument when the signature cannot
   /// be read live (no topic per channel).
-  ExecutionMonitor(ros::NodeHandle& nh, lfd::SensorySignature signature);
+  /// max_silence: s a source topic may go without a message (at least 10 of its periods).
+  ExecutionMonitor(ros::NodeHandle& nh, lfd::SensorySignature signature, double max_silence);
 
   /// Judges the readings of the motion of `plan` that starts at `t0` (segments in plan order,
   /// as many as the signature's: else std::invalid_argument).
@@ -36,6 +48,12 @@ class ExecutionMonitor {
   /// The worst reading so far (score: sustained deviation / threshold) and the first alarm.
   lfd::Deviation worst() const;
   std::optional<lfd::Deviation> alarm() const;
+  /// The source that has been silent the longest beyond what it may be, at `now` during the
+  /// motion; none before the start, after the end or while stopped. `now` is best the stamp of
+  /// the latest joint state: a loaded machine then delays both alike (the clock would run ahead).
+  std::optional<Silence> silence(const ros::Time& now) const;
+  /// The sensor topics not connected yet (SensorChannels::unconnected).
+  std::vector<std::string> unconnected() const { return channels_->unconnected(); }
   /// Sensor data that could not be read ("" = none).
   std::string problem() const { return channels_ ? channels_->problem() : ""; }
 
@@ -43,6 +61,7 @@ class ExecutionMonitor {
   void onReading(const ros::Time& stamp, const Eigen::VectorXd& values);
 
   lfd::SensorySignature signature_;
+  double max_silence_;
   lfd::SignatureMonitor monitor_;
   std::vector<std::pair<double, double>> spans_;  ///< each segment's [start, end) s of the motion
   ros::Time t0_;

@@ -38,6 +38,19 @@ class SensorChannels {
   SensorChannels(const SensorChannels&) = delete;
   SensorChannels& operator=(const SensorChannels&) = delete;
 
+  /// The source topics no publisher is connected to yet (roscpp connects in the background: a
+  /// motion started before that would lose its first messages).
+  std::vector<std::string> unconnected() const;
+
+  /// Each source topic's readable messages: their header stamps (their arrival on ros::Time
+  /// when they have none).
+  struct Activity {
+    std::string topic;
+    ros::Time first, last;  ///< zero before the first message
+    std::size_t count = 0;
+  };
+  std::vector<Activity> activity() const;
+
   /// What could not be read so far (a message whose bytes or fields do not fit), "" = nothing.
   std::string problem() const;
 
@@ -49,6 +62,8 @@ class SensorChannels {
     std::string reader_key;             ///< type + md5 the reader was made for
     std::unique_ptr<lfd::rosmsg::FieldReader> reader;
     std::vector<std::uint8_t> bytes;  ///< the last message, serialized (reused: 200 Hz each)
+    ros::Time first, last;            ///< stamps (Activity)
+    std::size_t count = 0;
     ros::Subscriber subscriber;
   };
   void onMessage(Source* source, const topic_tools::ShapeShifter::ConstPtr& msg);

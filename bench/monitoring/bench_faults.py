@@ -1,0 +1,191 @@
+#!/usr/bin/env python3
+"""Execution monitoring against injected faults (issue 25, "Detection"): how many faults the
+executor's monitor raises, how soon after the fault, and how well its anomaly score separates
+faulty runs from nominal ones (ROC AUC).
+
+Every goal runs once as it is (nominal) and once per fault that applies to its task, in MuJoCo
+through the bridge's /bridge/inject_fault (sim only). Nothing is chosen per task: the faults are
+derived from the skill library and the task file.
+  object_removed  the object of the first segment's goal frame goes to its park pose (config
+                  scene.yaml) halfway through that segment: the hand reaches for nothing.
+  grip_lost       the grip's force drops to 0 at 30% of the first segment whose demonstrations
+                  hold something (the pads loaded over most of it, from the sensory signature).
+  sensors_frozen  every sensor row of the signature repeats its reading from 0.3 s into the motion
+                  (a stale driver); detected only where the demonstrations sensed a change later.
+  sensors_silenced  every sensor row of the signature stops publishing at 30% of the first segment
+                  (a dead driver).
+  joint_locked    each scene joint of the task (the drawer's slide) is stuck from the start.
+Detection counts the sensor faults and the faulty runs whose task failed (judged by the task file's
+success rules, as a demonstration is); a fault of the world the task survived (a weak grip while
+pushing) is counted apart. Delay: sim s from the fault to the alarm (the alarm's "s into the motion"), for the faults with a
+moment (not sensors_frozen, which is wrong only once the sensors should have changed).
+
+  bench_faults.py --library-dir DIR [--mode sim] [--tasks grasp,drawer] [--goals N]
+                  [--attach] [--out result.json]
+"""
+import argparse
+import json
+import os
+import re
+import statistics
+import sys
+import time
+
+from lfd_tools import bags, lockstep, master, report, reproduction, tasks
+
+FROZEN_AT_S = 0.3
+SENSOR_FAULTS = ("sensors_frozen", "sensors_silenced")  # faults of the monitoring itself: always counted
+ALARM_TIME = re.compile(r"\(([-\d.]+) s into the motion\)")
+
+
+def held_segment(signature):
+    """The first segment in which the demonstrations' pads were loaded over most of the segment
+    (mean level above half of the pads' largest mean), or None."""
+    touch = [k for k, c in enumerate(signature["channels"]) if c.startswith(bags.touch_topic() + "/")]
+    if not touch:
+        return None
+    levels = [max(statistics.mean(seg["channels"][k]["mean"]) for k in touch) for seg in signature["segments"]]
+    top = max(levels)
+    for s, level in enumerate(levels):
+        if s > 0 and top > 0 and level > 0.5 * top:
+            return s
+    return None
+
+
+def faults_for(task, library, scene, durations):
+    """[(name, [InjectFault requests], offset s into the motion or None)] that apply to the task."""
+    from geometry_msgs.msg import Pose
+    from lfd_msgs.srv import InjectFaultRequest
+
+    def request(kind, target="", at=0.0, pose=None, value=0.0):
+        return InjectFaultRequest(kind=kind, target=target, at_time=at, pose=pose or Pose(), value=value)
+
+    def at(segment, fraction):
+        return sum(durations[:segment]) + fraction * durations[segment]
+
+    out = []
+    frame = library["segments"][0]["goal"]["position"]["frame"]  # object:<name>, heading:<name>, goal
+    obj = frame.split(":", 1)[1] if ":" in frame else None
+    if obj in tasks.scene()["objects"]:
+        park = lockstep.pose_msg(tasks.pose(tasks.scene()["objects"][obj]["park"]))
+        out.append(("object_removed", [request("move_object", obj, at(0, 0.5), park)], at(0, 0.5)))
+    held = held_segment(library["sensory_signature"])
+    if held is not None:
+        out.append(("grip_lost", [request("weaken_grip", at=at(held, 0.3), value=0.0)], at(held, 0.3)))
+    rows = sorted(set(library["sensory_signature"]["sources"]))
+    out.append(("sensors_frozen", [request("freeze_sensor", r, FROZEN_AT_S) for r in rows], None))
+    out.append(("sensors_silenced", [request("silence_sensor", r, at(0, 0.3)) for r in rows], at(0, 0.3)))
+    joints = list((scene.get("joints") or {}).keys())
+    if joints:
+        out.append(("joint_locked", [request("lock_joint", j, 0.0) for j in joints], 0.0))
+    return out
+
+
+def run_goal(cell, inject, task, scene, library_path, faults, offset):
+    """One goal with `faults` (requests with at_time relative to the motion start), judged by the
+    task's success rules: its record."""
+    def schedule(feedback):
+        t0 = feedback.motion_start.to_sec()
+        for f in faults:
+            f.at_time += t0
+            r = inject(f)
+            if not r.success:
+                raise RuntimeError("inject_fault: " + r.message)
+
+    res, _, outcome = reproduction.execute_and_judge(cell, task, scene, library_path, on_moving=schedule)
+    alarm = ALARM_TIME.search(res.monitor_alarm or "")
+    alarm_time = float(alarm.group(1)) if alarm else None
+    return {"monitored": res.monitored, "score": res.max_anomaly_score, "alarm": res.monitor_alarm,
+            "alarm_time_s": alarm_time, "fault_time_s": offset,
+            "delay_s": alarm_time - offset if alarm_time is not None and offset is not None else None,
+            "goal_succeeded": res.success, "task_succeeded": bool(res.success and outcome["success"]),
+            "judged": outcome["reason"], "error": res.error}
+
+
+def auc(negatives, positives):
+    """P(a faulty run scores above a nominal one), ties counting half."""
+    if not negatives or not positives:
+        return None
+    wins = sum((p > n) + 0.5 * (p == n) for p in positives for n in negatives)
+    return wins / (len(negatives) * len(positives))
+
+
+def summarize(runs):
+    """Detection over the sensor faults and the faults that made the task fail (one the task
+    survived, e.g. a weak grip while pushing, is counted apart); false alarms over the nominal runs."""
+    nominal = [r["score"] for r in runs if r["fault"] == "none"]
+    faulty = [r for r in runs if r["fault"] != "none" and (not r["task_succeeded"] or r["fault"] in SENSOR_FAULTS)]
+    by_fault = {}
+    for r in faulty:
+        by_fault.setdefault(r["fault"], []).append(r)
+    delays = [r["delay_s"] for r in faulty if r["delay_s"] is not None]
+    return {
+        "nominal_runs": len(nominal),
+        "nominal_task_failures": sum(not r["task_succeeded"] for r in runs if r["fault"] == "none"),
+        "harmless_faults": sum(r["fault"] not in ("none",) + SENSOR_FAULTS and r["task_succeeded"] for r in runs),
+        "harmless_faults_alarmed": sum(r["fault"] not in ("none",) + SENSOR_FAULTS and r["task_succeeded"] and
+                                       bool(r["alarm"]) for r in runs),
+        "false_alarms": sum(bool(r["alarm"]) for r in runs if r["fault"] == "none"),
+        "faulty_runs": len(faulty),
+        "detected": sum(bool(r["alarm"]) for r in faulty),
+        "detection_rate": sum(bool(r["alarm"]) for r in faulty) / len(faulty) if faulty else None,
+        "median_delay_s": statistics.median(delays) if delays else None,
+        "roc_auc": auc(nominal, [r["score"] for r in faulty]),
+        "per_fault": {f: {"runs": len(rs), "detected": sum(bool(r["alarm"]) for r in rs),
+                          "median_delay_s": statistics.median([r["delay_s"] for r in rs if r["delay_s"] is not None])
+                          if any(r["delay_s"] is not None for r in rs) else None}
+                      for f, rs in sorted(by_fault.items())},
+    }
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawTextHelpFormatter)
+    ap.add_argument("--library-dir", required=True)
+    ap.add_argument("--mode", default="sim")
+    ap.add_argument("--tasks", default=None, help="comma-separated (default: every task)")
+    ap.add_argument("--goals", type=int, default=5, help="unseen goals per task (the first N)")
+    ap.add_argument("--attach", action="store_true", help="use the nodes at ROS_MASTER_URI")
+    ap.add_argument("--out", default=None)
+    args = ap.parse_args()
+    lib_dir = os.path.abspath(args.library_dir)
+    names = [t for t in args.tasks.split(",") if t] if args.tasks else tasks.names()
+    results = {"runs": []}
+    with report.written_on_exit(args.out or os.path.join(lib_dir, "bench_faults.json"), results):
+        with master.graph_for_this_process(["lfd_launch", "reproduce.launch", "library_dir:=" + lib_dir],
+                                           args.attach):
+            cell = lockstep.Cell(node_name="bench_faults")
+            from lfd_msgs.srv import InjectFault
+            inject = cell.rospy.ServiceProxy("/bridge/inject_fault", InjectFault)  # up with the bridge
+            for task in names:
+                path = os.path.join(lib_dir, "%s_%s.json" % (task, args.mode))
+                with open(path) as f:
+                    library = json.load(f)
+                if "sensory_signature" not in library:
+                    print("%s: no sensory signature, skipped" % task, flush=True)
+                    continue
+                for scene in tasks.unseen_scenes(task, args.mode)[:args.goals]:
+                    reproduction.place_scene(cell, task, scene)
+                    plan, _ = cell.execute(lockstep.execute_goal(path, scene, dry_run=True))
+                    cases = [("none", [], None)] + faults_for(task, library, scene, list(plan.segment_durations))
+                    for name, faults, offset in cases:
+                        started = time.time()
+                        try:
+                            r = run_goal(cell, inject, task, scene, path, faults, offset)
+                        except RuntimeError as exc:
+                            r = {"monitored": False, "score": 0.0, "alarm": "", "alarm_time_s": None,
+                                 "fault_time_s": offset, "delay_s": None, "goal_succeeded": False,
+                                 "task_succeeded": False, "judged": "", "error": str(exc)}
+                        r.update(task=task, goal=scene["id"], fault=name)
+                        results["runs"].append(r)
+                        print("%-6s goal %3d %-16s %-7s score %6.2f %-6s delay %s  %.1f s  %s" % (
+                            task, scene["id"], name, "ok" if r["task_succeeded"] else "FAILED",
+                            r["score"], "ALARM" if r["alarm"] else "-",
+                            "-" if r["delay_s"] is None else "%.3f s" % r["delay_s"], time.time() - started,
+                            (r["alarm"] or r["error"])[:90]), flush=True)
+            results["summary"] = summarize(results["runs"])
+            print(json.dumps(results["summary"], indent=1))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(report.run_client(main))

@@ -1,0 +1,37 @@
+"""One reproduction in the simulated cell, judged as a demonstration is: the task's scene placed,
+the executor's goal driven in lockstep, the objects left to settle, and the task's success rules
+applied to what was measured (lfd_tools.judge). Shared by reproduce_goals.py and the monitoring
+benchmarks (which inject faults once the motion is sent)."""
+from lfd_tools import bags, judge, lockstep, tasks
+
+SETTLE_BEFORE_S = 0.3  # sim s after placing the objects, before executing
+SETTLE_AFTER_S = 1.0   # sim s for the objects to come to rest before they are judged
+
+
+def place_scene(cell, task, scene):
+    """The task's objects where the scene has them (the others parked), its joints at their start."""
+    cell.set_scene(dict(tasks.parked(task), **scene["objects"]), SETTLE_BEFORE_S, scene.get("joints"))
+
+
+def execute_and_judge(cell, task, scene, library, duration_scale=1.0, allow_extrapolation=False,
+                      after_scene=None, on_moving=None):
+    """(result, wall s, judged outcome). after_scene(): once the scene is placed (e.g. start a bag);
+    on_moving(feedback): once the motion is sent (lockstep.Cell.execute)."""
+    criterion = tasks.success_criterion(task)
+    place_scene(cell, task, scene)
+    if after_scene:
+        after_scene()
+    measured = cell.record(bags.topics_for(criterion))
+    try:
+        res, wall = cell.execute(lockstep.execute_goal(library, scene, duration_scale, allow_extrapolation),
+                                 on_moving=on_moving)
+        if res is None:
+            raise RuntimeError("the executor gave no result")
+        cell.advance(SETTLE_AFTER_S)
+        if not measured.wait_until(cell.now()):
+            raise RuntimeError("the final state was not published (%s)" % ", ".join(measured.messages))
+    finally:
+        measured.close()
+    outcome = judge.judge_rules(criterion, bags.measure(measured, criterion, tasks.base_in_world()),
+                                scene, tasks.table_top())
+    return res, wall, outcome
