@@ -8,6 +8,14 @@ SETTLE_BEFORE_S = 0.3  # sim s after placing the objects, before executing
 SETTLE_AFTER_S = 1.0   # sim s for the objects to come to rest before they are judged
 
 
+class NotJudged(RuntimeError):
+    """The goal ended but its outcome could not be measured; `result` is the executor's."""
+
+    def __init__(self, message, result):
+        RuntimeError.__init__(self, message)
+        self.result = result
+
+
 def place_scene(cell, task, scene):
     """The task's objects where the scene has them (the others parked), its joints at their start."""
     cell.set_scene(dict(tasks.parked(task), **scene["objects"]), SETTLE_BEFORE_S, scene.get("joints"))
@@ -29,7 +37,7 @@ def execute_and_judge(cell, task, scene, library, duration_scale=1.0, allow_extr
             raise RuntimeError("the executor gave no result")
         cell.advance(SETTLE_AFTER_S)
         if not measured.wait_until(cell.now()):
-            raise RuntimeError("the final state was not published (%s)" % ", ".join(measured.messages))
+            raise NotJudged("the final state was not published (%s)" % ", ".join(measured.messages), res)
     finally:
         measured.close()
     outcome = judge.judge_rules(criterion, bags.measure(measured, criterion, tasks.base_in_world()),
