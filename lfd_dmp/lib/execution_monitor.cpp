@@ -83,27 +83,33 @@ std::optional<lfd::Deviation> ExecutionMonitor::alarm() const {
   return alarm_;
 }
 
+std::pair<std::size_t, double> ExecutionMonitor::segmentAt(double t) const {
+  std::size_t s = 0;
+  while (s + 1 < spans_.size() && t >= spans_[s].second) ++s;
+  const auto [begin, end] = spans_[s];
+  return {s, (t - begin) / (end - begin)};
+}
+
 std::optional<Silence> ExecutionMonitor::silence(const ros::Time& now) const {
   std::lock_guard<std::mutex> lock(mutex_);
   if (!active_ || now < t0_ || spans_.empty()) return std::nullopt;
   const double t = (now - t0_).toSec();
   if (t >= spans_.back().second) return std::nullopt;
-  // Ten periods: a stream may be late by a few messages (a lockstep chunk is 50 ms).
-  const double floor = max_silence_;
+  const auto [segment, phase] = segmentAt(t);
   std::optional<Silence> worst;
   for (const SensorChannels::Activity& a : channels_->activity()) {
     Silence s;
     s.topic = a.topic;
     s.period = a.count > 1 ? (a.last - a.first).toSec() / static_cast<double>(a.count - 1) : 0.0;
-    s.allowed = std::max(floor, 10.0 * s.period);
+    // Ten periods: a stream may be late by a few messages (a lockstep chunk is 50 ms).
+    s.allowed = std::max(max_silence_, 10.0 * s.period);
     const ros::Time since = a.count > 0 && a.last > t0_ ? a.last : t0_;
     s.gap = (now - since).toSec();
-    if (a.count == 0) s.allowed = std::max(s.allowed, 2.0 * floor);  // no period known yet
+    if (a.count == 0) s.allowed = std::max(s.allowed, 2.0 * max_silence_);  // no period known yet
     if (s.gap <= s.allowed || (worst && s.gap / s.allowed <= worst->gap / worst->allowed)) continue;
     s.time = t;
-    while (s.segment + 1 < spans_.size() && t >= spans_[s.segment].second) ++s.segment;
-    const auto [begin, end] = spans_[s.segment];
-    s.phase = (t - begin) / (end - begin);
+    s.segment = segment;
+    s.phase = phase;
     worst = s;
   }
   return worst;
@@ -113,11 +119,9 @@ void ExecutionMonitor::onReading(const ros::Time& stamp, const Eigen::VectorXd& 
   std::lock_guard<std::mutex> lock(mutex_);
   if (!active_ || stamp < t0_) return;
   const double t = (stamp - t0_).toSec();
-  std::size_t s = 0;
-  while (s + 1 < spans_.size() && t >= spans_[s].second) ++s;
   if (t >= spans_.back().second) return;  // settling: no demonstration says what comes after
-  const auto [begin, end] = spans_[s];
-  const lfd::Deviation d = monitor_.observe(s, (t - begin) / (end - begin), t, values);
+  const auto [s, phase] = segmentAt(t);
+  const lfd::Deviation d = monitor_.observe(s, phase, t, values);
   if (d.score > worst_.score) worst_ = d;
   if (d.score > 1.0 && !alarm_) alarm_ = d;
 }

@@ -11,6 +11,7 @@
 #include <mutex>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "lfd_core/sensory_signature.hpp"
@@ -59,6 +60,8 @@ class ExecutionMonitor {
 
  private:
   void onReading(const ros::Time& stamp, const Eigen::VectorXd& values);
+  /// The segment of the motion at `t` s from its start and the phase in it (mutex_ held).
+  std::pair<std::size_t, double> segmentAt(double t) const;
 
   lfd::SensorySignature signature_;
   double max_silence_;
