@@ -20,6 +20,7 @@
 // contact_threshold, lead_in, tail, scene_settle, phase_rate, skip_existing, lockstep,
 // lockstep_chunk, lockstep_contact_chunk, physics_dt, tool/*, teleop/*.
 #include <atomic>
+#include <chrono>
 #include <cmath>
 #include <fstream>
 #include <iomanip>
@@ -56,6 +57,7 @@
 #include "lfd_sim_bridge/demo_plan.hpp"
 #include "lfd_sim_bridge/pose_msg.hpp"
 #include "lfd_sim_bridge/task_file.hpp"
+#include "lfd_sim_bridge/wall_profile.hpp"
 
 namespace {
 
@@ -111,6 +113,8 @@ struct DemoResult {
   double duration = 0.0;
   std::string final_state;  // where the task's objects and joints ended (logged, never judged)
   std::string error;
+  double wall = 0.0;                       // s of wall time the demo took, all included
+  lfd_sim_bridge::WallProfile wall_parts;  // the part of it each activity took
 };
 
 // One dataset being recorded: its job and its task, interpreted for its mode.
@@ -132,7 +136,7 @@ struct PhaseEnd {
 
 class Demonstrator {
  public:
-  Demonstrator(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh), tf_listener_(tf_buffer_) {
+  Demonstrator(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh) {
     seed_ = param(pnh, "seed", 1);
     const task::Scene scene = task::loadScene(required<std::string>(pnh, "scene_file"));
     robot_ = lfd::loadRobotSetup(required<std::string>(pnh, "robot_file"));
@@ -259,8 +263,11 @@ class Demonstrator {
     // The IK of the robot file (chain, costs, posture) for poses in base_link; base_link's
     // pose in the world comes from /tf_static.
     converter_ = std::make_unique<lfd::CartesianToJoints>(lfd::makeCartesianToJoints(urdf, robot_));
+    // A listener only for this lookup: kept, it would take in every /tf message of every demo.
+    tf2_ros::Buffer tf_buffer;
+    const tf2_ros::TransformListener tf_listener(tf_buffer);
     const geometry_msgs::TransformStamped w =
-        tf_buffer_.lookupTransform("world", "base_link", ros::Time(0), ros::Duration(30.0));
+        tf_buffer.lookupTransform("world", "base_link", ros::Time(0), ros::Duration(30.0));
     world_from_base_ = Eigen::Isometry3d::Identity();
     world_from_base_.translation() = Eigen::Vector3d(
         w.transform.translation.x, w.transform.translation.y, w.transform.translation.z);
@@ -311,6 +318,9 @@ class Demonstrator {
       result.error = "skipped (exists)";
       return result;
     }
+    using Clock = lfd_sim_bridge::WallProfile::Clock;
+    const Clock::time_point wall_start = Clock::now();
+    profile_ = &result.wall_parts;
     try {
       execute(c, &result);
     } catch (const std::exception& e) {
@@ -319,6 +329,8 @@ class Demonstrator {
                 mode().c_str(), c.id, e.what());
       stopRecordingIfActive();
     }
+    profile_ = nullptr;
+    result.wall = std::chrono::duration<double>(Clock::now() - wall_start).count();
     return result;
   }
 
@@ -340,7 +352,10 @@ class Demonstrator {
     // The dataset's first reset selects its mode's noise on the bridge (config/bridge.yaml
     // noise_profiles), restarting the noise generator: one launch or several, same noise.
     if (!noise_selected_) reset.request.noise_profile = mode();
-    call(reset_client_, reset);
+    {
+      const auto scope = measure("scene_calls");
+      call(reset_client_, reset);
+    }
     noise_selected_ = true;
     lfd_msgs::SetScene set;
     for (const task::SceneObject& o : scene().objects) {
@@ -349,7 +364,10 @@ class Demonstrator {
       set.request.poses.push_back(
           lfd_sim_bridge::toPoseMsg(used == c.objects.end() ? o.park : used->second));
     }
-    call(scene_client_, set);
+    {
+      const auto scope = measure("scene_calls");
+      call(scene_client_, set);
+    }
     advanceTo(now() + ros::Duration(settle_before_));
   }
 
@@ -408,7 +426,11 @@ class Demonstrator {
         teleop.enabled
             ? demo::Tremor(teleop.tremor_rms, teleop.tremor_low_hz, teleop.tremor_high_hz, rng())
             : demo::Tremor();
-    const double planned = checkReachable(state, start, q0);
+    double planned = 0.0;
+    {
+      const auto scope = measure("planning");
+      planned = checkReachable(state, start, q0);
+    }
 
     lfd_msgs::StartRecording start_rec;
     start_rec.request.bag_path = result->bag;
@@ -420,7 +442,10 @@ class Demonstrator {
     meta.mode = mode();
     meta.speed = speed;
     meta.extra_json = metadata(c, state, speed, tremor.rms(), planned);
-    call(start_client_, start_rec);
+    {
+      const auto scope = measure("recorder_calls");
+      call(start_client_, start_rec);
+    }
     recording_ = true;
     const ros::Time demo_start = meta.header.stamp;
     ROS_INFO("demonstrator: %s/%s configuration %d, speed %.2f, planned %.1f s -> %s",
@@ -433,8 +458,12 @@ class Demonstrator {
     double t0 = 0.0;
     for (size_t i = 0; i < definition().phases.size(); ++i) {
       const demo::Phase phase = dataset().interpreter->planPhase(state, i, from);
-      const lfd::JointPath path =
-          converter_->convert(demo::samplePhase(from, phase, sample_period_, t0, &tremor), seed);
+      lfd::JointPath path;
+      {
+        const auto scope = measure("planning");
+        path =
+            converter_->convert(demo::samplePhase(from, phase, sample_period_, t0, &tremor), seed);
+      }
       const PhaseEnd end = runPhase(phase, path);
       from = end.contact ? demo::phasePoseAt(from, phase, end.contact_time)
                          : phase.segments.back().target;
@@ -443,10 +472,13 @@ class Demonstrator {
     }
 
     advanceTo(now() + ros::Duration(tail_));
-    // The recorder stops at its newest /clock: let the last one (paused sim) reach it.
-    ros::WallDuration(0.02).sleep();
     lfd_msgs::StopRecording stop;
-    call(stop_client_, stop);
+    {
+      const auto scope = measure("recorder_calls");
+      // The recorder stops at its newest /clock: let the last one (paused sim) reach it.
+      ros::WallDuration(0.02).sleep();
+      call(stop_client_, stop);
+    }
     recording_ = false;
     {
       std::lock_guard<std::mutex> lock(phase_mutex_);
@@ -599,7 +631,12 @@ class Demonstrator {
       lfd_msgs::StepSim step;
       step.request.steps = static_cast<uint32_t>(std::lround(span / physics_dt_));
       if (step.request.steps == 0) break;
-      if (!step_client_.call(step) || !step.response.success)
+      bool stepped = false;
+      {
+        const auto scope = measure(fresh_sensors ? "contact_step_calls" : "step_calls");
+        stepped = step_client_.call(step);
+      }
+      if (!stepped || !step.response.success)
         throw std::runtime_error("/bridge/step failed: " + step.response.message);
       now_ = ros::Time(step.response.sim_time);
       publishPhaseGrid(now_);
@@ -609,6 +646,7 @@ class Demonstrator {
 
   // Lockstep: the sensors of the step just taken (for contact checks) reach this node.
   void waitForFreshSensors() {
+    const auto scope = measure("sensor_waits");
     const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(0.2);
     while (ros::ok() && ros::WallTime::now() < deadline) {
       {
@@ -624,6 +662,7 @@ class Demonstrator {
   // orders the two, so give the topic time to land before the bridge steps (3 ms was not always
   // enough on an idle machine, where a push demo once never moved the box).
   void letMessagesArrive() {
+    const auto scope = measure("settle_sleeps");
     if (lockstep_) ros::WallDuration(0.02).sleep();
   }
 
@@ -635,6 +674,11 @@ class Demonstrator {
   }
 
   // --- helpers ---
+  // Counts the scope's wall time for the demo being recorded (nothing between demos).
+  lfd_sim_bridge::WallProfile::Scope measure(const char* activity) {
+    return lfd_sim_bridge::WallProfile::Scope(profile_, activity);
+  }
+
   template <typename Srv>
   void call(ros::ServiceClient& client, Srv& srv) {
     if (!client.call(srv))
@@ -717,17 +761,18 @@ class Demonstrator {
       out << "  - {configuration: " << r.configuration << ", bag: " << demo::jsonString(r.bag)
           << ", recorded: " << (r.recorded ? "true" : "false") << ", duration: " << r.duration
           << ", final: " << (r.final_state.empty() ? "{}" : r.final_state)
-          << ", error: " << demo::jsonString(r.error) << "}\n";
+          << ", error: " << demo::jsonString(r.error) << ", wall: " << r.wall
+          << ", wall_parts: " << r.wall_parts.flowMap()
+          << ", wall_counts: " << r.wall_parts.countsFlowMap() << "}\n";
     }
   }
 
   ros::NodeHandle nh_;
-  tf2_ros::Buffer tf_buffer_;
-  tf2_ros::TransformListener tf_listener_;
   int seed_ = 1;
   std::vector<Dataset> datasets_;
-  const Dataset* dataset_ = nullptr;  // the one being recorded
-  bool noise_selected_ = false;       // its noise profile is selected on the bridge
+  const Dataset* dataset_ = nullptr;                // the one being recorded
+  bool noise_selected_ = false;                     // its noise profile is selected on the bridge
+  lfd_sim_bridge::WallProfile* profile_ = nullptr;  // the wall-time breakdown of the current demo
   double speed_min_, speed_max_, sample_period_, lead_in_, tail_, settle_before_, phase_period_,
       opening_scale_ = 2.0;
   bool skip_existing_ = true;
