@@ -23,7 +23,6 @@ moment (not sensors_frozen, which is wrong only once the sensors should have cha
   bench_faults.py --library-dir DIR [--mode sim] [--tasks grasp,drawer] [--goals N]
                   [--attach] [--out result.json]
 """
-import argparse
 import json
 import os
 import re
@@ -142,16 +141,11 @@ def summarize(runs):
 
 
 def main():
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawTextHelpFormatter)
-    ap.add_argument("--library-dir", required=True)
-    ap.add_argument("--mode", default="sim")
-    ap.add_argument("--tasks", default=None, help="comma-separated (default: every task)")
-    ap.add_argument("--goals", type=int, default=5, help="unseen goals per task (the first N)")
-    ap.add_argument("--attach", action="store_true", help="use the nodes at ROS_MASTER_URI")
+    ap = reproduction.goal_bench_parser(__doc__, goals=5)
     ap.add_argument("--out", default=None)
     args = ap.parse_args()
     lib_dir = os.path.abspath(args.library_dir)
-    names = [t for t in args.tasks.split(",") if t] if args.tasks else tasks.names()
+    names = reproduction.selected_tasks(args.tasks)
     results = {"runs": []}
     with report.written_on_exit(args.out or os.path.join(lib_dir, "bench_faults.json"), results):
         with master.graph_for_this_process(["lfd_launch", "reproduce.launch", "library_dir:=" + lib_dir],

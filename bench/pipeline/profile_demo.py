@@ -27,63 +27,16 @@ import shutil
 import subprocess
 import sys
 import tempfile
-import threading
 import time
 
 import yaml
 
+from lfd_tools.processes import CpuSampler
+
 ROOT = os.path.abspath(os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", ".."))
 GENERATE = os.path.join(ROOT, "lfd_sim_bridge", "scripts", "generate_datasets.py")
-TICKS = os.sysconf("SC_CLK_TCK")
 BRIDGE_LINE = re.compile(r"wall time since the last reset, (\d+) steps: (\{.*\})")
 ROS_STAMP = re.compile(r"^\[ *\w+\] \[(\d+\.\d+)(?:, (\d+\.\d+))?\]: (.*)$")
-
-
-def descendants(root_pid):
-    """pid -> (name, user s, system s) of root_pid's process tree now."""
-    children, stats = {}, {}
-    for entry in os.listdir("/proc"):
-        if not entry.isdigit():
-            continue
-        try:
-            with open("/proc/%s/stat" % entry) as f:
-                text = f.read()
-        except OSError:
-            continue
-        name = text[text.index("(") + 1:text.rindex(")")]
-        fields = text[text.rindex(")") + 2:].split()
-        children.setdefault(int(fields[1]), []).append(int(entry))
-        stats[int(entry)] = (name, int(fields[11]) / TICKS, int(fields[12]) / TICKS)
-    tree, todo = {}, [root_pid]
-    while todo:
-        pid = todo.pop()
-        if pid in stats:
-            tree[pid] = stats[pid]
-        todo.extend(children.get(pid, []))
-    return tree
-
-
-class CpuSampler(threading.Thread):
-    """Keeps the last CPU reading of every process of a tree (a process's times stay readable
-    until it exits; the sample before that is at most one period old)."""
-
-    def __init__(self, root_pid, period=0.2):
-        super().__init__(daemon=True)
-        self.root_pid, self.period, self.last = root_pid, period, {}
-        self.done = threading.Event()
-
-    def run(self):
-        while not self.done.is_set():
-            self.last.update(descendants(self.root_pid))
-            self.done.wait(self.period)
-
-    def by_name(self):
-        totals = {}
-        for name, user, system in self.last.values():
-            t = totals.setdefault(name, [0.0, 0.0])
-            t[0] += user
-            t[1] += system
-        return totals
 
 
 def demo_summaries(out):
@@ -140,8 +93,7 @@ def main():
     sampler.start()
     output = proc.communicate()[0]
     wall = time.time() - start
-    sampler.done.set()
-    sampler.join()
+    sampler.stop()
     if proc.returncode != 0:
         print(output[-3000:])
         sys.exit("generate_datasets.py failed (exit %d)" % proc.returncode)
@@ -167,7 +119,7 @@ def main():
         "bridge_parts_s": bridge_parts,
         "step_handshake_s": handshake,
         "cpu_s": {name: {"user": round(u, 2), "system": round(s, 2)}
-                  for name, (u, s) in sorted(sampler.by_name().items(), key=lambda kv: -sum(kv[1]))},
+                  for name, (u, s) in sampler.by_name().items()},
     }
     print("%d demos of %s: %.1f s of sim time in %.1f s wall (%.1fx real time overall, %.1fx within "
           "the demos)" % (len(demos), args.dataset, sim_s, wall, sim_s / wall, sim_s / max(demo_wall, 1e-9)))

@@ -7,6 +7,8 @@ executor knows no simulator (it follows sim time); this client does.
 No rospy timeout is used while paused: rospy's run on sim time, which stands still until this
 client steps. Every wait here is bounded in wall time.
 """
+import collections
+import contextlib
 import time
 
 STEP_CHUNK = 50  # physics steps (1 ms) per /bridge/step call while a goal moves
@@ -116,6 +118,8 @@ class Cell(object):
                 raise RuntimeError("the executor's action /executor/execute did not come up in 120 s")
             time.sleep(0.01)
         self.goal_handle, self.feedback = None, []
+        # Wall s and calls by activity since the last take_wall() (bench/pipeline/profile_reproduction.py).
+        self.wall, self.calls = collections.Counter(), collections.Counter()
         self.srv["/bridge/pause"](data=lockstep)
         self.sim_time = self.step(1) if lockstep else None
         while rospy.Time.now().is_zero():
@@ -132,8 +136,26 @@ class Cell(object):
                 and any(c.callerid_pub == server for c in a.result_sub.impl.connections)
                 and any(c.callerid_pub == server for c in a.feedback_sub.impl.connections))
 
+    @contextlib.contextmanager
+    def timed(self, activity):
+        """Counts the block's wall time under `activity` (nested blocks count in both)."""
+        start = time.perf_counter()
+        try:
+            yield
+        finally:
+            self.wall[activity] += time.perf_counter() - start
+            self.calls[activity] += 1
+
+    def take_wall(self):
+        """({activity: wall s}, {activity: calls}) since the last call; the counters restart."""
+        taken = dict(self.wall), dict(self.calls)
+        self.wall.clear()
+        self.calls.clear()
+        return taken
+
     def step(self, steps):
-        r = self.srv["/bridge/step"](steps=steps)
+        with self.timed("step_calls"):
+            r = self.srv["/bridge/step"](steps=steps)
         if not r.success:
             raise RuntimeError("/bridge/step: " + r.message)
         self.sim_time = r.sim_time
@@ -158,12 +180,14 @@ class Cell(object):
         """Resets the robot and the objects (the articulated joints {name: value} at their start),
         places {name: pose}, lets them settle (sim s)."""
         joints = joints or {}
-        r = self.srv["/bridge/reset"](joint_names=list(joints), positions=[float(v) for v in joints.values()],
-                                      reset_objects=True)
+        with self.timed("scene_calls"):
+            r = self.srv["/bridge/reset"](joint_names=list(joints), positions=[float(v) for v in joints.values()],
+                                          reset_objects=True)
         if not r.success:
             raise RuntimeError("reset failed: " + r.message)
-        s = self.srv["/bridge/set_scene"](object_names=list(placed),
-                                          poses=[pose_msg(p) for p in placed.values()])
+        with self.timed("scene_calls"):
+            s = self.srv["/bridge/set_scene"](object_names=list(placed),
+                                              poses=[pose_msg(p) for p in placed.values()])
         if not s.success:
             raise RuntimeError("set_scene failed: " + s.message)
         self.advance(settle)
@@ -215,10 +239,16 @@ class Cell(object):
         on_moving(feedback): called once the motion is sent (feedback.motion_start), before any
         of it is stepped (e.g. to schedule faults on its clock)."""
         started = time.time()
-        self.send(goal)
-        if on_moving and self.drive(until=self.moving, timeout=timeout) and not self.done():
+        with self.timed("planning"):  # until the executor has planned and sent the motion (or ended)
+            self.send(goal)
+            driven = self.drive(until=self.moving, timeout=timeout)
+        if driven and on_moving and not self.done():
             on_moving(next(f for f in self.feedback if f.state != f.PLANNING))
-        if not self.drive(timeout=max(1.0, timeout - (time.time() - started))):
+        stepped_before = self.wall["step_calls"]
+        with self.timed("motion"):
+            driven = driven and self.drive(timeout=max(1.0, timeout - (time.time() - started)))
+        self.wall["motion_step_calls"] += self.wall["step_calls"] - stepped_before
+        if not driven:
             self.cancel()
             raise RuntimeError("the goal took over %.0f s of wall time; cancelled" % (time.time() - started))
         return self.result()[0], time.time() - started

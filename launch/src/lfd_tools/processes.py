@@ -4,6 +4,7 @@ roslaunch's nodes leave their parent's group and outlive it when roslaunch is ki
 import contextlib
 import os
 import signal
+import threading
 import time
 
 TAG_VAR = "LFD_PIPELINE_TAG"  # <pipeline pid>:<stage>, inherited by everything a stage starts
@@ -71,3 +72,55 @@ def session_processes(sid):
         if int(fields[3]) == sid and fields[0] != "Z":
             pids.append(int(entry))
     return pids
+
+
+def tree_cpu(root_pid):
+    """{pid: (command name, user s, system s)} of root_pid and every process below it now."""
+    ticks = os.sysconf("SC_CLK_TCK")
+    children, stats = {}, {}
+    for entry in os.listdir("/proc"):
+        if not entry.isdigit():
+            continue
+        try:
+            with open("/proc/%s/stat" % entry) as f:
+                text = f.read()
+        except OSError:
+            continue
+        name, fields = text[text.index("(") + 1:text.rindex(")")], text[text.rindex(")") + 2:].split()
+        children.setdefault(int(fields[1]), []).append(int(entry))
+        stats[int(entry)] = (name, int(fields[11]) / ticks, int(fields[12]) / ticks)
+    tree, todo = {}, [root_pid]
+    while todo:
+        pid = todo.pop()
+        if pid in stats:
+            tree[pid] = stats[pid]
+        todo.extend(children.get(pid, []))
+    return tree
+
+
+class CpuSampler(threading.Thread):
+    """The CPU time of every process of a tree, sampled until stop(): each process's last reading
+    is kept (a process that exits loses at most one period of it)."""
+
+    def __init__(self, root_pid, period=0.2):
+        threading.Thread.__init__(self, daemon=True)
+        self.root_pid, self.period, self.last = root_pid, period, {}
+        self._done = threading.Event()
+
+    def run(self):
+        while not self._done.is_set():
+            self.last.update(tree_cpu(self.root_pid))
+            self._done.wait(self.period)
+
+    def stop(self):
+        self._done.set()
+        self.join()
+
+    def by_name(self):
+        """{command name: [user s, system s]}, largest total first."""
+        totals = {}
+        for name, user, system in self.last.values():
+            t = totals.setdefault(name, [0.0, 0.0])
+            t[0] += user
+            t[1] += system
+        return dict(sorted(totals.items(), key=lambda kv: -sum(kv[1])))
