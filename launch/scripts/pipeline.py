@@ -363,6 +363,8 @@ def problems(report):
 
 def write_report(out, report):
     lines = ["# lfd pipeline report", ""]
+    if "robot" in report:
+        lines += ["Robot: %s (package %s_description)" % (report["robot"], report["robot"]), ""]
     if "datasets" in report:
         lines += ["## Datasets", "", "| dataset | demos |", "| --- | --- |"]
         lines += ["| %s | %d |" % (n, d["demos"]) for n, d in sorted(report["datasets"].items())]
@@ -464,6 +466,9 @@ def main():
                          "reproduces the simulated tasks; teleop adds ~3.5 min")
     ap.add_argument("--force", action="store_true",
                     help="learn and reproduce again even where results exist")
+    ap.add_argument("--robot", default=config.robot_name(),
+                    help="the robot, a <robot>_description package (default $LFD_ROBOT or %s); "
+                         "every stage's launch files and tools use it" % config.DEFAULT_ROBOT)
     ap.add_argument("--jobs", type=int, default=0,
                     help="independent simulations / figure jobs at once (0 = one per core)")
     # roslaunch (launch/pipeline.launch) appends __name:= / __log:= remappings: not ours.
@@ -476,6 +481,13 @@ def main():
     if bad:
         say("error: unknown dataset(s) %s; known: %s" % (",".join(bad), ",".join(datasets)))
         return 2
+
+    try:
+        config.robot_dir(args.robot)
+    except RuntimeError as exc:
+        say("error: %s" % exc)
+        return 2
+    os.environ["LFD_ROBOT"] = args.robot  # every launch file and tool started from here reads it
 
     out = os.path.abspath(args.out)
     try:
@@ -499,6 +511,11 @@ def main():
     if os.path.exists(report_path):
         with contextlib.suppress(ValueError, OSError):
             report = json.load(open(report_path))
+    if report.get("robot", args.robot) != args.robot:
+        say("error: %s holds results of robot %s, not %s: choose another --out"
+            % (out, report["robot"], args.robot))
+        return 2
+    report["robot"] = args.robot
     report.setdefault("timings", {})
     report["stage_errors"] = {}  # this run's
     status = 0

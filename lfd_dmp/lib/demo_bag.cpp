@@ -127,7 +127,9 @@ void readMessages(rosbag::Bag& bag, const std::string& path, const DemoBagTopics
     } else {
       const auto msg = lfd::instantiateChecked<sensor_msgs::JointState>(m, index, path);
       if (!msg) continue;
-      const auto it = std::find(msg->name.begin(), msg->name.end(), topics.gripper_joint);
+      const auto it = topics.gripper_joint.empty()
+                          ? msg->name.begin()
+                          : std::find(msg->name.begin(), msg->name.end(), topics.gripper_joint);
       if (it == msg->name.end()) continue;
       const size_t i = static_cast<size_t>(it - msg->name.begin());
       if (i >= msg->position.size() || !std::isfinite(msg->position[i])) continue;

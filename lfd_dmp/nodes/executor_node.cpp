@@ -264,7 +264,7 @@ class Executor {
   }
 
   std::string cartesianFrame() const {
-    return robot_.cartesian_frame.empty() ? robot_.base_link : robot_.cartesian_frame;
+    return robot_.poseFrame();
   }
 
   // ---- the request -----------------------------------------------------------------------------

@@ -16,8 +16,9 @@
 //   clock_rate            Hz (sim time) of /clock; also how often commands are polled
 //   start_paused, headless, use_urdf_limits
 //   rtf_report_period     wall seconds between "real-time factor" INFO lines (0 = never)
-//   initial_posture, kp, kd, damping_ratio, velocity_limits, default_velocity_limit,
-//   effort_limits, default_effort_limit, gravity_compensation, gripper_opening_scale,
+//   kp, kd, damping_ratio, velocity_limits, default_velocity_limit,
+//   effort_limits, default_effort_limit, gravity_compensation,
+//   (the ready posture and the gripper's opening scale are the robot file's)
 //   objects, max_abs_velocity, touch_time_constant (see WorkcellConfig)
 //   noise_profiles        {name: {seed, joint_position, ...}}: readings noise (SensorNoise)
 //   noise_profile         the profile at startup; a /bridge/reset request may select another
@@ -134,10 +135,11 @@ lfd_sim::WorkcellConfig loadConfig(ros::NodeHandle& pnh, const lfd::RobotSetup& 
                                    const std::vector<lfd_sim::SensorBinding>& sensors) {
   lfd_sim::WorkcellConfig c;
   c.gripper_joint = robot.gripper.joint;
-  c.base_body = robot.cartesian_frame.empty() ? robot.base_link : robot.cartesian_frame;
+  c.base_body = robot.poseFrame();
   c.ee_site = robot.tip_link;
   c.sensors = lfd_sim::sensorGroups(sensors);
-  c.initial_posture = mapParam(pnh, "initial_posture");
+  c.initial_posture = robot.initial_posture;
+  c.gripper_opening_scale = robot.gripper.opening_scale;
   c.kp = mapParam(pnh, "kp");
   c.kd = mapParam(pnh, "kd");
   c.velocity_limits = mapParam(pnh, "velocity_limits");
@@ -147,7 +149,6 @@ lfd_sim::WorkcellConfig loadConfig(ros::NodeHandle& pnh, const lfd::RobotSetup& 
   c.default_velocity_limit = param(pnh, "default_velocity_limit", c.default_velocity_limit);
   c.default_effort_limit = param(pnh, "default_effort_limit", c.default_effort_limit);
   c.gravity_compensation = param(pnh, "gravity_compensation", c.gravity_compensation);
-  c.gripper_opening_scale = param(pnh, "gripper_opening_scale", c.gripper_opening_scale);
   c.objects = param(pnh, "objects", c.objects);
   c.max_abs_velocity = param(pnh, "max_abs_velocity", c.max_abs_velocity);
   c.touch_time_constant = param(pnh, "touch_time_constant", c.touch_time_constant);

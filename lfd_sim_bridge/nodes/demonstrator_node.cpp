@@ -180,7 +180,6 @@ class Demonstrator {
     contact_chunk_ = param(pnh, "lockstep_contact_chunk", 0.01);
     physics_dt_ = param(pnh, "physics_dt", 0.001);
     publish_period_ = 1.0 / nh.param("/bridge/publish_rate", 200.0);
-    opening_scale_ = nh.param("/bridge/gripper_opening_scale", 2.0);
 
     trajectory_pub_ = nh.advertise<trajectory_msgs::JointTrajectory>("joint_trajectory", 10);
     gripper_pub_ = nh.advertise<lfd_msgs::GripperCommand>("gripper/command", 10);
@@ -260,14 +259,14 @@ class Demonstrator {
     std::string urdf;
     if (!nh_.getParam("/robot_description", urdf))
       throw std::runtime_error("/robot_description is not set (launch sim.launch)");
-    // The IK of the robot file (chain, costs, posture) for poses in base_link; base_link's
+    // The IK of the robot file (chain, costs, posture) for poses in its pose frame; that frame's
     // pose in the world comes from /tf_static.
     converter_ = std::make_unique<lfd::CartesianToJoints>(lfd::makeCartesianToJoints(urdf, robot_));
     // A listener only for this lookup: kept, it would take in every /tf message of every demo.
     tf2_ros::Buffer tf_buffer;
     const tf2_ros::TransformListener tf_listener(tf_buffer);
     const geometry_msgs::TransformStamped w =
-        tf_buffer.lookupTransform("world", "base_link", ros::Time(0), ros::Duration(30.0));
+        tf_buffer.lookupTransform("world", robot_.poseFrame(), ros::Time(0), ros::Duration(30.0));
     world_from_base_ = Eigen::Isometry3d::Identity();
     world_from_base_.translation() = Eigen::Vector3d(
         w.transform.translation.x, w.transform.translation.y, w.transform.translation.z);
@@ -342,7 +341,7 @@ class Demonstrator {
       // Closed before recording starts: a closing transient at the start would only mislead the
       // feature selection.
       reset.request.joint_names.push_back(robot_.gripper.joint);
-      reset.request.positions.push_back(robot_.gripper.close_opening / opening_scale_);
+      reset.request.positions.push_back(robot_.gripper.close_opening / robot_.gripper.opening_scale);
     }
     for (const std::string& joint : definition().joints(scene())) {
       const auto q = c.joints.find(joint);
@@ -773,8 +772,7 @@ class Demonstrator {
   const Dataset* dataset_ = nullptr;                // the one being recorded
   bool noise_selected_ = false;                     // its noise profile is selected on the bridge
   lfd_sim_bridge::WallProfile* profile_ = nullptr;  // the wall-time breakdown of the current demo
-  double speed_min_, speed_max_, sample_period_, lead_in_, tail_, settle_before_, phase_period_,
-      opening_scale_ = 2.0;
+  double speed_min_, speed_max_, sample_period_, lead_in_, tail_, settle_before_, phase_period_;
   bool skip_existing_ = true;
   lfd::RobotSetup robot_;
   std::unique_ptr<lfd::CartesianToJoints> converter_;

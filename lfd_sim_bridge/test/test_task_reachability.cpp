@@ -1,9 +1,9 @@
 // Every task file (config/tasks/*.yaml) follows the protocol -- counts, unseen goals inside the
 // demonstrated range and different from every demonstration, parked objects out of the way -- and
 // every path the demonstrator plans for any of its scenes, demonstrated or unseen, sim or teleop,
-// whatever the per-demo variation draws, is reachable by the IK of the robot file
-// (jvrc1_description) along a continuous branch with margin from the joint limits (as the
-// demonstrator converts it).
+// whatever the per-demo variation draws, is reachable by the IK of each robot's robot file
+// (jvrc1_description: the humanoid, arm7_description: the 7-DoF arm) along a continuous branch with
+// margin from the joint limits (as the demonstrator converts it).
 #include <gtest/gtest.h>
 
 #include <dirent.h>
@@ -11,6 +11,7 @@
 #include <cmath>
 #include <fstream>
 #include <iterator>
+#include <map>
 #include <random>
 #include <set>
 #include <string>
@@ -26,8 +27,21 @@ namespace task = lfd_sim_bridge::task;
 
 namespace {
 
-const std::string kModelDir = LFD_SIM_MODEL_DIR;
 const std::string kConfig = std::string(LFD_CONFIG_DIR) + "/";
+
+// One robot description package: its robot file and its URDF.
+struct RobotCase {
+  std::string name;
+  std::string dir;   // the package's folder (models/, config/robot.yaml)
+  std::string urdf;  // URDF file name in models/
+  std::string robotFile() const { return dir + "/config/robot.yaml"; }
+  std::string urdfPath() const { return dir + "/models/" + urdf; }
+};
+
+std::ostream& operator<<(std::ostream& os, const RobotCase& r) { return os << r.name; }
+
+const std::vector<RobotCase> kRobots = {{"jvrc1", LFD_JVRC1_ROBOT_DIR, "jvrc1_like.urdf"},
+                                        {"arm7", LFD_ARM7_ROBOT_DIR, "arm7.urdf"}};
 
 std::vector<std::string> taskNames() {
   std::vector<std::string> names;
@@ -43,24 +57,38 @@ std::vector<std::string> taskNames() {
   return names;
 }
 
+// The task files themselves (robot-independent).
 class TaskFiles : public ::testing::Test {
+ protected:
+  void SetUp() override { scene_ = task::loadScene(kConfig + "scene.yaml"); }
+  task::Scene scene_;
+};
+
+// Per-task tally of the reachability check.
+struct TaskTally {
+  size_t paths = 0, samples = 0;
+  double worst_margin = 1e9;
+};
+
+// The task files on one robot.
+class TaskReach : public ::testing::TestWithParam<RobotCase> {
  protected:
   void SetUp() override {
     scene_ = task::loadScene(kConfig + "scene.yaml");
-    robot_ = lfd::loadRobotSetup(std::string(LFD_ROBOT_FILE));
-    std::ifstream f(kModelDir + "/jvrc1_like.urdf");
+    robot_ = lfd::loadRobotSetup(GetParam().robotFile());
+    std::ifstream f(GetParam().urdfPath());
     urdf_.assign(std::istreambuf_iterator<char>(f), {});
-    min_margin_ =
-        YAML::LoadFile(std::string(LFD_ROBOT_FILE))["ik"]["min_limit_margin"].as<double>();
+    ASSERT_FALSE(urdf_.empty()) << GetParam().urdfPath();
+    min_margin_ = YAML::LoadFile(GetParam().robotFile())["ik"]["min_limit_margin"].as<double>();
     world_from_base_.translation() = scene_.base_in_world;
   }
 
-  // The demonstrator's start: the bridge's ready posture (config/bridge.yaml).
+  // The demonstrator's start: the robot file's ready posture.
   Eigen::VectorXd ready(const lfd::KinematicChain& chain) const {
     Eigen::VectorXd q = Eigen::VectorXd::Zero(chain.dof());
-    for (const auto& kv : YAML::LoadFile(kConfig + "bridge.yaml")["initial_posture"]) {
-      const int i = chain.jointIndex(kv.first.as<std::string>());
-      if (i >= 0) q[i] = kv.second.as<double>();
+    for (const auto& [joint, value] : robot_.initial_posture) {
+      const int i = chain.jointIndex(joint);
+      if (i >= 0) q[i] = value;
     }
     return q;
   }
@@ -68,7 +96,7 @@ class TaskFiles : public ::testing::Test {
   // Plans and converts one scene's demonstration like the demonstrator; every sample within the
   // IK tolerance (convert throws otherwise), the margin kept, no jump between samples.
   void expectReachable(const task::TaskDefinition& t, const task::Configuration& c, bool teleop,
-                       uint32_t seed, const std::string& what) {
+                       uint32_t seed, const std::string& what, TaskTally* tally) {
     demo::TeleopStyle style;
     style.enabled = teleop;
     const demo::TaskInterpreter in(t, scene_, robot_.gripper, demo::ToolGeometry{}, style);
@@ -79,6 +107,7 @@ class TaskFiles : public ::testing::Test {
     std::mt19937 rng(seed);
     const demo::DemoPlan plan = in.planAll(in.begin(c, world_from_base_, start, 1.0, rng));
     demo::Pose from = start;
+    ++tally->paths;
     for (const demo::Phase& phase : plan.phases) {
       lfd::JointPath path;
       try {
@@ -87,9 +116,11 @@ class TaskFiles : public ::testing::Test {
         ADD_FAILURE() << what << " phase " << phase.name << ": " << e.what();
         return;
       }
+      tally->samples += path.positions.size();
       for (size_t k = 0; k < path.positions.size(); ++k) {
         const double margin = chain.limitMargin(path.positions[k]);
         worst_margin_ = std::min(worst_margin_, margin);
+        tally->worst_margin = std::min(tally->worst_margin, margin);
         if (margin < min_margin_) {
           int worst = 0;
           (path.positions[k] - chain.lowerLimits())
@@ -167,23 +198,31 @@ TEST_F(TaskFiles, CountsAndUnseenGoalsFollowTheProtocol) {
   }
 }
 
-TEST_F(TaskFiles, EveryPlannedPathIsReachableWithMargin) {
+TEST_P(TaskReach, EveryPlannedPathIsReachableWithMargin) {
+  std::map<std::string, TaskTally> tallies;
   for (const std::string& name : taskNames()) {
     const task::TaskDefinition t =
         task::loadTask(task::taskFilePath(kConfig + "tasks", name), scene_);
+    TaskTally& tally = tallies[name];
     for (const std::string mode : {"sim", "teleop"}) {
       for (const auto* list : {&t.configurations.at(mode), &t.unseen.at(mode)}) {
         for (const task::Configuration& c : *list) {
           for (uint32_t seed : {1u, 2u}) {  // the per-demo variation and the operator's draws
             expectReachable(t, c, mode == "teleop", seed,
-                            name + "." + mode + " id " + std::to_string(c.id));
+                            GetParam().name + ": " + name + "." + mode + " id " + std::to_string(c.id),
+                            &tally);
             if (HasFailure()) return;
           }
         }
       }
     }
   }
-  std::printf("task paths: smallest joint-limit margin %.3f rad\n", worst_margin_);
+  for (const auto& [name, tally] : tallies)
+    std::printf("%s %s: %zu paths, %zu IK samples, smallest joint-limit margin %.3f rad\n",
+                GetParam().name.c_str(), name.c_str(), tally.paths, tally.samples,
+                tally.worst_margin);
+  std::printf("%s task paths: smallest joint-limit margin %.3f rad\n", GetParam().name.c_str(),
+              worst_margin_);
 }
 
 TEST_F(TaskFiles, ParkedObjectsAreOnTheTableAndOutOfTheWorkspace) {
@@ -200,14 +239,17 @@ TEST_F(TaskFiles, ParkedObjectsAreOnTheTableAndOutOfTheWorkspace) {
   }
 }
 
-TEST(TaskReachability, IkRefusesAnUnreachableGoal) {
+TEST_P(TaskReach, IkRefusesAnUnreachableGoal) {
   // Guard for the executor: a goal far outside the workspace is reported, not silently clipped.
-  const auto chain = lfd::KinematicChain::fromUrdfFile(kModelDir + "/jvrc1_like.urdf", "base_link",
-                                                       "r_gripper_tcp");
+  const auto chain =
+      lfd::KinematicChain::fromUrdfFile(GetParam().urdfPath(), robot_.base_link, robot_.tip_link);
   lfd::InverseKinematics ik(chain);
   Eigen::Isometry3d far = Eigen::Isometry3d::Identity();
   far.translation() << 1.2, -0.9, -0.05;
   EXPECT_FALSE(ik.reach(far, chain.midRange()).converged);
 }
+
+INSTANTIATE_TEST_SUITE_P(Robots, TaskReach, ::testing::ValuesIn(kRobots),
+                         [](const auto& info) { return info.param.name; });
 
 }  // namespace

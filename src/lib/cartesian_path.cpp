@@ -67,12 +67,12 @@ JointPath CartesianToJoints::convert(const std::vector<TimedPose>& samples,
       // Warm start failed (e.g. a joint limit blocks the branch): try the solver's restarts.
       const IkResult retry = ik_.reach(target, previous);
       if (!retry.failure.empty())
-        throw std::runtime_error("IK failed for the TCP pose at t=" + std::to_string(sample.t) +
-                                 " s: " + retry.failure);
+        throw std::runtime_error("IK failed for " + robot_name_ + " at the TCP pose at t=" +
+                                 std::to_string(sample.t) + " s: " + retry.failure);
       if (!acceptable(retry)) {
         std::ostringstream msg;
-        msg << "IK cannot reach the TCP pose at t=" << sample.t << " s, position ("
-            << sample.pose.position.transpose() << "): residual " << retry.position_error * 1000.0
+        msg << robot_name_ << " cannot reach the TCP pose at t=" << sample.t << " s, position ("
+            << sample.pose.position.transpose() << "): IK residual " << retry.position_error * 1000.0
             << " mm, " << retry.orientation_error << " rad";
         throw std::runtime_error(msg.str());
       }

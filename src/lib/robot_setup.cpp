@@ -65,6 +65,8 @@ void readGripper(const YAML::Node& g, const std::string& path, GripperSetup* gri
   if (g["close_opening"]) gripper->close_opening = g["close_opening"].as<double>();
   if (g["close_effort"])
     gripper->close_effort = positiveNumber(g["close_effort"], path, "gripper.close_effort");
+  if (g["opening_scale"])
+    gripper->opening_scale = positiveNumber(g["opening_scale"], path, "gripper.opening_scale");
   if (!std::isfinite(gripper->open_opening) || !std::isfinite(gripper->close_opening) ||
       gripper->open_opening < gripper->close_opening)
     fail(path, "gripper.open_opening must be finite and >= close_opening");
@@ -147,8 +149,10 @@ RobotSetup loadRobotSetup(const std::string& path) {
   }
   RobotSetup setup;
   try {
+    if (root["name"]) setup.name = "robot " + text(root["name"], path, "name");
     readIk(root["ik"], path, &setup);
     readGripper(root["gripper"], path, &setup.gripper);
+    setup.initial_posture = jointMap(root["initial_posture"], path, "initial_posture");
     readSensors(root["sensors"], path, &setup);
   } catch (const YAML::Exception& e) {
     fail(path, std::string("invalid value: ") + e.what());
@@ -168,8 +172,7 @@ CartesianToJoints makeCartesianToJoints(const std::string& urdf_xml, const Robot
     if (setup.preferred_posture.count(joint)) preferred[i] = setup.preferred_posture.at(joint);
   }
   Eigen::Isometry3d chain_base = Eigen::Isometry3d::Identity();
-  const std::string& frame =
-      setup.cartesian_frame.empty() ? setup.base_link : setup.cartesian_frame;
+  const std::string& frame = setup.poseFrame();
   if (frame != setup.base_link) {
     // The chain root's pose in the Cartesian frame, with every joint between them at zero.
     const KinematicChain to_root = KinematicChain::fromUrdfString(urdf_xml, frame, setup.base_link);
@@ -177,6 +180,7 @@ CartesianToJoints makeCartesianToJoints(const std::string& urdf_xml, const Robot
   }
   CartesianToJoints converter(chain, chain_base, options, setup.ik_tolerance);
   converter.setPreferredPosture(preferred);
+  converter.setRobotName(setup.name);
   return converter;
 }
 

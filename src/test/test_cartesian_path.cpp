@@ -50,11 +50,15 @@ Eigen::VectorXd home(const lfd::CartesianToJoints& ik) {
 
 TEST(RobotSetup, RepositoryFileDescribesTheWaistAndRightArm) {
   const lfd::RobotSetup s = lfd::loadRobotSetup(kRobotFile);
+  EXPECT_EQ(s.name, "robot jvrc1");
   EXPECT_EQ(s.base_link, "base_link");
   EXPECT_EQ(s.tip_link, "r_gripper_tcp");
   EXPECT_GT(s.joint_costs.at("WAIST_R"), s.joint_costs.at("WAIST_Y"));
   EXPECT_EQ(s.gripper.joint, "R_GRIPPER");
   EXPECT_GT(s.gripper.open_opening, s.gripper.close_opening);
+  EXPECT_EQ(s.gripper.opening_scale, 2.0);  // each pad moves by the joint
+  EXPECT_EQ(s.initial_posture.count("R_ELBOW_P"), 1u);
+  EXPECT_EQ(s.initial_posture.count("R_GRIPPER"), 1u);
   // The sensor table, rows and fields in the file's order (the order readings are taken in).
   ASSERT_EQ(s.sensors.size(), 3u);
   EXPECT_EQ(s.sensors[0].topic, "/wrist_ft");
@@ -87,6 +91,9 @@ TEST(RobotSetup, BadFilesAreClearErrors) {
               "open_opening");
   expectError("ik: [1, 2\n", "cannot be read");
   expectError("ik: {tip_link: t}\ngripper: {close_effort: 5}\n", "gripper.joint");
+  expectError("ik: {tip_link: t}\ngripper: {joint: G, opening_scale: 0}\n", "gripper.opening_scale");
+  expectError("ik: {tip_link: t}\ninitial_posture: {J: .nan}\n", "initial_posture.J");
+  expectError("ik: {tip_link: t}\ninitial_posture: [1]\n", "initial_posture must map");
   const std::string ik = "ik: {tip_link: t}\n";
   expectError(ik + "sensors: {a: 1}\n", "sensors must be a list");
   expectError(ik + "sensors: [{topic: /f, type: T, fields: {force: s}}]\n", "sensors[0].frame");
@@ -154,6 +161,9 @@ TEST(CartesianToJoints, UnreachablePoseIsAClearError) {
     FAIL() << "a pose 2 m away must not be reachable";
   } catch (const std::runtime_error& e) {
     EXPECT_NE(std::string(e.what()).find("t=0.1"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("position (2 0 0)"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("robot jvrc1 cannot reach"), std::string::npos)
+        << e.what();  // the robot file's name
   }
   EXPECT_THROW(ik.convert(samples, Eigen::VectorXd::Zero(2)), std::invalid_argument);
 }

@@ -17,6 +17,7 @@
 #include <cmath>
 
 #include "bridge_test_utils.hpp"
+#include "lfd_core/robot_setup.hpp"
 
 namespace {
 
@@ -241,9 +242,10 @@ TEST_F(BridgeServices, ResetRestoresPostureAndObjects) {
   ASSERT_TRUE(reset.response.success) << reset.response.message;
   EXPECT_TRUE(
       waitFor([&] { return std::abs(probe_.position("R_SHOULDER_Y") - 0.3) < 1e-9; }, 10.0));
-  double configured = 0.0;  // the bridge's configured initial posture (config/bridge.yaml)
-  ASSERT_TRUE(ros::param::get("/bridge/initial_posture/R_ELBOW_P", configured));
-  EXPECT_NEAR(probe_.position("R_ELBOW_P"), configured, 1e-9);
+  std::string robot_file;  // the bridge's robot file, whose ready posture a reset restores
+  ASSERT_TRUE(ros::param::get("/bridge/robot_file", robot_file));
+  EXPECT_NEAR(probe_.position("R_ELBOW_P"),
+              lfd::loadRobotSetup(robot_file).initial_posture.at("R_ELBOW_P"), 1e-9);
   geometry_msgs::PoseStamped stick;
   EXPECT_TRUE(waitFor(
       [&] {

@@ -20,11 +20,33 @@ def config_path(name):
     return os.path.join(config_dir(), name)
 
 
+# The robot when LFD_ROBOT does not name one (the launch files' `robot` argument has the same
+# default: roslaunch cannot read it from here).
+DEFAULT_ROBOT = "jvrc1"
+
+
+def robot_name():
+    """The robot the tools and launch files use: $LFD_ROBOT (the pipeline's --robot sets it), else
+    the default. Its description package is <robot>_description."""
+    return os.environ.get("LFD_ROBOT") or DEFAULT_ROBOT
+
+
+def robot_dir(name=None):
+    """The robot's description package folder (config/robot.yaml, models/, launch/upload.launch).
+    Raises RuntimeError naming the package when it is not installed."""
+    import rospkg
+    package = (name or robot_name()) + "_description"
+    try:
+        return rospkg.RosPack().get_path(package)
+    except rospkg.ResourceNotFound:
+        raise RuntimeError("robot %r: no package %s (a robot is a <robot>_description package with "
+                           "config/robot.yaml; see README, Adding a robot)" % (name or robot_name(), package))
+
+
 def robot_file():
     """The robot file (lfd::loadRobotSetup's; its sensor table names the topics it publishes): the
     robot description package's config/robot.yaml."""
-    import rospkg
-    return os.path.join(rospkg.RosPack().get_path("jvrc1_description"), "config", "robot.yaml")
+    return os.path.join(robot_dir(), "config", "robot.yaml")
 
 
 @functools.lru_cache(maxsize=None)

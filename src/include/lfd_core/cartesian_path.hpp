@@ -5,6 +5,7 @@
 #pragma once
 
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
@@ -41,6 +42,8 @@ class CartesianToJoints {
                     const IkTolerance& tolerance = IkTolerance());
 
   void setPreferredPosture(const Eigen::VectorXd& q) { ik_.setPreferredPosture(q); }
+  // The robot an unreachable pose's error names (its robot file's `name`).
+  void setRobotName(std::string name) { robot_name_ = std::move(name); }
   const KinematicChain& chain() const { return ik_.chain(); }
 
   // TCP pose (in the samples' frame) of a joint vector of the chain.
@@ -58,6 +61,7 @@ class CartesianToJoints {
   Eigen::Isometry3d chain_base_;
   IkTolerance tolerance_;
   IkResult result_;
+  std::string robot_name_ = "the robot";
 };
 
 }  // namespace lfd

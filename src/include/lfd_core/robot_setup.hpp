@@ -19,6 +19,8 @@ struct GripperSetup {
   double open_opening = 0.08;  // m between the pads when opened
   double close_opening = 0.0;  // m commanded to close (the effort limit stops it on an object)
   double close_effort = 20.0;  // N
+  // Opening between the pads per unit of the joint (a joint moving each pad of two: 2).
+  double opening_scale = 1.0;
 };
 
 // One row of the sensor table, the way ros_control's hardware interfaces describe a sensor: which
@@ -33,6 +35,7 @@ struct SensorEntry {
 };
 
 struct RobotSetup {
+  std::string name = "the robot";       // how messages name it (robot.yaml `name`)
   std::string base_link = "base_link";  // IK chain root (URDF link)
   std::string tip_link;                 // tool centre point (URDF link)
   // Frame of every Cartesian pose (end-effector topic, plans, rollouts); "" = base_link.
@@ -41,7 +44,15 @@ struct RobotSetup {
   std::map<std::string, double> preferred_posture;  // rad; unlisted joints: 0
   IkTolerance ik_tolerance;
   GripperSetup gripper;
+  // The ready posture a simulated robot starts in and returns to at a reset (rad or m; unlisted
+  // joints: 0). The gripper joint's entry is in joint units.
+  std::map<std::string, double> initial_posture;
   std::vector<SensorEntry> sensors;  // the sensor table, in the file's order
+
+  // The frame of every Cartesian pose: cartesian_frame, or the chain's base link.
+  const std::string& poseFrame() const {
+    return cartesian_frame.empty() ? base_link : cartesian_frame;
+  }
 };
 
 // The row of `setup.sensors` publishing `type` (the first one), or nullptr.
