@@ -291,6 +291,7 @@ def snapshots(report, key, bag, figs, times=None):
     """MuJoCo snapshots of a bag into figs/snapshots/<key> (default times: the end of each of its
     ground-truth phases). They need OSMesa, the plots do not: a failure is a reported problem."""
     cmd = ["rosrun", "lfd_sim_bridge", "snapshot", "--bag", bag,
+           "--model", os.path.join(config.robot_dir(), "models", "workcell.xml"),
            "--out", os.path.join(figs, "snapshots", key)]
     if times:
         cmd += ["--times", ",".join("%.3f" % t for t in times)]

@@ -26,11 +26,11 @@ Writes {"<reproduction key>": {task: record}} (lfd_tools.report.reproduction_rec
 with the goals done ("complete": false). Exit status 0 only if every goal was reached.
 """
 import argparse
+import itertools
 import json
 import os
 import subprocess
 import sys
-import time
 
 from lfd_tools import bags, lockstep, master, report, reproduction, tasks
 
@@ -47,20 +47,31 @@ def library_summary(path):
     return (sum(full) / len(full) if full else None), len(full), len(lib["segments"])
 
 
+RECORDER_TIMEOUT_S = 30.0
+
+
 class BagRecording(object):
     """`rosbag record` of one reproduction (for snapshots and rviz replay); stopped by SIGINT so
     the bag is closed properly."""
+    count = itertools.count()
 
     def __init__(self, path, objects):
         self.path = path
+        # A name of its own: a node taking a running node's name makes the master shut that one down.
+        node = "lfd_goal_recorder_%d_%d" % (os.getpid(), next(BagRecording.count))
         topics = ["/joint_states", "/objects/joint_states", "/ee_pose", "/gripper/state",
                   bags.touch_topic(), "/executor/planned_path", "/executor/executed_path",
                   "/executor/segment_markers"]
         topics += ["/objects/%s/pose" % o for o in objects]
-        self.proc = subprocess.Popen(["rosbag", "record", "-q", "-O", path] + topics,
+        self.proc = subprocess.Popen(["rosbag", "record", "-q", "-O", path] + topics + ["__name:=" + node],
                                      stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
                                      start_new_session=True)
-        time.sleep(1.5)  # wall time for rosbag to subscribe before anything moves
+        # Nothing moves before rosbag receives every published topic: a fixed 1.5 s wait missed
+        # the first 5 s of a goal's motion on a loaded machine (lockstep does not wait for it).
+        missing = master.wait_for_inbound("/" + node, topics, RECORDER_TIMEOUT_S, self.proc)
+        if missing:
+            print("warning: %s not connected to %s after %.0f s: the bag may miss the motion's start"
+                  % (node, ", ".join(missing), RECORDER_TIMEOUT_S), file=sys.stderr)
 
     def stop(self):
         master.stop_group(self.proc, 20)

@@ -45,7 +45,7 @@ namespace {
 struct Options {
   std::string bag;
   std::string out;
-  // The robot's scene (LFD_SIM_MODEL_DIR: jvrc1_description's models, set by CMake).
+  // The default robot's scene (LFD_SIM_MODEL_DIR, set by CMake); --model names another robot's.
   std::string model = (std::filesystem::path(LFD_SIM_MODEL_DIR) / "workcell.xml").string();
   std::string times;  // empty: segment ends
   bool relative = false;

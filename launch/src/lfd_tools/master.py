@@ -159,3 +159,34 @@ def service_proxies(node_name, services, timeout=120.0):
             raise RuntimeError("service %s did not come up within %.0f s" % (name, timeout))
         proxies[name] = rospy.ServiceProxy(name, typ)
     return proxies
+
+
+def inbound_topics(node):
+    """The topics `node` receives on a live connection (its bus info; the master's registration of
+    a subscription comes before the publishers connect)."""
+    import xmlrpc.client
+    import rosgraph
+    uri = rosgraph.Master("/lfd_tools_probe").lookupNode(node)
+    code, _, info = xmlrpc.client.ServerProxy(uri).getBusInfo("/lfd_tools_probe")
+    # roscpp: [id, peer, direction i/o, transport, topic, connected, ...]
+    return {c[4] for c in info if c[2] == "i" and (len(c) < 6 or c[5])} if code == 1 else set()
+
+
+def wait_for_inbound(node, topics, timeout, proc=None):
+    """Waits until `node` is connected to every topic of `topics` that has a publisher. Returns the
+    published topics it still misses after `timeout`, or as soon as `proc` (the node's process)
+    has ended (empty: all connected)."""
+    import rosgraph
+    master, deadline = rosgraph.Master("/lfd_tools_probe"), time.time() + timeout
+    while True:
+        missing = set()
+        try:
+            published = {t for t, nodes in master.getSystemState()[0] if nodes}
+            missing = (set(topics) & published) - inbound_topics(node)
+        except (rosgraph.MasterError, OSError) as exc:  # the node is not up yet
+            missing = {"(%s)" % exc}
+        if proc is not None and proc.poll() is not None:
+            return sorted(missing | {"(its process ended, exit %d)" % proc.returncode})
+        if not missing or time.time() > deadline:
+            return sorted(missing)
+        time.sleep(0.05)
