@@ -34,8 +34,8 @@ import math
 import os
 import sys
 
-from lfd_tools.robot_models import (DARK_COLOR, FINGER_COLOR, NY, Y, Z, Link, Robot, fixed, generate, geom,
-                                    load_scene, prismatic, revolute, scene_file_beside)
+from lfd_tools.robot_models import (DARK_COLOR, Y, Z, HandNames, Link, Robot, generate, geom, load_scene,
+                                    parallel_gripper, revolute, scene_file_beside)
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 SCENE_FILE = scene_file_beside(HERE)
@@ -65,8 +65,13 @@ SENSORS = [
     ('touch', 'pad_left', 'touch_left_site'),
     ('touch', 'pad_right', 'touch_right_site'),
 ]
-# The finger pads that get the soft contact with the table (finger body, pad geom).
-FINGERS = (('finger_left', 'finger_left_pad'), ('finger_right', 'finger_right_pad'))
+# The hand's names (the shared parallel gripper, lfd_tools.robot_models.parallel_gripper).
+HAND = HandNames(ft_frame='ft_frame', ft_joint='ft_joint', palm='hand', palm_joint='hand_joint',
+                 finger_left='finger_left', finger_right='finger_right',
+                 finger_joint='finger_joint', mimic_joint='finger_joint_mimic',
+                 pad_left='finger_left_pad', pad_right='finger_right_pad',
+                 touch_left='touch_left_site', touch_right='touch_right_site',
+                 tcp='tcp', tcp_joint='tcp_joint')
 
 
 def stand_links():
@@ -100,34 +105,15 @@ def arm_links():
 
 
 def hand_links():
-    """The humanoid's gripper (jvrc1_description r_gripper_*), renamed, hanging from ft_frame."""
-    return [
-        # Massless frame of the wrist force/torque sensor (at the flange), turned so that the hand
-        # below it points along the forearm.
-        Link('ft_frame', 'arm_link_7', fixed('ft_joint'), (0.0, 0.0, FLANGE), rpy=(0.0, math.pi, 0.0)),
-        # Palm; everything below it is the load seen by the F/T sensor.
-        Link('hand', 'ft_frame', fixed('hand_joint'), (0.0, 0.0, 0.0), 0.35,
-             [geom('box', (0.03, 0.06, 0.0175), (0.0, 0.0, -0.0175), collide=True, color=DARK_COLOR)]),
-        # Finger frames sit on the pad (inner face); the finger body extends outwards from it.
-        Link('finger_left', 'hand', prismatic('finger_joint', Y, 0.0, 0.045, DRIVE['gripper']),
-             (0.0, 0.0, -0.035), 0.05,
-             [geom('box', (0.012, 0.006, 0.03), (0.0, 0.006, -0.03), collide=True, color=FINGER_COLOR,
-                   name='finger_left_pad')],
-             [('touch_left_site', (0.0, 0.006, -0.03), (0.013, 0.007, 0.031))]),
-        Link('finger_right', 'hand',
-             prismatic('finger_joint_mimic', NY, 0.0, 0.045, DRIVE['gripper'], mimic='finger_joint'),
-             (0.0, 0.0, -0.035), 0.05,
-             [geom('box', (0.012, 0.006, 0.03), (0.0, -0.006, -0.03), collide=True, color=FINGER_COLOR,
-                   name='finger_right_pad')],
-             [('touch_right_site', (0.0, -0.006, -0.03), (0.013, 0.007, 0.031))]),
-        # Tool centre point: between the pads, 12 mm above the finger tips.
-        Link('tcp', 'hand', fixed('tcp_joint'), (0.0, 0.0, -0.083)),
-    ]
+    """The humanoid's gripper (lfd_tools.robot_models.parallel_gripper, jvrc1_description's
+    r_gripper_*), renamed, its F/T frame at the flange turned by pi about y so that the hand points
+    along the forearm."""
+    return parallel_gripper(HAND, 'arm_link_7', (0.0, 0.0, FLANGE), DRIVE['gripper'], ft_rpy=(0.0, math.pi, 0.0))
 
 
 def robot():
-    return Robot('arm7', stand_links() + arm_links() + hand_links(), SENSORS, ft_frame='ft_frame',
-                 finger_pads=FINGERS)
+    return Robot('arm7', stand_links() + arm_links() + hand_links(), SENSORS, ft_frame=HAND.ft_frame,
+                 finger_pads=HAND.finger_pads())
 
 
 def main(out_dir=HERE):

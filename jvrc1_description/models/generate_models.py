@@ -28,8 +28,8 @@ Run (after `source devel/setup.bash`): /usr/bin/python3 jvrc1_description/models
 import os
 import sys
 
-from lfd_tools.robot_models import (DARK_COLOR, FINGER_COLOR, NY, X, Y, Z, Link, Robot, fixed, generate,
-                                    geom, prismatic, revolute, scene_file_beside, load_scene)
+from lfd_tools.robot_models import (DARK_COLOR, X, Y, Z, HandNames, Link, Robot, generate, geom, load_scene,
+                                    parallel_gripper, revolute, scene_file_beside)
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 SCENE_FILE = scene_file_beside(HERE)
@@ -61,8 +61,15 @@ SENSORS = [
     ('accelerometer', 'imu_accel', 'imu'),
     ('framequat', 'imu_quat', 'imu'),
 ]
-# The finger pads that get the soft contact with the table (finger body, pad geom).
-FINGERS = (('r_gripper_finger_l', 'r_finger_l_pad'), ('r_gripper_finger_r', 'r_finger_r_pad'))
+# The right hand: the shared parallel gripper (lfd_tools.robot_models.parallel_gripper) under these
+# names, its F/T frame r_wrist_ft at the flange 4.5 cm below the wrist.
+HAND = HandNames(ft_frame='r_wrist_ft', ft_joint='R_WRIST_FT_JOINT',
+                 palm='r_gripper_palm', palm_joint='R_GRIPPER_PALM_JOINT',
+                 finger_left='r_gripper_finger_l', finger_right='r_gripper_finger_r',
+                 finger_joint='R_GRIPPER', mimic_joint='R_GRIPPER_MIMIC',
+                 pad_left='r_finger_l_pad', pad_right='r_finger_r_pad',
+                 touch_left='r_touch_left_site', touch_right='r_touch_right_site',
+                 tcp='r_gripper_tcp', tcp_joint='R_GRIPPER_TCP_JOINT')
 OPTION_NOTE = ('1 kHz physics. Elliptic friction cones with a high impratio keep a pinch grasp from creeping;\n'
                '       the Euler integrator treats the (large) joint damping implicitly; sparse Jacobians are a\n'
                '       little faster for this 46-DoF tree.')
@@ -118,26 +125,8 @@ def arm_links(side):
         Link('r_wrist_y_link', 'r_wrist_r_link', revolute('R_WRIST_Y', Y, -1.75, 1.75, DRIVE['wrist']),
              (0.0, 0.0, 0.0), 0.3, [geom('cylinder', (0.035, 0.02), (0.0, 0.0, -0.02), collide=True,
                                          color=DARK_COLOR)]),
-        # Massless frame of the wrist force/torque sensor (at the flange).
-        Link('r_wrist_ft', 'r_wrist_y_link', fixed('R_WRIST_FT_JOINT'), (0.0, 0.0, -0.045)),
-        # Palm; everything below it is the load seen by the F/T sensor.
-        Link('r_gripper_palm', 'r_wrist_ft', fixed('R_GRIPPER_PALM_JOINT'), (0.0, 0.0, 0.0), 0.35,
-             [geom('box', (0.03, 0.06, 0.0175), (0.0, 0.0, -0.0175), collide=True, color=DARK_COLOR)]),
-        # Finger frames sit on the pad (inner face); the finger body extends outwards from it.
-        Link('r_gripper_finger_l', 'r_gripper_palm', prismatic('R_GRIPPER', Y, 0.0, 0.045, DRIVE['gripper']),
-             (0.0, 0.0, -0.035), 0.05,
-             [geom('box', (0.012, 0.006, 0.03), (0.0, 0.006, -0.03), collide=True, color=FINGER_COLOR,
-                   name='r_finger_l_pad')],
-             [('r_touch_left_site', (0.0, 0.006, -0.03), (0.013, 0.007, 0.031))]),
-        Link('r_gripper_finger_r', 'r_gripper_palm',
-             prismatic('R_GRIPPER_MIMIC', NY, 0.0, 0.045, DRIVE['gripper'], mimic='R_GRIPPER'),
-             (0.0, 0.0, -0.035), 0.05,
-             [geom('box', (0.012, 0.006, 0.03), (0.0, -0.006, -0.03), collide=True, color=FINGER_COLOR,
-                   name='r_finger_r_pad')],
-             [('r_touch_right_site', (0.0, -0.006, -0.03), (0.013, 0.007, 0.031))]),
-        # Tool centre point: between the pads, 12 mm above the finger tips.
-        Link('r_gripper_tcp', 'r_gripper_palm', fixed('R_GRIPPER_TCP_JOINT'), (0.0, 0.0, -0.083)),
     ]
+    links += parallel_gripper(HAND, 'r_wrist_y_link', (0.0, 0.0, -0.045), DRIVE['gripper'])
     return links
 
 
@@ -164,8 +153,8 @@ def robot_links():
 
 
 def robot():
-    return Robot('jvrc1_like', robot_links(), SENSORS, ft_frame='r_wrist_ft', imu=('imu', 'base_link'),
-                 finger_pads=FINGERS, option_note=OPTION_NOTE)
+    return Robot('jvrc1_like', robot_links(), SENSORS, ft_frame=HAND.ft_frame, imu=('imu', 'base_link'),
+                 finger_pads=HAND.finger_pads(), option_note=OPTION_NOTE)
 
 
 def main(out_dir=HERE):

@@ -14,10 +14,10 @@ STATE = ([f"/ee_pose/pose/position/{a}" for a in "xyz"] +
          [f"/ee_pose/pose/orientation/{a}" for a in "xyzw"] +
          [f"/ee_twist/twist/linear/{a}" for a in "xyz"] +
          [f"/ee_twist/twist/angular/{a}" for a in "xyz"] +
-         ["/gripper/state/position/R_GRIPPER"])
+         ["/gripper/state/position/gripper"])
 SENSOR = ([f"/wrist_ft/wrench/force/{a}" for a in "xyz"] +
           [f"/wrist_ft/wrench/torque/{a}" for a in "xyz"] +
-          ["/touch/values/r_touch_left", "/touch/values/r_touch_right"])
+          ["/touch/values/pad_left", "/touch/values/pad_right"])
 
 
 def demo(rng, n, rate):
@@ -35,12 +35,12 @@ def demo(rng, n, rate):
         cols[f"/ee_twist/twist/angular/{a}"] = 0.02 * rng.standard_normal(n)
         cols[f"/ee_pose/pose/orientation/{a}"] = 0.05 * np.sin(2 * np.pi * rng.uniform(0.05, 0.2) * t)
     cols["/ee_pose/pose/orientation/w"] = np.sqrt(1 - sum(cols[f"/ee_pose/pose/orientation/{a}"] ** 2 for a in "xyz"))
-    cols["/gripper/state/position/R_GRIPPER"] = np.where(closed, 0.02, 0.08) + 5e-4 * rng.standard_normal(n)
+    cols["/gripper/state/position/gripper"] = np.where(closed, 0.02, 0.08) + 5e-4 * rng.standard_normal(n)
     for k, a in enumerate("xyz"):
         cols[f"/wrist_ft/wrench/force/{a}"] = np.where(closed, -3.0 * (k == 2), 0) + 0.05 * rng.standard_normal(n)
         cols[f"/wrist_ft/wrench/torque/{a}"] = 0.01 * rng.standard_normal(n)
-    cols["/touch/values/r_touch_left"] = np.where(closed, 4.0, 0) + 0.02 * rng.standard_normal(n)
-    cols["/touch/values/r_touch_right"] = np.where(closed, 3.5, 0) + 0.02 * rng.standard_normal(n)
+    cols["/touch/values/pad_left"] = np.where(closed, 4.0, 0) + 0.02 * rng.standard_normal(n)
+    cols["/touch/values/pad_right"] = np.where(closed, 3.5, 0) + 0.02 * rng.standard_normal(n)
     return t, cols, int(np.argmax(closed))
 
 

@@ -158,13 +158,10 @@ WorkcellSim::WorkcellSim(const std::string& mjcf_path, const WorkcellConfig& con
   for (int j : joint_ids_)
     object_joint_.push_back(m_->body_rootid[m_->jnt_bodyid[j]] != m_->body_rootid[base_body_]);
   ee_site_ = mj_name2id(m_, mjOBJ_SITE, config_.ee_site.c_str());
-  if (ee_site_ < 0 && !config_.ee_site.empty())
-    this->log(LogLevel::kWarn, "no site '" + config_.ee_site + "' in the model");
   gripper_ = actuatedIndex(config_.gripper_joint);
-  if (gripper_ < 0 && !config_.gripper_joint.empty())
-    this->log(LogLevel::kWarn, "no actuated gripper joint '" + config_.gripper_joint + "'");
 
   try {
+    checkRobotNames();
     configureSensors();
   } catch (...) {  // the destructor does not run for a constructor that throws
     mj_deleteData(d_);
@@ -192,12 +189,21 @@ WorkcellSim::WorkcellSim(const std::string& mjcf_path, const WorkcellConfig& con
     std::copy(m_->body_pos + 3 * b, m_->body_pos + 3 * b + 3, scene_mocap_.begin() + 7 * id);
     std::copy(m_->body_quat + 4 * b, m_->body_quat + 4 * b + 4, scene_mocap_.begin() + 7 * id + 3);
   }
-  for (const auto& [name, value] : config_.initial_posture) {
-    if (!hasJoint(name)) {
-      this->log(LogLevel::kWarn, "initial posture names unknown joint '" + name + "'; ignored");
-    }
-  }
   reset({}, true);
+}
+
+// The robot file describes this model: a name it gives that the model lacks is a robot file for
+// another robot (or a typo), which would record demos with an idle gripper or a wrong posture.
+void WorkcellSim::checkRobotNames() const {
+  const auto fail = [](const std::string& what) {
+    throw std::invalid_argument("the robot file does not match the model: " + what);
+  };
+  if (ee_site_ < 0 && !config_.ee_site.empty())
+    fail("no site or frame '" + config_.ee_site + "' (the IK tip link)");
+  if (gripper_ < 0 && !config_.gripper_joint.empty())
+    fail("no actuated gripper joint '" + config_.gripper_joint + "'");
+  for (const auto& [name, value] : config_.initial_posture)
+    if (!hasJoint(name)) fail("initial_posture names joint '" + name + "', which it does not have");
 }
 
 WorkcellSim::~WorkcellSim() {

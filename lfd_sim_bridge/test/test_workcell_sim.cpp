@@ -75,6 +75,28 @@ TEST(WorkcellSim, ATableSensorTheModelLacksIsAClearError) {
   }
 }
 
+// A robot file for another robot (or with a typo) is refused before anything runs: a gripper
+// joint, tip frame or posture joint the model lacks would record demos with an idle gripper.
+TEST(WorkcellSim, RobotFileNamesTheModelLacksAreClearErrors) {
+  const auto expectRefused = [](const lfd_sim::WorkcellConfig& c, const std::string& needle) {
+    try {
+      lfd_sim::WorkcellSim sim(kModel, c);
+      ADD_FAILURE() << "accepted a robot file naming " << needle;
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
+    }
+  };
+  lfd_sim::WorkcellConfig c = readyConfig();
+  c.gripper_joint = "finger_joint";
+  expectRefused(c, "gripper joint 'finger_joint'");
+  c = readyConfig();
+  c.ee_site = "tcp";
+  expectRefused(c, "'tcp'");
+  c = readyConfig();
+  c.initial_posture["arm_joint_1"] = 0.1;
+  expectRefused(c, "'arm_joint_1'");
+}
+
 // The table bound to the message types: fields in the message's order, dimensions checked.
 TEST(SensorTable, BindsRowsAndRefusesWrongOnes) {
   const lfd::RobotSetup robot = lfd::loadRobotSetup(kRobotFile);

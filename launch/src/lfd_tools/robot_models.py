@@ -2,8 +2,9 @@
 the MJCF robot (to be <include>d) and the MuJoCo workcell scene of config/scene.yaml out.
 
 A robot description package (jvrc1_description, arm7_description, ...) keeps only its own data in
-models/generate_models.py -- its links (Link, with revolute/prismatic/fixed joints and geom()s),
-and a Robot naming what is robot-specific: the sensors, the massless frame that becomes the
+models/generate_models.py -- its links (Link, with revolute/prismatic/fixed joints and geom()s;
+the parallel gripper every robot shares comes from parallel_gripper(), under the robot's own
+names, HandNames), and a Robot naming what is robot-specific: the sensors, the massless frame that becomes the
 force/torque site, the optional IMU site, the finger pads that get the soft contact with the table,
 the include file name -- and calls generate(). The URDF and the MJCF come from the same link
 list, so they cannot drift apart (lfd_sim_bridge/test/test_model_consistency.cpp checks it for
@@ -21,6 +22,7 @@ actuator named like it.
 
 import math
 import os
+from dataclasses import dataclass
 
 import yaml
 
@@ -136,6 +138,64 @@ def fixed(name):
 
 X, Y, Z = (1, 0, 0), (0, 1, 0), (0, 0, 1)
 NY, NZ = (0, -1, 0), (0, 0, -1)
+
+
+# ----------------------------------------------------------------------------------------------
+# The parallel gripper every robot carries (the grasps of the task files are tuned for it)
+
+
+@dataclass(frozen=True)
+class HandNames:
+    """The names of one robot's parallel gripper (parallel_gripper()): its links, joints, pad geoms
+    and touch sites. Only the names differ from robot to robot; the hand is the same."""
+    ft_frame: str       # massless frame of the wrist force/torque sensor (a site of the palm in MJCF)
+    ft_joint: str       # its fixed joint to the parent link (the flange)
+    palm: str           # the palm body: everything from it down is the F/T sensor's load
+    palm_joint: str     # fixed, at the F/T frame's origin
+    finger_left: str    # finger bodies, framed on their pad's inner face
+    finger_right: str
+    finger_joint: str   # the driven prismatic joint (left finger, +y): half the opening between the pads
+    mimic_joint: str    # the right finger's joint (-y), following finger_joint (an MJCF equality)
+    pad_left: str       # the pads' collision geoms (soft contact with the table)
+    pad_right: str
+    touch_left: str     # the pads' touch sites
+    touch_right: str
+    tcp: str            # tool centre point frame: between the pads, 12 mm above the finger tips
+    tcp_joint: str
+
+    def finger_pads(self):
+        """Robot(finger_pads=...): (finger body, pad geom) of both fingers."""
+        return ((self.finger_left, self.pad_left), (self.finger_right, self.pad_right))
+
+
+def parallel_gripper(names, parent, ft_origin, drive, ft_rpy=(0.0, 0.0, 0.0)):
+    """The links of the parallel gripper hanging from `parent`: the massless F/T frame at
+    `ft_origin` (translation in the parent frame) turned by `ft_rpy` (URDF rpy), the palm fixed at
+    it, two prismatic fingers (0 = closed to 0.045 m = open, each pad from the centre plane, the
+    pads closing along the palm's y; finger_joint drives, mimic_joint follows) with their pads and
+    touch sites, and the TCP. The fingers point along the F/T frame's -z. drive: the fingers'
+    (kp, damping, armature, velocity limit, effort limit) (revolute())."""
+    n = names
+    return [
+        # Massless frame of the wrist force/torque sensor (at the flange).
+        Link(n.ft_frame, parent, fixed(n.ft_joint), tuple(ft_origin), rpy=tuple(ft_rpy)),
+        # Palm; everything below it is the load seen by the F/T sensor.
+        Link(n.palm, n.ft_frame, fixed(n.palm_joint), (0.0, 0.0, 0.0), 0.35,
+             [geom('box', (0.03, 0.06, 0.0175), (0.0, 0.0, -0.0175), collide=True, color=DARK_COLOR)]),
+        # Finger frames sit on the pad (inner face); the finger body extends outwards from it.
+        Link(n.finger_left, n.palm, prismatic(n.finger_joint, Y, 0.0, 0.045, drive),
+             (0.0, 0.0, -0.035), 0.05,
+             [geom('box', (0.012, 0.006, 0.03), (0.0, 0.006, -0.03), collide=True, color=FINGER_COLOR,
+                   name=n.pad_left)],
+             [(n.touch_left, (0.0, 0.006, -0.03), (0.013, 0.007, 0.031))]),
+        Link(n.finger_right, n.palm, prismatic(n.mimic_joint, NY, 0.0, 0.045, drive, mimic=n.finger_joint),
+             (0.0, 0.0, -0.035), 0.05,
+             [geom('box', (0.012, 0.006, 0.03), (0.0, -0.006, -0.03), collide=True, color=FINGER_COLOR,
+                   name=n.pad_right)],
+             [(n.touch_right, (0.0, -0.006, -0.03), (0.013, 0.007, 0.031))]),
+        # Tool centre point: between the pads, 12 mm above the finger tips.
+        Link(n.tcp, n.palm, fixed(n.tcp_joint), (0.0, 0.0, -0.083)),
+    ]
 
 
 class Robot:

@@ -257,6 +257,7 @@ class WorkcellSim {
     const double SensorNoise::*noise = nullptr;  // the kind's noise; nullptr = exact
   };
   std::vector<std::vector<SensorSlot>> sensor_slots_;  // parallel to config_.sensors
+  void checkRobotNames() const;  // throws std::invalid_argument naming the first mismatch
   void configureSensors();
   SensorSlot sensorSlot(const std::string& group, const std::string& sensor);
   std::vector<int> touch_adr_;          // sensordata address of each touch sensor read

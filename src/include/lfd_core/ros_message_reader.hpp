@@ -7,7 +7,7 @@
 //   objects/0/pose/pose/position/x   element 0 of an array of messages, then its fields
 //   objects/id=13/pose/pose/position/x  the first element whose (number or string) field id is 13
 //   transforms/child_frame_id=hand/transform/translation/x   (e.g. tf2_msgs/TFMessage)
-//   position/R_GRIPPER               an array of numbers indexed by name: the name is looked up in
+//   position/elbow_joint             an array of numbers indexed by name: the name is looked up in
 //                                    the nearest string[] called name, names or *_names (the
 //                                    array's own message first, then the enclosing ones), e.g.
 //                                    sensor_msgs/JointState position/<joint> or
