@@ -1,64 +1,82 @@
-// IK, FK and Jacobian throughput on the 7-DoF right arm (chest_link -> r_gripper_tcp) of the lfd
-// humanoid. The IK case mimics DMP execution: each solve is warm-started from the previous
-// solution and the target moves a few millimetres along a smooth path.
+// IK, FK and Jacobian throughput on each robot's IK chain, as its robot file describes it (the
+// humanoid's waist and right arm, 10 DoF; the arm's 7 DoF), from its preferred posture. The IK
+// case mimics DMP execution: each solve is warm-started from the previous solution and the target
+// moves a few millimetres along a smooth path. Nothing here names a joint: the chain, its costs
+// and posture are the robot file's (lfd::makeCartesianToJoints).
 #include <benchmark/benchmark.h>
 
 #include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
 #include <string>
+#include <vector>
 
 #include "lfd_core/inverse_kinematics.hpp"
 #include "lfd_core/kinematic_chain.hpp"
+#include "lfd_core/robot_setup.hpp"
 
 namespace {
 
-const std::string kUrdf = std::string(LFD_ROBOT_DIR) + "/models/jvrc1_like.urdf";
+// A robot description package's IK chain and preferred posture.
+struct Robot {
+  std::string name;  // the robot file's
+  lfd::KinematicChain chain;
+  Eigen::VectorXd posture;
+};
 
-lfd::KinematicChain armChain(const char* base) {
-  return lfd::KinematicChain::fromUrdfFile(kUrdf, base, "r_gripper_tcp");
+// The package's one URDF (models/*.urdf).
+std::string urdfOf(const std::filesystem::path& dir) {
+  for (const auto& entry : std::filesystem::directory_iterator(dir / "models"))
+    if (entry.path().extension() == ".urdf") {
+      std::ifstream in(entry.path());
+      std::stringstream text;
+      text << in.rdbuf();
+      return text.str();
+    }
+  throw std::runtime_error("no URDF under " + (dir / "models").string());
 }
 
-// A comfortable reaching posture (elbow bent, hand in front of the body).
-Eigen::VectorXd homePosture(const lfd::KinematicChain& chain) {
+Robot loadRobot(const std::filesystem::path& dir) {
+  const lfd::RobotSetup setup = lfd::loadRobotSetup((dir / "config" / "robot.yaml").string());
+  lfd::KinematicChain chain =
+      lfd::KinematicChain::fromUrdfString(urdfOf(dir), setup.base_link, setup.tip_link);
   Eigen::VectorXd q = Eigen::VectorXd::Zero(chain.dof());
-  q[chain.jointIndex("R_SHOULDER_P")] = -0.6;
-  q[chain.jointIndex("R_SHOULDER_R")] = -0.2;
-  q[chain.jointIndex("R_ELBOW_P")] = -1.2;
-  q[chain.jointIndex("R_WRIST_Y")] = -0.3;
-  return q;
+  for (int i = 0; i < chain.dof(); ++i) {
+    const auto it = setup.preferred_posture.find(chain.jointNames()[i]);
+    if (it != setup.preferred_posture.end()) q[i] = it->second;
+  }
+  return {setup.name, std::move(chain), q};
 }
 
-void BM_Forward(benchmark::State& state) {
-  const auto chain = armChain("chest_link");
-  Eigen::VectorXd q = homePosture(chain);
+void forward(benchmark::State& state, const Robot& robot) {
+  Eigen::VectorXd q = robot.posture;
   for (auto _ : state) {
     q[0] += 1e-9;
-    benchmark::DoNotOptimize(chain.forward(q));
+    benchmark::DoNotOptimize(robot.chain.forward(q));
   }
   state.counters["fk/s"] = benchmark::Counter(state.iterations(), benchmark::Counter::kIsRate);
 }
 
-void BM_ForwardAndJacobian(benchmark::State& state) {
-  const auto chain = armChain("chest_link");
-  Eigen::VectorXd q = homePosture(chain);
+void forwardAndJacobian(benchmark::State& state, const Robot& robot) {
+  Eigen::VectorXd q = robot.posture;
   Eigen::Isometry3d pose;
-  lfd::Matrix6Xd jac(6, chain.dof());
+  lfd::Matrix6Xd jac(6, robot.chain.dof());
   for (auto _ : state) {
     q[0] += 1e-9;
-    chain.forwardAndJacobian(q, pose, jac);
+    robot.chain.forwardAndJacobian(q, pose, jac);
     benchmark::DoNotOptimize(jac.data());
   }
   state.counters["jac/s"] = benchmark::Counter(state.iterations(), benchmark::Counter::kIsRate);
 }
 
 // Warm-started tracking of a circle of radius 5 cm sampled every 2 mm (a DMP-like stream).
-void trackCircle(benchmark::State& state, const char* base) {
-  const auto chain = armChain(base);
-  lfd::InverseKinematics ik(chain);
-  Eigen::VectorXd q = homePosture(chain);
-  ik.setPreferredPosture(q);
-  const Eigen::Isometry3d center = chain.forward(q);
+void ikWarmStart(benchmark::State& state, const Robot& robot) {
+  lfd::InverseKinematics ik(robot.chain);
+  ik.setPreferredPosture(robot.posture);
+  const Eigen::Isometry3d center = robot.chain.forward(robot.posture);
   lfd::IkResult result;
-  result.q = q;
+  result.q = robot.posture;
   double phase = 0.0;
   int64_t failures = 0, iterations = 0;
   for (auto _ : state) {
@@ -75,24 +93,15 @@ void trackCircle(benchmark::State& state, const char* base) {
   state.counters["iter/solve"] = static_cast<double>(iterations) / state.iterations();
 }
 
-void BM_IkWarmStart7Dof(benchmark::State& state) {
-  trackCircle(state, "chest_link");
-}
-void BM_IkWarmStart10DofWithWaist(benchmark::State& state) {
-  trackCircle(state, "base_link");
-}
-
 // Cold solves from the preferred posture toward random-ish reachable targets (reachability query).
-void BM_IkColdReach7Dof(benchmark::State& state) {
-  const auto chain = armChain("chest_link");
-  lfd::InverseKinematics ik(chain);
-  const Eigen::VectorXd home = homePosture(chain);
+void ikColdReach(benchmark::State& state, const Robot& robot) {
+  lfd::InverseKinematics ik(robot.chain);
   int64_t k = 0, failures = 0;
   for (auto _ : state) {
-    Eigen::VectorXd q = home;
+    Eigen::VectorXd q = robot.posture;
     for (int i = 0; i < q.size(); ++i) q[i] += 0.4 * std::sin(0.7 * (++k) + i);
-    chain.clampToLimits(q);
-    const lfd::IkResult r = ik.reach(chain.forward(q), home);
+    robot.chain.clampToLimits(q);
+    const lfd::IkResult r = ik.reach(robot.chain.forward(q), robot.posture);
     if (!r.converged) ++failures;
   }
   state.counters["solves/s"] = benchmark::Counter(state.iterations(), benchmark::Counter::kIsRate);
@@ -101,9 +110,23 @@ void BM_IkColdReach7Dof(benchmark::State& state) {
 
 }  // namespace
 
-BENCHMARK(BM_Forward);
-BENCHMARK(BM_ForwardAndJacobian);
-BENCHMARK(BM_IkWarmStart7Dof);
-BENCHMARK(BM_IkWarmStart10DofWithWaist);
-BENCHMARK(BM_IkColdReach7Dof);
-BENCHMARK_MAIN();
+int main(int argc, char** argv) {
+  static const std::vector<Robot> robots = {loadRobot(LFD_ROBOT_DIR), loadRobot(LFD_ARM7_ROBOT_DIR)};
+  for (const Robot& robot : robots) {
+    const std::string tag = robot.name + " (" + std::to_string(robot.chain.dof()) + " DoF)";
+    const auto add = [&robot, &tag](const std::string& what,
+                                    void (*run)(benchmark::State&, const Robot&)) {
+      benchmark::RegisterBenchmark((what + "/" + tag).c_str(),
+                                   [&robot, run](benchmark::State& state) { run(state, robot); });
+    };
+    add("Forward", forward);
+    add("ForwardAndJacobian", forwardAndJacobian);
+    add("IkWarmStart", ikWarmStart);
+    add("IkColdReach", ikColdReach);
+  }
+  benchmark::Initialize(&argc, argv);
+  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  return 0;
+}

@@ -3,10 +3,12 @@
 //   workcell  lfd_sim::WorkcellSim::step: targets, rate/position/effort limits, gravity
 //             feed-forward, divergence checks
 //   +sensors  workcell plus readState() at the bridge's publish rate (every 5 steps = 200 Hz)
-//   +traj     as +sensors while a trajectory sweeps the right arm (contacts-free motion)
-// Usage: bench_realtime_factor [sim_seconds=10] [repeats=3] [model=LFD_SIM_MODEL_DIR/workcell.xml,
-// jvrc1_description] Prints the best of `repeats` runs per variant (least disturbed by other
-// processes).
+//   +traj     as +sensors while a trajectory sweeps every joint of the robot file's ready posture
+//             but the gripper by +-0.05 rad (a contact-free motion of the whole arm)
+// Usage: bench_realtime_factor [sim_seconds=10] [repeats=3] [model=LFD_SIM_MODEL_DIR/workcell.xml]
+//                              [robot_file=LFD_ROBOT_FILE] (the default robot's; another robot:
+// its workcell.xml and config/robot.yaml). Prints the best of `repeats` runs per variant (least
+// disturbed by other processes).
 #include <mujoco/mujoco.h>
 
 #include <chrono>
@@ -14,7 +16,9 @@
 #include <cstdlib>
 #include <functional>
 #include <string>
+#include <vector>
 
+#include "lfd_core/robot_setup.hpp"
 #include "lfd_sim_bridge/workcell_sim.hpp"
 
 namespace {
@@ -31,11 +35,27 @@ double best(int repeats, const std::function<double()>& one_run) {
   return best_rtf;
 }
 
-lfd_sim::WorkcellConfig benchConfig() {
+lfd_sim::WorkcellConfig benchConfig(const lfd::RobotSetup& robot) {
   lfd_sim::WorkcellConfig c;
-  c.initial_posture = {
-      {"R_SHOULDER_P", -0.3}, {"R_ELBOW_P", -1.3}, {"R_WRIST_Y", 1.4}, {"R_GRIPPER", 0.03}};
+  c.initial_posture = robot.initial_posture;
   return c;
+}
+
+// Ten waypoints alternating +-0.05 rad about the ready posture on every joint but the gripper's.
+lfd_sim::JointTrajectory sweep(const lfd::RobotSetup& robot, double seconds) {
+  lfd_sim::JointTrajectory traj;
+  std::vector<double> ready;
+  for (const auto& [joint, value] : robot.initial_posture) {
+    if (joint == robot.gripper.joint) continue;
+    traj.joint_names.push_back(joint);
+    ready.push_back(value);
+  }
+  for (int i = 1; i <= 10; ++i) {
+    std::vector<double> q = ready;
+    for (double& v : q) v += (i % 2 ? 0.05 : -0.05);
+    traj.points.push_back({seconds * i / 10.0, q, {}});
+  }
+  return traj;
 }
 
 }  // namespace
@@ -44,8 +64,9 @@ int main(int argc, char** argv) {
   const double seconds = argc > 1 ? std::atof(argv[1]) : 10.0;
   const int repeats = argc > 2 ? std::atoi(argv[2]) : 3;
   const std::string model = argc > 3 ? argv[3] : std::string(LFD_SIM_MODEL_DIR) + "/workcell.xml";
+  const lfd::RobotSetup robot = lfd::loadRobotSetup(argc > 4 ? argv[4] : LFD_ROBOT_FILE);
   if (!(seconds > 0) || repeats < 1) {
-    std::fprintf(stderr, "usage: %s [sim_seconds>0] [repeats>=1] [model]\n", argv[0]);
+    std::fprintf(stderr, "usage: %s [sim_seconds>0] [repeats>=1] [model] [robot_file]\n", argv[0]);
     return 2;
   }
 
@@ -73,12 +94,12 @@ int main(int argc, char** argv) {
 
   auto quiet = [](lfd_sim::LogLevel, const std::string&) {};
   const double workcell = best(repeats, [&] {
-    lfd_sim::WorkcellSim sim(model, benchConfig(), quiet);
+    lfd_sim::WorkcellSim sim(model, benchConfig(robot), quiet);
     return seconds / wallSeconds([&] { sim.step(static_cast<int>(steps)); });
   });
 
   const double with_sensors = best(repeats, [&] {
-    lfd_sim::WorkcellSim sim(model, benchConfig(), quiet);
+    lfd_sim::WorkcellSim sim(model, benchConfig(robot), quiet);
     lfd_sim::WorkcellState state;
     return seconds / wallSeconds([&] {
              for (long k = 1; k <= steps; ++k) {
@@ -89,13 +110,8 @@ int main(int argc, char** argv) {
   });
 
   const double with_trajectory = best(repeats, [&] {
-    lfd_sim::WorkcellSim sim(model, benchConfig(), quiet);
-    lfd_sim::JointTrajectory traj{{"R_SHOULDER_Y", "R_ELBOW_Y"}, {}};
-    for (int i = 1; i <= 10; ++i) {
-      const double sign = (i % 2) ? 1.0 : -1.0;
-      traj.points.push_back({seconds * i / 10.0, {0.6 * sign, -0.5 * sign}, {}});
-    }
-    sim.setTrajectory(traj);
+    lfd_sim::WorkcellSim sim(model, benchConfig(robot), quiet);
+    sim.setTrajectory(sweep(robot, seconds));
     lfd_sim::WorkcellState state;
     return seconds / wallSeconds([&] {
              for (long k = 1; k <= steps; ++k) {

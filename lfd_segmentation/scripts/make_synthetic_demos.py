@@ -17,7 +17,7 @@ STATE = ([f"/ee_pose/pose/position/{a}" for a in "xyz"] +
          ["/gripper/state/position/gripper"])
 SENSOR = ([f"/wrist_ft/wrench/force/{a}" for a in "xyz"] +
           [f"/wrist_ft/wrench/torque/{a}" for a in "xyz"] +
-          ["/touch/values/pad_left", "/touch/values/pad_right"])
+          ["/touch/values/left", "/touch/values/right"])
 
 
 def demo(rng, n, rate):
@@ -39,8 +39,8 @@ def demo(rng, n, rate):
     for k, a in enumerate("xyz"):
         cols[f"/wrist_ft/wrench/force/{a}"] = np.where(closed, -3.0 * (k == 2), 0) + 0.05 * rng.standard_normal(n)
         cols[f"/wrist_ft/wrench/torque/{a}"] = 0.01 * rng.standard_normal(n)
-    cols["/touch/values/pad_left"] = np.where(closed, 4.0, 0) + 0.02 * rng.standard_normal(n)
-    cols["/touch/values/pad_right"] = np.where(closed, 3.5, 0) + 0.02 * rng.standard_normal(n)
+    cols["/touch/values/left"] = np.where(closed, 4.0, 0) + 0.02 * rng.standard_normal(n)
+    cols["/touch/values/right"] = np.where(closed, 3.5, 0) + 0.02 * rng.standard_normal(n)
     return t, cols, int(np.argmax(closed))
 
 

@@ -149,7 +149,7 @@ RobotSetup loadRobotSetup(const std::string& path) {
   }
   RobotSetup setup;
   try {
-    if (root["name"]) setup.name = "robot " + text(root["name"], path, "name");
+    if (root["name"]) setup.name = text(root["name"], path, "name");
     readIk(root["ik"], path, &setup);
     readGripper(root["gripper"], path, &setup.gripper);
     setup.initial_posture = jointMap(root["initial_posture"], path, "initial_posture");
@@ -180,7 +180,7 @@ CartesianToJoints makeCartesianToJoints(const std::string& urdf_xml, const Robot
   }
   CartesianToJoints converter(chain, chain_base, options, setup.ik_tolerance);
   converter.setPreferredPosture(preferred);
-  converter.setRobotName(setup.name);
+  converter.setRobotName(setup.name.empty() ? "the robot" : "robot " + setup.name);
   return converter;
 }
 

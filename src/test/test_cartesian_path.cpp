@@ -50,7 +50,7 @@ Eigen::VectorXd home(const lfd::CartesianToJoints& ik) {
 
 TEST(RobotSetup, RepositoryFileDescribesTheWaistAndRightArm) {
   const lfd::RobotSetup s = lfd::loadRobotSetup(kRobotFile);
-  EXPECT_EQ(s.name, "robot jvrc1");
+  EXPECT_EQ(s.name, "jvrc1");
   EXPECT_EQ(s.base_link, "base_link");
   EXPECT_EQ(s.tip_link, "r_gripper_tcp");
   EXPECT_GT(s.joint_costs.at("WAIST_R"), s.joint_costs.at("WAIST_Y"));

@@ -35,7 +35,7 @@ struct SensorEntry {
 };
 
 struct RobotSetup {
-  std::string name = "the robot";       // how messages name it (robot.yaml `name`)
+  std::string name;  // robot.yaml `name` (its package: <name>_description); messages use it
   std::string base_link = "base_link";  // IK chain root (URDF link)
   std::string tip_link;                 // tool centre point (URDF link)
   // Frame of every Cartesian pose (end-effector topic, plans, rollouts); "" = base_link.
