@@ -263,9 +263,7 @@ class Executor {
     return *planner_;
   }
 
-  std::string cartesianFrame() const {
-    return robot_.poseFrame();
-  }
+  std::string cartesianFrame() const { return robot_.poseFrame(); }
 
   // ---- the request -----------------------------------------------------------------------------
   std::string libraryPath(const std::string& s) const {

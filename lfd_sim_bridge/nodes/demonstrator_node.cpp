@@ -341,7 +341,8 @@ class Demonstrator {
       // Closed before recording starts: a closing transient at the start would only mislead the
       // feature selection.
       reset.request.joint_names.push_back(robot_.gripper.joint);
-      reset.request.positions.push_back(robot_.gripper.close_opening / robot_.gripper.opening_scale);
+      reset.request.positions.push_back(robot_.gripper.close_opening /
+                                        robot_.gripper.opening_scale);
     }
     for (const std::string& joint : definition().joints(scene())) {
       const auto q = c.joints.find(joint);

@@ -42,16 +42,16 @@ struct Frame {
 
 // One robot description package and what its models must contain.
 struct RobotCase {
-  std::string name;         // test name suffix
-  std::string dir;          // the package's folder (models/, config/robot.yaml)
-  std::string urdf;         // URDF file name in models/
-  std::string mjcf;         // the MJCF robot file in models/ (workcell.xml includes it)
-  std::string root;         // the root link (fixed at the mount point)
-  size_t movable_joints;    // moving URDF joints
+  std::string name;                    // test name suffix
+  std::string dir;                     // the package's folder (models/, config/robot.yaml)
+  std::string urdf;                    // URDF file name in models/
+  std::string mjcf;                    // the MJCF robot file in models/ (workcell.xml includes it)
+  std::string root;                    // the root link (fixed at the mount point)
+  size_t movable_joints;               // moving URDF joints
   std::map<std::string, int> sensors;  // MJCF sensor -> type
-  std::string ft_site;      // the wrist force/torque site
-  std::string finger;       // a finger body (hangs from the F/T site's body)
-  std::string imu_site;     // "" = no IMU
+  std::string ft_site;                 // the wrist force/torque site
+  std::string finger;                  // a finger body (hangs from the F/T site's body)
+  std::string imu_site;                // "" = no IMU
   double min_mass, max_mass;           // kg, the whole robot
   std::vector<Frame> frames;           // URDF chains from the root checked against MuJoCo
 
@@ -61,7 +61,9 @@ struct RobotCase {
   std::string robotFile() const { return dir + "/config/robot.yaml"; }
 };
 
-std::ostream& operator<<(std::ostream& os, const RobotCase& r) { return os << r.name; }
+std::ostream& operator<<(std::ostream& os, const RobotCase& r) {
+  return os << r.name;
+}
 
 std::vector<RobotCase> robots() {
   RobotCase humanoid;
@@ -417,7 +419,8 @@ TEST_P(ModelConsistency, TheWorkcellSimulatesTheReadyPostureAndTheGripper) {
   EXPECT_LT(sag, 0.01) << "the ready posture sags under gravity";
   d->ctrl[gripper] = setup.gripper.close_opening / setup.gripper.opening_scale;
   ASSERT_NO_FATAL_FAILURE(step(1.5));
-  EXPECT_NEAR(finger(finger_joint), setup.gripper.close_opening / setup.gripper.opening_scale, 2e-3);
+  EXPECT_NEAR(finger(finger_joint), setup.gripper.close_opening / setup.gripper.opening_scale,
+              2e-3);
   EXPECT_NEAR(finger(mimic), finger(finger_joint), 2e-3);
   for (const lfd::SensorEntry& row : setup.sensors)
     if (row.type == "lfd_msgs/Touch")

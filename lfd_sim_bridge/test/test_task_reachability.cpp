@@ -38,7 +38,9 @@ struct RobotCase {
   std::string urdfPath() const { return dir + "/models/" + urdf; }
 };
 
-std::ostream& operator<<(std::ostream& os, const RobotCase& r) { return os << r.name; }
+std::ostream& operator<<(std::ostream& os, const RobotCase& r) {
+  return os << r.name;
+}
 
 const std::vector<RobotCase> kRobots = {{"jvrc1", LFD_JVRC1_ROBOT_DIR, "jvrc1_like.urdf"},
                                         {"arm7", LFD_ARM7_ROBOT_DIR, "arm7.urdf"}};
@@ -208,9 +210,9 @@ TEST_P(TaskReach, EveryPlannedPathIsReachableWithMargin) {
       for (const auto* list : {&t.configurations.at(mode), &t.unseen.at(mode)}) {
         for (const task::Configuration& c : *list) {
           for (uint32_t seed : {1u, 2u}) {  // the per-demo variation and the operator's draws
-            expectReachable(t, c, mode == "teleop", seed,
-                            GetParam().name + ": " + name + "." + mode + " id " + std::to_string(c.id),
-                            &tally);
+            expectReachable(
+                t, c, mode == "teleop", seed,
+                GetParam().name + ": " + name + "." + mode + " id " + std::to_string(c.id), &tally);
             if (HasFailure()) return;
           }
         }

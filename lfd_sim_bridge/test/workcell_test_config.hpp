@@ -33,7 +33,8 @@ inline const std::vector<double>& reading(const lfd_sim::WorkcellState& s, const
   return r->values.at(k);
 }
 
-// Arm bent over the table (like the robot file's ready posture), so arm joints move without hitting anything.
+// Arm bent over the table (like the robot file's ready posture), so arm joints move without hitting
+// anything.
 inline lfd_sim::WorkcellConfig readyConfig() {
   lfd_sim::WorkcellConfig c = robotConfig();
   c.initial_posture = {

@@ -72,8 +72,8 @@ JointPath CartesianToJoints::convert(const std::vector<TimedPose>& samples,
       if (!acceptable(retry)) {
         std::ostringstream msg;
         msg << robot_name_ << " cannot reach the TCP pose at t=" << sample.t << " s, position ("
-            << sample.pose.position.transpose() << "): IK residual " << retry.position_error * 1000.0
-            << " mm, " << retry.orientation_error << " rad";
+            << sample.pose.position.transpose() << "): IK residual "
+            << retry.position_error * 1000.0 << " mm, " << retry.orientation_error << " rad";
         throw std::runtime_error(msg.str());
       }
       result_ = retry;

@@ -91,7 +91,8 @@ TEST(RobotSetup, BadFilesAreClearErrors) {
               "open_opening");
   expectError("ik: [1, 2\n", "cannot be read");
   expectError("ik: {tip_link: t}\ngripper: {close_effort: 5}\n", "gripper.joint");
-  expectError("ik: {tip_link: t}\ngripper: {joint: G, opening_scale: 0}\n", "gripper.opening_scale");
+  expectError("ik: {tip_link: t}\ngripper: {joint: G, opening_scale: 0}\n",
+              "gripper.opening_scale");
   expectError("ik: {tip_link: t}\ninitial_posture: {J: .nan}\n", "initial_posture.J");
   expectError("ik: {tip_link: t}\ninitial_posture: [1]\n", "initial_posture must map");
   const std::string ik = "ik: {tip_link: t}\n";

@@ -14,13 +14,13 @@
 namespace lfd_dmp {
 
 struct DemoBagTopics {
-  std::string pose = "/ee_pose";            ///< geometry_msgs/PoseStamped (base_link)
-  std::string gripper = "/gripper/state";   ///< sensor_msgs/JointState
+  std::string pose = "/ee_pose";           ///< geometry_msgs/PoseStamped (base_link)
+  std::string gripper = "/gripper/state";  ///< sensor_msgs/JointState
   /// Joint whose position is the opening; "" = the message's first joint (a gripper state
   /// names its gripper alone, whatever the robot calls it).
   std::string gripper_joint;
-  std::string metadata = "/lfd/metadata";   ///< lfd_msgs/DemoMetadata (extra_json: the scene)
-  std::string tf_static = "/tf_static";     ///< tf2_msgs/TFMessage
+  std::string metadata = "/lfd/metadata";  ///< lfd_msgs/DemoMetadata (extra_json: the scene)
+  std::string tf_static = "/tf_static";    ///< tf2_msgs/TFMessage
 };
 
 /// The pose of frame `source` in frame `target` from elsewhere than the bag (the live tf tree);
