@@ -477,6 +477,7 @@ class BridgeNode {
   // Validated on receipt, whole (WorkcellSim::setTrajectory: sizes, finite values, times, each
   // velocity within its joint's limit); a refused trajectory is logged and nothing moves.
   void onTrajectory(const trajectory_msgs::JointTrajectory::ConstPtr& msg) {
+    last_trajectory_stamp_ = msg->header.stamp.toSec();
     lfd_sim::JointTrajectory traj;
     traj.joint_names = msg->joint_names;
     traj.points.reserve(msg->points.size());
@@ -511,6 +512,7 @@ class BridgeNode {
   // motion sends its gripper events in advance, so they happen on time whatever the load); a zero
   // or past stamp, at once. A command drops the pending ones stamped after it (a stop cancels).
   void onGripper(const lfd_msgs::GripperCommand::ConstPtr& msg) {
+    last_gripper_stamp_ = msg->header.stamp.toSec();
     while (!pending_gripper_.empty() && pending_gripper_.back().header.stamp > msg->header.stamp)
       pending_gripper_.pop_back();
     if (msg->header.stamp.toSec() <= sim_->time() + 0.5 * sim_->timestep())
@@ -660,6 +662,8 @@ class BridgeNode {
 
   bool onStep(lfd_msgs::StepSim::Request& req, lfd_msgs::StepSim::Response& res) {
     res.sim_time = sim_->time();
+    res.last_trajectory_stamp = last_trajectory_stamp_;
+    res.last_gripper_stamp = last_gripper_stamp_;
     if (!paused_) {
       res.success = false;
       res.message = "the simulation is running; pause it (/bridge/pause) before stepping";
@@ -670,6 +674,11 @@ class BridgeNode {
       res.success = false;
       res.message = std::to_string(req.steps) + " steps is over the limit of " +
                     std::to_string(max_steps_per_call_) + " per call (~max_steps_per_call)";
+      return true;
+    }
+    if (req.steps == 0) {  // a query: a republished state would duplicate a recorded stamp
+      res.success = true;
+      res.message = "stepped 0";
       return true;
     }
     for (uint32_t i = 0; i < req.steps; ++i) stepOnce();
@@ -697,6 +706,7 @@ class BridgeNode {
   int max_steps_per_call_ = 10000;
   lfd::StringBudget strings_;  // ~limits/max_request_string_bytes of every request string
   bool paused_ = false;
+  double last_trajectory_stamp_ = -1.0, last_gripper_stamp_ = -1.0;  // the commands taken in
   ros::Time last_clock_, last_tf_;
   ThrottledErrors errors_;
   static constexpr size_t kMaxPendingGripper = 1000;

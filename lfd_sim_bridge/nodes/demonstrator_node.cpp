@@ -61,6 +61,10 @@
 
 namespace {
 
+// Wall time a lockstep step may take to deliver a command to the bridge, or this step's sensor
+// reading back: far beyond any load seen (1.4 s of lag); beyond it the bridge is gone or hung.
+constexpr double kCommandWait = 10.0;
+
 namespace demo = lfd_sim_bridge::demo;
 namespace task = lfd_sim_bridge::task;
 
@@ -418,6 +422,7 @@ class Demonstrator {
     const double speed = speed_min_ + (speed_max_ - speed_min_) * unit(rng);
     placeScene(c);
 
+    if (lockstep_) waitForFreshSensors();  // the joints after the scene's settling, not before
     const Eigen::VectorXd q0 = currentChainPositions();
     const demo::Pose start = converter_->forward(q0);
     demo::DemoState state = dataset().interpreter->begin(c, world_from_base_, start, speed, rng);
@@ -571,7 +576,7 @@ class Demonstrator {
       }
     }
     trajectory_pub_.publish(msg);
-    letMessagesArrive();
+    waitUntilTaken(msg.header.stamp, &lfd_msgs::StepSim::Response::last_trajectory_stamp);
   }
 
   void sendGripper(const demo::GripperAction& action) {
@@ -580,7 +585,7 @@ class Demonstrator {
     g.position = action.opening;
     g.max_effort = action.max_effort;
     gripper_pub_.publish(g);
-    letMessagesArrive();
+    waitUntilTaken(g.header.stamp, &lfd_msgs::StepSim::Response::last_gripper_stamp);
   }
 
   // --- ground-truth phase: at every transition and on a fixed sim-time grid in between ---
@@ -647,23 +652,41 @@ class Demonstrator {
   // Lockstep: the sensors of the step just taken (for contact checks) reach this node.
   void waitForFreshSensors() {
     const auto scope = measure("sensor_waits");
-    const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(0.2);
-    while (ros::ok() && ros::WallTime::now() < deadline) {
+    // A bounded wait would let a loaded machine decide a contact on an older reading (the
+    // sensor topics lagged /joint_states by up to 1.4 s): wait for this step's reading.
+    const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(kCommandWait);
+    while (ros::ok()) {
       {
         std::lock_guard<std::mutex> lock(mutex_);
-        if (touch_.header.stamp >= now_ - ros::Duration(publish_period_ / 2)) return;
+        const ros::Time fresh = now_ - ros::Duration(publish_period_ / 2);
+        if (touch_.header.stamp >= fresh && joints_.header.stamp >= fresh) return;
       }
+      if (ros::WallTime::now() > deadline)
+        throw std::runtime_error("no touch and joint reading of sim time " + std::to_string(now_.toSec()) +
+                                 " s within " + std::to_string(kCommandWait) + " s of wall time");
       ros::WallDuration(0.0002).sleep();
     }
   }
 
   // A command published just before a /bridge/step call must be processed before that step.
-  // The trajectory travels on a topic, the next /bridge/step on a service connection: nothing
-  // orders the two, so give the topic time to land before the bridge steps (3 ms was not always
-  // enough on an idle machine, where a push demo once never moved the box).
-  void letMessagesArrive() {
+  // The command travels on a topic, the next /bridge/step on a service connection: nothing orders
+  // the two. Lockstep asks the bridge (0-step calls) until it reports the command's stamp taken in:
+  // a fixed sleep (20 ms) let a loaded machine step past a command, and demos differed run to run.
+  void waitUntilTaken(const ros::Time& stamp, double lfd_msgs::StepSim::Response::*taken) {
+    if (!lockstep_) return;
     const auto scope = measure("settle_sleeps");
-    if (lockstep_) ros::WallDuration(0.02).sleep();
+    const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(kCommandWait);
+    while (ros::ok()) {
+      lfd_msgs::StepSim query;  // steps = 0
+      if (!step_client_.call(query) || !query.response.success)
+        throw std::runtime_error("/bridge/step (query) failed: " + query.response.message);
+      if (query.response.*taken >= stamp.toSec() - 1e-9) return;
+      if (ros::WallTime::now() > deadline)
+        throw std::runtime_error("the bridge did not take in a command stamped " +
+                                 std::to_string(stamp.toSec()) + " s within " +
+                                 std::to_string(kCommandWait) + " s of wall time");
+      ros::WallDuration(0.0005).sleep();
+    }
   }
 
   void setPaused(bool paused) {
@@ -713,6 +736,7 @@ class Demonstrator {
   }
 
   bool inContact(demo::Contact mode) {
+    if (lockstep_) waitForFreshSensors();  // this step's pads, not a reading from before it
     std::lock_guard<std::mutex> lock(mutex_);
     if (touch_.values.empty()) return false;
     const auto [lo, hi] = std::minmax_element(touch_.values.begin(), touch_.values.end());
