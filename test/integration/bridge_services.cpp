@@ -5,6 +5,7 @@
 // selects a noise profile.
 #include <geometry_msgs/WrenchStamped.h>
 #include <gtest/gtest.h>
+#include <lfd_msgs/GripperCommand.h>
 #include <lfd_msgs/InjectFault.h>
 #include <lfd_msgs/ResetSim.h>
 #include <lfd_msgs/SetScene.h>
@@ -103,6 +104,37 @@ TEST_F(BridgeServices, PauseAndStepAdvanceExactly) {
   ASSERT_TRUE(call("/bridge/step", &step));
   EXPECT_FALSE(step.response.success);
   EXPECT_TRUE(probe_.waitUntilSimTime(t0 + 0.5, 20.0)) << "did not resume";
+}
+
+// A lockstep client that has just published a command asks with 0-step calls until the bridge
+// reports the command's stamp taken in (the demonstrator's demos are then identical whatever the
+// load); such a query neither advances time nor publishes a duplicate state.
+TEST_F(BridgeServices, AStepQueryReportsTheCommandsTakenIn) {
+  ASSERT_TRUE(setPaused(true));
+  lfd_msgs::StepSim query;
+  ASSERT_TRUE(call("/bridge/step", &query));
+  ASSERT_TRUE(query.response.success) << query.response.message;
+  const double t0 = query.response.sim_time;
+  ros::WallDuration(0.3).sleep();  // the /clock messages sent before the pause have landed
+  const double clock0 = probe_.clockTime();
+  ros::Publisher gripper = nh_.advertise<lfd_msgs::GripperCommand>("/gripper/command", 10);
+  ASSERT_TRUE(waitFor([&] { return gripper.getNumSubscribers() > 0; }, 10.0));
+  lfd_msgs::GripperCommand g;
+  g.header.stamp = ros::Time(t0);
+  g.position = 0.05;
+  g.max_effort = 10.0;
+  gripper.publish(g);
+  EXPECT_TRUE(waitFor(
+      [&] {
+        lfd_msgs::StepSim q;
+        return call("/bridge/step", &q) && std::abs(q.response.last_gripper_stamp - t0) < 1e-9;
+      },
+      10.0))
+      << "the gripper command stamped " << t0 << " s was never reported taken in";
+  ASSERT_TRUE(call("/bridge/step", &query));
+  EXPECT_DOUBLE_EQ(query.response.sim_time, t0);
+  ros::WallDuration(0.2).sleep();
+  EXPECT_DOUBLE_EQ(probe_.clockTime(), clock0);  // nothing published by the queries
 }
 
 TEST_F(BridgeServices, SetScenePlacesObjects) {
