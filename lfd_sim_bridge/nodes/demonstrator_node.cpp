@@ -662,8 +662,9 @@ class Demonstrator {
         if (touch_.header.stamp >= fresh && joints_.header.stamp >= fresh) return;
       }
       if (ros::WallTime::now() > deadline)
-        throw std::runtime_error("no touch and joint reading of sim time " + std::to_string(now_.toSec()) +
-                                 " s within " + std::to_string(kCommandWait) + " s of wall time");
+        throw std::runtime_error("no touch and joint reading of sim time " +
+                                 std::to_string(now_.toSec()) + " s within " +
+                                 std::to_string(kCommandWait) + " s of wall time");
       ros::WallDuration(0.0002).sleep();
     }
   }
