@@ -1,7 +1,7 @@
 // DMP benchmark: accuracy figures (printed first), rollout steps/s, learning time per segment.
 //   bench_dmp                      # all
 //   bench_dmp --benchmark_filter=Rollout
-#include "../../src/test/dmp_test_curves.hpp"
+#include "dmp_test_curves.hpp"
 #include "lfd_core/dmp_generalization.hpp"
 #include "lfd_core/position_dmp.hpp"
 #include "lfd_core/segment_dmp.hpp"

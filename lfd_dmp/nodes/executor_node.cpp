@@ -52,12 +52,6 @@ double wallSince(Clock::time_point t0) {
   return std::chrono::duration<double>(Clock::now() - t0).count();
 }
 
-template <typename T>
-T param(ros::NodeHandle& pnh, const std::string& key, const T& fallback) {
-  T v;
-  return pnh.getParam(key, v) ? v : fallback;
-}
-
 Eigen::Vector3d vectorParam(ros::NodeHandle& pnh, const std::string& key,
                             const Eigen::Vector3d& fallback) {
   std::vector<double> v;
@@ -173,57 +167,55 @@ class Executor {
 
   // ---- configuration ---------------------------------------------------------------------------
   void loadParameters(ros::NodeHandle& pnh) {
-    library_dir_ = param<std::string>(pnh, "library_dir", "");
-    robot_ = lfd::loadRobotSetup(param<std::string>(pnh, "robot_file", ""));
-    options_.dt = param(pnh, "dt", options_.dt);
-    options_.all_segment_goals = param(pnh, "all_segment_goals", options_.all_segment_goals);
-    options_.heading_frames = param(pnh, "heading_frames", options_.heading_frames);
+    library_dir_ = pnh.param<std::string>("library_dir", "");
+    robot_ = lfd::loadRobotSetup(pnh.param<std::string>("robot_file", ""));
+    options_.dt = pnh.param("dt", options_.dt);
+    options_.all_segment_goals = pnh.param("all_segment_goals", options_.all_segment_goals);
+    options_.heading_frames = pnh.param("heading_frames", options_.heading_frames);
     options_.frames.min_heading_length =
-        param(pnh, "min_heading_length", options_.frames.min_heading_length);
+        pnh.param("min_heading_length", options_.frames.min_heading_length);
     options_.gripper_threshold_fraction =
-        param(pnh, "gripper/threshold_fraction", options_.gripper_threshold_fraction);
-    options_.gripper_hysteresis = param(pnh, "gripper/hysteresis", options_.gripper_hysteresis);
-    options_.gripper_min_range = param(pnh, "gripper/min_range", options_.gripper_min_range);
+        pnh.param("gripper/threshold_fraction", options_.gripper_threshold_fraction);
+    options_.gripper_hysteresis = pnh.param("gripper/hysteresis", options_.gripper_hysteresis);
+    options_.gripper_min_range = pnh.param("gripper/min_range", options_.gripper_min_range);
     auto& gen = options_.generalization;
-    gen.bandwidth = param(pnh, "generalization/bandwidth", 0.0);
-    gen.local_linear = param(pnh, "generalization/local_linear", gen.local_linear);
-    gen.slope_ridge = param(pnh, "generalization/slope_ridge", gen.slope_ridge);
+    gen.bandwidth = pnh.param("generalization/bandwidth", 0.0);
+    gen.local_linear = pnh.param("generalization/local_linear", gen.local_linear);
+    gen.slope_ridge = pnh.param("generalization/slope_ridge", gen.slope_ridge);
     gen.slope_ridge_candidates =
-        param(pnh, "generalization/slope_ridge_candidates", gen.slope_ridge_candidates);
-    gen.range_margin = param(pnh, "generalization/range_margin", gen.range_margin);
+        pnh.param("generalization/slope_ridge_candidates", gen.slope_ridge_candidates);
+    gen.range_margin = pnh.param("generalization/range_margin", gen.range_margin);
     options_.min_range_margin =
-        param(pnh, "generalization/min_range_margin", options_.min_range_margin);
+        pnh.param("generalization/min_range_margin", options_.min_range_margin);
     options_.min_range_angle =
-        param(pnh, "generalization/min_range_angle", options_.min_range_angle);
-    monitoring_ = param(pnh, "monitoring/enabled", monitoring_);
-    stop_on_alarm_ = param(pnh, "monitoring/stop_on_alarm", stop_on_alarm_);
-    max_silence_ = param(pnh, "monitoring/max_silence", max_silence_);
+        pnh.param("generalization/min_range_angle", options_.min_range_angle);
+    monitoring_ = pnh.param("monitoring/enabled", monitoring_);
+    stop_on_alarm_ = pnh.param("monitoring/stop_on_alarm", stop_on_alarm_);
+    max_silence_ = pnh.param("monitoring/max_silence", max_silence_);
     if (!(max_silence_ > 0.0))
       throw std::runtime_error("executor: ~monitoring/max_silence must be > 0");
-    settle_time_ = param(pnh, "settle_time", settle_time_);
-    clock_timeout_ = param(pnh, "clock_timeout", clock_timeout_);
-    motion_lead_ = param(pnh, "motion_lead", motion_lead_);
-    connect_timeout_ = param(pnh, "connect_timeout", connect_timeout_);
-    tf_timeout_ = param(pnh, "tf_timeout", tf_timeout_);
-    trajectory_period_ = param(pnh, "trajectory_period", trajectory_period_);
-    feedback_period_ = param(pnh, "feedback_period", feedback_period_);
-    paths_.allowed_roots = param(pnh, "allowed_roots", paths_.allowed_roots);
+    settle_time_ = pnh.param("settle_time", settle_time_);
+    clock_timeout_ = pnh.param("clock_timeout", clock_timeout_);
+    motion_lead_ = pnh.param("motion_lead", motion_lead_);
+    connect_timeout_ = pnh.param("connect_timeout", connect_timeout_);
+    tf_timeout_ = pnh.param("tf_timeout", tf_timeout_);
+    trajectory_period_ = pnh.param("trajectory_period", trajectory_period_);
+    feedback_period_ = pnh.param("feedback_period", feedback_period_);
+    paths_.allowed_roots = pnh.param("allowed_roots", paths_.allowed_roots);
     paths_.require_absolute = true;  // the node's working directory is not the caller's
     strings_.max_bytes = static_cast<std::size_t>(std::max(
-        0, param(pnh, "limits/max_request_string_bytes", static_cast<int>(strings_.max_bytes))));
+        0, pnh.param("limits/max_request_string_bytes", static_cast<int>(strings_.max_bytes))));
     strings_.key = "~limits/max_request_string_bytes";
-    limits_.min_duration_scale =
-        param(pnh, "limits/min_duration_scale", limits_.min_duration_scale);
-    limits_.max_duration_scale =
-        param(pnh, "limits/max_duration_scale", limits_.max_duration_scale);
-    limits_.max_plan_seconds = param(pnh, "limits/max_plan_seconds", limits_.max_plan_seconds);
+    limits_.min_duration_scale = pnh.param("limits/min_duration_scale", limits_.min_duration_scale);
+    limits_.max_duration_scale = pnh.param("limits/max_duration_scale", limits_.max_duration_scale);
+    limits_.max_plan_seconds = pnh.param("limits/max_plan_seconds", limits_.max_plan_seconds);
     limits_.quaternion_tolerance =
-        param(pnh, "limits/quaternion_tolerance", limits_.quaternion_tolerance);
+        pnh.param("limits/quaternion_tolerance", limits_.quaternion_tolerance);
     limits_.workspace_min = vectorParam(pnh, "limits/workspace_min", limits_.workspace_min);
     limits_.workspace_max = vectorParam(pnh, "limits/workspace_max", limits_.workspace_max);
-    limits_.max_objects = param(pnh, "limits/max_objects", static_cast<int>(limits_.max_objects));
+    limits_.max_objects = pnh.param("limits/max_objects", static_cast<int>(limits_.max_objects));
     limits_.max_name_length =
-        param(pnh, "limits/max_name_length", static_cast<int>(limits_.max_name_length));
+        pnh.param("limits/max_name_length", static_cast<int>(limits_.max_name_length));
     lfd_dmp::checkLimits(limits_);
     loadLibraryLimits(pnh);
     if (!(options_.dt > 0.0) || !(settle_time_ >= 0.0) || !(clock_timeout_ > 0.0) ||
@@ -237,12 +229,12 @@ class Executor {
   void loadLibraryLimits(ros::NodeHandle& pnh) {
     lfd_dmp::LibraryLimits& l = library_limits_;
     auto count = [&](const char* key, std::size_t fallback) {
-      return static_cast<std::size_t>(std::max(
-          0, param(pnh, std::string("library_limits/") + key, static_cast<int>(fallback))));
+      return static_cast<std::size_t>(
+          std::max(0, pnh.param(std::string("library_limits/") + key, static_cast<int>(fallback))));
     };
-    l.min_tau = param(pnh, "library_limits/min_tau", l.min_tau);
-    l.max_tau = param(pnh, "library_limits/max_tau", l.max_tau);
-    l.max_tau_ratio = param(pnh, "library_limits/max_tau_ratio", l.max_tau_ratio);
+    l.min_tau = pnh.param("library_limits/min_tau", l.min_tau);
+    l.max_tau = pnh.param("library_limits/max_tau", l.max_tau);
+    l.max_tau_ratio = pnh.param("library_limits/max_tau_ratio", l.max_tau_ratio);
     l.max_segments = count("max_segments", l.max_segments);
     l.max_demos = count("max_demos", l.max_demos);
     l.max_num_basis = static_cast<int>(count("max_num_basis", l.max_num_basis));

@@ -88,7 +88,7 @@ TEST(DmpTool, LearnThenRolloutToANewGoal) {
   for (const auto& p : {csv, json, traj_csv}) std::remove(p.c_str());
 }
 
-// Issue 12: `dmp_tool learn --basis 300` crashed (Eigen LDLT under -march=native with pinned
+// Regression: `dmp_tool learn --basis 300` crashed (Eigen LDLT under -march=native with pinned
 // alignment). 300 and 1000 basis functions (1000 > the demo's 1200 samples / 2) must learn, save,
 // load and reproduce the demo.
 TEST(DmpTool, LearnsWithHundredsOfBasisFunctions) {
@@ -176,7 +176,7 @@ TEST(DmpTool, BadInputGivesClearErrors) {
     f << "t,x,y\n0,0,0\n0.1,0.1,0\n0.2,nan,0\n";
   }
   EXPECT_EQ(run({"learn", "--csv", csv, "--out", json}, &out, &err), 1);
-  EXPECT_NE(err.find("line 4, column \"x\""), std::string::npos) << err;
+  EXPECT_NE(err.find("line 4, column 2 ('x')"), std::string::npos) << err;
   EXPECT_FALSE(std::ifstream(json).good());
 
   // Too short for a DMP.
@@ -213,7 +213,7 @@ std::string fileText(const std::string& path) {
   return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
 }
 
-// Issue 12: an existing output was silently replaced, even when it was the command's own input.
+// Regression: an existing output was silently replaced, even when it was the command's own input.
 TEST(DmpTool, KeepsAnExistingOutputUnlessOverwrite) {
   const std::string csv = writeDemoCsv("keep.csv", 0.6, 100);
   const std::string json = tempPath("keep.json");
@@ -222,7 +222,7 @@ TEST(DmpTool, KeepsAnExistingOutputUnlessOverwrite) {
   EXPECT_EQ(run({"learn", "--csv", csv, "--out", json}, &out, &err), 1);
   EXPECT_NE(err.find("exists; set overwrite"), std::string::npos) << err;
   EXPECT_EQ(fileText(json), "precious\n");
-  // Issue 23: --overwrite replaced any file; it replaces only a skill library lfd wrote.
+  // Regression: --overwrite replaced any file; it replaces only a skill library lfd wrote.
   EXPECT_EQ(run({"learn", "--csv", csv, "--out", json, "--overwrite"}, &out, &err), 1);
   EXPECT_NE(err.find("keep.json"), std::string::npos) << err;
   EXPECT_NE(err.find("was not written by lfd as a skill library"), std::string::npos) << err;
@@ -236,7 +236,7 @@ TEST(DmpTool, KeepsAnExistingOutputUnlessOverwrite) {
   for (const auto& p : {csv, json}) std::remove(p.c_str());
 }
 
-// Issue 23: a rollout's --overwrite replaces only a trajectory CSV dmp_tool wrote (its first line
+// Regression: a rollout's --overwrite replaces only a trajectory CSV dmp_tool wrote (its first line
 // marks it); a demonstration CSV or any other file of that name is kept.
 TEST(DmpTool, RolloutOverwritesOnlyATrajectoryItWrote) {
   const std::string csv = writeDemoCsv("roll.csv", 0.6, 100);
@@ -259,8 +259,8 @@ TEST(DmpTool, RolloutOverwritesOnlyATrajectoryItWrote) {
   for (const auto& p : {csv, json, traj, other}) std::remove(p.c_str());
 }
 
-// Issue 23: a CSV saved with a UTF-8 byte-order mark named its first column "\xef\xbb\xbft"; UTF-16
-// is refused saying so.
+// Regression: a CSV saved with a UTF-8 byte-order mark named its first column "\xef\xbb\xbft";
+// UTF-16 is refused saying so.
 TEST(DmpTool, AUtf8ByteOrderMarkIsSkippedAndUtf16IsRefused) {
   const std::string plain = writeDemoCsv("bom_plain.csv", 0.6, 100);
   const std::string bom = tempPath("bom.csv");
@@ -286,7 +286,7 @@ TEST(DmpTool, AUtf8ByteOrderMarkIsSkippedAndUtf16IsRefused) {
   for (const auto& p : {plain, bom, utf16}) std::remove(p.c_str());
 }
 
-// Issue 23: a library's strings are bounded when it is loaded (library_limits); one lfd writes
+// Regression: a library's strings are bounded when it is loaded (library_limits); one lfd writes
 // must load again, so a 10 kB task name is refused before anything is written.
 TEST(DmpTool, ALibraryThatCouldNotBeLoadedIsNeverWritten) {
   const std::string csv = writeDemoCsv("long_task.csv", 0.6, 100);

@@ -1,4 +1,4 @@
-// Property test of dmp_tool (issue 12): seeded random commands built from extreme values (huge,
+// Property test of dmp_tool: seeded random commands built from extreme values (huge,
 // tiny, non-finite, negative, empty, non-unit quaternions, wrong dimensions, duplicated flags,
 // very long strings, paths that are pipes, folders or the inputs). Every answer must be exit 0
 // with a readable output or exit 1/2 with an error line; the inputs must keep their bytes; and a

@@ -1,4 +1,4 @@
-// Checks of an execution request (issue 12): bounds named in their refusals, quaternions normalized
+// Checks of an execution request: bounds named in their refusals, quaternions normalized
 // within a tolerance and refused beyond, non-finite and out-of-workspace poses refused.
 #include "lfd_dmp/execution_request.hpp"
 
@@ -24,7 +24,7 @@ TEST(ExecutionRequest, DurationScaleIsBoundedByTheConfiguredLimits) {
   const RequestLimits l;
   EXPECT_EQ(lfd_dmp::checkedDurationScale(0.0, l), 1.0);  // unset: the learned pace
   EXPECT_EQ(lfd_dmp::checkedDurationScale(2.5, l), 2.5);
-  // Issue 12: 1e-9 "succeeded" without moving; 1000 took 1.36 GB.
+  // Regression: 1e-9 "succeeded" without moving; 1000 took 1.36 GB.
   for (double bad : {1e-9, 1000.0, -1.0, std::nan(""), std::numeric_limits<double>::infinity()}) {
     const std::string m = refusal([&] { lfd_dmp::checkedDurationScale(bad, l); });
     EXPECT_NE(m.find("~limits/min_duration_scale"), std::string::npos) << bad << ": " << m;
@@ -38,7 +38,7 @@ TEST(ExecutionRequest, QuaternionsAreNormalizedWithinTheToleranceAndRefusedBeyon
   const lfd::Pose ok = lfd_dmp::checkedPose(p, Eigen::Vector4d(c, 0, 0, s) * 1.005, "goal", l);
   EXPECT_NEAR(ok.orientation.norm(), 1.0, 1e-12);
   EXPECT_NEAR(ok.orientation.angularDistance(Eigen::Quaterniond(c, 0, 0, s)), 0.0, 1e-12);
-  // Issue 12: 2 x a yaw of 0.3 was planned at 0.96 rad; a zero quaternion was read as yaw 0.
+  // Regression: 2 x a yaw of 0.3 was planned at 0.96 rad; a zero quaternion was read as yaw 0.
   std::string m =
       refusal([&] { lfd_dmp::checkedPose(p, Eigen::Vector4d(2 * c, 0, 0, 2 * s), "goal", l); });
   EXPECT_NE(m.find("norm 2"), std::string::npos) << m;

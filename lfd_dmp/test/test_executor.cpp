@@ -186,7 +186,7 @@ TEST_F(PlannerTest, SegmentsRunInSequenceFromTheCurrentPoseToEachNewGoal) {
   EXPECT_NEAR(planner_.plan(lib_, targets(grasp, goal), q0_, 0.04, opt).duration(), 6.75, 0.05);
 }
 
-// Issue 23: the driver refuses a trajectory whose velocity is beyond a joint's limit; the
+// Regression: the driver refuses a trajectory whose velocity is beyond a joint's limit; the
 // executor checks the trajectory it would send first, so the goal fails naming the joint. A
 // normal plan is within the limits.
 TEST_F(PlannerTest, ATrajectoryFasterThanAJointsLimitIsRefusedBeforeItIsSent) {
@@ -231,7 +231,7 @@ TEST_F(PlannerTest, RefusesUnreachableGoalsAndMismatchedLibraries) {
   EXPECT_THROW(planner_.plan(empty, {}, q0_, 0.04, opt), std::invalid_argument);
 }
 
-// Issue 12: a library (built in memory, past the loader's bounds) whose finite weights are so
+// Regression: a library (built in memory, past the loader's bounds) whose finite weights are so
 // huge that the rollout overflows crashed the executor node (IK returned an empty joint vector).
 // Planning must fail with a clear error instead.
 TEST_F(PlannerTest, OverflowingSkillWeightsAreAClearError) {
@@ -352,7 +352,7 @@ TEST_F(PlannerTest, GoalsOutsideTheDemonstratedRangeAreRefusedUnlessAllowed) {
   EXPECT_NE(convex.warnings.back().find("kernel average"), std::string::npos);
 }
 
-// Issue 12: duration_scale 1000 took 1.36 GB. The plan is refused before anything is allocated,
+// Regression: duration_scale 1000 took 1.36 GB. The plan is refused before anything is allocated,
 // naming the limit; planning can be cancelled between pieces of work.
 TEST_F(PlannerTest, LongPlansAreRefusedAndPlanningCanBeCancelled) {
   lfd_dmp::ExecutorOptions opt;

@@ -314,7 +314,7 @@ TEST(DemoBag, ReadsPosesAndInterpolatesTheGripper) {
   EXPECT_THROW(lfd_dmp::readDemoBag(path), std::runtime_error);
 }
 
-// Issue 23: a topic declared geometry_msgs/PoseStamped whose message holds other bytes (here a
+// Regression: a topic declared geometry_msgs/PoseStamped whose message holds other bytes (here a
 // PoseStamped cut short) made roscpp throw "Buffer Overrun", which was all the learner said. The
 // error names the file, the topic, the declared type, the message's index and time.
 TEST(DemoBag, MessageBytesThatDoNotMatchTheDeclaredTypeAreNamed) {
@@ -348,7 +348,7 @@ TEST(DemoBag, MessageBytesThatDoNotMatchTheDeclaredTypeAreNamed) {
   std::remove(path.c_str());
 }
 
-// Issue 23 row 1: a link swapped between a demo bag and a FIFO while the learner reads it never
+// Regression: a link swapped between a demo bag and a FIFO while the learner reads it never
 // hangs it in open() (it checked the path, then opened it again by name).
 TEST(DemoBag, LinkSwappedToFifoNeverHangsTheReader) {
   const std::string dir = ::testing::TempDir() + "/lfd_dmp_race_" + std::to_string(::getpid());
@@ -363,7 +363,7 @@ TEST(DemoBag, LinkSwappedToFifoNeverHangsTheReader) {
   std::filesystem::remove_all(dir);
 }
 
-// Issue 23 row 4: one pose stamped 5 s late. The reader used to skip every pose stamped before it
+// Regression: one pose stamped 5 s late. The reader used to skip every pose stamped before it
 // (half the demo) and the learner succeeded with its first segment ending 3 s off; the shared
 // timestamp policy keeps every pose in stamp order and warns, naming the topic and the count.
 TEST(DemoBag, APoseStampedLateIsPutInOrderAndWarned) {

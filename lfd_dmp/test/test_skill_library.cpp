@@ -182,7 +182,7 @@ TEST(SkillLibrary, ValidationNamesTheProblem) {
             std::string::npos)
       << loadError(j);
 
-  // Issue 12: finite but huge numbers overflowed the rollout and crashed the executor's IK.
+  // Regression: finite but huge numbers overflowed the rollout and crashed the executor's IK.
   j = good;
   j["segments"][0]["demos"][1]["dmp"]["position"]["weights"][2][5] = 1e300;
   EXPECT_NE(loadError(j).find("segments[0].demos[1].dmp.position.weights: weight 1e+300"),
@@ -251,7 +251,7 @@ TEST(SkillLibrary, ValidationNamesTheProblem) {
 
 // catkin_add_gtest links gtest without gtest_main (and the static gtest_main archive is then simply
 // not pulled in by the standalone build).
-// Issue 23 row 8: a library whose tau is 1e-6 s (or 0.05 s where its demos took 9.8 s)
+// Regression: a library whose tau is 1e-6 s (or 0.05 s where its demos took 9.8 s)
 // "succeeded" in 0.1 s without moving. Durations, sizes and strings are checked on load; each
 // refusal names the segment, the field and the limit's key. The valid library still loads.
 TEST(SkillLibrary, ImplausibleDurationsAndSizesAreRefusedOnLoad) {

@@ -46,9 +46,10 @@ const char* kUsage = R"(usage: segment [options] FILE...
                             distance_average | weighted_distance_average, or 'all'. Several: the
                             features are selected once and the JSON holds one result per name
                             under "methods" (the selection does not depend on the combination)
-  --procedure NAME          zone_search (default: zones first, changepoints on their events) |
-                            paper (the paper's: paper_candidates anywhere, then the zone filter) |
-                            joint (all demos together: every kind of evidence, agreed by DTW)
+  --procedure NAME          joint (all demos together: every kind of evidence, agreed by DTW) |
+                            zone_search (zones first, changepoints on their events) |
+                            paper (the paper's: paper_candidates anywhere, then the zone filter);
+                            default: the config's 'procedure' (the shipped one: joint)
   --threshold T             relevance threshold in (0,1]
   --min-segment-seconds S   min segment length min_s (s)
   --window-seconds S        fixed ClaSP window (s)

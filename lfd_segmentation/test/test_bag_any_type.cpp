@@ -10,8 +10,8 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
-#include "../../src/test/ros_serialized_bytes.hpp"
 #include "lfd_segmentation/bag_features.hpp"
+#include "ros_serialized_bytes.hpp"
 
 namespace {
 

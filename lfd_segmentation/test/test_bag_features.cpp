@@ -118,7 +118,7 @@ TEST(BagFeatures, UnreadableOrTruncatedBagIsARuntimeError) {
                std::runtime_error);
 }
 
-// Issue 23 row 1: a link swapped between a bag and a FIFO while the reader runs never hangs it
+// Regression: a link swapped between a bag and a FIFO while the reader runs never hangs it
 // (the path was checked, then opened again by name: open() blocked on the FIFO forever).
 TEST(BagFeatures, LinkSwappedToFifoNeverHangsTheReader) {
   const fs::path dir = temp_dir();
@@ -134,7 +134,7 @@ TEST(BagFeatures, LinkSwappedToFifoNeverHangsTheReader) {
   EXPECT_GT(r.read_calls, 0);  // the bag itself is still read when the link points at it
 }
 
-// Issue 23 row 4: one /ee_pose stamped 5 s late is kept, in stamp order, and warned about by the
+// Regression: one /ee_pose stamped 5 s late is kept, in stamp order, and warned about by the
 // same policy as the learner's reader (lfd_core/stamp_order.hpp).
 TEST(BagFeatures, AMessageStampedLateIsPutInOrderAndWarned) {
   const std::string bag = (temp_dir() / "late_pose.bag").string();

@@ -162,7 +162,7 @@ TEST(SegmentCli, BadInputFailsWithAnErrorInTheJson) {
   EXPECT_EQ(status, 1);
 }
 
-// Issue 23 row 7: a column name or a file name with bytes that are not UTF-8 made the JSON writer
+// Regression: a column name or a file name with bytes that are not UTF-8 made the JSON writer
 // throw (nlohmann type_error 316) and the CLI abort (exit 134). Now the JSON is valid (U+FFFD for
 // the bad bytes), an error quotes the name printably, and never more than ~200 characters of it.
 TEST(SegmentCli, NonUtf8NamesGiveValidJsonAndLongInputIsQuotedShort) {
@@ -362,7 +362,7 @@ TEST(CsvFeatures, ParsesHeaderTimeAndRejectsRaggedRows) {
   EXPECT_EQ(rated.time, (std::vector<double>{0.0}));
 }
 
-// Issue 12: a 10M-row CSV took 1.9 GB and no result in 300 s; +-1e308 overflowed the distances.
+// Regression: a 10M-row CSV took 1.9 GB and no result in 300 s; +-1e308 overflowed the distances.
 TEST(CsvFeatures, LimitsStopTheReadAndNameRowAndColumn) {
   const std::string csv = (temp_dir() / "limits.csv").string();
   {
@@ -389,7 +389,7 @@ TEST(CsvFeatures, LimitsStopTheReadAndNameRowAndColumn) {
   }
 }
 
-// Issue 23: a CSV saved with a UTF-8 byte-order mark (as spreadsheet programs save it) gave "no
+// Regression: a CSV saved with a UTF-8 byte-order mark (as spreadsheet programs save it) gave "no
 // time column": the first column was named "\xef\xbb\xbftime". The mark is skipped; UTF-16 is
 // refused saying so.
 TEST(CsvFeatures, AUtf8ByteOrderMarkIsSkippedAndUtf16IsRefused) {
@@ -423,7 +423,7 @@ TEST(CsvFeatures, AUtf8ByteOrderMarkIsSkippedAndUtf16IsRefused) {
   }
 }
 
-// Issue 23: 10,000 feature columns took 1.1 GB. The header is checked against
+// Regression: 10,000 feature columns took 1.1 GB. The header is checked against
 // limits/max_features before any row is read.
 TEST(CsvFeatures, TooManyFeatureColumnsAreRefusedOnTheHeader) {
   const std::string csv = (temp_dir() / "wide.csv").string();
@@ -456,7 +456,7 @@ TEST(CsvFeatures, TooManyFeatureColumnsAreRefusedOnTheHeader) {
       << j.dump();
 }
 
-// Issue 23: an output replaced any regular file. --output replaces a result file the CLI wrote
+// Regression: an output replaced any regular file. --output replaces a result file the CLI wrote
 // (scripts rerun into their folder), never another file: it is kept and the error says why.
 TEST(SegmentCli, OutputReplacesOnlyAResultFileItWrote) {
   const fs::path dir = temp_dir();
@@ -518,7 +518,7 @@ TEST(SegmentCli, RefusesAPipeAndNeverWritesOverAnInput) {
   }
 }
 
-// Property test of the CLI (issue 12): 40 seeded random command lines of extreme values and bad
+// Property test of the CLI: 40 seeded random command lines of extreme values and bad
 // files. Each run ends (under `timeout`) with exit 0 and a result or exit 1 and an error in the
 // JSON, never a crash, and the input CSV keeps its bytes. About 2 s.
 TEST(SegmentCli, RandomExtremeCommandLinesGiveAResultOrAClearError) {

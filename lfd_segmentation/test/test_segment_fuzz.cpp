@@ -1,4 +1,4 @@
-// Property test of the segmentation service body (issue 12): seeded random requests mixing good
+// Property test of the segmentation service body: seeded random requests mixing good
 // bags with extreme inputs (missing, empty, duplicated, very long and '..' paths, a named pipe, a
 // folder, a device, a corrupt bag, a bag with a message stamped hours late or a 1e308 sample) and
 // extreme numbers (NaN, inf, 1e300, 1e-300, negative, huge counts). Each answer must be a clear

@@ -101,7 +101,7 @@ TEST_F(SegmentService, ACachedSelectionGivesTheUncachedAnswer) {
   fs::remove(bags[1]);  // good1 is written afresh by the next test that needs it
 }
 
-// Issue 23: a bag replaced by a corrupt file of the same size and modification time (touch -r
+// Regression: a bag replaced by a corrupt file of the same size and modification time (touch -r
 // old new; mv new bag) still got the cached success: the cache was keyed by path, size and mtime.
 // Keyed by the identity of the descriptor read (inode, ctime...), the request reads the new file
 // and fails naming it.
@@ -141,7 +141,7 @@ TEST_F(SegmentService, ABagReplacedBySameSizeSameTimeCorruptFileIsNotTheCachedOn
   for (const std::string& b : request_bags) fs::remove(b);
 }
 
-// Issue 23: a service resolves a relative path against its own working directory, which the
+// Regression: a service resolves a relative path against its own working directory, which the
 // client neither sees nor chose. Every bag path (every part of one) must be absolute; the error
 // names the field.
 TEST_F(SegmentService, RelativeBagPathsAreRefusedNamingTheField) {
@@ -155,7 +155,7 @@ TEST_F(SegmentService, RelativeBagPathsAreRefusedNamingTheField) {
   expect_error(r, "absolute path");
 }
 
-// Issue 23: every string of a request within limits/max_request_string_bytes, checked before any
+// Regression: every string of a request within limits/max_request_string_bytes, checked before any
 // work (a 10 MB string was echoed into errors and logs); the error quotes at most 200 characters.
 TEST_F(SegmentService, AnOverlongRequestStringIsRefusedBeforeAnyWork) {
   lfd_msgs::Segment::Request request;
@@ -170,7 +170,7 @@ TEST_F(SegmentService, AnOverlongRequestStringIsRefusedBeforeAnyWork) {
   expect_error(paths, "bag_paths[1]: a string of 300009 bytes");
 }
 
-// Issue 23: 10,000 feature columns took 1.1 GB. Features beyond limits/max_features are refused
+// Regression: 10,000 feature columns took 1.1 GB. Features beyond limits/max_features are refused
 // as the topics' fields are expanded, before the bags are read whole and resampled.
 TEST_F(SegmentService, TooManyFeaturesAreRefusedBeforeResampling) {
   lfd_segmentation::SegmentationParams few = params_;
@@ -184,7 +184,7 @@ TEST_F(SegmentService, TooManyFeaturesAreRefusedBeforeResampling) {
   EXPECT_EQ(params_.limits.max_features, 256u);  // the shipped bound takes these bags
 }
 
-// Issue 23: a topic whose connection declares geometry_msgs/PoseStamped but whose message holds
+// Regression: a topic whose connection declares geometry_msgs/PoseStamped but whose message holds
 // other bytes read as "Buffer Overrun". The error names the file, the topic, the declared type,
 // the message's index and time, and says the bytes do not match; the service answers.
 TEST_F(SegmentService, MessageBytesThatDoNotMatchTheDeclaredTypeAreNamed) {
@@ -303,7 +303,7 @@ TEST_F(SegmentService, FeaturesThatDifferBetweenDemos) {
   expect_error(call({good_bags(1)[0], bag("other_touch", o)}), "features differ");
 }
 
-// Issue 12: a named pipe as a bag path blocked the node in open() forever. If the code under test
+// Regression: a named pipe as a bag path blocked the node in open() forever. If the code under test
 // blocks, the test opens the pipe's other end itself so it can fail instead of hanging.
 TEST_F(SegmentService, NamedPipeIsRefusedAtOnce) {
   const std::string fifo = (dir_ / "pipe.bag").string();
@@ -344,7 +344,7 @@ TEST_F(SegmentService, TooManyBagsAreRefusedNamingTheLimit) {
   expect_error(r, "limits/max_bags");
 }
 
-// Issue 23 row 2: entries written as parts of one demo ("a.bag,b.bag,...") passed max_bags, which
+// Regression: entries written as parts of one demo ("a.bag,b.bag,...") passed max_bags, which
 // counted entries: 32 of them expanded to 290 bags (120 s, 581 MB). The budget counts the bags
 // the request expands to, and their bytes, before reading any, with the shipped limits.
 TEST_F(SegmentService, PartsOfDemosCountAgainstTheBudgetBeforeAnyWork) {
@@ -370,7 +370,7 @@ TEST_F(SegmentService, PartsOfDemosCountAgainstTheBudgetBeforeAnyWork) {
   expect_error(bytes, "(limits/max_total_bytes)");
 }
 
-// Issue 12: one message stamped 20,000 s late made the service unresponsive for over 90 s.
+// Regression: one message stamped 20,000 s late made the service unresponsive for over 90 s.
 TEST_F(SegmentService, AMessageStampedHoursLateIsRefusedFast) {
   DemoBagOptions o;
   o.late_twist_seconds = 20000;
@@ -388,8 +388,8 @@ TEST_F(SegmentService, ValuesThatWouldOverflowDistancesAreRefused) {
   EXPECT_NE(r.error.find("/ee_twist/twist/linear/x"), std::string::npos) << r.error;
 }
 
-// Issue 12: inf or 1e300 min_segment_seconds and a window as long as the demo returned success with
-// 0 changepoints.
+// Regression: inf or 1e300 min_segment_seconds and a window as long as the demo returned success
+// with 0 changepoints.
 TEST_F(SegmentService, DurationsNoDemoCanHaveAreClearErrors) {
   for (double bad :
        {std::numeric_limits<double>::infinity(), 1e300, std::numeric_limits<double>::quiet_NaN()}) {

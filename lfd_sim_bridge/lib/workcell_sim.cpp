@@ -363,9 +363,9 @@ void WorkcellSim::setJointTargets(const std::vector<std::string>& names,
   }
 }
 
-// Issue 23: velocities of 1.7e308, clamped to the limit, still made the Hermite segments overshoot
-// both waypoints of a 0.1 rad move by 0.6 rad, with nothing logged (the clamp warned once per
-// joint). A waypoint velocity beyond the joint's limit is a wrong trajectory: refused whole.
+// Regression: velocities of 1.7e308, clamped to the limit, still made the Hermite segments
+// overshoot both waypoints of a 0.1 rad move by 0.6 rad, with nothing logged (the clamp warned once
+// per joint). A waypoint velocity beyond the joint's limit is a wrong trajectory: refused whole.
 void WorkcellSim::checkTrajectoryVelocities(const JointTrajectory& trajectory,
                                             const std::vector<int>& index) const {
   for (size_t k = 0; k < trajectory.points.size(); ++k) {

@@ -60,15 +60,9 @@
 
 namespace {
 
-// [helper D] Sensor publisher queues: a recorder that falls behind a fast sim for a moment must
+// Sensor publisher queues: a recorder that falls behind a fast sim for a moment must
 // receive every sample later rather than lose it (the default of 10 dropped samples under load).
 constexpr uint32_t kSensorQueue = 2000;
-
-template <typename T>
-T param(ros::NodeHandle& pnh, const std::string& name, const T& fallback) {
-  T value;
-  return pnh.getParam(name, value) ? value : fallback;
-}
 
 std::map<std::string, double> mapParam(ros::NodeHandle& pnh, const std::string& name) {
   std::map<std::string, double> value;
@@ -144,19 +138,18 @@ lfd_sim::WorkcellConfig loadConfig(ros::NodeHandle& pnh, const lfd::RobotSetup& 
   c.kd = mapParam(pnh, "kd");
   c.velocity_limits = mapParam(pnh, "velocity_limits");
   c.effort_limits = mapParam(pnh, "effort_limits");
-  c.default_kp = param(pnh, "default_kp", c.default_kp);
-  c.damping_ratio = param(pnh, "damping_ratio", c.damping_ratio);
-  c.default_velocity_limit = param(pnh, "default_velocity_limit", c.default_velocity_limit);
-  c.default_effort_limit = param(pnh, "default_effort_limit", c.default_effort_limit);
-  c.gravity_compensation = param(pnh, "gravity_compensation", c.gravity_compensation);
-  c.objects = param(pnh, "objects", c.objects);
-  c.max_abs_velocity = param(pnh, "max_abs_velocity", c.max_abs_velocity);
-  c.touch_time_constant = param(pnh, "touch_time_constant", c.touch_time_constant);
-  c.quaternion_tolerance = param(pnh, "quaternion_tolerance", c.quaternion_tolerance);
+  c.default_kp = pnh.param("default_kp", c.default_kp);
+  c.damping_ratio = pnh.param("damping_ratio", c.damping_ratio);
+  c.default_velocity_limit = pnh.param("default_velocity_limit", c.default_velocity_limit);
+  c.default_effort_limit = pnh.param("default_effort_limit", c.default_effort_limit);
+  c.gravity_compensation = pnh.param("gravity_compensation", c.gravity_compensation);
+  c.objects = pnh.param("objects", c.objects);
+  c.max_abs_velocity = pnh.param("max_abs_velocity", c.max_abs_velocity);
+  c.touch_time_constant = pnh.param("touch_time_constant", c.touch_time_constant);
+  c.quaternion_tolerance = pnh.param("quaternion_tolerance", c.quaternion_tolerance);
   for (const auto& [key, bound] : {std::pair{"workspace_min", &c.workspace_min},
                                    std::pair{"workspace_max", &c.workspace_max}}) {
-    const std::vector<double> v =
-        param(pnh, key, std::vector<double>(bound->begin(), bound->end()));
+    const std::vector<double> v = pnh.param(key, std::vector<double>(bound->begin(), bound->end()));
     if (v.size() != 3) throw std::invalid_argument(std::string("~") + key + " needs [x, y, z]");
     std::copy(v.begin(), v.end(), bound->begin());
   }
@@ -227,23 +220,23 @@ class ThrottledErrors {
 class BridgeNode {
  public:
   BridgeNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh) {
-    const std::string model_path = param<std::string>(pnh, "model_path", "");
+    const std::string model_path = pnh.param<std::string>("model_path", "");
     if (model_path.empty()) throw std::runtime_error("~model_path is not set");
     noise_profiles_ = loadNoiseProfiles(pnh);
-    const lfd::RobotSetup robot = lfd::loadRobotSetup(param<std::string>(pnh, "robot_file", ""));
+    const lfd::RobotSetup robot = lfd::loadRobotSetup(pnh.param<std::string>("robot_file", ""));
     const std::vector<lfd_sim::SensorBinding> sensors = lfd_sim::bindSensorTable(robot.sensors);
     lfd_sim::WorkcellConfig config = loadConfig(pnh, robot, sensors);
     gripper_joint_ = config.gripper_joint;
     base_frame_ = config.base_body;
-    world_frame_ = param<std::string>(pnh, "world_frame", "");
+    world_frame_ = pnh.param<std::string>("world_frame", "");
     if (world_frame_.empty()) throw std::runtime_error("~world_frame is not set");
-    const NoiseProfile& start = noiseProfile(param<std::string>(pnh, "noise_profile", ""));
+    const NoiseProfile& start = noiseProfile(pnh.param<std::string>("noise_profile", ""));
     config.noise = start.noise;
     config.noise_seed = start.seed;
     sim_ = std::make_unique<lfd_sim::WorkcellSim>(model_path, config, rosLogSink);
     lfd_sim::checkSensorDimensions(
         sensors, [this](const std::string& name) { return sim_->sensorDimension(name); });
-    if (param(pnh, "use_urdf_limits", true)) {
+    if (pnh.param("use_urdf_limits", true)) {
       std::string urdf;
       if (nh.getParam("robot_description", urdf)) {
         sim_->applyUrdfLimits(urdf);
@@ -251,22 +244,22 @@ class BridgeNode {
         ROS_WARN("use_urdf_limits is set but /robot_description is missing; MJCF/config limits");
       }
     }
-    real_time_factor_ = param(pnh, "real_time_factor", 0.0);
-    const double publish_rate = param(pnh, "publish_rate", 200.0);
-    const double clock_rate = param(pnh, "clock_rate", 200.0);
+    real_time_factor_ = pnh.param("real_time_factor", 0.0);
+    const double publish_rate = pnh.param("publish_rate", 200.0);
+    const double clock_rate = pnh.param("clock_rate", 200.0);
     if (!(publish_rate > 0) || !(clock_rate > 0)) {
       throw std::invalid_argument("~publish_rate and ~clock_rate must be positive");
     }
     const double dt = sim_->timestep();
     publish_every_ = std::max<long>(1, std::lround(1.0 / (publish_rate * dt)));
     clock_every_ = std::max<long>(1, std::lround(1.0 / (clock_rate * dt)));
-    paused_ = param(pnh, "start_paused", false);
-    max_steps_per_call_ = param(pnh, "max_steps_per_call", max_steps_per_call_);
+    paused_ = pnh.param("start_paused", false);
+    max_steps_per_call_ = pnh.param("max_steps_per_call", max_steps_per_call_);
     strings_.max_bytes = static_cast<std::size_t>(std::max(
-        0, param(pnh, "limits/max_request_string_bytes", static_cast<int>(strings_.max_bytes))));
+        0, pnh.param("limits/max_request_string_bytes", static_cast<int>(strings_.max_bytes))));
     strings_.key = "~limits/max_request_string_bytes";
-    rtf_report_period_ = param(pnh, "rtf_report_period", 30.0);
-    if (!param(pnh, "headless", true)) {
+    rtf_report_period_ = pnh.param("rtf_report_period", 30.0);
+    if (!pnh.param("headless", true)) {
       ROS_WARN(
           "headless:=false requested, but the bridge has no MuJoCo viewer; use rviz "
           "(robot, tf and object poses are all published)");
@@ -683,7 +676,7 @@ class BridgeNode {
     }
     for (uint32_t i = 0; i < req.steps; ++i) stepOnce();
     publishClock();  // the final time is always announced (skipped only if already sent)
-    // [helper D] Only if stepOnce() did not just publish it: a duplicate at the same stamp would
+    // Only if stepOnce() did not just publish it: a duplicate at the same stamp would
     // distort the recorded topic rates when a demonstrator steps the sim in lockstep.
     if (step_count_ % publish_every_ != 0) publishState();
     res.success = true;

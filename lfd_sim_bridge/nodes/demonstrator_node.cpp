@@ -69,12 +69,6 @@ namespace demo = lfd_sim_bridge::demo;
 namespace task = lfd_sim_bridge::task;
 
 template <typename T>
-T param(const ros::NodeHandle& pnh, const std::string& name, const T& fallback) {
-  T value;
-  return pnh.getParam(name, value) ? value : fallback;
-}
-
-template <typename T>
 T required(const ros::NodeHandle& pnh, const std::string& name) {
   T value;
   if (!pnh.getParam(name, value) || value == T())
@@ -141,7 +135,7 @@ struct PhaseEnd {
 class Demonstrator {
  public:
   Demonstrator(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh) {
-    seed_ = param(pnh, "seed", 1);
+    seed_ = pnh.param("seed", 1);
     const task::Scene scene = task::loadScene(required<std::string>(pnh, "scene_file"));
     robot_ = lfd::loadRobotSetup(required<std::string>(pnh, "robot_file"));
     demo::ToolGeometry tool;
@@ -165,24 +159,24 @@ class Demonstrator {
       d.teleop = teleopStyle(pnh, teleop);
       d.interpreter = std::make_unique<demo::TaskInterpreter>(definition, scene, robot_.gripper,
                                                               tool, d.teleop);
-      d.contact_threshold = teleop ? param(pnh, "teleop/contact_threshold", 4.0)
-                                   : param(pnh, "contact_threshold", 0.5);
+      d.contact_threshold =
+          teleop ? pnh.param("teleop/contact_threshold", 4.0) : pnh.param("contact_threshold", 0.5);
       objects.insert(definition.objects.begin(), definition.objects.end());
       datasets_.push_back(std::move(d));
     }
 
-    speed_min_ = param(pnh, "speed_min", 0.7);
-    speed_max_ = param(pnh, "speed_max", 1.3);
-    sample_period_ = param(pnh, "sample_period", 0.02);
-    lead_in_ = param(pnh, "lead_in", 0.3);
-    tail_ = param(pnh, "tail", 0.5);
-    settle_before_ = param(pnh, "scene_settle", 0.3);
-    phase_period_ = 1.0 / param(pnh, "phase_rate", 20.0);
-    skip_existing_ = param(pnh, "skip_existing", true);
-    lockstep_ = param(pnh, "lockstep", true);
-    chunk_ = param(pnh, "lockstep_chunk", 0.05);
-    contact_chunk_ = param(pnh, "lockstep_contact_chunk", 0.01);
-    physics_dt_ = param(pnh, "physics_dt", 0.001);
+    speed_min_ = pnh.param("speed_min", 0.7);
+    speed_max_ = pnh.param("speed_max", 1.3);
+    sample_period_ = pnh.param("sample_period", 0.02);
+    lead_in_ = pnh.param("lead_in", 0.3);
+    tail_ = pnh.param("tail", 0.5);
+    settle_before_ = pnh.param("scene_settle", 0.3);
+    phase_period_ = 1.0 / pnh.param("phase_rate", 20.0);
+    skip_existing_ = pnh.param("skip_existing", true);
+    lockstep_ = pnh.param("lockstep", true);
+    chunk_ = pnh.param("lockstep_chunk", 0.05);
+    contact_chunk_ = pnh.param("lockstep_contact_chunk", 0.01);
+    physics_dt_ = pnh.param("physics_dt", 0.001);
     publish_period_ = 1.0 / nh.param("/bridge/publish_rate", 200.0);
 
     trajectory_pub_ = nh.advertise<trajectory_msgs::JointTrajectory>("joint_trajectory", 10);

@@ -137,7 +137,7 @@ TEST_F(BagRecorderTest, BadPathsAreRejected) {
       << "an existing bag must never be overwritten";
 }
 
-// Issue 12: starting a recording to the path of a crashed one truncated the crashed `.active`.
+// Regression: starting a recording to the path of a crashed one truncated the crashed `.active`.
 TEST_F(BagRecorderTest, AnExistingActiveFileIsNeverTruncated) {
   fs::create_directories(dir_);
   const std::string path = (dir_ / "demo.bag").string();
@@ -149,8 +149,8 @@ TEST_F(BagRecorderTest, AnExistingActiveFileIsNeverTruncated) {
             "the only copy of a demonstration");
 }
 
-// Issue 12: after kill -9 the last 0.77 s of a demo were lost. A child records 10 topics at 200 Hz
-// (the recorder's load) for 6 s of bag time and kills itself with SIGKILL mid-recording; the
+// Regression: after kill -9 the last 0.77 s of a demo were lost. A child records 10 topics at 200
+// Hz (the recorder's load) for 6 s of bag time and kills itself with SIGKILL mid-recording; the
 // recovery reindexes its `.active`, and at most 0.2 s of bag time may be missing.
 TEST_F(BagRecorderTest, KillNineLosesAtMostTwoTenthsOfASecondAndIsRecovered) {
   fs::create_directories(dir_);

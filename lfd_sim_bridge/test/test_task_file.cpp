@@ -179,7 +179,7 @@ TEST(TaskFile, BadSceneFilesAreRefusedNamingTheKey) {
   EXPECT_THROW(task::loadScene("/nonexistent/scene.yaml"), std::runtime_error);
 }
 
-// Issue 23, round two: the bounds of the scene's task_limits (max_step_seconds 120,
+// Regression: the bounds of the scene's task_limits (max_step_seconds 120,
 // max_nesting_depth 16), which lfd_tools.tasks reads too.
 TEST(TaskFile, TimesOverTheScenesBoundAreRefused) {
   const std::string over = "is over 120";

@@ -1,4 +1,4 @@
-// Faults injected into the workcell (issue 25, sim only): a weakened grip, a locked joint, a
+// Faults injected into the workcell (sim only): a weakened grip, a locked joint, a
 // frozen sensor and a moved object, each applied at its time and undone by a reset; bad faults
 // are refused naming what is wrong.
 #include <gtest/gtest.h>

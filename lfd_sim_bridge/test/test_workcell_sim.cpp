@@ -421,7 +421,7 @@ std::string refusal(const std::function<void()>& f) {
   return "";
 }
 
-// Issue 12: x = 1e11 was accepted and the bridge then reset on every physics step; a non-unit
+// Regression: x = 1e11 was accepted and the bridge then reset on every physics step; a non-unit
 // quaternion far from 1 was silently normalized.
 TEST(WorkcellSim, ObjectPosesOutsideTheWorkspaceOrNonUnitAreRefused) {
   LogCounter logs;
@@ -443,7 +443,7 @@ TEST(WorkcellSim, ObjectPosesOutsideTheWorkspaceOrNonUnitAreRefused) {
   EXPECT_EQ(sim.divergenceCount(), 0);
 }
 
-// Issue 12: /joint_trajectory velocities of 1.7e308 swung the elbow between its limits; issue 23:
+// Found in review: /joint_trajectory velocities of 1.7e308 swung the elbow between its limits;
 // clamped to the limit, they still made the elbow overshoot both waypoints by 0.6 rad, with
 // nothing logged. A velocity beyond the joint's limit refuses the trajectory (nothing moves); one
 // within it is followed through its waypoints.

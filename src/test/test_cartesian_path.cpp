@@ -169,7 +169,7 @@ TEST(CartesianToJoints, UnreachablePoseIsAClearError) {
   EXPECT_THROW(ik.convert(samples, Eigen::VectorXd::Zero(2)), std::invalid_argument);
 }
 
-// Issue 12: a pose so far away that IK's error overflows (a skill library with weights of 1e300)
+// Regression: a pose so far away that IK's error overflows (a skill library with weights of 1e300)
 // made convert() read an empty joint vector (segfault in the executor).
 TEST(CartesianToJoints, OverflowingOrNonFinitePoseIsAClearError) {
   lfd::CartesianToJoints ik = repositoryIk();

@@ -1,7 +1,8 @@
-// Large DMP fits (issue 12): the learner accepts up to 10000 basis functions, and a fit with a few
-// hundred exercises Eigen's blocked LDLT kernels, which crashed (an AVX store into a 16-byte
-// aligned buffer) while the build mixed -march=native with pinned Eigen alignment. The fit must
-// stay finite and reproduce the demo at least as well as the default 50 basis functions.
+// Large DMP fits: the learner accepts up to 1000 basis functions (learner.yaml
+// limits/max_num_basis), and a fit with a few hundred exercises Eigen's blocked LDLT kernels,
+// which crashed (an AVX store into a 16-byte aligned buffer) while the build mixed -march=native
+// with pinned Eigen alignment. The fit must stay finite and reproduce the demo at least as well
+// as the default 50 basis functions.
 #include "dmp_test_curves.hpp"
 #include "lfd_core/position_dmp.hpp"
 

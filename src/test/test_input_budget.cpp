@@ -1,6 +1,6 @@
-// The request budget (issue 23 row 2): the files a request expands to, and their bytes, are
+// The request budget: the files a request expands to, and their bytes, are
 // refused before any work, naming the config key; a FIFO among them is refused at once. Every
-// string of a request within one bound (issue 23).
+// string of a request within one bound.
 #include "lfd_core/input_budget.hpp"
 
 #include <gtest/gtest.h>
@@ -71,7 +71,7 @@ TEST_F(InputBudgetTest, ANamedPipeAmongTheFilesIsRefused) {
 
 }  // namespace
 
-// Issue 23: one bound for every string of a request; the refusal names the field and the key and
+// Regression: one bound for every string of a request; the refusal names the field and the key and
 // quotes at most 200 characters (a 10 MB string was echoed whole into errors, logs, feedback).
 TEST(RequestStrings, AStringOverTheBudgetIsRefusedNamingTheFieldAndKey) {
   lfd::StringBudget budget;

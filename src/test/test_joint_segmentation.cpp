@@ -248,7 +248,7 @@ TEST(JointSegmentation, FindsTheContactOnsetAndReleaseOfAWipe) {
 TEST(JointSegmentation, AWipeWithADeadSensorIsSegmentedFromItsMotionOrWarned) {
   // Skipped: the method is weak here. The dead demo's only evidence near its contact onset is
   // the slide starting after a 0.3 s stop (weight 0.22, below min_piece_weight 0.3), so its
-  // onset goes to a ClaSP changepoint mid-slide, 1.9 s off (issue 22, left open).
+  // onset goes to a ClaSP changepoint mid-slide, 1.9 s off (left open).
   GTEST_SKIP() << "the dead demo's onset has no evidence as sure as min_piece_weight";
   segment_with_a_dead_sensor(reach_press_retract(6, 11, 0.25), 2);
 }

@@ -257,7 +257,7 @@ TEST(InverseKinematics, PreferredPostureShapesTheRedundancy) {
 
 }  // namespace
 
-// Issue 12: a finite target so far away that every attempt's pose error overflows returned an
+// Regression: a finite target so far away that every attempt's pose error overflows returned an
 // empty q with error 0 (read as success; the executor then indexed the empty vector).
 TEST(InverseKinematics, OverflowingTargetIsAClearFailureNeverAnEmptyResult) {
   const auto chain = taskChain();

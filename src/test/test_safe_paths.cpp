@@ -1,5 +1,5 @@
-// Safe paths (issue 12): regular-file inputs, roots, "..", no output over an input, atomic writes
-// that keep an existing file unless asked to overwrite. Issue 23: file identities for caches,
+// Safe paths: regular-file inputs, roots, "..", no output over an input, atomic writes
+// that keep an existing file unless asked to overwrite. Regression: file identities for caches,
 // overwrite replaces only lfd's own files, relative request paths refused in services.
 #include "lfd_core/safe_paths.hpp"
 
@@ -70,7 +70,7 @@ TEST_F(SafePaths, NamedPipeIsRefusedWithoutBlocking) {
       std::string::npos);
 }
 
-// Issue 23 row 1: a link to a FIFO is refused at once, with the reason, by the file-access layer.
+// Regression: a link to a FIFO is refused at once, with the reason, by the file-access layer.
 TEST_F(SafePaths, LinkToNamedPipeIsRefusedAtOnce) {
   const std::string fifo = (dir_ / "root" / "pipe.bag").string();
   const std::string link = (dir_ / "root" / "link.bag").string();
@@ -85,7 +85,7 @@ TEST_F(SafePaths, LinkToNamedPipeIsRefusedAtOnce) {
   EXPECT_NE(error.find("link.bag"), std::string::npos) << error;  // names the user's path
 }
 
-// Issue 23 row 1: what the layer returns reaches the checked file, whatever the link points at
+// Regression: what the layer returns reaches the checked file, whatever the link points at
 // once it was opened (readers open readPath(), never the user's path again).
 TEST_F(SafePaths, LinkSwappedAfterOpeningStillReadsTheCheckedFile) {
   const std::string file = write(dir_ / "root" / "a.bag", "the real bag");
@@ -188,7 +188,7 @@ TEST_F(SafePaths, AtomicWriteKeepsOrReplaces) {
   EXPECT_EQ(read(fresh), "first");
 }
 
-// Issue 23: overwrite: true replaced any regular file under the roots (a test .bashrc went).
+// Regression: overwrite: true replaced any regular file under the roots (a test .bashrc went).
 // An existing file is replaced only when it is recognisably lfd's own product of the output's
 // kind; anything else is kept, and the error names the path and says lfd did not write it.
 TEST_F(SafePaths, OverwriteReplacesOnlyFilesLfdWroteOfThatKind) {
@@ -243,7 +243,7 @@ TEST_F(SafePaths, OverwriteReplacesOnlyFilesLfdWroteOfThatKind) {
   EXPECT_NE(errorOf([&] { lfd::checkOutputFile(foreign, rooted(), true, {}, csv); }), "");
 }
 
-// Issue 23: service request paths must be absolute (a relative one resolves against the node's
+// Regression: service request paths must be absolute (a relative one resolves against the node's
 // working directory); the CLIs keep taking relative paths.
 TEST_F(SafePaths, RelativeRequestPathsAreRefusedUnderRequireAbsolute) {
   lfd::PathPolicy service;
@@ -270,7 +270,7 @@ TEST_F(SafePaths, RelativeRequestPathsAreRefusedUnderRequireAbsolute) {
   fs::current_path(cwd);
 }
 
-// Issue 23: a bag replaced by another file of the same size and modification time looked the
+// Regression: a bag replaced by another file of the same size and modification time looked the
 // same to a cache keyed by path, size and mtime. The identity of an open file tells them apart.
 TEST_F(SafePaths, IdentityTellsAReplacedFileOfTheSameSizeAndTime) {
   const std::string bag = write(dir_ / "root" / "a.bag", "the real bag");

@@ -1,4 +1,4 @@
-// The sensory signature of a skill (issue 25): learned from demonstrations, it passes nominal runs
+// The sensory signature of a skill: learned from demonstrations, it passes nominal runs
 // and flags a reproduction whose sensations differ, naming the segment, the channel and when.
 #include "lfd_core/sensory_signature.hpp"
 

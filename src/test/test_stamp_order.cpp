@@ -1,4 +1,4 @@
-// The shared timestamp policy (issue 23 row 4): stamp order, out-of-order, duplicate and gap
+// The shared timestamp policy: stamp order, out-of-order, duplicate and gap
 // counts.
 #include "lfd_core/stamp_order.hpp"
 

@@ -335,7 +335,7 @@ TEST_F(BridgeServices, ResetSelectsTheNoiseProfile) {
   EXPECT_NE(unknown.response.message.find("no_such_profile"), std::string::npos);
 }
 
-// Issue 23: every request string within ~limits/max_request_string_bytes, checked before any
+// Regression: every request string within ~limits/max_request_string_bytes, checked before any
 // work; the error names the field and quotes at most 200 characters (a 10 MB name was echoed).
 TEST_F(BridgeServices, OverlongRequestStringsAreRefusedBeforeAnyWork) {
   lfd_msgs::ResetSim reset;

@@ -6,8 +6,8 @@
 
 #include <filesystem>
 
-#include "../../lfd_segmentation/test/demo_bag_writer.hpp"
-#include "../../src/test/support/link_swap_race.hpp"
+#include "demo_bag_writer.hpp"
+#include "link_swap_race.hpp"
 
 namespace {
 
@@ -114,7 +114,7 @@ TEST(SegmentationService, SurvivesBadInputAndSegmentsGoodInput) {
   fs::remove_all(dir());
 }
 
-// Issue 23 row 1, against the running node: a link swapped between a bag and a FIFO while
+// Regression, against the running node: a link swapped between a bag and a FIFO while
 // requests run (3 s) never hangs the node in open(); it still segments afterwards.
 TEST(SegmentationService, LinkSwappedToFifoNeverHangsTheNode) {
   ASSERT_TRUE(ros::service::waitForService("/segmentation/segment", ros::Duration(30)));

@@ -1,4 +1,4 @@
-// The sensors a demonstration bag recorded, for the sensory signature (issue 25): the topics the
+// The sensors a demonstration bag recorded, for the sensory signature: the topics the
 // segmentation's topic list marks `monitor` (a gripper's opening, a wrist F/T, touch pads), read
 // and resampled by the segmentation's own bag reader, so that the monitor sees the very features
 // the segmentation saw.

@@ -1,4 +1,4 @@
-// Live execution monitoring (issue 25): every reading of the library's monitored sensors is judged
+// Live execution monitoring: every reading of the library's monitored sensors is judged
 // against the sensory signature of the segment the motion is in (lfd_core/sensory_signature.hpp),
 // at the phase the plan has reached at the reading's stamp. It keeps the worst anomaly score and
 // the first alarm (a deviation beyond what the demonstrations showed, lasting the signature's

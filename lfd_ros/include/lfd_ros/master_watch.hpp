@@ -1,4 +1,4 @@
-// Every long-running lfd node outlives a restart of the ROS master (issue 23, round two). roscpp
+// Every long-running lfd node outlives a restart of the ROS master (round two). roscpp
 // registers a node's topics and services once, when they are made: after a restart the node ran on,
 // unknown to the new master, never found by a client, and said nothing. The watch notices the
 // master going away and another master coming back, says so with ROS_ERROR, and ends the node with

@@ -1,4 +1,4 @@
-// Faults scheduled at sim times (issue 25: tests and benchmarks of execution monitoring, sim
+// Faults scheduled at sim times (tests and benchmarks of execution monitoring, sim
 // only). The bridge's ~inject_fault service fills the schedule; each step applies what is due.
 // ROS-free: the bridge turns a silenced sensor into a topic that stops, the rest is the workcell's.
 #pragma once

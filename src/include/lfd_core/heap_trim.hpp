@@ -1,4 +1,4 @@
-// Memory back to the system after a large request (issue 23: after one, the segmentation node
+// Memory back to the system after a large request (after one, the segmentation node
 // stayed at 264 MB and the executor at 829 MB while idle). glibc keeps freed heap pages for
 // reuse; malloc_trim(0) returns the free ones, so an idle node shrinks back to its working set.
 #pragma once

@@ -1,6 +1,6 @@
 // One budget for the files a request makes a node read, computed from the expanded work (every
 // file after a demo's parts are split out, their total size) and checked before any work starts
-// (issue 23 row 2: 32 request entries of 290 bag parts passed a limit of 32 bags, then took 120 s
+// (32 request entries of 290 bag parts passed a limit of 32 bags, then took 120 s
 // and 581 MB and blocked the next request), and one bound for every string a request carries
 // (a 10 MB string was echoed into errors, logs and feedback). Every refusal names its config key.
 #pragma once

@@ -56,7 +56,7 @@ struct MultivariateSegmentationConfig {
   /// Default distance here is Euclidean, not ClaSP's z-normalized one: robot features are
   /// piecewise smooth (min-jerk moves, gripper steps) and z-normalization erases the level and
   /// amplitude differences that tell the phases apart (measured on synthetic 2-phase
-  /// demonstrations: 18/20 correct vs 11/20; see the S2 report).
+  /// demonstrations: 18/20 correct vs 11/20).
   ClaspConfig clasp = [] {
     ClaspConfig c;
     c.distance = ClaspDistance::kEuclidean;

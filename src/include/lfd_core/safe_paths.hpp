@@ -39,7 +39,7 @@ struct FileIdentity {
   bool operator==(const FileIdentity& other) const { return key() == other.key(); }
 };
 
-/// A file to read, opened once (issue 23: checking a path and opening it again by name let a link
+/// A file to read, opened once (checking a path and opening it again by name let a link
 /// swapped in between to a FIFO hang open()). Readers that take a file name (rosbag, ifstream,
 /// yaml-cpp) open `readPath()`, the still-open descriptor's /proc entry: it always reaches the
 /// file that was checked, whatever the user's path points at by then. Move-only; closes on
@@ -82,7 +82,7 @@ InputFile openInputFile(const std::string& path, const PathPolicy& policy = {},
 std::string checkInputFile(const std::string& path, const PathPolicy& policy = {});
 
 /// The kind of file an output is. `overwrite` replaces an existing file only when it is
-/// recognisably an lfd product of that kind (issue 23: overwrite: true replaced a test .bashrc,
+/// recognisably an lfd product of that kind (overwrite: true replaced a test .bashrc,
 /// any regular file under the roots could go). The predicate gets the existing file, opened by
 /// the file-access layer, and says whether lfd wrote it.
 struct OutputKind {

@@ -1,5 +1,5 @@
 // The sensations each skill's demonstrations always showed, and a monitor that compares a
-// reproduction with them (issue 25, the paper's multisensory idea turned around: the signals that
+// reproduction with them (the paper's multisensory idea turned around: the signals that
 // cut the demonstrations into skills also tell whether a skill is going as demonstrated).
 //
 // A signature holds, per segment and per sensor channel, the level the demonstrations showed along

@@ -1,7 +1,7 @@
 // The one timestamp policy of every reader of recorded messages (the segmentation's bag reader,
 // the learner's demo reader): messages are taken in the order of their stamps, never of their
 // arrival; out-of-order and duplicate stamps are counted, and so are gaps, and each reader passes
-// the warning on. Nothing is dropped silently (issue 23 row 4: the learner skipped every pose
+// the warning on. Nothing is dropped silently (the learner skipped every pose
 // stamped before one 5 s late message, 48% of a demo, while the segmentation sorted the same bag).
 #pragma once
 

@@ -8,7 +8,7 @@
 
 namespace lfd {
 
-/// How many characters of one user-supplied value an error message quotes (issue 23: a 10 MB
+/// How many characters of one user-supplied value an error message quotes (a 10 MB
 /// string was echoed whole into errors and logs). Enough for any real path or name.
 constexpr std::size_t kMaxQuotedChars = 200;
 

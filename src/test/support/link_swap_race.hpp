@@ -1,4 +1,4 @@
-// Test helper (issue 23 row 1): a symlink swapped between a regular file and a FIFO while a reader
+// Test helper: a symlink swapped between a regular file and a FIFO while a reader
 // opens it again and again. A reader that checks the path and then opens it by name can open the
 // FIFO and block in open() forever; the watchdog notices a call running over `hang_seconds`,
 // opens the FIFO for writing (which lets the blocked open() return) and reports the hang.

@@ -18,7 +18,7 @@
 #include <random>
 #include <string>
 
-#include "../../src/test/support/declared_type_bytes.hpp"
+#include "declared_type_bytes.hpp"
 
 namespace lfd_segmentation_test {
 
