@@ -10,9 +10,9 @@ Writes, next to this file:
 
 The writers are the robot-independent lfd_tools.robot_models (launch/src/lfd_tools, importable
 after `source devel/setup.bash`); this file holds only the arm's tables. The arm stands where
-config/scene.yaml puts the robot (base_link_in_world, the IK and Cartesian frame of every task pose):
-its root link base_link is that mount point, no rotation, on a column down to the floor (beside the
-table: the table starts at x = 0.15).
+config/scene.yaml puts the robot (base_link_in_world, the IK and Cartesian frame of every task
+pose): its root link base_link is that mount point, no rotation, on a column down to the floor
+(beside the table: the table starts at x = 0.15).
 
 Kinematics (like a KUKA iiwa / Franka, elbow in the middle): joints alternate about z and y --
 shoulder arm_joint_1 (z) 0.10 above the base, arm_joint_2 (y) and arm_joint_3 (z) at the shoulder
@@ -27,15 +27,16 @@ mimic, each pad 0 = closed to 0.045 = open from the centre plane) and the TCP be
 12 mm above the finger tips. A positive arm_joint_2 or arm_joint_4 leans the arm forward (+x).
 The links are long (0.50 + 0.50): the task files' poses reach 0.93 m from the base (x 0.76,
 y -0.50) with the hand vertical above them, and the ready pose comes back to 0.28 m.
-Run (after `source devel/setup.bash`): /usr/bin/python3 arm7_description/models/generate_models.py [OUT_DIR]
+Run (after `source devel/setup.bash`):
+  /usr/bin/python3 arm7_description/models/generate_models.py [OUT_DIR]
 """
 
 import math
 import os
 import sys
 
-from lfd_tools.robot_models import (DARK_COLOR, Y, Z, HandNames, Link, Robot, generate, geom, load_scene,
-                                    parallel_gripper, revolute, scene_file_beside)
+from lfd_tools.robot_models import (DARK_COLOR, Y, Z, HandNames, Link, Robot, generate, geom,
+                                    load_scene, parallel_gripper, revolute, scene_file_beside)
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 SCENE_FILE = scene_file_beside(HERE)
@@ -95,7 +96,8 @@ def arm_links():
         Link('arm_link_4', 'arm_link_3', revolute('arm_joint_4', Y, -0.30, 3.00, DRIVE['elbow']),
              (0.0, 0.0, UPPER_ARM), 2.0, [geom('sphere', (0.06,), color=DARK_COLOR)]),
         Link('arm_link_5', 'arm_link_4', revolute('arm_joint_5', Z, -2.90, 2.90, DRIVE['elbow']),
-             (0.0, 0.0, 0.0), 2.5, [geom('cylinder', (0.05, 0.19), (0.0, 0.0, 0.25), collide=True)]),
+             (0.0, 0.0, 0.0), 2.5,
+             [geom('cylinder', (0.05, 0.19), (0.0, 0.0, 0.25), collide=True)]),
         Link('arm_link_6', 'arm_link_5', revolute('arm_joint_6', Y, -2.10, 2.10, DRIVE['wrist']),
              (0.0, 0.0, FOREARM), 1.0, [geom('sphere', (0.045,), color=DARK_COLOR)]),
         Link('arm_link_7', 'arm_link_6', revolute('arm_joint_7', Z, -2.90, 2.90, DRIVE['wrist']),
@@ -108,12 +110,13 @@ def hand_links():
     """The humanoid's gripper (lfd_tools.robot_models.parallel_gripper, jvrc1_description's
     r_gripper_*), renamed, its F/T frame at the flange turned by pi about y so that the hand points
     along the forearm."""
-    return parallel_gripper(HAND, 'arm_link_7', (0.0, 0.0, FLANGE), DRIVE['gripper'], ft_rpy=(0.0, math.pi, 0.0))
+    return parallel_gripper(HAND, 'arm_link_7', (0.0, 0.0, FLANGE), DRIVE['gripper'],
+                            ft_rpy=(0.0, math.pi, 0.0))
 
 
 def robot():
-    return Robot('arm7', stand_links() + arm_links() + hand_links(), SENSORS, ft_frame=HAND.ft_frame,
-                 finger_pads=HAND.finger_pads())
+    return Robot('arm7', stand_links() + arm_links() + hand_links(), SENSORS,
+                 ft_frame=HAND.ft_frame, finger_pads=HAND.finger_pads())
 
 
 def main(out_dir=HERE):

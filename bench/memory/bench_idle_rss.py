@@ -10,8 +10,8 @@ The data: a sim_grasp dataset of 4 demos and its skill library, made by the pipe
 (datasets and learn stages, ~3 min; kept and reused when DIR is given again). The segmentation
 request names N bags (default 32, limits/max_bags: the dataset's bags repeated); the goal is an
 unseen grasp scene at duration scale S (default 10, limits/max_duration_scale: ten times the
-demonstrated pace; extrapolation allowed) run to its end in the simulation, in lockstep. Run after `./lfd build` with
-devel/setup.bash sourced.
+demonstrated pace; extrapolation allowed) run to its end in the simulation, in lockstep. Run after
+`./lfd build` with devel/setup.bash sourced.
 """
 import argparse
 import glob
@@ -45,7 +45,8 @@ def node_pid(node, timeout=120.0):
     deadline = time.time() + timeout
     while time.time() < deadline:
         try:
-            code, _, pid = xmlrpc.client.ServerProxy(probe.lookupNode(node)).getPid("/bench_idle_rss")
+            server = xmlrpc.client.ServerProxy(probe.lookupNode(node))
+            code, _, pid = server.getPid("/bench_idle_rss")
             if code == 1:
                 return pid
         except (OSError, rosgraph.MasterException):
@@ -69,8 +70,9 @@ def make_data(out):
     bags = sorted(glob.glob(os.path.join(out, "datasets", "%s_%s" % (MODE, TASK), "*.bag")))
     library = os.path.join(out, "skills", "%s_%s.json" % (TASK, MODE))
     if not bags or not os.path.exists(library):
-        subprocess.check_call(["/usr/bin/python3", PIPELINE, "--out", out, "--stages", "datasets,learn",
-                               "--datasets", "%s_%s" % (MODE, TASK), "--demos", "4"], stdout=subprocess.DEVNULL)
+        subprocess.check_call(["/usr/bin/python3", PIPELINE, "--out", out, "--stages",
+                               "datasets,learn", "--datasets", "%s_%s" % (MODE, TASK), "--demos",
+                               "4"], stdout=subprocess.DEVNULL)
         bags = sorted(glob.glob(os.path.join(out, "datasets", "%s_%s" % (MODE, TASK), "*.bag")))
     return bags, library
 
@@ -78,7 +80,8 @@ def make_data(out):
 def segmentation_figures(bags, count, env):
     import rospy
     from lfd_msgs.srv import Segment
-    with master.background_launch(["roslaunch", "lfd_launch", "segment.launch", "output:=log"], env):
+    with master.background_launch(["roslaunch", "lfd_launch", "segment.launch",
+                                   "output:=log"], env):
         pid = node_pid("/segmentation")
         rospy.wait_for_service("/segmentation/segment", timeout=120)
         call = rospy.ServiceProxy("/segmentation/segment", Segment)
@@ -101,7 +104,8 @@ def executor_figures(library, duration_scale, env):
 
         def execute():
             # 4 demos span a narrow range: the goal runs anyway (what is measured is its length)
-            res, _ = cell.execute(lockstep.execute_goal(library, scene, duration_scale, allow_extrapolation=True),
+            res, _ = cell.execute(lockstep.execute_goal(library, scene, duration_scale,
+                                                        allow_extrapolation=True),
                                   timeout=1800)
             if res is None or not res.success:
                 raise RuntimeError("the goal failed: %s" % (res.error if res else "no result"))
@@ -110,7 +114,8 @@ def executor_figures(library, duration_scale, env):
 
 
 def main():
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap = argparse.ArgumentParser(description=__doc__,
+                                 formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--out", help="data folder (kept); default: a temporary one, removed")
     ap.add_argument("--bags", type=int, default=32)
     ap.add_argument("--duration-scale", type=float, default=10.0)
@@ -122,9 +127,10 @@ def main():
             os.environ["ROS_MASTER_URI"] = env["ROS_MASTER_URI"]
             import rospy
             rospy.init_node("bench_idle_rss", anonymous=True, disable_signals=True)
-            figures = {"segmentation (%d bags)" % args.bags: segmentation_figures(bags, args.bags, env),
-                       "executor (duration scale %g)" % args.duration_scale:
-                           executor_figures(library, args.duration_scale, env)}
+            figures = {
+                "segmentation (%d bags)" % args.bags: segmentation_figures(bags, args.bags, env),
+                "executor (duration scale %g)" % args.duration_scale:
+                    executor_figures(library, args.duration_scale, env)}
         print("%-32s %10s %10s %12s" % ("VmRSS, MB", "before", "peak", "idle after"))
         for name, f in figures.items():
             print("%-32s %10.0f %10.0f %12.0f" % (name, f["before"], f["peak"], f["idle_after"]))

@@ -17,8 +17,9 @@ derived from the skill library and the task file.
   joint_locked    each scene joint of the task (the drawer's slide) is stuck from the start.
 Detection counts the sensor faults and the faulty runs whose task failed (judged by the task file's
 success rules, as a demonstration is); a fault of the world the task survived (a weak grip while
-pushing) is counted apart. Delay: sim s from the fault to the alarm (the alarm's "s into the motion"), for the faults with a
-moment (not sensors_frozen, which is wrong only once the sensors should have changed).
+pushing) is counted apart. Delay: sim s from the fault to the alarm (the alarm's "s into the
+motion"), for the faults with a moment (not sensors_frozen, which is wrong only once the sensors
+should have changed).
 
   bench_faults.py --library-dir DIR [--mode sim] [--tasks grasp,drawer] [--goals N]
                   [--attach] [--out result.json]
@@ -33,17 +34,20 @@ import time
 from lfd_tools import bags, lockstep, master, report, reproduction, tasks
 
 FROZEN_AT_S = 0.3
-SENSOR_FAULTS = ("sensors_frozen", "sensors_silenced")  # faults of the monitoring itself: always counted
+# faults of the monitoring itself: always counted
+SENSOR_FAULTS = ("sensors_frozen", "sensors_silenced")
 ALARM_TIME = re.compile(r"\(([-\d.]+) s into the motion\)")
 
 
 def held_segment(signature):
     """The first segment in which the demonstrations' pads were loaded over most of the segment
     (mean level above half of the pads' largest mean), or None."""
-    touch = [k for k, c in enumerate(signature["channels"]) if c.startswith(bags.touch_topic() + "/")]
+    touch = [k for k, c in enumerate(signature["channels"])
+             if c.startswith(bags.touch_topic() + "/")]
     if not touch:
         return None
-    levels = [max(statistics.mean(seg["channels"][k]["mean"]) for k in touch) for seg in signature["segments"]]
+    levels = [max(statistics.mean(seg["channels"][k]["mean"]) for k in touch)
+              for seg in signature["segments"]]
     top = max(levels)
     for s, level in enumerate(levels):
         if s > 0 and top > 0 and level > 0.5 * top:
@@ -57,23 +61,27 @@ def faults_for(task, library, scene, durations):
     from lfd_msgs.srv import InjectFaultRequest
 
     def request(kind, target="", at=0.0, pose=None, value=0.0):
-        return InjectFaultRequest(kind=kind, target=target, at_time=at, pose=pose or Pose(), value=value)
+        return InjectFaultRequest(kind=kind, target=target, at_time=at, pose=pose or Pose(),
+                                  value=value)
 
     def at(segment, fraction):
         return sum(durations[:segment]) + fraction * durations[segment]
 
     out = []
-    frame = library["segments"][0]["goal"]["position"]["frame"]  # object:<name>, heading:<name>, goal
+    # object:<name>, heading:<name>, goal
+    frame = library["segments"][0]["goal"]["position"]["frame"]
     obj = frame.split(":", 1)[1] if ":" in frame else None
     if obj in tasks.scene()["objects"]:
         park = lockstep.pose_msg(tasks.pose(tasks.scene()["objects"][obj]["park"]))
         out.append(("object_removed", [request("move_object", obj, at(0, 0.5), park)], at(0, 0.5)))
     held = held_segment(library["sensory_signature"])
     if held is not None:
-        out.append(("grip_lost", [request("weaken_grip", at=at(held, 0.3), value=0.0)], at(held, 0.3)))
+        out.append(("grip_lost", [request("weaken_grip", at=at(held, 0.3), value=0.0)],
+                    at(held, 0.3)))
     rows = sorted(set(library["sensory_signature"]["sources"]))
     out.append(("sensors_frozen", [request("freeze_sensor", r, FROZEN_AT_S) for r in rows], None))
-    out.append(("sensors_silenced", [request("silence_sensor", r, at(0, 0.3)) for r in rows], at(0, 0.3)))
+    out.append(("sensors_silenced",
+                [request("silence_sensor", r, at(0, 0.3)) for r in rows], at(0, 0.3)))
     joints = list((scene.get("joints") or {}).keys())
     if joints:
         out.append(("joint_locked", [request("lock_joint", j, 0.0) for j in joints], 0.0))
@@ -92,16 +100,19 @@ def run_goal(cell, inject, task, scene, library_path, faults, offset):
                 raise RuntimeError("inject_fault: " + r.message)
 
     try:
-        res, _, outcome = reproduction.execute_and_judge(cell, task, scene, library_path, on_moving=schedule)
+        res, _, outcome = reproduction.execute_and_judge(cell, task, scene, library_path,
+                                                         on_moving=schedule)
     except reproduction.NotJudged as exc:  # a silenced sensor the task's judge reads: a failed task
         res, outcome = exc.result, {"success": False, "reason": str(exc)}
     alarm = ALARM_TIME.search(res.monitor_alarm or "")
     alarm_time = float(alarm.group(1)) if alarm else None
     return {"monitored": res.monitored, "score": res.max_anomaly_score, "alarm": res.monitor_alarm,
             "alarm_time_s": alarm_time, "fault_time_s": offset,
-            "delay_s": alarm_time - offset if alarm_time is not None and offset is not None else None,
-            "goal_succeeded": res.success, "task_succeeded": bool(res.success and outcome["success"]),
-            "judged": outcome["reason"], "error": res.error}
+            "delay_s": (alarm_time - offset if alarm_time is not None and offset is not None
+                        else None),
+            "goal_succeeded": res.success,
+            "task_succeeded": bool(res.success and outcome["success"]), "judged": outcome["reason"],
+            "error": res.error}
 
 
 def auc(negatives, positives):
@@ -114,9 +125,11 @@ def auc(negatives, positives):
 
 def summarize(runs):
     """Detection over the sensor faults and the faults that made the task fail (one the task
-    survived, e.g. a weak grip while pushing, is counted apart); false alarms over the nominal runs."""
+    survived, e.g. a weak grip while pushing, is counted apart); false alarms over the nominal
+    runs."""
     nominal = [r["score"] for r in runs if r["fault"] == "none"]
-    faulty = [r for r in runs if r["fault"] != "none" and (not r["task_succeeded"] or r["fault"] in SENSOR_FAULTS)]
+    faulty = [r for r in runs if r["fault"] != "none"
+              and (not r["task_succeeded"] or r["fault"] in SENSOR_FAULTS)]
     by_fault = {}
     for r in faulty:
         by_fault.setdefault(r["fault"], []).append(r)
@@ -124,8 +137,10 @@ def summarize(runs):
     return {
         "nominal_runs": len(nominal),
         "nominal_task_failures": sum(not r["task_succeeded"] for r in runs if r["fault"] == "none"),
-        "harmless_faults": sum(r["fault"] not in ("none",) + SENSOR_FAULTS and r["task_succeeded"] for r in runs),
-        "harmless_faults_alarmed": sum(r["fault"] not in ("none",) + SENSOR_FAULTS and r["task_succeeded"] and
+        "harmless_faults": sum(r["fault"] not in ("none",) + SENSOR_FAULTS and r["task_succeeded"]
+                               for r in runs),
+        "harmless_faults_alarmed": sum(r["fault"] not in ("none",) + SENSOR_FAULTS
+                                       and r["task_succeeded"] and
                                        bool(r["alarm"]) for r in runs),
         "false_alarms": sum(bool(r["alarm"]) for r in runs if r["fault"] == "none"),
         "faulty_runs": len(faulty),
@@ -134,7 +149,8 @@ def summarize(runs):
         "median_delay_s": statistics.median(delays) if delays else None,
         "roc_auc": auc(nominal, [r["score"] for r in faulty]),
         "per_fault": {f: {"runs": len(rs), "detected": sum(bool(r["alarm"]) for r in rs),
-                          "median_delay_s": statistics.median([r["delay_s"] for r in rs if r["delay_s"] is not None])
+                          "median_delay_s": statistics.median([r["delay_s"] for r in rs
+                                                               if r["delay_s"] is not None])
                           if any(r["delay_s"] is not None for r in rs) else None}
                       for f, rs in sorted(by_fault.items())},
     }
@@ -148,11 +164,13 @@ def main():
     names = reproduction.selected_tasks(args.tasks)
     results = {"runs": []}
     with report.written_on_exit(args.out or os.path.join(lib_dir, "bench_faults.json"), results):
-        with master.graph_for_this_process(["lfd_launch", "reproduce.launch", "library_dir:=" + lib_dir],
+        with master.graph_for_this_process(["lfd_launch", "reproduce.launch",
+                                            "library_dir:=" + lib_dir],
                                            args.attach):
             cell = lockstep.Cell(node_name="bench_faults")
             from lfd_msgs.srv import InjectFault
-            inject = cell.rospy.ServiceProxy("/bridge/inject_fault", InjectFault)  # up with the bridge
+            # up with the bridge
+            inject = cell.rospy.ServiceProxy("/bridge/inject_fault", InjectFault)
             for task in names:
                 path = os.path.join(lib_dir, "%s_%s.json" % (task, args.mode))
                 with open(path) as f:
@@ -163,22 +181,24 @@ def main():
                 for scene in tasks.unseen_scenes(task, args.mode)[:args.goals]:
                     reproduction.place_scene(cell, task, scene)
                     plan, _ = cell.execute(lockstep.execute_goal(path, scene, dry_run=True))
-                    cases = [("none", [], None)] + faults_for(task, library, scene, list(plan.segment_durations))
+                    cases = [("none", [], None)] + faults_for(task, library, scene,
+                                                              list(plan.segment_durations))
                     for name, faults, offset in cases:
                         started = time.time()
                         try:
                             r = run_goal(cell, inject, task, scene, path, faults, offset)
                         except RuntimeError as exc:
-                            r = {"monitored": False, "score": 0.0, "alarm": "", "alarm_time_s": None,
-                                 "fault_time_s": offset, "delay_s": None, "goal_succeeded": False,
-                                 "task_succeeded": False, "judged": "", "error": str(exc)}
+                            r = {"monitored": False, "score": 0.0, "alarm": "",
+                                 "alarm_time_s": None, "fault_time_s": offset, "delay_s": None,
+                                 "goal_succeeded": False, "task_succeeded": False, "judged": "",
+                                 "error": str(exc)}
                         r.update(task=task, goal=scene["id"], fault=name)
                         results["runs"].append(r)
                         print("%-6s goal %3d %-16s %-7s score %6.2f %-6s delay %s  %.1f s  %s" % (
                             task, scene["id"], name, "ok" if r["task_succeeded"] else "FAILED",
                             r["score"], "ALARM" if r["alarm"] else "-",
-                            "-" if r["delay_s"] is None else "%.3f s" % r["delay_s"], time.time() - started,
-                            (r["alarm"] or r["error"])[:90]), flush=True)
+                            "-" if r["delay_s"] is None else "%.3f s" % r["delay_s"],
+                            time.time() - started, (r["alarm"] or r["error"])[:90]), flush=True)
             results["summary"] = summarize(results["runs"])
             print(json.dumps(results["summary"], indent=1))
     return 0

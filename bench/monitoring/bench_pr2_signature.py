@@ -50,11 +50,15 @@ def score(cli, topics, channels, data, labels, train, runs):
 
 
 def main():
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--data", default=os.path.normpath(os.path.join(ROOT, "..", "shared", "data", "pr2_ikea")))
-    ap.add_argument("--cli", default=os.path.join(ROOT, "devel", "lib", "lfd_segmentation", "signature"))
+    ap = argparse.ArgumentParser(description=__doc__,
+                                 formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--data", default=os.path.normpath(os.path.join(ROOT, "..", "shared",
+                                                                    "data", "pr2_ikea")))
+    ap.add_argument("--cli", default=os.path.join(ROOT, "devel", "lib", "lfd_segmentation",
+                                                  "signature"))
     ap.add_argument("--topics", default=os.path.join(ROOT, "config", "topics_pr2_ikea.yaml"))
-    ap.add_argument("--channels", help="comma-separated features to monitor (default: the topics' sensors)")
+    ap.add_argument("--channels",
+                    help="comma-separated features to monitor (default: the topics' sensors)")
     ap.add_argument("--with-object", action="store_true",
                     help="monitor the leg marker's position too (the AR world model, a camera)")
     ap.add_argument("--out")
@@ -66,7 +70,8 @@ def main():
     positives = sorted(r for r, v in labels["runs"].items() if v["outcome"] == "success")
     negatives = sorted(FAILED_SEGMENT)
     rows, ok, total = [], 0, 0
-    print("%-14s %-8s %-12s %8s %8s  worst channel at the failed segment" % ("learned from", "run", "segment", "score", "pos max"))
+    print("%-14s %-8s %-12s %8s %8s  worst channel at the failed segment"
+          % ("learned from", "run", "segment", "score", "pos max"))
     for train in itertools.combinations(positives, 2):
         held = [r for r in positives if r not in train]
         result = score(a.cli, a.topics, a.channels, a.data, labels, train, held + negatives)
@@ -78,13 +83,14 @@ def main():
             worst = by_run[neg]["segments"][s]["worst"]
             total += 1
             ok += neg_score > max(pos_scores)
-            rows.append({"train": train, "run": neg, "segment": FAILED_SEGMENT[neg], "score": neg_score,
-                         "positive_max": max(pos_scores), "worst": worst})
+            rows.append({"train": train, "run": neg, "segment": FAILED_SEGMENT[neg],
+                         "score": neg_score, "positive_max": max(pos_scores), "worst": worst})
             print("%-14s %-8s %-12s %8.2f %8.2f  %s t=%.1f s expected %.3g measured %.3g" % (
-                "+".join(train), neg, FAILED_SEGMENT[neg], neg_score, max(pos_scores), worst["channel"],
-                worst["time"], worst["expected"], worst["measured"]))
+                "+".join(train), neg, FAILED_SEGMENT[neg], neg_score, max(pos_scores),
+                worst["channel"], worst["time"], worst["expected"], worst["measured"]))
         for p in held:
-            rows.append({"train": train, "run": p, "alarms": [max(seg["scores"]) > 1 for seg in by_run[p]["segments"]],
+            rows.append({"train": train, "run": p,
+                         "alarms": [max(seg["scores"]) > 1 for seg in by_run[p]["segments"]],
                          "scores": [max(seg["scores"]) for seg in by_run[p]["segments"]]})
             print("%-14s %-8s nominal, per segment: %s" % ("+".join(train), p,
                   " ".join("%.2f" % max(seg["scores"]) for seg in by_run[p]["segments"])))
@@ -93,7 +99,8 @@ def main():
                     w = seg["worst"]
                     print("    false alarm: %s t=%.1f s phase %.2f expected %.3g measured %.3g" % (
                         w["channel"], w["time"], w["phase"], w["expected"], w["measured"]))
-    print("failed runs above every held-out successful run on their failed segment: %d of %d" % (ok, total))
+    print("failed runs above every held-out successful run on their failed segment: %d of %d"
+          % (ok, total))
     if a.out:
         json.dump({"rows": rows, "separated": ok, "cases": total}, open(a.out, "w"), indent=1)
 

@@ -34,14 +34,16 @@ def figures_of(report, wall):
     out = {"%s_s" % s: timings.get("%s_s" % s) for s in STAGES}
     out["wall_s"] = wall
     out["per_demo_s"] = timings["datasets_s"] / demos if demos and "datasets_s" in timings else None
-    out["per_goal_s"] = timings["reproduce_s"] / goals if goals and "reproduce_s" in timings else None
+    out["per_goal_s"] = (timings["reproduce_s"] / goals if goals and "reproduce_s" in timings
+                         else None)
     out["demos"], out["goals"] = demos, goals
     return out
 
 
 def show(figures):
     for key, value in figures.items():
-        text = "-" if value is None else ("%d" % value if key in ("demos", "goals") else "%.1f" % value)
+        text = "-" if value is None else ("%d" % value if key in ("demos", "goals")
+                                          else "%.1f" % value)
         print("  %-14s %s" % (key, text))
 
 
@@ -53,12 +55,14 @@ def one_run(out, pipeline_args):
     with open(os.path.join(out, "report.json")) as f:
         report = json.load(f)
     if rc != 0:
-        print("pipeline exited %d: %s" % (rc, "; ".join(report.get("problems", []))), file=sys.stderr)
+        print("pipeline exited %d: %s" % (rc, "; ".join(report.get("problems", []))),
+              file=sys.stderr)
     return figures_of(report, wall)
 
 
 def main():
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap = argparse.ArgumentParser(description=__doc__,
+                                 formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--out", default=None)
     ap.add_argument("--keep", action="store_true")
     ap.add_argument("--runs", type=int, default=1)

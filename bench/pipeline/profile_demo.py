@@ -62,7 +62,8 @@ def log_facts(out):
                 wall, text = float(s.group(1)), s.group(3)
                 if text.startswith("demonstrator: waiting for the bridge"):
                     stamps.setdefault("demonstrator_up", wall)
-                elif "speed" in text and text.startswith("demonstrator: ") and "configuration" in text:
+                elif ("speed" in text and text.startswith("demonstrator: ")
+                      and "configuration" in text):
                     stamps.setdefault("first_demo", wall)
                 elif "recorded," in text and text.startswith("demonstrator: configuration"):
                     stamps["last_demo_end"] = wall
@@ -112,7 +113,8 @@ def main():
         "demos_wall_s": demo_wall,
         "before_first_demo_s": stamps["first_demo"] - start if "first_demo" in stamps else None,
         "graph_up_s": stamps["demonstrator_up"] - start if "demonstrator_up" in stamps else None,
-        "after_last_demo_s": start + wall - stamps["last_demo_end"] if "last_demo_end" in stamps else None,
+        "after_last_demo_s": (start + wall - stamps["last_demo_end"] if "last_demo_end" in stamps
+                              else None),
         "demonstrator_parts_s": parts,
         "demonstrator_counts": counts,
         "demonstrator_other_s": demo_wall - sum(parts.values()),
@@ -121,8 +123,9 @@ def main():
         "cpu_s": {name: {"user": round(u, 2), "system": round(s, 2)}
                   for name, (u, s) in sampler.by_name().items()},
     }
-    print("%d demos of %s: %.1f s of sim time in %.1f s wall (%.1fx real time overall, %.1fx within "
-          "the demos)" % (len(demos), args.dataset, sim_s, wall, sim_s / wall, sim_s / max(demo_wall, 1e-9)))
+    print("%d demos of %s: %.1f s of sim time in %.1f s wall (%.1fx real time overall, "
+          "%.1fx within the demos)"
+          % (len(demos), args.dataset, sim_s, wall, sim_s / wall, sim_s / max(demo_wall, 1e-9)))
     for key in ("graph_up_s", "before_first_demo_s", "after_last_demo_s"):
         if result[key] is not None:
             print("  %-34s %6.2f s" % (key, result[key]))
@@ -134,10 +137,13 @@ def main():
             ("%d step round trips beyond the bridge's work" % calls, handshake)]
     rows += [("demonstrator: %s (%d)" % (k, counts.get(k, 0)), v) for k, v in sorted(parts.items())
              if k not in step_kinds]
-    rows += [("  of which: all of %s (%d)" % (k, counts.get(k, 0)), parts.get(k, 0.0)) for k in step_kinds]
-    rows.append(("demonstrator: the rest (its own code, callbacks)", result["demonstrator_other_s"]))
+    rows += [("  of which: all of %s (%d)" % (k, counts.get(k, 0)), parts.get(k, 0.0))
+             for k in step_kinds]
+    rows.append(("demonstrator: the rest (its own code, callbacks)",
+                 result["demonstrator_other_s"]))
     for name, seconds in rows:
-        print("    %-48s %6.2f s  %5.1f%%" % (name, seconds, 100.0 * seconds / max(demo_wall, 1e-9)))
+        print("    %-48s %6.2f s  %5.1f%%"
+              % (name, seconds, 100.0 * seconds / max(demo_wall, 1e-9)))
     print("  CPU by process (user + system):")
     for name, cpu in result["cpu_s"].items():
         if cpu["user"] + cpu["system"] >= 0.05:

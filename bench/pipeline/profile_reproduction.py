@@ -47,10 +47,12 @@ def profile_goals(cell, lib_dir, mode, names, goals):
                 success = False
             wall = time.perf_counter() - started
             parts, calls = cell.take_wall()
-            rows.append({"task": task, "goal": scene["id"], "wall_s": wall, "sim_s": cell.now() - sim_start,
-                         "parts": parts, "calls": calls, "success": success})
+            rows.append({"task": task, "goal": scene["id"], "wall_s": wall,
+                         "sim_s": cell.now() - sim_start, "parts": parts, "calls": calls,
+                         "success": success})
             print("%-7s goal %3d  %5.1f s sim in %5.2f s wall  %s" % (
-                task, scene["id"], rows[-1]["sim_s"], wall, "ok" if success else "FAILED"), flush=True)
+                task, scene["id"], rows[-1]["sim_s"], wall,
+                "ok" if success else "FAILED"), flush=True)
     return rows
 
 
@@ -60,10 +62,13 @@ def show(rows, cpu):
     for r in rows:
         parts.update(r["parts"])
         calls.update(r["calls"])
-    print("%d goals: %.1f s of sim time in %.1f s wall (%.1fx real time)" % (len(rows), sim, wall, sim / max(wall, 1e-9)))
+    print("%d goals: %.1f s of sim time in %.1f s wall (%.1fx real time)"
+          % (len(rows), sim, wall, sim / max(wall, 1e-9)))
     for name in ORDER:
-        print("  %-44s %6.2f s  %5.1f%%" % ("%s (%d)" % (name, calls[name]), parts[name], 100 * parts[name] / wall))
-    print("  %-44s %6.2f s" % ("of which /bridge/step round trips (%d)" % calls["step_calls"], parts["step_calls"]))
+        print("  %-44s %6.2f s  %5.1f%%"
+              % ("%s (%d)" % (name, calls[name]), parts[name], 100 * parts[name] / wall))
+    print("  %-44s %6.2f s"
+          % ("of which /bridge/step round trips (%d)" % calls["step_calls"], parts["step_calls"]))
     print("  %-44s %6.2f s" % ("of motion: its step round trips", parts["motion_step_calls"]))
     print("  %-44s %6.2f s" % ("of motion: the rest (client loop, action traffic)",
                                parts["motion"] - parts["motion_step_calls"]))
@@ -82,8 +87,10 @@ def main():
     names = reproduction.selected_tasks(args.tasks)
     sampler = CpuSampler(os.getpid())
     sampler.start()
-    with master.graph_for_this_process(["lfd_launch", "reproduce.launch", "library_dir:=" + lib_dir], args.attach):
-        rows = profile_goals(Cell(node_name="profile_reproduction"), lib_dir, args.mode, names, args.goals)
+    with master.graph_for_this_process(["lfd_launch", "reproduce.launch",
+                                        "library_dir:=" + lib_dir], args.attach):
+        rows = profile_goals(Cell(node_name="profile_reproduction"), lib_dir, args.mode,
+                             names, args.goals)
         sampler.stop()  # before the graph goes down with its CPU readings
     cpu = sampler.by_name()
     show(rows, cpu)

@@ -41,8 +41,10 @@ def segment(args, folder, truth):
     """(answer as lfd_tools.segmentation_scoring takes it, error or "", seconds) of one CLI run
     on every demo of a class's folder."""
     out = os.path.join(folder, "segment.json")
-    cmd = [args.cli, "--no-profiles", "--output", out, "--state-columns", ",".join(truth["state_columns"])]
-    cmd += ["--sensor-columns", ",".join(truth["sensor_columns"])] if truth["sensor_columns"] else []
+    cmd = [args.cli, "--no-profiles", "--output", out, "--state-columns",
+           ",".join(truth["state_columns"])]
+    cmd += ["--sensor-columns",
+            ",".join(truth["sensor_columns"])] if truth["sensor_columns"] else []
     cmd += ["--config", args.config] if args.config else []
     cmd += ["--procedure", args.procedure] if args.procedure else []
     cmd += [os.path.join(folder, d["file"]) for d in truth["demos"]]
@@ -50,9 +52,11 @@ def segment(args, folder, truth):
         os.remove(out)
     start = time.time()
     try:
-        proc = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, universal_newlines=True)
+        proc = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                              universal_newlines=True)
     except OSError as e:  # e.g. a CLI being rebuilt
-        return no_answer(len(truth["demos"]), str(e)), "cannot run the CLI: %s" % e, time.time() - start
+        return (no_answer(len(truth["demos"]), str(e)), "cannot run the CLI: %s" % e,
+                time.time() - start)
     elapsed = time.time() - start
     try:
         with open(out) as f:
@@ -61,17 +65,21 @@ def segment(args, folder, truth):
         res = {"success": False,
                "error": "no result (exit %d): %s" % (proc.returncode, proc.stderr.strip()[-300:])}
     if not res.get("success"):
-        return no_answer(len(truth["demos"]), res.get("error", "")), res.get("error", "failed"), elapsed
-    demos = [{"changepoint_times": d["changepoint_times"], "rejected_times": d.get("rejected_times", []),
+        return no_answer(len(truth["demos"]),
+                         res.get("error", "")), res.get("error", "failed"), elapsed
+    demos = [{"changepoint_times": d["changepoint_times"],
+              "rejected_times": d.get("rejected_times", []),
               "pruned_times": d.get("pruned_times", []),
-              "zones": [(z["begin_time"], z["end_time"]) for z in d.get("zones", [])]} for d in res["demos"]]
+              "zones": [(z["begin_time"], z["end_time"])
+                        for z in d.get("zones", [])]} for d in res["demos"]]
     return ({"demos": demos, "selected_features": res["selected_features"],
              "selected_weights": res["feature_weights"], "warnings": res["warnings"]}, "", elapsed)
 
 
 def no_answer(n, error):
     """A failed run: every demo without changepoints."""
-    return {"demos": [{"changepoint_times": [], "rejected_times": [], "pruned_times": [], "zones": []}] * n,
+    return {"demos": [{"changepoint_times": [], "rejected_times": [], "pruned_times": [],
+                       "zones": []}] * n,
             "selected_features": [], "selected_weights": [], "warnings": [error]}
 
 
@@ -83,10 +91,12 @@ def score_seed(args, name, seed, work):
     inputs = [os.path.join(folder, d["file"]) for d in truth["demos"]]
     clocks = [np.loadtxt(p, delimiter=",", skiprows=1, usecols=0) for p in inputs]
     spans = [(c[0], c[-1]) for c in clocks]
-    windows = [[(c[0] + b, c[0] + b) for b in d["boundaries_s"]] for c, d in zip(clocks, truth["demos"])]
+    windows = [[(c[0] + b, c[0] + b) for b in d["boundaries_s"]]
+               for c, d in zip(clocks, truth["demos"])]
     answer, error, elapsed = segment(args, folder, truth)
-    scores = {tol: segmentation_scoring.score_answer(answer, args.procedure or "default", inputs, windows,
-                                                      spans, tol, elapsed) for tol in TOLERANCES}
+    scores = {tol: segmentation_scoring.score_answer(answer, args.procedure or "default", inputs,
+                                                     windows, spans, tol,
+                                                     elapsed) for tol in TOLERANCES}
     for s in scores.values():
         for d, t in zip(s["details"], truth["demos"]):
             d.update({"seed": seed, "truth_s": t["boundaries_s"]})
@@ -114,27 +124,32 @@ def score_class(args, name, work):
 
 
 HEADER = "%-22s %5s %-14s %6s %-14s %6s %6s %6s %7s %7s %5s %9s %7s" % (
-    "class", "demos", "ok@0.5", "rate", "ok@1.0", "rate", "cover", "f1@0.5", "err_med", "err_p95", "none",
-    "cps/truth", "time_s")
+    "class", "demos", "ok@0.5", "rate", "ok@1.0", "rate", "cover", "f1@0.5", "err_med", "err_p95",
+    "none", "cps/truth", "time_s")
 
 
 def row(name, r):
     a, b = r["at"]["0.5"], r["at"]["1.0"]
     per_seed = lambda tol: ",".join(str(s["correct"][tol]) for s in r["seeds"])
     line = "%-22s %5d %-14s %6.2f %-14s %6.2f %6.3f %6.3f %7.2f %7.2f %5d %4.1f/%-4.1f %7.1f" % (
-        name, a["demos"], per_seed("0.5"), a["success_rate"], per_seed("1.0"), b["success_rate"], a["covering"],
-        a["f1"], a["time_error_median_s"], a["time_error_p95_s"], a["transitions_without_changepoint"],
-        r["changepoints_per_demo"], r["boundaries_per_demo"], sum(s["seconds"] for s in r["seeds"]))
+        name, a["demos"], per_seed("0.5"), a["success_rate"], per_seed("1.0"), b["success_rate"],
+        a["covering"], a["f1"], a["time_error_median_s"], a["time_error_p95_s"],
+        a["transitions_without_changepoint"], r["changepoints_per_demo"], r["boundaries_per_demo"],
+        sum(s["seconds"] for s in r["seeds"]))
     errors = ["seed %d: %s" % (s["seed"], s["error"]) for s in r["seeds"] if s["error"]]
     return line + "".join("\n    error: " + e for e in errors)
 
 
 def parse_args():
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap = argparse.ArgumentParser(description=__doc__,
+                                 formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--cli", default=DEFAULT_CLI, help="the `segment` CLI (default: %(default)s)")
-    ap.add_argument("--config", default="", help="passed to the CLI as --config (default: the CLI's own)")
-    ap.add_argument("--procedure", default="", help="passed to the CLI as --procedure (default: the config's)")
-    ap.add_argument("--classes", default="", help="comma-separated (default: all, rate variants included)")
+    ap.add_argument("--config", default="",
+                    help="passed to the CLI as --config (default: the CLI's own)")
+    ap.add_argument("--procedure", default="",
+                    help="passed to the CLI as --procedure (default: the config's)")
+    ap.add_argument("--classes", default="",
+                    help="comma-separated (default: all, rate variants included)")
     ap.add_argument("--seeds", default="0,1,2")
     ap.add_argument("--out", default="", help="write every figure and per-demo detail here (JSON)")
     ap.add_argument("--min-success", type=float, default=None,
@@ -145,7 +160,8 @@ def parse_args():
     names = [c for c in args.classes.split(",") if c] or list(signal_classes.CLASSES)
     unknown = [c for c in names if c not in signal_classes.CLASSES]
     if unknown:
-        ap.error("unknown class %s; known: %s" % (", ".join(unknown), ", ".join(signal_classes.CLASSES)))
+        ap.error("unknown class %s; known: %s"
+                 % (", ".join(unknown), ", ".join(signal_classes.CLASSES)))
     if not os.access(args.cli, os.X_OK):
         ap.error("no `segment` CLI at %s (./lfd build, or --cli)" % args.cli)
     return args, names
@@ -167,8 +183,9 @@ def main():
             shutil.rmtree(work, ignore_errors=True)
     if args.out:
         with open(args.out, "w") as f:
-            json.dump({"cli": args.cli, "config": args.config, "procedure": args.procedure, "seeds": args.seeds,
-                       "tolerances_s": list(TOLERANCES), "classes": results}, f, indent=1)
+            json.dump({"cli": args.cli, "config": args.config, "procedure": args.procedure,
+                       "seeds": args.seeds, "tolerances_s": list(TOLERANCES),
+                       "classes": results}, f, indent=1)
     below = [n for n, r in results.items() if args.min_success is not None
              and r["at"]["0.5"]["success_rate"] < args.min_success]
     if below:

@@ -22,18 +22,20 @@ gripper centre plane: 0 = closed, 0.045 = fully open (gap = 2 * R_GRIPPER).
 The robot's files and the scene it stands in are generated together because the scene includes the
 robot (a relative MJCF <include>) and pairs its finger pads with the table; a second robot has its
 own description package and its own scene of the same config/scene.yaml.
-Run (after `source devel/setup.bash`): /usr/bin/python3 jvrc1_description/models/generate_models.py [OUT_DIR]
+Run (after `source devel/setup.bash`):
+  /usr/bin/python3 jvrc1_description/models/generate_models.py [OUT_DIR]
 """
 
 import os
 import sys
 
-from lfd_tools.robot_models import (DARK_COLOR, X, Y, Z, HandNames, Link, Robot, generate, geom, load_scene,
-                                    parallel_gripper, revolute, scene_file_beside)
+from lfd_tools.robot_models import (DARK_COLOR, X, Y, Z, HandNames, Link, Robot, generate, geom,
+                                    load_scene, parallel_gripper, revolute, scene_file_beside)
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 SCENE_FILE = scene_file_beside(HERE)
-PELVIS_HEIGHT = load_scene(SCENE_FILE)['base_link_in_world'][2]  # world z of base_link (the pelvis is fixed)
+# world z of base_link (the pelvis is fixed)
+PELVIS_HEIGHT = load_scene(SCENE_FILE)['base_link_in_world'][2]
 
 # Per-joint-group actuation: (kp, damping, armature, velocity limit, effort limit).
 # Gains are stiff, like a high-ratio position-controlled humanoid servo, so that gravity sag stays
@@ -70,8 +72,10 @@ HAND = HandNames(ft_frame='r_wrist_ft', ft_joint='R_WRIST_FT_JOINT',
                  pad_left='r_finger_l_pad', pad_right='r_finger_r_pad',
                  touch_left='r_touch_left_site', touch_right='r_touch_right_site',
                  tcp='r_gripper_tcp', tcp_joint='R_GRIPPER_TCP_JOINT')
-OPTION_NOTE = ('1 kHz physics. Elliptic friction cones with a high impratio keep a pinch grasp from creeping;\n'
-               '       the Euler integrator treats the (large) joint damping implicitly; sparse Jacobians are a\n'
+OPTION_NOTE = ('1 kHz physics. Elliptic friction cones with a high impratio keep a pinch grasp '
+               'from creeping;\n'
+               '       the Euler integrator treats the (large) joint damping implicitly; sparse '
+               'Jacobians are a\n'
                '       little faster for this 46-DoF tree.')
 
 
@@ -81,18 +85,24 @@ def leg_links(side):
     # Hip roll range is mirrored so that positive values always mean "towards the other leg" for L.
     roll = (-0.80, 0.35) if side == 'R' else (-0.35, 0.80)
     return [
-        Link(f'{p}_hip_p_link', 'base_link', revolute(f'{side}_HIP_P', Y, -2.00, 0.60, DRIVE['hip']),
-             (0.0, s * 0.096, -0.10), 1.0, [geom('sphere', (0.05,))]),
-        Link(f'{p}_hip_r_link', f'{p}_hip_p_link', revolute(f'{side}_HIP_R', X, *roll, DRIVE['hip']),
-             (0.0, 0.0, 0.0), 1.0, [geom('cylinder', (0.05, 0.04), color=DARK_COLOR)]),
-        Link(f'{p}_hip_y_link', f'{p}_hip_r_link', revolute(f'{side}_HIP_Y', Z, -0.80, 0.80, DRIVE['hip']),
-             (0.0, 0.0, 0.0), 5.0, [geom('cylinder', (0.06, 0.165), (0.0, 0.0, -0.165))]),
-        Link(f'{p}_knee_link', f'{p}_hip_y_link', revolute(f'{side}_KNEE', Y, 0.0, 2.40, DRIVE['knee']),
-             (0.0, 0.0, -0.33), 3.0, [geom('cylinder', (0.05, 0.165), (0.0, 0.0, -0.165))]),
-        Link(f'{p}_ankle_r_link', f'{p}_knee_link', revolute(f'{side}_ANKLE_R', X, -0.50, 0.50, DRIVE['ankle']),
-             (0.0, 0.0, -0.33), 0.5, [geom('sphere', (0.035,), color=DARK_COLOR)]),
-        Link(f'{p}_ankle_p_link', f'{p}_ankle_r_link', revolute(f'{side}_ANKLE_P', Y, -1.20, 0.80, DRIVE['ankle']),
-             (0.0, 0.0, 0.0), 1.5, [geom('box', (0.11, 0.05, 0.02), (0.03, 0.0, -0.068))]),
+        Link(f'{p}_hip_p_link', 'base_link',
+             revolute(f'{side}_HIP_P', Y, -2.00, 0.60, DRIVE['hip']), (0.0, s * 0.096, -0.10), 1.0,
+             [geom('sphere', (0.05,))]),
+        Link(f'{p}_hip_r_link', f'{p}_hip_p_link',
+             revolute(f'{side}_HIP_R', X, *roll, DRIVE['hip']), (0.0, 0.0, 0.0), 1.0,
+             [geom('cylinder', (0.05, 0.04), color=DARK_COLOR)]),
+        Link(f'{p}_hip_y_link', f'{p}_hip_r_link',
+             revolute(f'{side}_HIP_Y', Z, -0.80, 0.80, DRIVE['hip']), (0.0, 0.0, 0.0), 5.0,
+             [geom('cylinder', (0.06, 0.165), (0.0, 0.0, -0.165))]),
+        Link(f'{p}_knee_link', f'{p}_hip_y_link',
+             revolute(f'{side}_KNEE', Y, 0.0, 2.40, DRIVE['knee']), (0.0, 0.0, -0.33), 3.0,
+             [geom('cylinder', (0.05, 0.165), (0.0, 0.0, -0.165))]),
+        Link(f'{p}_ankle_r_link', f'{p}_knee_link',
+             revolute(f'{side}_ANKLE_R', X, -0.50, 0.50, DRIVE['ankle']), (0.0, 0.0, -0.33), 0.5,
+             [geom('sphere', (0.035,), color=DARK_COLOR)]),
+        Link(f'{p}_ankle_p_link', f'{p}_ankle_r_link',
+             revolute(f'{side}_ANKLE_P', Y, -1.20, 0.80, DRIVE['ankle']), (0.0, 0.0, 0.0), 1.5,
+             [geom('box', (0.11, 0.05, 0.02), (0.03, 0.0, -0.068))]),
     ]
 
 
@@ -103,26 +113,34 @@ def arm_links(side):
     roll = (-1.75, 0.35) if side == 'R' else (-0.35, 1.75)
     collide = side == 'R'  # only the working (right) forearm and hand touch the world
     links = [
-        Link(f'{p}_shoulder_p_link', 'chest_link', revolute(f'{side}_SHOULDER_P', Y, -3.10, 1.00, DRIVE['shoulder']),
+        Link(f'{p}_shoulder_p_link', 'chest_link',
+             revolute(f'{side}_SHOULDER_P', Y, -3.10, 1.00, DRIVE['shoulder']),
              (0.0, s * 0.21, 0.36), 0.8, [geom('sphere', (0.05,), color=DARK_COLOR)]),
-        Link(f'{p}_shoulder_r_link', f'{p}_shoulder_p_link', revolute(f'{side}_SHOULDER_R', X, *roll, DRIVE['shoulder']),
-             (0.0, 0.0, 0.0), 0.8, [geom('cylinder', (0.045, 0.04), color=DARK_COLOR)]),
-        Link(f'{p}_shoulder_y_link', f'{p}_shoulder_r_link', revolute(f'{side}_SHOULDER_Y', Z, -1.60, 1.60, DRIVE['shoulder']),
-             (0.0, 0.0, 0.0), 2.0, [geom('cylinder', (0.045, 0.13), (0.0, 0.0, -0.15))]),
-        Link(f'{p}_elbow_p_link', f'{p}_shoulder_y_link', revolute(f'{side}_ELBOW_P', Y, -2.50, 0.00, DRIVE['elbow']),
-             (0.0, 0.0, -0.30), 0.5, [geom('sphere', (0.042,), color=DARK_COLOR)]),
-        Link(f'{p}_elbow_y_link', f'{p}_elbow_p_link', revolute(f'{side}_ELBOW_Y', Z, -1.60, 1.60, DRIVE['elbow']),
-             (0.0, 0.0, 0.0), 1.2, [geom('cylinder', (0.04, 0.11), (0.0, 0.0, -0.13), collide=collide)]),
-        Link(f'{p}_wrist_r_link', f'{p}_elbow_y_link', revolute(f'{side}_WRIST_R', X, -1.40, 1.40, DRIVE['wrist']),
-             (0.0, 0.0, -0.26), 0.2, [geom('sphere', (0.03,), color=DARK_COLOR)]),
+        Link(f'{p}_shoulder_r_link', f'{p}_shoulder_p_link',
+             revolute(f'{side}_SHOULDER_R', X, *roll, DRIVE['shoulder']), (0.0, 0.0, 0.0), 0.8,
+             [geom('cylinder', (0.045, 0.04), color=DARK_COLOR)]),
+        Link(f'{p}_shoulder_y_link', f'{p}_shoulder_r_link',
+             revolute(f'{side}_SHOULDER_Y', Z, -1.60, 1.60, DRIVE['shoulder']), (0.0, 0.0, 0.0),
+             2.0, [geom('cylinder', (0.045, 0.13), (0.0, 0.0, -0.15))]),
+        Link(f'{p}_elbow_p_link', f'{p}_shoulder_y_link',
+             revolute(f'{side}_ELBOW_P', Y, -2.50, 0.00, DRIVE['elbow']), (0.0, 0.0, -0.30), 0.5,
+             [geom('sphere', (0.042,), color=DARK_COLOR)]),
+        Link(f'{p}_elbow_y_link', f'{p}_elbow_p_link',
+             revolute(f'{side}_ELBOW_Y', Z, -1.60, 1.60, DRIVE['elbow']), (0.0, 0.0, 0.0), 1.2,
+             [geom('cylinder', (0.04, 0.11), (0.0, 0.0, -0.13), collide=collide)]),
+        Link(f'{p}_wrist_r_link', f'{p}_elbow_y_link',
+             revolute(f'{side}_WRIST_R', X, -1.40, 1.40, DRIVE['wrist']), (0.0, 0.0, -0.26), 0.2,
+             [geom('sphere', (0.03,), color=DARK_COLOR)]),
     ]
     if side == 'L':
         # Simple paddle hand: the left arm does not manipulate.
-        links.append(Link('l_wrist_y_link', 'l_wrist_r_link', revolute('L_WRIST_Y', Y, -1.75, 1.75, DRIVE['wrist']),
-                          (0.0, 0.0, 0.0), 0.5, [geom('box', (0.02, 0.045, 0.06), (0.0, 0.0, -0.08))]))
+        links.append(Link('l_wrist_y_link', 'l_wrist_r_link',
+                          revolute('L_WRIST_Y', Y, -1.75, 1.75, DRIVE['wrist']), (0.0, 0.0, 0.0),
+                          0.5, [geom('box', (0.02, 0.045, 0.06), (0.0, 0.0, -0.08))]))
         return links
     links += [
-        Link('r_wrist_y_link', 'r_wrist_r_link', revolute('R_WRIST_Y', Y, -1.75, 1.75, DRIVE['wrist']),
+        Link('r_wrist_y_link', 'r_wrist_r_link',
+             revolute('R_WRIST_Y', Y, -1.75, 1.75, DRIVE['wrist']),
              (0.0, 0.0, 0.0), 0.3, [geom('cylinder', (0.035, 0.02), (0.0, 0.0, -0.02), collide=True,
                                          color=DARK_COLOR)]),
     ]
@@ -142,7 +160,8 @@ def robot_links():
         Link('chest_link', 'waist_p_link', revolute('WAIST_R', X, -0.50, 0.50, DRIVE['waist']),
              (0.0, 0.0, 0.0), 12.0, [geom('box', (0.11, 0.16, 0.16), (0.0, 0.0, 0.22))]),
         Link('neck_y_link', 'chest_link', revolute('NECK_Y', Z, -1.20, 1.20, DRIVE['neck']),
-             (0.0, 0.0, 0.44), 0.3, [geom('cylinder', (0.035, 0.03), (0.0, 0.0, 0.02), color=DARK_COLOR)]),
+             (0.0, 0.0, 0.44), 0.3,
+             [geom('cylinder', (0.035, 0.03), (0.0, 0.0, 0.02), color=DARK_COLOR)]),
         Link('neck_r_link', 'neck_y_link', revolute('NECK_R', X, -0.50, 0.50, DRIVE['neck']),
              (0.0, 0.0, 0.0), 0.3, [geom('sphere', (0.03,), color=DARK_COLOR)]),
         Link('head_link', 'neck_r_link', revolute('NECK_P', Y, -0.60, 0.90, DRIVE['neck']),
@@ -153,8 +172,8 @@ def robot_links():
 
 
 def robot():
-    return Robot('jvrc1_like', robot_links(), SENSORS, ft_frame=HAND.ft_frame, imu=('imu', 'base_link'),
-                 finger_pads=HAND.finger_pads(), option_note=OPTION_NOTE)
+    return Robot('jvrc1_like', robot_links(), SENSORS, ft_frame=HAND.ft_frame,
+                 imu=('imu', 'base_link'), finger_pads=HAND.finger_pads(), option_note=OPTION_NOTE)
 
 
 def main(out_dir=HERE):

@@ -39,16 +39,17 @@ records of lfd_tools.report as the tools wrote them (their fields are documented
   timings.<stage>_s                      wall time of the stage's last run (datasets_s, segment_s,
                                          learn_s, reproduce_s; total_s their sum; a stage with
                                          nothing to redo keeps its previous time)
-  stage_errors.<stage>                   this run's error of a stage that failed (also in `problems`)
+  stage_errors.<stage>                   this run's error of a stage that failed (also in
+                                         `problems`)
   problems                               everything above that did not work, one line each
 A stage that fails (any exception, or a tool that exits non-zero) is recorded with its error under
 `stage_errors` and `problems` and ends the run with exit status 1. Every process a stage starts
 carries LFD_PIPELINE_TAG=<pid>:<stage> in its environment; whatever still runs when the stage ends
 (however it ends) is killed, roslaunch's nodes included.
-A task that cannot be learned or reproduced (e.g. push while its segmentation finds another number of
-changepoints than the task has transitions) is recorded with its error and listed under `problems`;
-the other tasks go on. <dataset> is <mode>_<task>, for every task file (config/tasks/*.yaml) and
-both modes by default (sim_grasp, ..., teleop_wipe).
+A task that cannot be learned or reproduced (e.g. push while its segmentation finds another number
+of changepoints than the task has transitions) is recorded with its error and listed under
+`problems`; the other tasks go on. <dataset> is <mode>_<task>, for every task file
+(config/tasks/*.yaml) and both modes by default (sim_grasp, ..., teleop_wipe).
 
 Resumable: the datasets stage keeps existing bags, learn keeps existing libraries and reproduce
 keeps results newer than their library for the same goals; `--force` redoes learn and reproduce.
@@ -83,7 +84,8 @@ def say(msg):
 
 def failed(what, rc, tail):
     """A stage error that carries the tool's own last words (e.g. its Python exception)."""
-    return RuntimeError("%s (exit %d)%s" % (what, rc, (": " + tail.replace("\n", " / ")) if tail else ""))
+    return RuntimeError("%s (exit %d)%s"
+                        % (what, rc, (": " + tail.replace("\n", " / ")) if tail else ""))
 
 
 def roots_arg(folder):
@@ -103,13 +105,15 @@ def stage_datasets(out, args, report):
     groups = split(args.datasets, workers(args.jobs))
 
     def generate(names):
-        cmd = ["/usr/bin/python3", os.path.join(ROOT, "lfd_sim_bridge", "scripts", "generate_datasets.py"),
+        cmd = ["/usr/bin/python3",
+               os.path.join(ROOT, "lfd_sim_bridge", "scripts", "generate_datasets.py"),
                "--out", data, "--datasets", ",".join(names), "--demos", str(args.demos)]
         with private_master() as env:
             return run_tool(cmd, env, label="+".join(names) if len(groups) > 1 else None)
 
     results = run_parallel([lambda g=g: generate(g) for g in groups], args.jobs)
-    report["datasets"] = {n: {"demos": count_bags(os.path.join(data, n)), "path": os.path.join(data, n)}
+    report["datasets"] = {n: {"demos": count_bags(os.path.join(data, n)),
+                              "path": os.path.join(data, n)}
                           for n in args.datasets}
     bad = [(rc, tail) for rc, tail in results if rc != 0]
     if bad:
@@ -131,9 +135,11 @@ def stage_segment(out, args, report):
     result = os.path.join(out, "segmentation.json")
     with private_master() as env:
         with background_launch(["roslaunch", "lfd_launch", "segment.launch", roots_arg(out)], env):
-            rc, tail = run_tool(["/usr/bin/python3", os.path.join(ROOT, "lfd_segmentation", "scripts",
-                                                              "evaluate_segmentation.py"),
-                            "--datasets", data, "--names", ",".join(args.datasets), "--out", result], env)
+            rc, tail = run_tool(["/usr/bin/python3",
+                                 os.path.join(ROOT, "lfd_segmentation", "scripts",
+                                              "evaluate_segmentation.py"),
+                                 "--datasets", data, "--names", ",".join(args.datasets),
+                                 "--out", result], env)
     if not os.path.exists(result):
         raise failed("segmentation evaluation produced no result", rc, tail)
     report["segmentation"] = load_json(result)["segmentation"]  # the records, as written
@@ -164,8 +170,8 @@ def stage_learn(out, args, report):
     os.makedirs(skills, exist_ok=True)
     learning = report.setdefault("learning", {})
     todo = {}
-    for mode, tasks in by_mode(args.datasets).items():
-        for task in tasks:
+    for mode, mode_tasks in by_mode(args.datasets).items():
+        for task in mode_tasks:
             library = os.path.join(skills, "%s_%s.json" % (task, mode))
             record = os.path.join(skills, "%s_%s.learning.json" % (task, mode))
             done = load_json(record)
@@ -180,22 +186,25 @@ def stage_learn(out, args, report):
     if not todo:
         return "skipped"
     with private_master() as env:
-        with background_launch(["roslaunch", "lfd_launch", "learn.launch", "output:=log", roots_arg(out)], env):
-            for mode, tasks in todo.items():
+        with background_launch(["roslaunch", "lfd_launch", "learn.launch", "output:=log",
+                                roots_arg(out)], env):
+            for mode, mode_tasks in todo.items():
                 result = os.path.join(skills, "learning_%s.json" % mode)
                 with contextlib.suppress(FileNotFoundError):
                     os.remove(result)
-                rc, tail = run_tool(["/usr/bin/python3", LEARN_SKILLS, "--attach", "--dataset", data, "--mode", mode,
-                                "--tasks", ",".join(tasks), "--library-dir", skills, "--out", result], env)
+                rc, tail = run_tool(["/usr/bin/python3", LEARN_SKILLS, "--attach", "--dataset",
+                                     data, "--mode", mode, "--tasks", ",".join(mode_tasks),
+                                     "--library-dir", skills, "--out", result], env)
                 res = load_json(result)
                 if res is None:
                     raise failed("learning %s produced no result" % mode, rc, tail)
-                for task in tasks:
+                for task in mode_tasks:
                     key = "%s_%s" % (mode, task)
                     entry = res["learning"].get(key, {"error": "not reached (interrupted?)"})
                     learning[key] = entry
                     if entry.get("error") is None and os.path.exists(entry.get("library") or ""):
-                        with open(os.path.join(skills, "%s_%s.learning.json" % (task, mode)), "w") as f:
+                        record = os.path.join(skills, "%s_%s.learning.json" % (task, mode))
+                        with open(record, "w") as f:
                             json.dump(entry, f, indent=1, sort_keys=True)
     return None
 
@@ -214,37 +223,39 @@ def stage_reproduce(out, args, report):
     results = os.path.join(out, "reproduction")
     os.makedirs(results, exist_ok=True)
     todo = {}
-    for mode, tasks in by_mode(args.datasets).items():
+    for mode, mode_tasks in by_mode(args.datasets).items():
         if mode not in args.reproduce_modes:
             continue
         section = report.setdefault(records.reproduction_key(mode), {})
-        for task in tasks:
+        for task in mode_tasks:
             library = os.path.join(skills, "%s_%s.json" % (task, mode))
             path = os.path.join(results, "%s_%s.json" % (task, mode))
             ids = goal_ids(task, mode, args.goals)
             if not os.path.exists(library):
                 err = (report.get("learning", {}).get("%s_%s" % (mode, task), {}).get("error")
                        or "no skill library %s: run the learn stage" % library)
-                section[task] = records.reproduction_record(library, (None, 0, 0), [], "not reproduced: " + err)
+                section[task] = records.reproduction_record(library, (None, 0, 0), [],
+                                                            "not reproduced: " + err)
                 say("reproduce %s_%s: %s" % (mode, task, section[task]["error"]))
                 continue
             done = task_record(path, mode, task)
             if (not args.force and done and load_json(path).get("complete")
                     and [g["id"] for g in done["goals"]] == ids
                     and os.path.getmtime(path) > os.path.getmtime(library)):
-                say("reproduce %s_%s: results newer than the library kept (--force reruns)" % (mode, task))
+                say("reproduce %s_%s: results newer than the library kept (--force reruns)"
+                    % (mode, task))
                 section[task] = done
                 continue
             todo.setdefault(mode, []).append((task, ids))
     if not todo:
         return "skipped"
-    items = [(mode, task, ids) for mode, tasks in todo.items() for task, ids in tasks]
+    items = [(mode, task, ids) for mode, mode_tasks in todo.items() for task, ids in mode_tasks]
     groups = split(items, workers(args.jobs))
 
     def reproduce(group):  # one simulation and executor for the worker's libraries
         with private_master() as env:
-            with background_launch(["roslaunch", "lfd_launch", "reproduce.launch", "library_dir:=" + skills,
-                                     roots_arg(out)], env):
+            with background_launch(["roslaunch", "lfd_launch", "reproduce.launch",
+                                    "library_dir:=" + skills, roots_arg(out)], env):
                 for mode, task, ids in group:
                     reproduce_one(results, skills, mode, task, ids, report, env,
                                   "%s_%s" % (mode, task) if len(groups) > 1 else None)
@@ -260,9 +271,10 @@ def reproduce_one(results, skills, mode, task, ids, report, env, label):
     say("reproduce %s_%s: %d unseen goals %s" % (mode, task, len(ids), ids))
     section = report[records.reproduction_key(mode)]
     try:
-        rc, tail = run_tool(["/usr/bin/python3", REPRODUCE_GOALS, "--attach", "--library-dir", skills, "--mode", mode,
-                        "--tasks", task, "--goals", ",".join(map(str, ids)), "--record-dir", results,
-                        "--out", path], env, label)
+        rc, tail = run_tool(["/usr/bin/python3", REPRODUCE_GOALS, "--attach", "--library-dir",
+                             skills, "--mode", mode, "--tasks", task, "--goals",
+                             ",".join(map(str, ids)), "--record-dir", results, "--out",
+                             path], env, label)
     except KeyboardInterrupt:  # report the goals done; a rerun redoes the task
         entry = task_record(path, mode, task)
         if entry:
@@ -327,7 +339,8 @@ def stage_figures(out, args, report):
             for goal in entry.get("goals", []):
                 if goal.get("bag") and goal.get("segment_end_times_s"):
                     name = "reproduction_%s_%s" % (task, mode)
-                    made[name] = snapshots(report, name, goal["bag"], figs, goal["segment_end_times_s"])
+                    made[name] = snapshots(report, name, goal["bag"], figs,
+                                           goal["segment_end_times_s"])
     write_report(out, report)  # the bars read this run's rates from report.json
     if report.get("segmentation"):
         made["success_rates"] = run_quiet(["/usr/bin/python3", plot, "--report",
@@ -351,7 +364,8 @@ def problems(report):
             out.append("learn %s: %s" % (name, e["error"]))
         elif e.get("expected_segments") and e.get("segments") != e["expected_segments"]:
             out.append("learn %s: %s segment(s) learned, the task has %d (changepoints per demo %s)"
-                       % (name, e.get("segments"), e["expected_segments"], e.get("changepoint_counts")))
+                       % (name, e.get("segments"), e["expected_segments"],
+                          e.get("changepoint_counts")))
     for key in ("reproduction", "reproduction_teleop"):
         for task, e in sorted(report.get(key, {}).items()):
             if e.get("error"):
@@ -373,26 +387,33 @@ def write_report(out, report):
     if "segmentation" in report:
         methods = sorted({m for e in report["segmentation"].values() for m in e["methods"]})
         lines += ["## Segmentation success rate", "",
-                  "| dataset | " + " | ".join(methods) + " | selected features (%s) |" % records.PAPER_METHOD,
+                  ("| dataset | " + " | ".join(methods)
+                   + " | selected features (%s) |" % records.PAPER_METHOD),
                   "| --- " * (len(methods) + 2) + "|"]
         for name, e in sorted(report["segmentation"].items()):
-            cells = ["%.0f%%" % (100 * e["methods"][m]) if e["methods"].get(m) is not None else "error"
+            cells = ["%.0f%%" % (100 * e["methods"][m]) if e["methods"].get(m) is not None
+                     else "error"
                      for m in methods]
-            lines.append("| %s | %s | %s |" % (name, " | ".join(cells), ", ".join(e["selected_features"])))
+            lines.append("| %s | %s | %s |"
+                         % (name, " | ".join(cells), ", ".join(e["selected_features"])))
         tol = next(iter(report["segmentation"].values()))["tolerance_s"]
-        lines += ["", "A changepoint counts when it lies within %.2f s of its ground-truth transition." % tol, ""]
+        lines += ["", "A changepoint counts when it lies within %.2f s of its ground-truth "
+                      "transition." % tol, ""]
     if report.get("learning"):
         lines += ["## Learning (skill libraries from the validated changepoints)", "",
-                  "| dataset | segments (task's) | demos used | changepoints per demo | warnings / error |",
+                  "| dataset | segments (task's) | demos used | changepoints per demo "
+                  "| warnings / error |",
                   "| --- | --- | --- | --- | --- |"]
         for name, e in sorted(report["learning"].items()):
-            notes = e.get("error") or ("%d warning(s)" % len(e["warnings"]) if e.get("warnings") else "")
+            notes = e.get("error") or ("%d warning(s)" % len(e["warnings"])
+                                       if e.get("warnings") else "")
             lines.append("| %s | %s (%s) | %s | %s | %s |" % (
                 name, e.get("segments"), e.get("expected_segments"), e.get("demos_used"),
                 " ".join(str(c) for c in e.get("changepoint_counts", [])), notes))
-        lines += ["", "Segment goals learned from the demos' scenes: the frame in which each segment's end "
-                  "varies least, and that spread (RMS across the demos).", "",
-                  "| dataset | segment | position frame (spread) | orientation frame (spread) | generalized along |",
+        lines += ["", "Segment goals learned from the demos' scenes: the frame in which each "
+                  "segment's end varies least, and that spread (RMS across the demos).", "",
+                  "| dataset | segment | position frame (spread) | orientation frame (spread) "
+                  "| generalized along |",
                   "| --- | --- | --- | --- | --- |"]
         for name, e in sorted(report["learning"].items()):
             for g in e.get("segment_goals", []):
@@ -400,20 +421,24 @@ def write_report(out, report):
                     continue
                 lines.append("| %s | %s | %s (%.1f mm) | %s (%.3f rad) | %s |" % (
                     name, g["segment"], g["position_frame"], 1e3 * g["position_spread_m"],
-                    g["orientation_frame"], g["orientation_spread_rad"], g.get("motion_frame") or "-"))
+                    g["orientation_frame"], g["orientation_spread_rad"],
+                    g.get("motion_frame") or "-"))
         lines.append("")
     for key, title in (("reproduction", "sim"), ("reproduction_teleop", "teleop")):
         if not report.get(key):
             continue
         lines += ["## Reproduction toward unseen goals (%s)" % title, "",
-                  "| task | success | time ratio | mean object error | mean TCP error | monitor alarms | note |",
+                  "| task | success | time ratio | mean object error | mean TCP error "
+                  "| monitor alarms | note |",
                   "| --- | --- | --- | --- | --- | --- | --- |"]
-        mm = lambda v: "-" if v is None else "%.1f mm" % (v * 1e3)  # noqa: E731
+        mm = lambda v: "-" if v is None else "%.1f mm" % (v * 1e3)
         for task, e in sorted(report[key].items()):
             goals = e.get("goals", [])
             lines.append("| %s | %s | %s | %s | %s | %s | %s |" % (
-                task, "%d/%d" % (sum(g["success"] for g in goals), len(goals)) if goals else "-",
-                "-" if e.get("execution_time_ratio") is None else "%.2f" % e["execution_time_ratio"],
+                task, ("%d/%d" % (sum(g["success"] for g in goals), len(goals))
+                       if goals else "-"),
+                ("-" if e.get("execution_time_ratio") is None
+                 else "%.2f" % e["execution_time_ratio"]),
                 mm(e.get("mean_object_position_error_m")), mm(e.get("mean_tcp_position_error_m")),
                 records.monitor_summary(goals), (e.get("error") or "").replace("|", "/")))
         lines += ["", "Success (the task files): " + "; ".join(
@@ -423,14 +448,15 @@ def write_report(out, report):
             if not e.get("goals"):
                 continue
             lines += ["%s, per goal%s:" % (task, records.ridges_note(e["goals"])), "",
-                      "| goal | result | object error | yaw error | TCP error | time ratio | planning | wall "
-                      "| anomaly score |",
+                      "| goal | result | object error | yaw error | TCP error | time ratio "
+                      "| planning | wall | anomaly score |",
                       "| --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
-            sec = lambda v: "-" if v is None else "%.2f s" % v  # noqa: E731
+            sec = lambda v: "-" if v is None else "%.2f s" % v
             for g in e["goals"]:
                 lines.append("| %d | %s | %s | %s | %s | %s | %s | %s | %s |" % (
                     g["id"], "ok" if g["success"] else "FAILED", mm(g["object_position_error_m"]),
-                    "-" if g["object_yaw_error_rad"] is None else "%.3f rad" % g["object_yaw_error_rad"],
+                    ("-" if g["object_yaw_error_rad"] is None
+                     else "%.3f rad" % g["object_yaw_error_rad"]),
                     mm(g["tcp_position_error_m"]),
                     "-" if g["time_ratio"] is None else "%.3f" % g["time_ratio"],
                     sec(g.get("planning_time_s")), sec(g.get("wall_time_s")),
@@ -439,30 +465,37 @@ def write_report(out, report):
     if report.get("figures"):
         lines += ["## Figures", ""]
         for name, paths in sorted(report["figures"].items()):
-            lines += ["### %s" % name, ""] + ["![%s](%s)" % (os.path.basename(p), p) for p in paths] + [""]
+            lines += ["### %s" % name, ""] + ["![%s](%s)" % (os.path.basename(p), p)
+                                              for p in paths] + [""]
     report["problems"] = problems(report) + report.get("figure_problems", [])
     if report["problems"]:
         lines += ["## Problems", ""] + ["- " + p for p in report["problems"]] + [""]
     with open(os.path.join(out, "report.json"), "w") as f:
         json.dump(report, f, indent=1, sort_keys=True)
-    lines += ["## Timings", ""] + ["- %s: %.1f s" % (k, v) for k, v in sorted(report["timings"].items())]
+    lines += ["## Timings", ""] + ["- %s: %.1f s" % (k, v)
+                                   for k, v in sorted(report["timings"].items())]
     with open(os.path.join(out, "report.md"), "w") as f:
         f.write("\n".join(lines) + "\n")
     return "\n".join(lines)
 
 
 def main():
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--out", default=os.path.join(ROOT, "lfd_output"), help="report and data folder")
+    ap = argparse.ArgumentParser(description=__doc__,
+                                 formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--out", default=os.path.join(ROOT, "lfd_output"),
+                    help="report and data folder")
     ap.add_argument("--stages", default=",".join(STAGES), help="comma list of " + ",".join(STAGES))
     datasets = tasks.datasets()
-    ap.add_argument("--datasets", default=",".join(datasets), type=lambda s: [x for x in s.split(",") if x],
+    ap.add_argument("--datasets", default=",".join(datasets),
+                    type=lambda s: [x for x in s.split(",") if x],
                     help="comma list of " + ",".join(datasets))
     ap.add_argument("--demos", type=int, default=0,
-                    help="datasets stage: record N configurations per dataset (0 = all of the task file)")
+                    help="datasets stage: record N configurations per dataset "
+                         "(0 = all of the task file)")
     ap.add_argument("--goals", type=int, default=0,
                     help="reproduce stage: N unseen goals per task (0 = all of the task file)")
-    ap.add_argument("--reproduce-modes", default="sim", type=lambda s: [x for x in s.split(",") if x],
+    ap.add_argument("--reproduce-modes", default="sim",
+                    type=lambda s: [x for x in s.split(",") if x],
                     help="reproduce stage: libraries of these modes (sim, teleop); the paper "
                          "reproduces the simulated tasks; teleop adds ~3.5 min")
     ap.add_argument("--force", action="store_true",
@@ -532,7 +565,8 @@ def main():
                 report["stage_errors"][stage] = "interrupted; rerun to resume"
                 raise
             except Exception as exc:  # noqa: BLE001 (any failure is the stage's, and is reported)
-                error = str(exc) if isinstance(exc, RuntimeError) else "%s: %s" % (type(exc).__name__, exc)
+                error = (str(exc) if isinstance(exc, RuntimeError)
+                         else "%s: %s" % (type(exc).__name__, exc))
                 say("error in stage %s: %s" % (stage, error))
                 report["stage_errors"][stage] = error
                 status = 1
@@ -553,7 +587,8 @@ def main():
         status = 130
     finally:
         kill_tagged("%d:" % os.getpid())
-    report["timings"]["total_s"] = round(sum(v for k, v in report["timings"].items() if k != "total_s"), 2)
+    report["timings"]["total_s"] = round(sum(v for k, v in report["timings"].items()
+                                             if k != "total_s"), 2)
     print(write_report(out, report))
     for p in report["problems"]:
         say("problem: " + p)

@@ -1,7 +1,7 @@
 #include "lfd_dmp/demo_bag.hpp"
 #include "lfd_dmp/demo_scene.hpp"
 
-#include <lfd_core/ros_bag_message.hpp>
+#include <lfd_ros/ros_bag_message.hpp>
 #include <lfd_core/safe_paths.hpp>
 #include <lfd_core/stamp_order.hpp>
 #include <lfd_core/user_text.hpp>

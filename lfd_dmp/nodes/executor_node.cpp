@@ -19,7 +19,7 @@
 #include <lfd_msgs/ExecuteTaskAction.h>
 #include <lfd_core/heap_trim.hpp>
 #include <lfd_core/robot_setup.hpp>
-#include <lfd_core/ros_request_strings.hpp>
+#include <lfd_ros/ros_request_strings.hpp>
 #include <lfd_core/safe_paths.hpp>
 #include <lfd_ros/master_watch.hpp>
 

@@ -20,7 +20,7 @@
 
 #include <lfd_core/heap_trim.hpp>
 #include <lfd_core/input_budget.hpp>
-#include <lfd_core/ros_request_strings.hpp>
+#include <lfd_ros/ros_request_strings.hpp>
 #include <lfd_core/safe_paths.hpp>
 #include <lfd_core/time_alignment.hpp>
 #include <lfd_ros/master_watch.hpp>

@@ -6,9 +6,10 @@
                   [--library-name '{task}_{mode}.json'] [--attach] [--out FILE.json]
 
 Bags: DIR/<mode>_<task>/*.bag (lfd_sim_bridge/scripts/generate_datasets.py). Changepoints:
-`segmentation` (default) calls /segmentation/segment (the paper's method of config/segmentation.yaml);
-`ground_truth` uses the demonstrator's /lfd/phase boundaries (the start of each expected
-transition's `to` phase in config/evaluation.yaml) and is labelled as such in the output.
+`segmentation` (default) calls /segmentation/segment (the paper's method of
+config/segmentation.yaml); `ground_truth` uses the demonstrator's /lfd/phase boundaries (the start
+of each expected transition's `to` phase, lfd_tools.tasks.expected_transitions of the task file)
+and is labelled as such in the output.
 /learner/learn learns the library from them, with the task's segment names
 (lfd_tools.tasks.segment_names); the learner's majority vote on the changepoint counts decides the
 number of segments and whether the names fit (otherwise they are left unnamed, with its warning).
@@ -34,7 +35,8 @@ def changepoints_from(services, source, bags, expected, record):
     """[DemoSegmentation] of the bags, from the segmentation service or the ground truth."""
     from lfd_msgs.msg import DemoSegmentation
     if source == "ground_truth":
-        return [DemoSegmentation(source=b, changepoint_times=lfd_bags.ground_truth_changepoints(b, expected))
+        return [DemoSegmentation(source=b,
+                                 changepoint_times=lfd_bags.ground_truth_changepoints(b, expected))
                 for b in bags], []
     seg = services["/segmentation/segment"](bag_paths=bags)
     if not seg.success:
@@ -44,7 +46,8 @@ def changepoints_from(services, source, bags, expected, record):
 
 
 def segment_goals(library):
-    """Per segment of a learned library: the goal frames chosen and their spread across the demos."""
+    """Per segment of a learned library: the goal frames chosen and their spread across the
+    demos."""
     with open(library) as f:
         lib = json.load(f)
     out = []
@@ -54,7 +57,8 @@ def segment_goals(library):
             out.append({"segment": seg["name"], "position_frame": None})
             continue
         out.append({"segment": seg["name"],
-                    "position_frame": g["position"]["frame"], "position_spread_m": g["position"]["spread_m"],
+                    "position_frame": g["position"]["frame"],
+                    "position_spread_m": g["position"]["spread_m"],
                     "orientation_frame": g["orientation"]["frame"],
                     "orientation_spread_rad": g["orientation"]["spread_rad"],
                     "motion_frame": g["heading"]["frame"] or None,
@@ -67,7 +71,8 @@ def learn(services, task, bags, source, library):
     from lfd_msgs.srv import LearnSkillsRequest
     names = tasks.segment_names(task)
     record = report.learning_record(task, len(names), bags, source)
-    demos, features = changepoints_from(services, source, bags, tasks.expected_transitions(task), record)
+    demos, features = changepoints_from(services, source, bags,
+                                        tasks.expected_transitions(task), record)
     record["selected_features"] = features
     record["changepoint_counts"] = [len(d.changepoint_times) for d in demos]
     record["changepoint_times"] = [list(d.changepoint_times) for d in demos]
@@ -87,15 +92,19 @@ def main():
     ap.add_argument("--dataset", required=True, help="folder of the <mode>_<task> bag folders")
     ap.add_argument("--mode", default="sim", help="sim | teleop")
     ap.add_argument("--tasks", default=None, help="comma-separated (default: every task)")
-    ap.add_argument("--changepoints", choices=["segmentation", "ground_truth"], default="segmentation")
+    ap.add_argument("--changepoints", choices=["segmentation", "ground_truth"],
+                    default="segmentation")
     ap.add_argument("--library-dir", default=None, help="default: <dataset>/skills_<changepoints>")
-    ap.add_argument("--library-name", default="{task}_{mode}.json", help="{task} and {mode} are replaced")
+    ap.add_argument("--library-name", default="{task}_{mode}.json",
+                    help="{task} and {mode} are replaced")
     ap.add_argument("--out", default=None, help="default: <library-dir>/learning_<mode>.json")
     ap.add_argument("--attach", action="store_true",
-                    help="use the nodes running at ROS_MASTER_URI (default: start a private master and the launch)")
+                    help="use the nodes running at ROS_MASTER_URI (default: start a private master "
+                         "and the launch)")
     args = ap.parse_args()
     dataset = os.path.abspath(args.dataset)
-    lib_dir = os.path.abspath(args.library_dir or os.path.join(dataset, "skills_" + args.changepoints))
+    lib_dir = os.path.abspath(args.library_dir
+                              or os.path.join(dataset, "skills_" + args.changepoints))
     os.makedirs(lib_dir, exist_ok=True)
     out = args.out or os.path.join(lib_dir, "learning_%s.json" % args.mode)
     names = [t for t in args.tasks.split(",") if t] if args.tasks else tasks.names()
@@ -105,7 +114,8 @@ def main():
         services["/segmentation/segment"] = Segment
     results, status = {"learning": {}, "changepoint_source": args.changepoints}, 0
     with report.written_on_exit(out, results):
-        with master.graph_for_this_process(["lfd_launch", "learn.launch", "output:=log"], args.attach):
+        with master.graph_for_this_process(["lfd_launch", "learn.launch", "output:=log"],
+                                           args.attach):
             proxies = master.service_proxies("learn_skills", services)
             for task in names:
                 key = "%s_%s" % (args.mode, task)
@@ -115,16 +125,16 @@ def main():
                     record = learn(proxies, task, bags, args.changepoints, library)
                 except RuntimeError as exc:
                     print("%-5s: ERROR %s" % (task, exc), flush=True)
-                    results["learning"][key] = dict(report.learning_record(task, None, [], args.changepoints),
-                                                    error=str(exc))
+                    results["learning"][key] = dict(
+                        report.learning_record(task, None, [], args.changepoints), error=str(exc))
                     status = 1
                     continue
                 results["learning"][key] = record
                 for w in record["warnings"]:
                     print("%-5s learn: warning: %s" % (task, w), flush=True)
                 print("%-5s learn: %d segment(s) x %d demo(s), changepoints per demo %s -> %s"
-                      % (task, record["segments"], record["demos_used"], record["changepoint_counts"],
-                         library), flush=True)
+                      % (task, record["segments"], record["demos_used"],
+                         record["changepoint_counts"], library), flush=True)
                 for g in record["segment_goals"]:
                     if g["position_frame"] is not None:
                         print("%-5s   %-10s ends in %s (spread %.1f mm) / %s (%.3f rad)%s" % (

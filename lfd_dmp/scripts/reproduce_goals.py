@@ -34,6 +34,7 @@ import sys
 
 from lfd_tools import bags, lockstep, master, report, reproduction, tasks
 
+
 def library_summary(path):
     """(mean demonstrated duration s, demos, segments) of a skill library."""
     with open(path) as f:
@@ -57,21 +58,23 @@ class BagRecording(object):
 
     def __init__(self, path, objects):
         self.path = path
-        # A name of its own: a node taking a running node's name makes the master shut that one down.
+        # A name of its own: a node taking a running node's name makes the master shut the
+        # running one down.
         node = "lfd_goal_recorder_%d_%d" % (os.getpid(), next(BagRecording.count))
         topics = ["/joint_states", "/objects/joint_states", "/ee_pose", "/gripper/state",
                   bags.touch_topic(), "/executor/planned_path", "/executor/executed_path",
                   "/executor/segment_markers"]
         topics += ["/objects/%s/pose" % o for o in objects]
-        self.proc = subprocess.Popen(["rosbag", "record", "-q", "-O", path] + topics + ["__name:=" + node],
+        self.proc = subprocess.Popen(["rosbag", "record", "-q", "-O", path] + topics
+                                     + ["__name:=" + node],
                                      stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
                                      start_new_session=True)
         # Nothing moves before rosbag receives every published topic: a fixed 1.5 s wait missed
         # the first 5 s of a goal's motion on a loaded machine (lockstep does not wait for it).
         missing = master.wait_for_inbound("/" + node, topics, RECORDER_TIMEOUT_S, self.proc)
         if missing:
-            print("warning: %s not connected to %s after %.0f s: the bag may miss the motion's start"
-                  % (node, ", ".join(missing), RECORDER_TIMEOUT_S), file=sys.stderr)
+            print("warning: %s not connected to %s after %.0f s: the bag may miss the motion's "
+                  "start" % (node, ", ".join(missing), RECORDER_TIMEOUT_S), file=sys.stderr)
 
     def stop(self):
         master.stop_group(self.proc, 20)
@@ -85,7 +88,8 @@ def reproduce(cell, task, scene, library, demo_duration, args, record_path=None)
 
     def start_recording():  # once the scene is placed: the bag shows the motion, not the reset
         if record_path:
-            recording.append(BagRecording(record_path, list(scene["objects"]) + list(tasks.parked(task))))
+            recording.append(BagRecording(record_path,
+                                          list(scene["objects"]) + list(tasks.parked(task))))
 
     try:
         res, wall, outcome = reproduction.execute_and_judge(
@@ -121,7 +125,8 @@ def reproduce_task(cell, task, mode, library, scenes, args, record):
         record.update(report.reproduction_record(library, summary, done))
         print("%-5s goal %3d (%d/%d): %-7s obj err %s  time ratio %s  wall %s %s" % (
             task, g["id"], n, len(scenes), "OK" if g["success"] else "FAILED",
-            "-" if g["object_position_error_m"] is None else "%.1f mm" % (1e3 * g["object_position_error_m"]),
+            ("-" if g["object_position_error_m"] is None
+             else "%.1f mm" % (1e3 * g["object_position_error_m"])),
             "-" if g["time_ratio"] is None else "%.3f" % g["time_ratio"],
             "-" if g["wall_time_s"] is None else "%.1f s" % g["wall_time_s"],
             g["error"] or ("" if g["success"] else g["judged"])), flush=True)
@@ -130,7 +135,8 @@ def reproduce_task(cell, task, mode, library, scenes, args, record):
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawTextHelpFormatter)
     ap.add_argument("--library-dir", required=True)
-    ap.add_argument("--library-name", default="{task}_{mode}.json", help="{task} and {mode} are replaced")
+    ap.add_argument("--library-name", default="{task}_{mode}.json",
+                    help="{task} and {mode} are replaced")
     ap.add_argument("--mode", default="sim", help="unseen goal set (sim | teleop)")
     ap.add_argument("--tasks", default=None, help="comma-separated (default: every task)")
     ap.add_argument("--goals", default="", help="comma-separated unseen ids (default all)")
@@ -140,10 +146,12 @@ def main():
     ap.add_argument("--record-dir", default=None,
                     help="record the first goal of each task into a bag there (snapshots, rviz)")
     ap.add_argument("--real-time", action="store_true",
-                    help="do not step the simulation: it runs on its own (launch it with real_time_factor:=1)")
+                    help="do not step the simulation: it runs on its own (launch it with "
+                         "real_time_factor:=1)")
     ap.add_argument("--out", default=None, help="default: <library-dir>/reproduction_<mode>.json")
     ap.add_argument("--attach", action="store_true",
-                    help="use the nodes running at ROS_MASTER_URI (default: start a private master and the launch)")
+                    help="use the nodes running at ROS_MASTER_URI (default: start a private master "
+                         "and the launch)")
     args = ap.parse_args()
     lib_dir = os.path.abspath(args.library_dir)
     out = args.out or os.path.join(lib_dir, "reproduction_%s.json" % args.mode)
@@ -152,9 +160,11 @@ def main():
     scenes = {}
     for t in names:
         try:
-            scenes[t] = [s for s in tasks.unseen_scenes(t, args.mode) if not wanted or s["id"] in wanted]
+            scenes[t] = [s for s in tasks.unseen_scenes(t, args.mode)
+                         if not wanted or s["id"] in wanted]
         except (KeyError, TypeError) as exc:
-            raise RuntimeError("task %s has no unseen %s scenes (%s: %s)" % (t, args.mode, type(exc).__name__, exc))
+            raise RuntimeError("task %s has no unseen %s scenes (%s: %s)"
+                               % (t, args.mode, type(exc).__name__, exc))
     key = report.reproduction_key(args.mode)
     results, status = {key: {}}, 0
     launch = ["lfd_launch", "reproduce.launch", "library_dir:=" + lib_dir]
@@ -167,8 +177,8 @@ def main():
                 record = results[key][task] = {}
                 library = os.path.join(lib_dir, args.library_name.format(task=task, mode=args.mode))
                 if not os.path.exists(library):
-                    record.update(report.reproduction_record(library, (None, 0, 0), [],
-                                                             "no skill library %s: learn it first" % library))
+                    record.update(report.reproduction_record(
+                        library, (None, 0, 0), [], "no skill library %s: learn it first" % library))
                     status = 1
                     continue
                 reproduce_task(cell, task, args.mode, library, scenes[task], args, record)

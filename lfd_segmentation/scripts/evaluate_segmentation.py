@@ -6,11 +6,13 @@ segmentation service (lfd_msgs/Segment) on all the dataset's bags at once, then 
 validated changepoints with the ground-truth phase transitions recorded on /lfd/phase (which the
 segmenter never reads). The protocol and its tolerance come from config/evaluation.yaml.
 
-  evaluate_segmentation.py --datasets DIR [--names sim_grasp,sim_push] [--methods ...] --out result.json
+  evaluate_segmentation.py --datasets DIR [--names sim_grasp,sim_push] [--methods ...]
+                           --out result.json
                            [--cli PATH/TO/segment [--seg-config YAML] [--topics YAML] [--no-sensors]
                             [--procedure paper]]
   evaluate_segmentation.py --truth truth.yaml ...        (demos whose truth is not on /lfd/phase)
-  evaluate_segmentation.py --labels pr2_ikea/labels.json [--runs pos_1,neg_1] [--write-truth t.yaml] ...
+  evaluate_segmentation.py --labels pr2_ikea/labels.json [--runs pos_1,neg_1]
+                           [--write-truth t.yaml] ...
 
 Ground-truth file (--truth; YAML or JSON), for recordings without /lfd/phase:
   demos:
@@ -79,13 +81,15 @@ class CliSegmenter(object):
         return tmp.name
 
     def _run(self, bags, methods):
-        cmd = [self.cli, "--config", self._config(), "--no-profiles", "--combination", ",".join(methods)]
+        cmd = [self.cli, "--config", self._config(), "--no-profiles", "--combination",
+               ",".join(methods)]
         if self.topics and not self.no_sensors:
             cmd += ["--topics", self.topics]
         if self.procedure:
             cmd += ["--procedure", self.procedure]
         cmd += bags
-        proc = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, universal_newlines=True)
+        proc = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                              universal_newlines=True)
         if not proc.stdout.strip():
             raise RuntimeError("segment CLI printed nothing: %s" % proc.stderr.strip()[-300:])
         out = json.loads(proc.stdout)
@@ -105,7 +109,8 @@ class CliSegmenter(object):
     def _answer(out):
         demos = []
         for d in out["demos"]:
-            demos.append({"changepoint_times": d["changepoint_times"], "rejected_times": d.get("rejected_times", []),
+            demos.append({"changepoint_times": d["changepoint_times"],
+                          "rejected_times": d.get("rejected_times", []),
                           "pruned_times": d.get("pruned_times", []),
                           "zones": [(z["begin_time"], z["end_time"]) for z in d.get("zones", [])]})
         return {"demos": demos, "selected_features": out["selected_features"],
@@ -119,11 +124,12 @@ def call_service(segment, bags, method):
     res = segment(SegmentRequest(bag_paths=bags, combination=method))
     if not res.success:
         raise RuntimeError("segmentation failed: %s" % res.error)
-    return {"demos": [{"changepoint_times": list(d.changepoint_times), "rejected_times": list(d.rejected_times),
+    return {"demos": [{"changepoint_times": list(d.changepoint_times),
+                       "rejected_times": list(d.rejected_times),
                        "pruned_times": list(d.pruned_times),
                        "zones": [(z.begin_time, z.end_time) for z in d.zones]} for d in res.demos],
-            "selected_features": list(res.selected_features), "selected_weights": list(res.selected_weights),
-            "warnings": list(res.warnings)}
+            "selected_features": list(res.selected_features),
+            "selected_weights": list(res.selected_weights), "warnings": list(res.warnings)}
 
 
 def make_segmenter(args):
@@ -131,8 +137,9 @@ def make_segmenter(args):
         return CliSegmenter(args.cli, args.seg_config, args.no_sensors, args.topics, args.procedure)
     # rospy.init_node waits for a master forever: without one, say so (or use --cli).
     if not master_online():
-        raise RuntimeError("no ROS master at %s for the segmentation service %s (start segment.launch, "
-                           "or use --cli)" % (os.environ.get("ROS_MASTER_URI"), args.service))
+        raise RuntimeError("no ROS master at %s for the segmentation service %s "
+                           "(start segment.launch, or use --cli)"
+                           % (os.environ.get("ROS_MASTER_URI"), args.service))
     rospy.init_node("evaluate_segmentation", anonymous=True, disable_signals=True)
     try:
         rospy.wait_for_service(args.service, timeout=30.0)
@@ -146,17 +153,20 @@ def datasets_to_run(args, config):
     """[(row name, evaluate(segment, method, tolerance))] from --truth/--labels or --datasets."""
     if args.truth or args.labels:
         if args.labels:
-            content = lfd_bags.truth_from_labels(args.labels, [r for r in args.runs.split(",") if r] or None)
+            runs = [r for r in args.runs.split(",") if r] or None
+            content = lfd_bags.truth_from_labels(args.labels, runs)
             if args.write_truth:
                 with open(args.write_truth, "w") as f:
                     yaml.safe_dump(content, f, sort_keys=False)
-            demos = lfd_bags.parse_truth(content, os.path.dirname(os.path.abspath(args.labels)), args.labels)
+            demos = lfd_bags.parse_truth(content, os.path.dirname(os.path.abspath(args.labels)),
+                                         args.labels)
         else:
             demos = lfd_bags.load_truth_file(args.truth)
         # a labels.json is named by its folder (pr2_ikea), a truth file by itself
         name = (os.path.basename(os.path.dirname(os.path.abspath(args.labels))) if args.labels
                 else os.path.splitext(os.path.basename(args.truth))[0])
-        return [(name, lambda seg, ms, tol: segmentation_scoring.evaluate_truth_file_methods(seg, demos, ms, tol))]
+        return [(name, lambda seg, ms, tol: segmentation_scoring.evaluate_truth_file_methods(
+            seg, demos, ms, tol))]
     if not args.datasets:
         raise RuntimeError("give --datasets, --truth or --labels")
     return [(n, lambda seg, ms, tol, n=n: segmentation_scoring.evaluate_dataset_methods(
@@ -165,31 +175,41 @@ def datasets_to_run(args, config):
 
 
 def main():
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap = argparse.ArgumentParser(description=__doc__,
+                                 formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--datasets", default="", help="folder holding one sub-folder per dataset")
-    ap.add_argument("--names", default="", help="comma list of <mode>_<task> (default: every task's, both modes)")
-    ap.add_argument("--truth", default="", help="ground-truth file (demos, their bags, changepoint times)")
-    ap.add_argument("--labels", default="", help="labels.json of phase-split runs (pr2_ikea format)")
+    ap.add_argument("--names", default="",
+                    help="comma list of <mode>_<task> (default: every task's, both modes)")
+    ap.add_argument("--truth", default="",
+                    help="ground-truth file (demos, their bags, changepoint times)")
+    ap.add_argument("--labels", default="",
+                    help="labels.json of phase-split runs (pr2_ikea format)")
     ap.add_argument("--runs", default="", help="with --labels: comma list of runs (default: all)")
-    ap.add_argument("--write-truth", default="", help="with --labels: also save the ground-truth file here")
-    ap.add_argument("--tolerance", type=float, default=None, help="seconds (default: evaluation.yaml)")
+    ap.add_argument("--write-truth", default="",
+                    help="with --labels: also save the ground-truth file here")
+    ap.add_argument("--tolerance", type=float, default=None,
+                    help="seconds (default: evaluation.yaml)")
     ap.add_argument("--methods", default="", help="comma list; default: all in evaluation.yaml")
-    ap.add_argument("--config", default="", help="evaluation protocol (default: config/evaluation.yaml)")
+    ap.add_argument("--config", default="",
+                    help="evaluation protocol (default: config/evaluation.yaml)")
     ap.add_argument("--service", default="/segmentation/segment")
     ap.add_argument("--out", default="", help="write the full result as JSON here")
     ap.add_argument("--cli", default="", help="run this `segment` CLI instead of the service")
     ap.add_argument("--seg-config", default="",
                     help="segmentation parameters for --cli (default: config/segmentation.yaml)")
-    ap.add_argument("--topics", default="", help="with --cli: topics file passed to `segment --topics`")
+    ap.add_argument("--topics", default="",
+                    help="with --cli: topics file passed to `segment --topics`")
     ap.add_argument("--no-sensors", action="store_true", help="with --cli: drop the sensor topics")
-    ap.add_argument("--procedure", default="", help="with --cli: zone_search or paper (segment --procedure)")
+    ap.add_argument("--procedure", default="",
+                    help="with --cli: zone_search or paper (segment --procedure)")
     args = ap.parse_args(rospy.myargv()[1:])
 
     try:
         args.seg_config = args.seg_config or lfd_config.config_path("segmentation.yaml")
         config = lfd_config.load_evaluation(args.config or None)
         methods = [m for m in args.methods.split(",") if m] or config["segmentation"]["methods"]
-        tol = args.tolerance if args.tolerance is not None else float(config["segmentation"]["tolerance_s"])
+        tol = (args.tolerance if args.tolerance is not None
+               else float(config["segmentation"]["tolerance_s"]))
         segment = make_segmenter(args)
         rows = datasets_to_run(args, config)
     except (RuntimeError, OSError, KeyError, ValueError, yaml.YAMLError) as exc:
@@ -198,12 +218,14 @@ def main():
 
     results, failures = {}, 0
     print("%-14s %-18s %8s %6s %6s %6s %7s %7s %8s  %s" % (
-        "dataset", "method", "correct", "rate", "cover", "f1", "err_med", "err_p95", "time_s", "features"))
+        "dataset", "method", "correct", "rate", "cover", "f1", "err_med", "err_p95",
+        "time_s", "features"))
     for name, evaluate in rows:
         results[name] = {}
         try:
             answers = evaluate(segment, methods, tol)
-        except (RuntimeError, rospy.ServiceException, rosbag.ROSBagException, OSError, ValueError) as exc:
+        except (RuntimeError, rospy.ServiceException, rosbag.ROSBagException,
+                OSError, ValueError) as exc:
             print("%-14s %-18s error: %s" % (name, ",".join(methods), exc))
             # also where a caller (the pipeline) looks for a tool's last words
             print("error: %s %s: %s" % (name, ",".join(methods), exc), file=sys.stderr)
@@ -213,14 +235,14 @@ def main():
         for method in methods:
             r = results[name][method] = answers[method]
             print("%-14s %-18s %4d/%-3d %5.0f%% %6.3f %6.3f %7.3f %7.3f %8.2f  %s" % (
-                name, method, r["correct"], r["demos"], 100 * r["success_rate"], r["covering"], r["f1"],
-                r["time_error_median_s"], r["time_error_p95_s"], r["service_time_s"],
+                name, method, r["correct"], r["demos"], 100 * r["success_rate"], r["covering"],
+                r["f1"], r["time_error_median_s"], r["time_error_p95_s"], r["service_time_s"],
                 ",".join(r["selected_features"])))
     print("tolerance: a changepoint counts when within %.2f s of its ground-truth transition" % tol)
     if args.out:
         with open(args.out, "w") as f:
-            json.dump({"tolerance_s": tol, "segmentation": {name: report.segmentation_record(r, tol)
-                                                            for name, r in results.items()}}, f, indent=1)
+            scored = {name: report.segmentation_record(r, tol) for name, r in results.items()}
+            json.dump({"tolerance_s": tol, "segmentation": scored}, f, indent=1)
     return 1 if failures else 0
 
 

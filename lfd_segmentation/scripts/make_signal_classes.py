@@ -39,7 +39,8 @@ def parse_classes(text):
     names = [c for c in text.split(",") if c] if text else list(signal_classes.CLASSES)
     unknown = [c for c in names if c not in signal_classes.CLASSES]
     if unknown:
-        raise ValueError("unknown class %s; known: %s" % (", ".join(unknown), ", ".join(signal_classes.CLASSES)))
+        raise ValueError("unknown class %s; known: %s"
+                         % (", ".join(unknown), ", ".join(signal_classes.CLASSES)))
     return names
 
 

@@ -30,14 +30,19 @@ def demo(rng, n, rate):
     start, goal = rng.uniform(-0.2, 0.2, 3), rng.uniform(-0.2, 0.2, 3)
     cols = {}
     for k, a in enumerate("xyz"):
-        cols[f"/ee_pose/pose/position/{a}"] = start[k] + (goal[k] - start[k]) * u + 1e-3 * rng.standard_normal(n)
+        cols[f"/ee_pose/pose/position/{a}"] = (start[k] + (goal[k] - start[k]) * u
+                                               + 1e-3 * rng.standard_normal(n))
         cols[f"/ee_twist/twist/linear/{a}"] = bump * (0.5 + 0.5 * k) + 3e-3 * rng.standard_normal(n)
         cols[f"/ee_twist/twist/angular/{a}"] = 0.02 * rng.standard_normal(n)
-        cols[f"/ee_pose/pose/orientation/{a}"] = 0.05 * np.sin(2 * np.pi * rng.uniform(0.05, 0.2) * t)
-    cols["/ee_pose/pose/orientation/w"] = np.sqrt(1 - sum(cols[f"/ee_pose/pose/orientation/{a}"] ** 2 for a in "xyz"))
-    cols["/gripper/state/position/gripper"] = np.where(closed, 0.02, 0.08) + 5e-4 * rng.standard_normal(n)
+        cols[f"/ee_pose/pose/orientation/{a}"] = 0.05 * np.sin(
+            2 * np.pi * rng.uniform(0.05, 0.2) * t)
+    cols["/ee_pose/pose/orientation/w"] = np.sqrt(
+        1 - sum(cols[f"/ee_pose/pose/orientation/{a}"] ** 2 for a in "xyz"))
+    cols["/gripper/state/position/gripper"] = (np.where(closed, 0.02, 0.08)
+                                               + 5e-4 * rng.standard_normal(n))
     for k, a in enumerate("xyz"):
-        cols[f"/wrist_ft/wrench/force/{a}"] = np.where(closed, -3.0 * (k == 2), 0) + 0.05 * rng.standard_normal(n)
+        cols[f"/wrist_ft/wrench/force/{a}"] = (np.where(closed, -3.0 * (k == 2), 0)
+                                               + 0.05 * rng.standard_normal(n))
         cols[f"/wrist_ft/wrench/torque/{a}"] = 0.01 * rng.standard_normal(n)
     cols["/touch/values/left"] = np.where(closed, 4.0, 0) + 0.02 * rng.standard_normal(n)
     cols["/touch/values/right"] = np.where(closed, 3.5, 0) + 0.02 * rng.standard_normal(n)

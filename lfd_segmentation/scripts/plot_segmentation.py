@@ -86,7 +86,8 @@ def load_config(path):
     for key in ("rate", "threshold"):  # the fallback clock of Fig. 5, the T of Fig. 4
         value = config.get(key, 1.0)
         if not isinstance(value, (int, float)) or not value > 0:
-            raise UserError("config '%s': %s must be a positive number, got %r" % (path, key, value))
+            raise UserError("config '%s': %s must be a positive number, got %r"
+                            % (path, key, value))
     return config
 
 
@@ -101,7 +102,8 @@ def as_matrix(rows):
 
 def require(obj, key, where):
     if not isinstance(obj, dict) or key not in obj:
-        raise UserError("%s has no key '%s' (is it the output of the `segment` CLI?)" % (where, key))
+        raise UserError("%s has no key '%s' (is it the output of the `segment` CLI?)"
+                        % (where, key))
     return obj[key]
 
 
@@ -296,7 +298,8 @@ def plot_correlations(seg, feats, out, prefix, written, feature=None):
             continue
         f = feats[k]
         im = draw_correlation(ax, f, None, annotate=False)
-        ax.set_title("%s\nr=%.2f score=%.2f" % (short(f["name"]), f["mean_correlation"], f["score"]),
+        ax.set_title("%s\nr=%.2f score=%.2f"
+                     % (short(f["name"]), f["mean_correlation"], f["score"]),
                      fontsize=7, fontweight="bold" if f.get("selected") else "normal")
         if f.get("selected"):
             for spine in ax.spines.values():
@@ -341,7 +344,8 @@ def plot_relevance(seg, feats, threshold, out, prefix, written):
 
 
 def at(seconds, index):
-    """Time of a sample index of the JSON on a demo's clock (a zone ends one past its last sample)."""
+    """Time of a sample index of the JSON on a demo's clock (a zone ends one past its last
+    sample)."""
     return seconds[min(int(index), len(seconds) - 1)]
 
 
@@ -368,7 +372,8 @@ def mark_changepoints(ax, demo, seconds, label=True):
 def plot_profile(seg, d, seconds, out, prefix, written, tag=""):
     demo = seg["demos"][d]
     if "profile" not in demo:
-        warn("the JSON holds no ClaSP profile (segment ran with --no-profiles): clasp_profile skipped")
+        warn("the JSON holds no ClaSP profile (segment ran with --no-profiles): "
+             "clasp_profile skipped")
         return
     profile = as_array(demo["profile"])
     penalized = as_array(demo.get("profile_penalized", []))
@@ -397,7 +402,8 @@ def plot_profile(seg, d, seconds, out, prefix, written, tag=""):
             xs, ys = zip(*pts)
             ax.scatter(xs, ys, marker="v" if accepted else "x", s=60, zorder=5,
                        color="tab:green" if accepted else "tab:red",
-                       label="candidate (significant)" if accepted else "candidate (not significant)")
+                       label=("candidate (significant)" if accepted
+                              else "candidate (not significant)"))
     mark_changepoints(ax, demo, seconds)
     ax.set_ylabel("score")
     handles, labels = ax.get_legend_handles_labels()
@@ -458,8 +464,8 @@ def plot_segmentation(features, phases, seg, d, out, prefix, written, tag=""):
 
 
 def report_rates(report):
-    """{dataset: {method: rate or None}} from a pipeline report.json or evaluate_segmentation.py output
-    (the same segmentation records, lfd_tools.report)."""
+    """{dataset: {method: rate or None}} from a pipeline report.json or evaluate_segmentation.py
+    output (the same segmentation records, lfd_tools.report)."""
     if isinstance(report, dict) and isinstance(report.get("segmentation"), dict):
         rates, tol = {}, None
         for name, entry in report["segmentation"].items():
@@ -522,7 +528,8 @@ def parse_demos(spec, count):
         raise UserError("--demo takes an index, a comma list of indices or 'all', got '%s'" % spec)
     for d in picked:
         if not 0 <= d < count:
-            raise UserError("--demo %d out of range: the JSON holds %d demonstration(s)" % (d, count))
+            raise UserError("--demo %d out of range: the JSON holds %d demonstration(s)"
+                            % (d, count))
     if not picked:
         raise UserError("--demo is empty")
     return picked
@@ -547,11 +554,13 @@ def demo_figures(args, seg, config, d, tag, written):
 def find_segment_cli():
     try:
         from catkin.find_in_workspaces import find_in_workspaces
-        found = find_in_workspaces(search_dirs=["libexec"], project="lfd_segmentation", path="segment")
+        found = find_in_workspaces(search_dirs=["libexec"], project="lfd_segmentation",
+                                   path="segment")
     except ImportError:
         found = []
     if not found:
-        raise UserError("the `segment` CLI is not in the sourced catkin workspace: pass --segment-cli")
+        raise UserError("the `segment` CLI is not in the sourced catkin workspace: "
+                        "pass --segment-cli")
     return found[0]
 
 
@@ -559,7 +568,8 @@ def segment_dataset(args):
     """--dataset DIR: run the `segment` CLI on DIR/*.bag; returns the JSON's path."""
     if not os.path.isdir(args.dataset):
         raise UserError("--dataset '%s' is not a folder" % args.dataset)
-    bags = sorted(os.path.join(args.dataset, f) for f in os.listdir(args.dataset) if f.endswith(".bag"))
+    bags = sorted(os.path.join(args.dataset, f) for f in os.listdir(args.dataset)
+                  if f.endswith(".bag"))
     if not bags:
         raise UserError("no .bag files in --dataset '%s'" % args.dataset)
     cli = args.segment_cli or find_segment_cli()
@@ -570,7 +580,8 @@ def segment_dataset(args):
     except OSError as e:
         raise UserError("cannot run %s: %s" % (cli, e))
     if run.returncode != 0:
-        raise UserError("segment failed (exit %d): %s" % (run.returncode, run.stderr.strip()[-2000:]))
+        raise UserError("segment failed (exit %d): %s"
+                        % (run.returncode, run.stderr.strip()[-2000:]))
     return out
 
 
@@ -579,19 +590,21 @@ def segment_figures(args, written):
     if not isinstance(seg, dict):
         raise UserError("'%s' is not a JSON object" % args.segment_json)
     if seg.get("success") is False:
-        raise UserError("'%s' records a failed segmentation: %s" % (args.segment_json, seg.get("error")))
+        raise UserError("'%s' records a failed segmentation: %s"
+                        % (args.segment_json, seg.get("error")))
     demos = require(seg, "demos", args.segment_json)
     if not isinstance(demos, list) or not demos:
         raise UserError("'%s' holds no demonstrations" % args.segment_json)
     picked = parse_demos(args.demo, len(demos))
     if args.bags and len(args.bags) != len(demos):
-        raise UserError("%d --bags for %d demonstrations in the JSON (give them in the JSON's order)"
-                        % (len(args.bags), len(demos)))
+        raise UserError("%d --bags for %d demonstrations in the JSON "
+                        "(give them in the JSON's order)" % (len(args.bags), len(demos)))
     for d in picked if args.bags else []:  # before any figure: no half-written set on a typo
         if not os.path.isfile(args.bags[d]):
             raise UserError("bag '%s' does not exist" % args.bags[d])
     config = load_config(args.config)
-    threshold = args.threshold if args.threshold is not None else float(config.get("threshold", 0.9))
+    threshold = (args.threshold if args.threshold is not None
+                 else float(config.get("threshold", 0.9)))
 
     feats = relevance_features(seg)
     if feats:
@@ -606,23 +619,28 @@ def segment_figures(args, written):
 
 
 def main(argv=None):
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--segment-json", help="output of `segment --features --feature-profiles --output`")
-    ap.add_argument("--dataset", help="folder of bags: run `segment` on DIR/*.bag first (the JSON is "
-                                      "kept as OUT/<prefix>segment.json), then draw")
-    ap.add_argument("--segment-cli", help="the `segment` executable (default: the catkin workspace's)")
+    ap = argparse.ArgumentParser(description=__doc__,
+                                 formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--segment-json",
+                    help="output of `segment --features --feature-profiles --output`")
+    ap.add_argument("--dataset", help="folder of bags: run `segment` on DIR/*.bag first (the JSON "
+                                      "is kept as OUT/<prefix>segment.json), then draw")
+    ap.add_argument("--segment-cli",
+                    help="the `segment` executable (default: the catkin workspace's)")
     ap.add_argument("--bags", nargs="+", help="the demos' bags for the ground-truth phases, in the "
                                               "JSON's order (default: the JSON's demos[].source)")
     ap.add_argument("--config", default=DEFAULT_CONFIG,
                     help="segmentation.yaml (given to segment with --dataset; T of Fig. 4)")
     ap.add_argument("--demo", default="0",
-                    help="demo(s) of the per-demo figures: index, comma list or 'all' (names then get "
-                         "the demo's name as suffix)")
+                    help="demo(s) of the per-demo figures: index, comma list or 'all' (names then "
+                         "get the demo's name as suffix)")
     ap.add_argument("--correlation-feature",
                     help="feature of correlation_best.png (default: the best DTW-weighted score)")
-    ap.add_argument("--threshold", type=float, help="T of the relevance figure (default: the config's)")
+    ap.add_argument("--threshold", type=float,
+                    help="T of the relevance figure (default: the config's)")
     ap.add_argument("--no-ground-truth", action="store_true", help="do not read /lfd/phase")
-    ap.add_argument("--report", help="pipeline report.json (or evaluate_segmentation.py --out JSON)")
+    ap.add_argument("--report",
+                    help="pipeline report.json (or evaluate_segmentation.py --out JSON)")
     ap.add_argument("--out", required=True, help="folder for the PNG files (created)")
     ap.add_argument("--prefix", default="", help="prefix of every PNG name, e.g. sim_grasp_")
     args = ap.parse_args(argv)

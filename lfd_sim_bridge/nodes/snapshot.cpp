@@ -30,7 +30,7 @@
 #include <cstring>
 #include <filesystem>
 #include <iostream>
-#include <lfd_core/ros_bag_message.hpp>
+#include <lfd_ros/ros_bag_message.hpp>
 #include <map>
 #include <memory>
 #include <sstream>

@@ -20,7 +20,8 @@ from lfd_tools import bags, tasks
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("paths", nargs="+", help="bags or folders of bags")
-    parser.add_argument("--tasks-dir", default=None, help="also find task files here (searched first)")
+    parser.add_argument("--tasks-dir", default=None,
+                        help="also find task files here (searched first)")
     parser.add_argument("--json", action="store_true", help="one JSON object per bag")
     args = parser.parse_args()
     if args.tasks_dir:

@@ -99,8 +99,8 @@ def missing_demos(name, out_root, args, attempt, outcomes):
     os.makedirs(out, exist_ok=True)
     missing, aside = redo.demos_to_record({i: bag_name(out, task, mode, i) for i in ids}, outcomes)
     for i, path, reason in aside:
-        print("[datasets] %s: configuration %d is no usable demonstration (%s): kept as %s, recorded again"
-              % (name, i, reason, path), flush=True)
+        print("[datasets] %s: configuration %d is no usable demonstration (%s): kept as %s, "
+              "recorded again" % (name, i, reason, path), flush=True)
     if not missing:
         if attempt == 1:
             print("[datasets] %s: complete (%d bags), skipped" % (name, len(ids)), flush=True)
@@ -159,8 +159,8 @@ def record(jobs, args, log_dir, attempt, crashes):
         print("[datasets] %s: timed out after %.0f s (%.0f s per dataset; logs in %s)"
               % ("+".join(names), timeout, args.timeout, log_dir), file=sys.stderr)
     if len(names) > 1:
-        print("[datasets] one launch for %s: %.1f s wall" % ("+".join(names), time.time() - launch_start),
-              flush=True)
+        print("[datasets] one launch for %s: %.1f s wall"
+              % ("+".join(names), time.time() - launch_start), flush=True)
 
 
 def split_output(lines, logs, first, crashes):
@@ -176,7 +176,8 @@ def split_output(lines, logs, first, crashes):
         for process, pid, signum in crashes_in(line):
             # A crash is a bug even when the retry records the missing demos: never hide it.
             print("[datasets] %s: CRASH: %s (pid %d) was killed by signal %d (see %s)"
-                  % (current, process, pid, signum, logs[current].name), file=sys.stderr, flush=True)
+                  % (current, process, pid, signum, logs[current].name),
+                  file=sys.stderr, flush=True)
             crashes.append((current, process, signum))
     print("[datasets] %s: %.1f s wall" % (current, time.time() - started), flush=True)
 
@@ -213,18 +214,22 @@ def summarize(out_root, names, args, outcomes):
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--out", required=True, help="folder receiving one subfolder per dataset")
-    parser.add_argument("--datasets", default="", help="comma-separated <mode>_<task> (default: every task, both modes)")
+    parser.add_argument("--datasets", default="",
+                        help="comma-separated <mode>_<task> (default: every task, both modes)")
     parser.add_argument("--seed", type=int, default=1)
     parser.add_argument("--tasks-dir", default=None,
-                        help="also find task files here (searched first; $%s)" % tasks.TASKS_PATH_VAR)
-    parser.add_argument("--demos", type=int, default=0, help="configurations per dataset, spread (0 = all)")
+                        help="also find task files here (searched first; $%s)"
+                             % tasks.TASKS_PATH_VAR)
+    parser.add_argument("--demos", type=int, default=0,
+                        help="configurations per dataset, spread (0 = all)")
     parser.add_argument("--timeout", type=float, default=600.0,
                         help="s per dataset (a launch of N datasets gets N times this)")
     parser.add_argument("--force", action="store_true", help="delete and regenerate")
     args = parser.parse_args()
     if args.tasks_dir:
         os.environ[tasks.TASKS_PATH_VAR] = ":".join(
-            [os.path.abspath(args.tasks_dir)] + [d for d in os.environ.get(tasks.TASKS_PATH_VAR, "").split(":") if d])
+            [os.path.abspath(args.tasks_dir)]
+            + [d for d in os.environ.get(tasks.TASKS_PATH_VAR, "").split(":") if d])
     try:
         known = tasks.datasets()
         names = [n.strip() for n in args.datasets.split(",") if n.strip()] or known

@@ -46,5 +46,6 @@ class BridgeNamespace(unittest.TestCase):
         for topic in ("/joint_states", "/gripper/state", "/ee_pose"):
             self.assertNotIn(topic, published)
 
+
 if __name__ == "__main__":
     rostest.rosrun("lfd_test", "bridge_namespace", BridgeNamespace)

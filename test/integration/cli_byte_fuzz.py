@@ -85,8 +85,9 @@ def mutations(rng, data):
         ("crlf", data.replace(b"\n", b"\r\n")),
         ("huge_numbers", data.replace(b"0.", b"1e308", 20)),
         ("nan", data.replace(b"0.1", b"nan", 5)),
-        ("deleted_lines", b"\n".join(l for l in lines if rng.random() > 0.2)),
-        ("duplicated_lines", b"\n".join(l + (b"\n" + l if rng.random() < 0.2 else b"") for l in lines)),
+        ("deleted_lines", b"\n".join(line for line in lines if rng.random() > 0.2)),
+        ("duplicated_lines",
+         b"\n".join(line + (b"\n" + line if rng.random() < 0.2 else b"") for line in lines)),
     ]
     return out
 

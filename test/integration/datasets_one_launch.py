@@ -23,8 +23,8 @@ LEAD_IN_S = 0.25  # the demonstrator holds still for lead_in (0.3 s) after the b
 
 
 def generate(out, datasets):
-    gen = subprocess.run(["/usr/bin/python3", os.path.join(SCRIPTS, "generate_datasets.py"), "--out", out,
-                          "--datasets", datasets, "--demos", "1"],
+    gen = subprocess.run(["/usr/bin/python3", os.path.join(SCRIPTS, "generate_datasets.py"),
+                          "--out", out, "--datasets", datasets, "--demos", "1"],
                          stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, timeout=300)
     print(gen.stdout)
     return gen
@@ -46,7 +46,8 @@ def at_rest(bag):
         for topic, msg, _ in b.read_messages(topics=["/touch", "/joint_states"]):
             if msg.header.stamp.to_sec() > start + LEAD_IN_S:
                 continue
-            (touch if topic == "/touch" else joints).append(list(msg.values if topic == "/touch" else msg.position))
+            (touch if topic == "/touch" else joints).append(list(msg.values if topic == "/touch"
+                                                                 else msg.position))
         duration = b.get_end_time() - b.get_start_time()
     return meta.mode, duration, np.array(touch), np.array(joints)
 
@@ -59,8 +60,10 @@ class DatasetsOneLaunch(unittest.TestCase):
             gen = generate(out, "teleop_grasp,sim_grasp")
             self.assertEqual(gen.returncode, 0, gen.stdout)
             self.assertIn("one launch for teleop_grasp+sim_grasp", gen.stdout)
-            logs = "".join(open(os.path.join(out, "logs", n + ".log")).read() for n in ("teleop_grasp", "sim_grasp"))
-            self.assertEqual(len(re.findall(r"process\[bridge-\d+\]: started", logs)), 1, logs[-3000:])
+            logs = "".join(open(os.path.join(out, "logs", n + ".log")).read()
+                           for n in ("teleop_grasp", "sim_grasp"))
+            self.assertEqual(len(re.findall(r"process\[bridge-\d+\]: started", logs)), 1,
+                             logs[-3000:])
             self.assertEqual(len(re.findall(r"process\[demonstrator-\d+\]: started", logs)), 1)
             # Each dataset's log holds its own demos.
             sim_log = open(os.path.join(out, "logs", "sim_grasp.log")).read()
@@ -84,9 +87,11 @@ class DatasetsOneLaunch(unittest.TestCase):
             _, alone_duration, _, _ = at_rest(the_bag(alone, "sim_grasp"))
             self.assertAlmostEqual(sim_duration, alone_duration, delta=0.006)  # one sensor period
             with rosbag.Bag(the_bag(alone, "sim_grasp")) as b:
-                alone_meta = json.loads(next(b.read_messages(topics=["/lfd/metadata"])).message.extra_json)
+                alone_meta = json.loads(
+                    next(b.read_messages(topics=["/lfd/metadata"])).message.extra_json)
             with rosbag.Bag(the_bag(out, "sim_grasp")) as b:
-                meta = json.loads(next(b.read_messages(topics=["/lfd/metadata"])).message.extra_json)
+                meta = json.loads(
+                    next(b.read_messages(topics=["/lfd/metadata"])).message.extra_json)
             self.assertEqual((meta["speed"], meta["planned_duration"]),
                              (alone_meta["speed"], alone_meta["planned_duration"]))
         finally:

@@ -62,7 +62,8 @@ class DatasetsSucceed(unittest.TestCase):
             self.assertEqual(sorted(scene["joints"]), sorted(tasks.joints(task)), bag)
             for got, want in [(scene["goal"], expected["goal"])] + [
                     (scene["objects"][o], expected["objects"][o]) for o in tasks.objects(task)]:
-                for a, b in zip(got["position"] + got["orientation"], want["position"] + want["orientation"]):
+                for a, b in zip(got["position"] + got["orientation"],
+                                want["position"] + want["orientation"]):
                     self.assertAlmostEqual(a, b, places=5, msg=bag)
             names = [p for p, _ in lfd_bags.phase_transitions(bag)[1]]
             self.assertEqual(names, [p["name"] for p in tasks.phases(task)], bag)

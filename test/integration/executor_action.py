@@ -114,7 +114,8 @@ class ExecutorAction(unittest.TestCase):
         self.assertIn(result.segment_frames[0].split(" / ")[0], ("object:stick", "heading:stick"))
         self.assertTrue(result.segment_frames[1].startswith("goal"), result.segment_frames)
         # Each segment's local linear fit, its ridge chosen by leave-one-out among executor.yaml's.
-        candidates = config.load_yaml(config.config_path("executor.yaml"))["generalization"]["slope_ridge_candidates"]
+        executor = config.load_yaml(config.config_path("executor.yaml"))
+        candidates = executor["generalization"]["slope_ridge_candidates"]
         self.assertEqual(len(result.segment_slope_ridges), 2)
         for ridge in result.segment_slope_ridges:
             self.assertIn(ridge, candidates)
@@ -129,7 +130,8 @@ class ExecutorAction(unittest.TestCase):
         self.assertLess(result.extrapolation_distance, 0.05)
         fb = self.cell.feedback
         states = [f.state for f in fb]
-        for s in (ExecuteTaskFeedback.PLANNING, ExecuteTaskFeedback.MOVING, ExecuteTaskFeedback.SETTLING):
+        for s in (ExecuteTaskFeedback.PLANNING, ExecuteTaskFeedback.MOVING,
+                  ExecuteTaskFeedback.SETTLING):
             self.assertIn(s, states)
         self.assertEqual(sorted({f.segment for f in fb if f.state != ExecuteTaskFeedback.PLANNING}),
                          sorted(tasks.segment_names(TASK)))
@@ -141,14 +143,16 @@ class ExecutorAction(unittest.TestCase):
         self.cell.advance(1.0)
         self.assertTrue(measured.wait_until(self.cell.now()))
         measured.close()
-        outcome = judge.judge_rules(criterion, bags.measure(measured, criterion, tasks.base_in_world()),
+        outcome = judge.judge_rules(criterion, bags.measure(measured, criterion,
+                                                            tasks.base_in_world()),
                                     self.scene, tasks.table_top())
         self.assertTrue(outcome["success"], outcome["reason"])
 
     def test_2_preempted_while_moving_then_answers(self):
         self.place()
         self.cell.send(self.goal(duration_scale=2.0))
-        self.assertTrue(self.cell.drive(until=lambda: self.latest() and self.latest().progress > 0.3))
+        self.assertTrue(
+            self.cell.drive(until=lambda: self.latest() and self.latest().progress > 0.3))
         self.assertFalse(self.cell.done())
         self.cell.cancel()
         cancelled = time.time()
@@ -180,7 +184,8 @@ class ExecutorAction(unittest.TestCase):
     def test_4_out_of_range_and_unreachable_goals(self):
         far = {"objects": {"stick": moved(self.scene["objects"]["stick"], 0.3, 0.25)},
                "goal": moved(self.scene["goal"], 0.3, 0.25)}
-        result = self.refused(self.goal(far), "outside the demonstrated range", "allow_extrapolation")
+        result = self.refused(self.goal(far), "outside the demonstrated range",
+                              "allow_extrapolation")
         self.assertTrue(result.outside_demo_range)
         self.assertGreater(result.extrapolation_distance, 0.1)  # reported with the refusal
         self.assertEqual(result.motion_start.to_sec(), 0.0)  # nothing moved
@@ -246,9 +251,11 @@ class ExecutorAction(unittest.TestCase):
         case("object names but", lambda x: x.object_poses.append(x.object_poses[0]))
         case("no transform", lambda x: setattr(x.goal.header, "frame_id", "nowhere"))
         case("frame_id", lambda x: setattr(x.goal.header, "frame_id", ""))
-        case("no object 'stick'", lambda x: (setattr(x, "object_names", []), setattr(x, "object_poses", [])))
+        case("no object 'stick'",
+             lambda x: (setattr(x, "object_names", []), setattr(x, "object_poses", [])))
         case("library is empty", lambda x: setattr(x, "library", ""))
-        case("missing.json", lambda x: setattr(x, "library", os.path.join(self.out, "missing.json")))
+        case("missing.json",
+             lambda x: setattr(x, "library", os.path.join(self.out, "missing.json")))
         case("~limits/max_name_length", lambda x: setattr(x, "library", "x" * 5000))
         # Issue 23: a library path must be absolute (the node's working directory is not the
         # caller's).
@@ -273,7 +280,8 @@ class ExecutorAction(unittest.TestCase):
         """Seeded random goals: each ends within ANSWER_S with a sane success or a clear error,
         and the whole run stays within FUZZ_SECONDS; the node answers at the end."""
         rng = random.Random(12)
-        extremes = [0.0, -0.0, 1e-300, 1e300, -1e300, float("nan"), float("inf"), -float("inf"), 1e-9, 7.0]
+        extremes = [0.0, -0.0, 1e-300, 1e300, -1e300, float("nan"), float("inf"),
+                    -float("inf"), 1e-9, 7.0]
         started = time.time()
         succeeded = 0
         for i in range(FUZZ_GOALS):
@@ -283,13 +291,15 @@ class ExecutorAction(unittest.TestCase):
                     setattr(p.pose.position, rng.choice("xyz"),
                             rng.choice(extremes + [rng.uniform(-3, 3)]))
                 if rng.random() < 0.2:
-                    setattr(p.pose.orientation, rng.choice("wxyz"), rng.choice(extremes + [rng.uniform(-2, 2)]))
+                    setattr(p.pose.orientation, rng.choice("wxyz"),
+                            rng.choice(extremes + [rng.uniform(-2, 2)]))
                 if rng.random() < 0.02:  # an unknown frame costs ~tf_timeout
                     p.header.frame_id = rng.choice(["", "base_link", "nowhere", "w" * 300])
             if rng.random() < 0.2:
                 goal.duration_scale = rng.choice(extremes + [rng.uniform(0.05, 12)])
             if rng.random() < 0.1:
-                goal.object_names = rng.choice([[], ["stick", "stick"], ["box"], ["s" * 1000], [""]])
+                goal.object_names = rng.choice([[], ["stick", "stick"], ["box"],
+                                                ["s" * 1000], [""]])
                 goal.object_poses = goal.object_poses[:1] * len(goal.object_names)
             if rng.random() < 0.05:
                 goal.library = rng.choice(["", "/", "../x", "/dev/zero", "grasp", "\0"])

@@ -36,7 +36,7 @@ class InstallListGuard(unittest.TestCase):
     def test_without_rosbash_rosrun_is_missing(self):
         rc, out = guard([p for p in self.listed if p != "rosbash"])
         self.assertEqual(rc, 1, out)
-        line = [l for l in out.splitlines() if l.strip().startswith("MISSING rosrun:")]
+        line = [x for x in out.splitlines() if x.strip().startswith("MISSING rosrun:")]
         self.assertEqual(len(line), 1, out)
         self.assertIn("rosbash", line[0])
         self.assertIn("launch/scripts/pipeline.py", line[0])  # the file that needs it
@@ -44,7 +44,8 @@ class InstallListGuard(unittest.TestCase):
     def test_without_matplotlib_its_imports_are_missing(self):
         rc, out = guard([p for p in self.listed if p != "python3-matplotlib"])
         self.assertEqual(rc, 1, out)
-        self.assertRegex(out, r"MISSING matplotlib: .*lfd_segmentation/scripts/plot_segmentation.py")
+        self.assertRegex(out,
+                         r"MISSING matplotlib: .*lfd_segmentation/scripts/plot_segmentation.py")
 
     def test_without_a_ros_package_its_key_is_missing(self):
         rc, out = guard([p for p in self.listed if p != "ros-robot-state-publisher"])

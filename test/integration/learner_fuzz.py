@@ -122,8 +122,9 @@ class LearnerFuzz(unittest.TestCase):
         self.assertFalse(os.path.exists("/etc/lfd_fuzz.json"))
 
     def test_5_limits_are_named(self):
-        self.assertRefused(self.call(self.valid(os.path.join(self.dir, "b.json"), num_basis=100000)),
-                           "limits/max_num_basis")
+        self.assertRefused(
+            self.call(self.valid(os.path.join(self.dir, "b.json"), num_basis=100000)),
+            "limits/max_num_basis")
         req = self.valid(os.path.join(self.dir, "many.json"), bag_paths=self.bags * 20,
                          changepoint_counts=[1] * 60,
                          changepoint_times=[START + DURATION / 2] * 60)

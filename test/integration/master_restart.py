@@ -71,19 +71,22 @@ class MasterRestart(unittest.TestCase):
         node_api = self.answer(probe.lookupNode, NODE)
         if not node_api:
             return None
-        code, _, pid = self.answer(xmlrpc.client.ServerProxy(node_api).getPid, "/master_restart_test") or (0, 0, 0)
+        code, _, pid = self.answer(xmlrpc.client.ServerProxy(node_api).getPid,
+                                   "/master_restart_test") or (0, 0, 0)
         return pid if code == 1 else None
 
     def test_the_node_registers_again_with_a_new_master(self):
         core = self.roscore()
-        launch = subprocess.Popen(["roslaunch", "--wait", "lfd_launch", "segment.launch", "output:=log"],
+        launch = subprocess.Popen(["roslaunch", "--wait", "lfd_launch", "segment.launch",
+                                   "output:=log"],
                                   env=self.env, stdout=subprocess.DEVNULL, start_new_session=True)
         self.launches.append(launch)
         first = wait_for("%s on the first master" % SERVICE, self.provider, START_S)
 
         # A crash of the master: nothing unregisters. rosmaster runs in a session of its own
         # (roslaunch starts each process so), so roscore's group is stopped after it.
-        os.kill(rosgraph.Master("/master_restart_test", master_uri=self.uri).getPid(), signal.SIGKILL)
+        os.kill(rosgraph.Master("/master_restart_test", master_uri=self.uri).getPid(),
+                signal.SIGKILL)
         master.stop_group(core, 20)
         self.cores.remove(core)
         wait_for("the old master gone", lambda: not master.port_open(self.port), 10)
@@ -93,7 +96,8 @@ class MasterRestart(unittest.TestCase):
         self.assertNotEqual(first, second, "the same process cannot have registered again")
         self.assertEqual(launch.poll(), None, "roslaunch ended")
         probe = rosgraph.Master("/master_restart_test", master_uri=self.uri)
-        self.assertTrue(probe.hasParam(NODE + "/rate"), "the node's parameters are not on the new master")
+        self.assertTrue(probe.hasParam(NODE + "/rate"),
+                        "the node's parameters are not on the new master")
         with self.assertRaises(ProcessLookupError):
             os.kill(first, 0)
 

@@ -36,7 +36,8 @@ def run_failing_pipeline(out, env_changes):
     env = dict(os.environ, LFD_PIPELINE_FAILURE_TEST=marker, **env_changes)
     proc = subprocess.Popen(["/usr/bin/python3", PIPELINE, "--out", out, "--stages", "segment",
                              "--datasets", "sim_grasp"], env=env, stdout=subprocess.PIPE,
-                            stderr=subprocess.STDOUT, universal_newlines=True, start_new_session=True)
+                            stderr=subprocess.STDOUT, universal_newlines=True,
+                            start_new_session=True)
     try:
         log, _ = proc.communicate(timeout=TIMEOUT)
     except subprocess.TimeoutExpired:
@@ -104,14 +105,16 @@ class ClientFailsOnData(FailingStage, unittest.TestCase):
 
 
 class StageCleanup(unittest.TestCase):
-    """kill_tagged (lfd_tools.processes, the pipeline's stage cleanup) ends what a stage started even when it left its parent's session and
-    outlived it (as roslaunch's nodes do when roslaunch is killed): a process group is not enough."""
+    """kill_tagged (lfd_tools.processes, the pipeline's stage cleanup) ends what a stage started
+    even when it left its parent's session and outlived it (as roslaunch's nodes do when roslaunch
+    is killed): a process group is not enough."""
 
     def test_orphan_in_its_own_session_is_killed(self):
         tag = "%d:cleanup_test" % os.getpid()
         env = dict(os.environ, **{processes.TAG_VAR: tag})
         # a child that starts a grandchild in a new session, then exits: the grandchild is orphaned
-        subprocess.run(["/usr/bin/python3", "-c", "import subprocess; subprocess.Popen(['sleep', '300'],"
+        subprocess.run(["/usr/bin/python3", "-c",
+                        "import subprocess; subprocess.Popen(['sleep', '300'],"
                         " start_new_session=True)"], env=env, check=True)
         time.sleep(0.5)
         self.assertEqual(len(processes.tagged_processes(tag)), 1)
@@ -133,7 +136,8 @@ class RunRoots(unittest.TestCase):
         os.symlink(os.path.join(base, "real_out"), out)
         self.assertEqual(config.run_roots(out), [out, os.path.join(base, "real_out")])
         os.symlink(os.path.join(base, "elsewhere", "all"), os.path.join(out, "datasets"))
-        os.symlink(os.path.join(base, "elsewhere", "one"), os.path.join(base, "elsewhere", "all", "sim_x"))
+        os.symlink(os.path.join(base, "elsewhere", "one"),
+                   os.path.join(base, "elsewhere", "all", "sim_x"))
         roots = config.run_roots(out)
         self.assertIn(os.path.join(base, "elsewhere", "all"), roots)
         self.assertIn(os.path.join(base, "elsewhere", "one"), roots)
@@ -143,7 +147,8 @@ class RunRoots(unittest.TestCase):
 
 def all_tests():
     return unittest.TestSuite([unittest.defaultTestLoader.loadTestsFromTestCase(c)
-                               for c in (ClientDiesAtOnce, ClientFailsOnData, StageCleanup, RunRoots)])
+                               for c in (ClientDiesAtOnce, ClientFailsOnData,
+                                         StageCleanup, RunRoots)])
 
 
 if __name__ == "__main__":

@@ -32,7 +32,8 @@ from sensor_msgs.msg import JointState
 RATE_HZ = 100.0  # recording rate of the synthetic topics
 # (width, height) in pixels of each figure; a layout that crops or resizes the canvas fails here.
 SEGMENT_FIGURES = {kind: figures.size_px(kind) for kind in (
-    "skill_map", "correlation_best", "correlation_all", "relevance", "clasp_profile", "segmentation")}
+    "skill_map", "correlation_best", "correlation_all", "relevance", "clasp_profile",
+    "segmentation")}
 REPORT_FIGURES = {"success_rates": figures.size_px("success_rates")}
 
 
@@ -42,7 +43,8 @@ def smoothstep(t, t0, duration):
 
 
 def write_grasp_bag(path, grasp_time, duration, seed):
-    """A grasp-like demo: reach in x, close the gripper at grasp_time (touch pads fire), lift in z."""
+    """A grasp-like demo: reach in x, close the gripper at grasp_time (touch pads fire), lift in
+    z."""
     rng = np.random.default_rng(seed)
     t = np.arange(0.0, duration, 1.0 / RATE_HZ)
     x = 0.3 * smoothstep(t, 0.3, grasp_time - 0.5)
@@ -93,11 +95,13 @@ def png_checks(testcase, path, kind, size):
     rgb = (img[..., :3] * 255).round().astype(int).reshape(-1, 3)
     colours = len(np.unique(rgb, axis=0))
     ink = np.mean(np.any(rgb < 240, axis=1))
-    testcase.assertGreaterEqual(colours, 40, "%s looks blank: %d distinct colours" % (path, colours))
+    testcase.assertGreaterEqual(colours, 40,
+                                "%s looks blank: %d distinct colours" % (path, colours))
     testcase.assertGreater(ink, MIN_INK[kind], "%s looks blank: %.1f %% ink" % (path, 100 * ink))
     for colour in MUST_HAVE.get(kind, ()):
         count = np.sum(np.all(np.abs(rgb - np.array(colour)) <= 30, axis=1))
-        testcase.assertGreaterEqual(count, 300, "%s: colour %s only on %d pixels" % (path, colour, count))
+        testcase.assertGreaterEqual(count, 300,
+                                    "%s: colour %s only on %d pixels" % (path, colour, count))
 
 
 class PlotFigures(unittest.TestCase):
@@ -105,8 +109,10 @@ class PlotFigures(unittest.TestCase):
     def setUpClass(cls):
         cls.tmp = tempfile.mkdtemp(prefix="lfd_plot_figures_")
         pack = rospkg.RosPack()
-        cls.script = os.path.join(pack.get_path("lfd_segmentation"), "scripts", "plot_segmentation.py")
-        found = find_in_workspaces(search_dirs=["libexec"], project="lfd_segmentation", path="segment")
+        cls.script = os.path.join(pack.get_path("lfd_segmentation"), "scripts",
+                                  "plot_segmentation.py")
+        found = find_in_workspaces(search_dirs=["libexec"], project="lfd_segmentation",
+                                   path="segment")
         assert found, "the lfd_segmentation `segment` CLI is not built"
         cls.segment = found[0]
         with open(os.path.join(pack.get_path("lfd_config"), "segmentation.yaml")) as f:
@@ -129,9 +135,10 @@ class PlotFigures(unittest.TestCase):
             write_grasp_bag(path, grasp, duration, d)
             cls.bags.append(path)
         cls.seg_json = os.path.join(cls.tmp, "seg.json")
-        seg = subprocess.run([cls.segment, "--config", cls.config, "--features", "--feature-profiles",
-                              "--output", cls.seg_json] + cls.bags, stdout=subprocess.PIPE,
-                             stderr=subprocess.STDOUT, text=True, timeout=60)
+        seg = subprocess.run([cls.segment, "--config", cls.config, "--features",
+                              "--feature-profiles", "--output", cls.seg_json] + cls.bags,
+                             stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+                             timeout=60)
         assert seg.returncode == 0, "segment failed:\n" + seg.stdout
 
     @classmethod
@@ -184,7 +191,8 @@ class PlotFigures(unittest.TestCase):
         d = 2
         with recorded("plot"), recorded("imshow"):
             status = plotter["main"](["--segment-json", self.seg_json, "--config", self.config,
-                                      "--out", os.path.join(self.tmp, "figs_drawn"), "--demo", str(d)])
+                                      "--out", os.path.join(self.tmp, "figs_drawn"),
+                                      "--demo", str(d)])
         self.assertEqual(status, 0)
         with open(self.seg_json) as f:
             seg = json.load(f)
@@ -220,7 +228,8 @@ class PlotFigures(unittest.TestCase):
         self.assertEqual(r.returncode, 0, r.stderr)
         self.assertIn("--features", r.stderr)
         self.assertEqual(sorted(os.listdir(out)), sorted(
-            "%s.png" % k for k in ("correlation_best", "correlation_all", "relevance", "clasp_profile")))
+            "%s.png" % k
+            for k in ("correlation_best", "correlation_all", "relevance", "clasp_profile")))
 
     def test_dataset_folder_and_several_demos(self):
         out = os.path.join(self.tmp, "figs_dataset")
@@ -251,10 +260,13 @@ class PlotFigures(unittest.TestCase):
         self.assertEqual(r.returncode, 0, r.stderr)
         png_checks(self, os.path.join(out, "success_rates.png"), "success_rates",
                    REPORT_FIGURES["success_rates"])
-        # evaluate_segmentation.py's own output: the same records (lfd_tools.report), a failed method too.
-        evaluation = {"tolerance_s": 0.5, "segmentation": {"sim_push": report_records.segmentation_record(
-            {"weighted_product": {"success_rate": 0.75}, "average": {"success_rate": 0.5},
-             "product": {"error": "the service failed"}}, 0.5)}}
+        # evaluate_segmentation.py's own output: the same records (lfd_tools.report), a failed
+        # method too.
+        evaluation = {"tolerance_s": 0.5,
+                      "segmentation": {"sim_push": report_records.segmentation_record(
+                          {"weighted_product": {"success_rate": 0.75},
+                           "average": {"success_rate": 0.5},
+                           "product": {"error": "the service failed"}}, 0.5)}}
         with open(path, "w") as f:
             json.dump(evaluation, f)
         r = self.plot("--report", path, "--out", out, "--prefix", "eval_")
@@ -280,9 +292,11 @@ class PlotFigures(unittest.TestCase):
             (["--segment-json", os.path.join(self.tmp, "missing.json")], "does not exist"),
             (["--segment-json", bad_json], "not valid JSON"),
             (["--segment-json", empty], "no key 'demos'"),
-            (["--segment-json", self.seg_json, "--config", self.config, "--demo", "9"], "out of range"),
+            (["--segment-json", self.seg_json, "--config", self.config, "--demo", "9"],
+             "out of range"),
             (["--segment-json", short_time, "--config", self.config], "feature_matrices[0] holds"),
-            (["--segment-json", self.seg_json, "--config", self.config, "--bags", "/nonexistent.bag"],
+            (["--segment-json", self.seg_json, "--config", self.config, "--bags",
+              "/nonexistent.bag"],
              "1 --bags for 4"),
             (["--segment-json", self.seg_json, "--config", self.config, "--bags"] +
              ["/nonexistent_%d.bag" % d for d in range(4)], "does not exist"),

@@ -22,7 +22,8 @@ class RecorderLiveBag(unittest.TestCase):
     def start(self, recorder, path):
         meta = DemoMetadata(task="live", extra_json="{}")
         meta.header.stamp = rospy.Time.now()
-        return rospy.ServiceProxy("/%s/start" % recorder, StartRecording)(bag_path=path, metadata=meta)
+        start = rospy.ServiceProxy("/%s/start" % recorder, StartRecording)
+        return start(bag_path=path, metadata=meta)
 
     def stop(self, recorder):
         return rospy.ServiceProxy("/%s/stop" % recorder, StopRecording)()

@@ -68,13 +68,15 @@ class RecorderTopics(unittest.TestCase):
                 name, rate = spec["name"], float(spec.get("rate", 0.0))
                 stamps = topic_stamps(bag, name)
                 # An event-driven topic (rate 0, e.g. the latched /tf_static) may come once.
-                self.assertGreaterEqual(len(stamps), 1 if rate <= 0.0 else 2, "%s missing from the bag" % name)
+                self.assertGreaterEqual(len(stamps), 1 if rate <= 0.0 else 2,
+                                        "%s missing from the bag" % name)
                 if rate <= 0.0:
                     continue
                 period = 1.0 / rate
                 measured = (len(stamps) - 1) / (stamps[-1] - stamps[0])
-                self.assertAlmostEqual(measured / rate, 1.0, delta=0.10,
-                                       msg="%s at %.1f Hz, configured %.1f Hz" % (name, measured, rate))
+                self.assertAlmostEqual(
+                    measured / rate, 1.0, delta=0.10,
+                    msg="%s at %.1f Hz, configured %.1f Hz" % (name, measured, rate))
                 gaps = [b - a for a, b in zip(stamps, stamps[1:])]
                 self.assertLessEqual(max(gaps), 2.0 * period + 1e-6,
                                      "%s has a gap of %.3f s" % (name, max(gaps)))
@@ -137,7 +139,8 @@ class RecorderTopics(unittest.TestCase):
         bag_path = os.path.join(self.output_dir, "paused", "paused.bag")
         try:
             rospy.wait_for_service("/recorder_paused/start", timeout=60.0)
-            meta = DemoMetadata(task="push", configuration=1, mode="sim", speed=1.0, extra_json="{}")
+            meta = DemoMetadata(task="push", configuration=1, mode="sim", speed=1.0,
+                                extra_json="{}")
             meta.header.stamp = rospy.Time.now()
             called = time.time()
             response = rospy.ServiceProxy("/recorder_paused/start", StartRecording)(

@@ -34,7 +34,8 @@ class SignalClassesBench(unittest.TestCase):
         with tempfile.TemporaryDirectory() as tmp:
             out = os.path.join(tmp, "bench.json")
             run = subprocess.run([sys.executable, BENCH, "--seeds", "0", "--out", out],
-                                 stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, timeout=600)
+                                 stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+                                 timeout=600)
             print(run.stdout)
             self.assertEqual(run.returncode, 0, run.stdout[-2000:])
             with open(out) as f:

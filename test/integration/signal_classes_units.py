@@ -39,7 +39,8 @@ for _base in ("contact_wipe", "in_contact_level"):
 
 
 def write(out, seed, classes=""):
-    cmd = ["/usr/bin/python3", SCRIPT, out, "--seed", str(seed)] + (["--classes", classes] if classes else [])
+    cmd = ["/usr/bin/python3", SCRIPT, out,
+           "--seed", str(seed)] + (["--classes", classes] if classes else [])
     subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, timeout=120)
 
 
@@ -95,13 +96,15 @@ class SignalClasses(unittest.TestCase):
                 self.assertEqual(content(self.out, name, f), content(again, name, f),
                                  "%s/%s differs between two runs of seed 3" % (name, f))
         for name in ("contact_wipe", "pause_boundaries"):
-            self.assertNotEqual(content(self.out, name, "demo_0.csv"), content(other, name, "demo_0.csv"),
+            self.assertNotEqual(content(self.out, name, "demo_0.csv"),
+                                content(other, name, "demo_0.csv"),
                                 "%s: seeds 3 and 4 wrote the same demo" % name)
 
     def test_a_subset_writes_what_the_whole_set_writes(self):
         part = os.path.join(self.tmp.name, "d")
         write(part, 3, "strokes")
-        self.assertEqual(content(part, "strokes", "demo_1.csv"), content(self.out, "strokes", "demo_1.csv"))
+        self.assertEqual(content(part, "strokes", "demo_1.csv"),
+                         content(self.out, "strokes", "demo_1.csv"))
 
     def test_declared_columns_on_an_even_clock(self):
         for name, (_, state, sensor, rate) in EXPECTED.items():
@@ -112,7 +115,9 @@ class SignalClasses(unittest.TestCase):
             self.assertEqual(truth["sensor_columns"], sensor, name)
             self.assertEqual(truth["rate_hz"], rate, name)
             for k, (header, rows) in enumerate(demos):
-                self.assertEqual(header, ["time"] + truth["state_columns"] + truth["sensor_columns"], (name, k))
+                self.assertEqual(header,
+                                 ["time"] + truth["state_columns"] + truth["sensor_columns"],
+                                 (name, k))
                 self.assertEqual(rows.shape[1], len(header), (name, k))
                 self.assertTrue(np.all(np.isfinite(rows)), (name, k))
                 self.assertEqual(rows[0, 0], 0.0)
@@ -126,14 +131,16 @@ class SignalClasses(unittest.TestCase):
                 b = d["boundaries_s"]
                 self.assertEqual(len(b), count, (name, d["file"]))
                 self.assertTrue(all(x < y for x, y in zip(b, b[1:])), (name, d["file"], b))
-                self.assertTrue(0.0 < b[0] and b[-1] < rows[-1, 0], (name, d["file"], b, rows[-1, 0]))
+                self.assertTrue(0.0 < b[0] and b[-1] < rows[-1, 0],
+                                (name, d["file"], b, rows[-1, 0]))
 
     def test_motions_are_continuous(self):
         # A hand moves at most 1.5 m/s, an arm's joints 3 rad/s; the noise adds a few 1e-4.
         for name, (_, state, _, rate) in EXPECTED.items():
             limit = (1.5 if state == POSE else 3.0) / rate + 2e-3
             for k, (header, rows) in enumerate(self.data[name][1]):
-                cols = [header.index(c) for c in (["x", "y", "z"] if state == POSE else header[1:8])]
+                cols = [header.index(c)
+                        for c in (["x", "y", "z"] if state == POSE else header[1:8])]
                 step = np.max(np.abs(np.diff(rows[:, cols], axis=0)))
                 self.assertLess(step, limit, (name, k))
 
@@ -152,7 +159,8 @@ class SignalClasses(unittest.TestCase):
         for rate in (25, 1000):
             other = self.data["contact_wipe@%d" % rate][0]["demos"]
             for a, b in zip(base, other):
-                self.assertTrue(np.allclose(a["boundaries_s"], b["boundaries_s"], atol=0.1), (rate, a, b))
+                self.assertTrue(np.allclose(a["boundaries_s"], b["boundaries_s"], atol=0.1),
+                                (rate, a, b))
 
     def test_short_phase_and_insertion_last_as_long_as_stated(self):
         for d in self.data["short_phase"][0]["demos"]:
@@ -183,15 +191,18 @@ class SignalClasses(unittest.TestCase):
             t, q = rows[:, 0], rows[:, 1:]
             at = lambda s: q[np.searchsorted(t, s)]
             for b in d["boundaries_s"]:
-                self.assertLess(np.max(np.abs(at(b - 0.02) - at(b - 0.98))), 0.003, (d["file"], b))  # still
-                self.assertGreater(np.max(np.abs(at(b + 0.6) - at(b))), 0.02, (d["file"], b))  # moving again
+                # still
+                self.assertLess(np.max(np.abs(at(b - 0.02) - at(b - 0.98))), 0.003, (d["file"], b))
+                # moving again
+                self.assertGreater(np.max(np.abs(at(b + 0.6) - at(b))), 0.02, (d["file"], b))
 
     def test_stale_and_dead_force_torque(self):
         truth, demos = self.data["stale_sensor"]
         dead, stale = 0, 0
         for header, rows in demos:
             ft = rows[:, [header.index(c) for c in WRENCH]]
-            repeats = int(np.argmax(np.any(ft != ft[0], axis=1))) or len(ft)  # rows equal to the first
+            # rows equal to the first
+            repeats = int(np.argmax(np.any(ft != ft[0], axis=1))) or len(ft)
             dead += repeats == len(ft)
             stale += 2.0 * 90 - 2 <= repeats <= 4.0 * 90 + 2
             self.assertTrue(repeats == 1 or repeats == len(ft) or repeats >= 2.0 * 90 - 2, repeats)

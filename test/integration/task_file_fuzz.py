@@ -1,8 +1,9 @@
 #!/usr/bin/python3
 """rostest (issue 23, round two): the two task file loaders, lfd_sim_bridge's (the demonstrator's,
 run as check_task) and lfd_tools.tasks (the scripts'), on bad files. Each refuses a NaN pose, a
-nesting deeper than the scene's task_limits/max_nesting_depth (PyYAML died of a RecursionError) and a
-time over its max_step_seconds (a step of 1e9 s recorded without end) with an error naming the file.
+nesting deeper than the scene's task_limits/max_nesting_depth (PyYAML died of a RecursionError)
+and a time over its max_step_seconds (a step of 1e9 s recorded without end) with an error naming
+the file.
 Then every shipped task file (config/tasks/*.yaml) mutated MUTANTS_PER_FILE times (seed 23: byte
 flips, truncation, deleted and repeated lines, huge numbers, NaN and infinities, deep nesting,
 wrong types, bytes that are not UTF-8, a BOM) goes through both: neither crashes, hangs or raises
@@ -26,15 +27,18 @@ NUMBER = re.compile(rb"(?<![\w.])-?\d+\.\d+(?![\w.])")
 
 
 def check_task():
-    return find_in_workspaces(search_dirs=["libexec"], project="lfd_sim_bridge", path="check_task")[0]
+    return find_in_workspaces(search_dirs=["libexec"], project="lfd_sim_bridge",
+                              path="check_task")[0]
 
 
 def cpp_verdict(path):
     """(accepted, error text) of the demonstrator's loader; fails the test on a crash or a hang."""
-    done = subprocess.run([check_task(), "--scene", tasks.scene_file(), path], stdout=subprocess.PIPE,
-                          stderr=subprocess.PIPE, timeout=TIMEOUT_S, universal_newlines=True, errors="replace")
+    done = subprocess.run([check_task(), "--scene", tasks.scene_file(), path],
+                          stdout=subprocess.PIPE, stderr=subprocess.PIPE, timeout=TIMEOUT_S,
+                          universal_newlines=True, errors="replace")
     if done.returncode not in (0, 1):
-        raise AssertionError("check_task ended with status %d on %s: %s" % (done.returncode, path, done.stderr))
+        raise AssertionError("check_task ended with status %d on %s: %s"
+                             % (done.returncode, path, done.stderr))
     return done.returncode == 0, done.stderr.strip()
 
 
@@ -47,7 +51,7 @@ def python_verdict(path):
         return False, str(exc)
 
 
-# ---- mutations: bytes in, bytes out, each drawn from `rng` ------------------------------------------
+# ---- mutations: bytes in, bytes out, each drawn from `rng` ---------------------------------------
 
 def flip_bytes(data, rng):
     data = bytearray(data)
@@ -79,7 +83,8 @@ def replace_number(data, rng, values):
 
 
 def huge_number(data, rng):
-    return replace_number(data, rng, [b"1e9", b"1.0e+9", b"-1.0e+300", b"1.0e+308", b"1e999", b"123456789012345678901234567890"])
+    return replace_number(data, rng, [b"1e9", b"1.0e+9", b"-1.0e+300", b"1.0e+308", b"1e999",
+                                      b"123456789012345678901234567890"])
 
 
 def not_finite(data, rng):
@@ -102,7 +107,8 @@ def deep_nesting(data, rng):
 
 def not_utf8(data, rng):
     k = rng.randrange(len(data))
-    return data[:k] + rng.choice([b"\xff", b"\xc3\x28", b"\xe2\x82", b"\x80abc", b"\x00"]) + data[k:]
+    return data[:k] + rng.choice([b"\xff", b"\xc3\x28", b"\xe2\x82",
+                                  b"\x80abc", b"\x00"]) + data[k:]
 
 
 def bom(data, rng):
@@ -135,7 +141,8 @@ class LoadersRefuse(unittest.TestCase):
             self.assertRegex(error, says, name)
 
     def first_sim_configuration(self, pose):
-        return re.sub(r"(configurations:\n  sim:\n    - \{id: 0, stick: )\[[^\]]*\]", r"\g<1>" + pose, self.grasp, 1)
+        return re.sub(r"(configurations:\n  sim:\n    - \{id: 0, stick: )\[[^\]]*\]",
+                      r"\g<1>" + pose, self.grasp, 1)
 
     def test_a_nan_pose(self):
         text = self.first_sim_configuration("[0.5, .nan, 0.815, 0.1]")
@@ -154,7 +161,8 @@ class LoadersRefuse(unittest.TestCase):
         self.refused_by_both(text, r"phases\[0\].steps\[\d\].duration: .* is over 120")
 
     def test_a_hold_or_a_settle_of_1e9_seconds(self):
-        self.refused_by_both(self.grasp.replace("settle: 0.3", "settle: 1.0e+9", 1), "settle: .* is over 120")
+        self.refused_by_both(self.grasp.replace("settle: 0.3", "settle: 1.0e+9", 1),
+                             "settle: .* is over 120")
 
     def test_a_contact_rule_with_a_gap_of_1e9_seconds(self):
         with open(os.path.join(config.config_path("tasks"), "wipe.yaml")) as f:
@@ -164,7 +172,8 @@ class LoadersRefuse(unittest.TestCase):
         path = os.path.join(self.dir, "wipe.yaml")
         with open(path, "w") as f:
             f.write(text)
-        with self.assertRaisesRegex(RuntimeError, re.escape(path) + r".*success\[0\]: max_gap_s: .* is over 120"):
+        with self.assertRaisesRegex(RuntimeError,
+                                    re.escape(path) + r".*success\[0\]: max_gap_s: .* is over 120"):
             tasks.read_task_file(path)
 
 
@@ -196,7 +205,8 @@ class TaskFileFuzz(unittest.TestCase):
                 if cpp != py and not (cpp and re.search(r": success(\[\d+\])?: ", py_error)):
                     disagreements.append("%s: check_task %s, lfd_tools.tasks %s" % (
                         path, cpp_error or "accepts", py_error or "accepts"))
-        print("task file fuzz: %(accepted)d mutants accepted, %(refused)d refused by both loaders" % counts)
+        print("task file fuzz: %(accepted)d mutants accepted, %(refused)d refused by both loaders"
+              % counts)
         self.assertEqual(disagreements, [])
         self.assertGreater(counts["accepted"], 0)  # a BOM, a repeated comment line, ...
         self.assertGreater(counts["refused"], counts["accepted"])

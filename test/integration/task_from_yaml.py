@@ -79,8 +79,8 @@ class TaskFromYaml(unittest.TestCase):
         self.assertNotIn("tap", os.listdir(rospkg.RosPack().get_path("lfd_config") + "/tasks"))
         data = os.path.join(self.root, "data")
         scripts = rospkg.RosPack().get_path("lfd_sim_bridge") + "/scripts"
-        gen = run(["/usr/bin/python3", scripts + "/generate_datasets.py", "--out", data, "--datasets", "sim_tap",
-                   "--tasks-dir", self.tasks_dir], self.env, 400)
+        gen = run(["/usr/bin/python3", scripts + "/generate_datasets.py", "--out", data,
+                   "--datasets", "sim_tap", "--tasks-dir", self.tasks_dir], self.env, 400)
         print(gen.stdout)
         self.assertEqual(gen.returncode, 0, gen.stdout)  # recorded, and every demo judged a success
         found = sorted(glob.glob(os.path.join(data, "sim_tap", "*.bag")))
@@ -88,18 +88,23 @@ class TaskFromYaml(unittest.TestCase):
         for bag in found:
             r = lfd_bags.demo_outcome(bag)
             self.assertTrue(r["success"], r["reason"])
-            self.assertEqual([p for p, _ in lfd_bags.phase_transitions(bag)[1]], ["approach", "press", "leave"])
+            self.assertEqual([p for p, _ in lfd_bags.phase_transitions(bag)[1]],
+                             ["approach", "press", "leave"])
             with rosbag.Bag(bag) as b:
-                meta = json.loads(next(b.read_messages(topics=["/lfd/metadata"])).message.extra_json)
+                meta = json.loads(
+                    next(b.read_messages(topics=["/lfd/metadata"])).message.extra_json)
             self.assertEqual(list(meta["scene"]["objects"]), ["box"])
 
         result = os.path.join(self.root, "segmentation.json")
-        found = find_in_workspaces(search_dirs=["libexec"], project="lfd_segmentation", path="segment")
+        found = find_in_workspaces(search_dirs=["libexec"], project="lfd_segmentation",
+                                   path="segment")
         self.assertTrue(found, "the lfd_segmentation `segment` CLI is not built")
         cli = found[0]
-        ev = run(["/usr/bin/python3", rospkg.RosPack().get_path("lfd_segmentation") + "/scripts/evaluate_segmentation.py",
-                  "--cli", cli, "--datasets", data, "--names", "sim_tap", "--methods", "weighted_product",
-                  "--out", result], self.env, 120)
+        ev = run(["/usr/bin/python3",
+                  rospkg.RosPack().get_path("lfd_segmentation")
+                  + "/scripts/evaluate_segmentation.py",
+                  "--cli", cli, "--datasets", data, "--names", "sim_tap", "--methods",
+                  "weighted_product", "--out", result], self.env, 120)
         print(ev.stdout)
         self.assertEqual(ev.returncode, 0, ev.stdout)
         with open(result) as f:

@@ -65,25 +65,32 @@ class TaskFromYamlReproduce(unittest.TestCase):
             os.makedirs(tasks_dir)
             with open(os.path.join(tasks_dir, "hoist.yaml"), "w") as f:
                 f.write(HOIST)
-            self.assertNotIn("hoist.yaml", os.listdir(rospkg.RosPack().get_path("lfd_config") + "/tasks"))
+            shipped = rospkg.RosPack().get_path("lfd_config") + "/tasks"
+            self.assertNotIn("hoist.yaml", os.listdir(shipped))
             env = dict(os.environ, **{tasks.TASKS_PATH_VAR: tasks_dir})
             out = os.path.join(root, "run")
-            pipeline = os.path.join(rospkg.RosPack().get_path("lfd_launch"), "scripts", "pipeline.py")
-            run = subprocess.run(["/usr/bin/python3", pipeline, "--out", out, "--datasets", "sim_hoist",
-                                  "--stages", "datasets,segment,learn,reproduce", "--reproduce-modes", "sim"],
-                                 env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
-                                 timeout=840)
+            pipeline = os.path.join(rospkg.RosPack().get_path("lfd_launch"), "scripts",
+                                    "pipeline.py")
+            run = subprocess.run(["/usr/bin/python3", pipeline, "--out", out, "--datasets",
+                                  "sim_hoist", "--stages", "datasets,segment,learn,reproduce",
+                                  "--reproduce-modes", "sim"],
+                                 env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+                                 text=True, timeout=840)
             print(run.stdout[-6000:])
             with open(os.path.join(out, "report.json")) as f:
                 report = json.load(f)
             learned = report["learning"]["sim_hoist"]
-            self.assertEqual([g["segment"] for g in learned["segment_goals"]], ["reach", "hoist"], learned)
+            self.assertEqual([g["segment"] for g in learned["segment_goals"]],
+                             ["reach", "hoist"], learned)
             # Learned, not written: the reach ends at the block, the hoist at the goal.
-            self.assertIn(learned["segment_goals"][0]["position_frame"], ("object:block", "heading:block"))
-            self.assertIn(learned["segment_goals"][1]["position_frame"], ("goal", "goal_heading:block"))
+            self.assertIn(learned["segment_goals"][0]["position_frame"],
+                          ("object:block", "heading:block"))
+            self.assertIn(learned["segment_goals"][1]["position_frame"],
+                          ("goal", "goal_heading:block"))
             reproduced = report["reproduction"]["hoist"]
             self.assertEqual(reproduced["goals_total"], 3, reproduced)
-            self.assertGreaterEqual(reproduced["successes"], 3, json.dumps(reproduced["goals"], indent=1)[:3000])
+            self.assertGreaterEqual(reproduced["successes"], 3,
+                                    json.dumps(reproduced["goals"], indent=1)[:3000])
             self.assertEqual(run.returncode, 0)
         finally:
             shutil.rmtree(root, ignore_errors=True)

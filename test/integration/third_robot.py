@@ -38,8 +38,9 @@ from lfd_tools import robot_models as rm
 PIPELINE = os.path.join(rospkg.RosPack().get_path("lfd_launch"), "scripts", "pipeline.py")
 ROBOT = "mini"
 PACKAGE = ROBOT + "_description"
-PIPELINE_TIMEOUT = 120  # s of wall time for each of the two runs (~10 s and ~15 s unloaded); with
-                        # their stop (40 s at most) within the rostest's time-limit (360)
+# s of wall time for each of the two runs (~10 s and ~15 s unloaded); with their stop (40 s at
+# most) within the rostest's time-limit (360)
+PIPELINE_TIMEOUT = 120
 
 # ---- the arm ----------------------------------------------------------------------------------
 # j1 turns about z at the base, j2, j3 and j4 pitch about y (shoulder, elbow, wrist), j5 rolls about
@@ -57,11 +58,11 @@ DRIVE = {
     'wrist': (400.0, 8.0, 0.05, 4.0, 30.0),
     'gripper': (1500.0, 40.0, 0.05, 0.15, 40.0),
 }
-HAND = rm.HandNames(ft_frame='flange_ft', ft_joint='flange_ft_fix', palm='claw', palm_joint='claw_fix',
-                    finger_left='jaw_left', finger_right='jaw_right', finger_joint='jaw',
-                    mimic_joint='jaw_follow', pad_left='jaw_left_pad', pad_right='jaw_right_pad',
-                    touch_left='jaw_left_touch', touch_right='jaw_right_touch',
-                    tcp='grip_point', tcp_joint='grip_point_fix')
+HAND = rm.HandNames(ft_frame='flange_ft', ft_joint='flange_ft_fix', palm='claw',
+                    palm_joint='claw_fix', finger_left='jaw_left', finger_right='jaw_right',
+                    finger_joint='jaw', mimic_joint='jaw_follow', pad_left='jaw_left_pad',
+                    pad_right='jaw_right_pad', touch_left='jaw_left_touch',
+                    touch_right='jaw_right_touch', tcp='grip_point', tcp_joint='grip_point_fix')
 SENSORS = [('force', 'wrench_f', HAND.ft_frame), ('torque', 'wrench_t', HAND.ft_frame),
            ('touch', 'tip_l', HAND.touch_left), ('touch', 'tip_r', HAND.touch_right)]
 JOINTS = ['j1', 'j2', 'j3', 'j4', 'j5', 'j6']
@@ -77,7 +78,8 @@ def mini_robot(mount):
         rm.Link('turret', 'base_link', rm.revolute('j1', Z, -2.9, 2.9, DRIVE['shoulder']),
                 (0.0, 0.0, 0.10), 3.0, [rm.geom('cylinder', (0.065, 0.09), (0.0, 0.0, 0.09))]),
         rm.Link('upper', 'turret', rm.revolute('j2', Y, -2.0, 2.0, DRIVE['shoulder']),
-                (0.0, 0.0, SHOULDER - 0.10), 3.0, [rm.geom('cylinder', (0.05, 0.2), (0.0, 0.0, 0.25))]),
+                (0.0, 0.0, SHOULDER - 0.10), 3.0,
+                [rm.geom('cylinder', (0.05, 0.2), (0.0, 0.0, 0.25))]),
         rm.Link('fore', 'upper', rm.revolute('j3', Y, -0.3, 3.0, DRIVE['elbow']),
                 (0.0, 0.0, UPPER), 2.0, [rm.geom('cylinder', (0.045, 0.2), (0.0, 0.0, 0.25))]),
         rm.Link('wrist_pitch', 'fore', rm.revolute('j4', Y, -2.1, 2.1, DRIVE['wrist']),
@@ -85,12 +87,13 @@ def mini_robot(mount):
         rm.Link('wrist_roll', 'wrist_pitch', rm.revolute('j5', X, -2.0, 2.0, DRIVE['wrist']),
                 (0.0, 0.0, 0.0), 0.3, [rm.geom('sphere', (0.035,), color=rm.DARK_COLOR)]),
         rm.Link('flange', 'wrist_roll', rm.revolute('j6', Z, -2.9, 2.9, DRIVE['wrist']),
-                (0.0, 0.0, 0.0), 0.3, [rm.geom('cylinder', (0.035, 0.02), (0.0, 0.0, 0.025), collide=True,
-                                               color=rm.DARK_COLOR)]),
+                (0.0, 0.0, 0.0), 0.3, [rm.geom('cylinder', (0.035, 0.02), (0.0, 0.0, 0.025),
+                                               collide=True, color=rm.DARK_COLOR)]),
     ]
     links += rm.parallel_gripper(HAND, 'flange', (0.0, 0.0, FLANGE), DRIVE['gripper'],
                                  ft_rpy=(0.0, math.pi, 0.0))
-    return rm.Robot('mini_arm', links, SENSORS, ft_frame=HAND.ft_frame, finger_pads=HAND.finger_pads())
+    return rm.Robot('mini_arm', links, SENSORS, ft_frame=HAND.ft_frame,
+                    finger_pads=HAND.finger_pads())
 
 
 def fingers_down(x, y, z, yaw=0.0):
@@ -117,7 +120,8 @@ def write_package(root):
     for sub in ('models', 'config', 'launch'):
         os.makedirs(os.path.join(pkg, sub))
     with open(os.path.join(pkg, 'package.xml'), 'w') as f:
-        f.write('<?xml version="1.0"?>\n<package format="2">\n  <name>%s</name>\n  <version>0.0.1</version>\n'
+        f.write('<?xml version="1.0"?>\n<package format="2">\n  <name>%s</name>\n  '
+                '<version>0.0.1</version>\n'
                 '  <description>A test robot (test/integration/third_robot.py).</description>\n'
                 '  <maintainer email="lfd@example.org">lfd maintainers</maintainer>\n'
                 '  <license>BSD-3-Clause</license>\n  <buildtool_depend>catkin</buildtool_depend>\n'
@@ -126,13 +130,17 @@ def write_package(root):
     robot = mini_robot(rm.load_scene(scene_path)['base_link_in_world'])
     rm.generate(robot, os.path.join(pkg, 'models'), scene_path)
     with open(os.path.join(pkg, 'launch', 'upload.launch'), 'w') as f:
-        f.write('<launch>\n  <param name="robot_description" textfile="$(find %s)/models/%s.urdf"/>\n'
+        f.write('<launch>\n  <param name="robot_description" '
+                'textfile="$(find %s)/models/%s.urdf"/>\n'
                 '</launch>\n' % (PACKAGE, robot.name))
-    # Ready: the TCP 10 cm above the table's near edge; preferred: 8 cm above the workspace's centre.
+    # Ready: the TCP 10 cm above the table's near edge; preferred: 8 cm above the workspace's centre
     scene = rm.load_scene(scene_path)
     table = scene['table_top'] - scene['base_link_in_world'][2]  # the table top's z in base_link
     ready = fingers_down(0.30, -0.28, table + 0.10)
     preferred = fingers_down(0.50, -0.28, table + 0.08)
+    values = {'name': ROBOT, 'tcp': HAND.tcp, 'jaw': HAND.finger_joint, 'ft': HAND.ft_frame,
+              'palm': HAND.palm, 'preferred': posture_yaml(preferred, indent='    '),
+              'ready': posture_yaml(ready, {HAND.finger_joint: 0.03}).rstrip('\n')}
     with open(os.path.join(pkg, 'config', 'robot.yaml'), 'w') as f:
         f.write('''name: %(name)s
 ik:
@@ -159,9 +167,7 @@ sensors:
     type: lfd_msgs/Touch
     frame: %(palm)s
     fields: {values: [tip_l, tip_r]}
-''' % {'name': ROBOT, 'tcp': HAND.tcp, 'jaw': HAND.finger_joint, 'ft': HAND.ft_frame, 'palm': HAND.palm,
-       'preferred': posture_yaml(preferred, indent='    '),
-       'ready': posture_yaml(ready, {HAND.finger_joint: 0.03}).rstrip('\n')})
+''' % values)
     return pkg
 
 
@@ -192,7 +198,8 @@ def node_complaints(out, limit=15):
     for log in sorted(glob.glob(os.path.join(out, 'datasets', 'logs', '*.log'))):
         with open(log, errors='replace') as f:
             for line in f:
-                line = re.sub(r'\x1b\[[0-9;]*m| \[[0-9.]+(, [0-9.]+)?\]', '', line).strip()  # colours, times
+                # colours, times
+                line = re.sub(r'\x1b\[[0-9;]*m| \[[0-9.]+(, [0-9.]+)?\]', '', line).strip()
                 if re.match(r'\[(FATAL|ERROR| WARN)\]', line) and line not in lines:
                     lines.append(line)
     return '\n'.join(lines[:limit])
@@ -208,20 +215,23 @@ class ThirdRobot(unittest.TestCase):
             'ROS_PACKAGE_PATH', '').split(':') if p])
         cls.env.pop('LFD_ROBOT', None)
         cls.out = os.path.join(cls.root, 'out')
-        cls.status, cls.log = pipeline(cls.env, '--robot', ROBOT, '--out', cls.out, '--stages', 'datasets',
-                                       '--datasets', 'sim_grasp', '--demos', '1', timeout=PIPELINE_TIMEOUT)
+        cls.status, cls.log = pipeline(cls.env, '--robot', ROBOT, '--out', cls.out, '--stages',
+                                       'datasets', '--datasets', 'sim_grasp', '--demos', '1',
+                                       timeout=PIPELINE_TIMEOUT)
         cls.report = cls.read_report()
         if cls.status != 0:
             cls.log += '\nthe nodes said:\n' + node_complaints(cls.out)
-        cls.bags = sorted(os.path.join(d, f) for d, _, files in os.walk(os.path.join(cls.out, 'datasets'))
+        cls.bags = sorted(os.path.join(d, f)
+                          for d, _, files in os.walk(os.path.join(cls.out, 'datasets'))
                           for f in files if f.endswith('.bag'))
 
         # The skill library of that demo (segmentation, then the learner: both read the gripper's
         # joint, whatever the robot names it).
         cls.learn_status, cls.learn_log, cls.learn_report = None, 'no demo to learn from', {}
         if cls.bags:
-            cls.learn_status, cls.learn_log = pipeline(cls.env, '--robot', ROBOT, '--out', cls.out, '--stages',
-                                                       'learn', '--datasets', 'sim_grasp', timeout=PIPELINE_TIMEOUT)
+            cls.learn_status, cls.learn_log = pipeline(cls.env, '--robot', ROBOT, '--out', cls.out,
+                                                       '--stages', 'learn', '--datasets',
+                                                       'sim_grasp', timeout=PIPELINE_TIMEOUT)
             cls.learn_report = cls.read_report()
 
     @classmethod
@@ -247,8 +257,9 @@ class ThirdRobot(unittest.TestCase):
             for f in os.listdir(models):
                 if f.endswith(('.urdf', '.xml')) and f != 'workcell.xml':
                     with open(os.path.join(models, f)) as text:
-                        found |= set(re.findall(r'<(?:link|joint|body|site|geom|force|torque|touch|position)'
-                                                r'\b[^>]*?\bname="([^"]+)"', text.read()))
+                        found |= set(re.findall(
+                            r'<(?:link|joint|body|site|geom|force|torque|touch|position)'
+                            r'\b[^>]*?\bname="([^"]+)"', text.read()))
             return found - {'base_link', 'world', 'world_to_base_link'}
         mine = names(PACKAGE)
         self.assertTrue({'j1', HAND.finger_joint, HAND.tcp, 'wrench_f', 'tip_l'} <= mine, mine)
@@ -256,14 +267,16 @@ class ThirdRobot(unittest.TestCase):
             self.assertEqual(mine & names(other), set(), other)
 
     def test_1_the_package_is_found(self):
-        found = subprocess.run(['rospack', 'find', PACKAGE], stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
-                               text=True, env=self.env)
+        found = subprocess.run(['rospack', 'find', PACKAGE], stdout=subprocess.PIPE,
+                               stderr=subprocess.STDOUT, text=True, env=self.env)
         self.assertEqual(found.stdout.strip(), self.pkg, found.stdout)
 
     def test_2_the_demo_is_recorded_and_succeeds(self):
-        self.assertEqual(self.status, 0, 'pipeline --robot %s failed:\n%s' % (ROBOT, self.log[-6000:]))
+        self.assertEqual(self.status, 0,
+                         'pipeline --robot %s failed:\n%s' % (ROBOT, self.log[-6000:]))
         self.assertEqual(self.report.get('robot'), ROBOT, self.report)
-        self.assertEqual(self.report.get('datasets', {}).get('sim_grasp', {}).get('demos'), 1, self.report)
+        self.assertEqual(self.report.get('datasets', {}).get('sim_grasp', {}).get('demos'), 1,
+                         self.report)
         self.assertEqual(self.report.get('stage_errors'), {}, self.report)
         self.assertEqual(len(self.bags), 1, self.bags)
         outcome = lfd_bags.demo_outcome(self.bags[0])
@@ -275,18 +288,20 @@ class ThirdRobot(unittest.TestCase):
         first = {}
         with rosbag.Bag(self.bags[0]) as bag:
             counts = {t: i.message_count for t, i in bag.get_type_and_topic_info().topics.items()}
-            for topic, msg, _ in bag.read_messages(topics=['/joint_states', '/gripper/state', '/touch',
-                                                           '/wrist_ft', '/ee_pose']):
+            for topic, msg, _ in bag.read_messages(topics=['/joint_states', '/gripper/state',
+                                                           '/touch', '/wrist_ft', '/ee_pose']):
                 first.setdefault(topic, msg)
                 if topic == '/touch' and max(msg.values, default=0.0) > 0.5:
                     first['touched'] = msg
                 if topic == '/wrist_ft':
                     f = msg.wrench.force
-                    first['max_force'] = max(first.get('max_force', 0.0), math.sqrt(f.x ** 2 + f.y ** 2 + f.z ** 2))
+                    first['max_force'] = max(first.get('max_force', 0.0),
+                                             math.sqrt(f.x ** 2 + f.y ** 2 + f.z ** 2))
         for topic in ('/wrist_ft', '/touch', '/joint_states', '/gripper/state', '/ee_pose'):
             self.assertGreater(counts.get(topic, 0), 100, '%s: %s' % (topic, counts))
         self.assertNotIn('/imu', counts)  # the robot file has no IMU row
-        self.assertEqual(list(first['/joint_states'].name), JOINTS + [HAND.finger_joint, HAND.mimic_joint])
+        self.assertEqual(list(first['/joint_states'].name),
+                         JOINTS + [HAND.finger_joint, HAND.mimic_joint])
         self.assertEqual(list(first['/gripper/state'].name), [HAND.finger_joint])
         self.assertEqual(first['/wrist_ft'].header.frame_id, HAND.ft_frame)
         self.assertEqual(first['/touch'].header.frame_id, HAND.palm)
@@ -297,7 +312,8 @@ class ThirdRobot(unittest.TestCase):
         self.assertEqual(first['/ee_pose'].header.frame_id, 'base_link')
 
     def test_4_a_skill_is_learned_from_it(self):
-        self.assertEqual(self.learn_status, 0, 'pipeline --stages learn failed:\n%s' % self.learn_log[-4000:])
+        self.assertEqual(self.learn_status, 0,
+                         'pipeline --stages learn failed:\n%s' % self.learn_log[-4000:])
         entry = self.learn_report.get('learning', {}).get('sim_grasp', {})
         self.assertNotIn('error', entry, entry)
         self.assertEqual(entry.get('segments'), entry.get('expected_segments'), entry)

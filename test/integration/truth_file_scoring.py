@@ -32,7 +32,8 @@ class FakeSegmenter(object):
 
     def __call__(self, inputs, method):
         self.inputs = inputs
-        return {"demos": [{"changepoint_times": c, "rejected_times": [], "pruned_times": [], "zones": []}
+        return {"demos": [{"changepoint_times": c, "rejected_times": [], "pruned_times": [],
+                           "zones": []}
                           for c in self.changepoints],
                 "selected_features": ["f"], "selected_weights": [1.0], "warnings": []}
 
@@ -69,12 +70,14 @@ class TruthFileScoring(unittest.TestCase):
 
     def evaluate(self, changepoints, tolerance=0.5):
         seg = FakeSegmenter(changepoints)
-        out = segmentation_scoring.evaluate_truth_file(seg, lfd_bags.load_truth_file(self.truth), "product", tolerance)
+        out = segmentation_scoring.evaluate_truth_file(seg, lfd_bags.load_truth_file(self.truth),
+                                                       "product", tolerance)
         return seg, out
 
     def test_parts_are_joined_in_order_and_times_relative_to_the_first_bag(self):
         seg, out = self.evaluate([[105.3], [203.0, 207.0]])
-        self.assertEqual(seg.inputs, [os.path.join(self.dir, "a1.bag") + "," + os.path.join(self.dir, "a2.bag"),
+        self.assertEqual(seg.inputs, [os.path.join(self.dir, "a1.bag") + ","
+                                      + os.path.join(self.dir, "a2.bag"),
                                       os.path.join(self.dir, "b.bag")])
         self.assertEqual(out["correct"], 2)
         a, b = out["details"]
@@ -112,14 +115,16 @@ class TruthFileScoring(unittest.TestCase):
     def test_several_methods_ask_a_multi_method_segmenter_once(self):
         demos = lfd_bags.load_truth_file(self.truth)
         seg = FakeMultiSegmenter([[105.3], [203.0, 207.0]])
-        out = segmentation_scoring.evaluate_truth_file_methods(seg, demos, ["product", "average"], 0.5)
+        out = segmentation_scoring.evaluate_truth_file_methods(seg, demos, ["product", "average"],
+                                                               0.5)
         self.assertEqual(seg.calls, [["product", "average"]])
         self.assertEqual(sorted(out), ["average", "product"])
         self.assertEqual(out["average"]["correct"], 2)
         self.assertEqual(out["product"]["details"][1]["truth_rel_s"], [3.0, 7.0])
         # one method, or a segmenter without .methods: one call per method
         plain = FakeSegmenter([[105.3], [203.0, 207.0]])
-        both = segmentation_scoring.evaluate_truth_file_methods(plain, demos, ["product", "average"], 0.5)
+        both = segmentation_scoring.evaluate_truth_file_methods(plain, demos,
+                                                                ["product", "average"], 0.5)
         self.assertEqual(both["average"]["correct"], out["average"]["correct"])
         seg.calls = []
         segmentation_scoring.evaluate_truth_file_methods(seg, demos, ["product"], 0.5)
@@ -132,11 +137,14 @@ class TruthFileScoring(unittest.TestCase):
         path = os.path.join(self.dir, "labels.json")
         with open(path, "w") as f:
             json.dump(labels, f)
-        demos = lfd_bags.truth_from_labels(path)["demos"]  # the single-part run has no boundary: left out
+        # the single-part run has no boundary: left out
+        demos = lfd_bags.truth_from_labels(path)["demos"]
         self.assertEqual([d["name"] for d in demos], ["r2"])
-        self.assertEqual(demos[0]["bags"], [os.path.join(self.dir, "r2/p1.bag"), os.path.join(self.dir, "r2/p2.bag")])
+        self.assertEqual(demos[0]["bags"],
+                         [os.path.join(self.dir, "r2/p1.bag"), os.path.join(self.dir, "r2/p2.bag")])
         self.assertEqual(demos[0]["changepoints_s"], [4.5])
-        self.assertEqual([d["name"] for d in lfd_bags.truth_from_labels(path, ["r1", "r2"])["demos"]], ["r1", "r2"])
+        named = lfd_bags.truth_from_labels(path, ["r1", "r2"])["demos"]
+        self.assertEqual([d["name"] for d in named], ["r1", "r2"])
 
     def test_malformed_truth_file_gives_a_clear_error(self):
         bad = os.path.join(self.dir, "bad.yaml")

@@ -31,7 +31,8 @@ SYSTEM_PATH = "/usr/sbin:/usr/bin:/sbin:/bin"  # dpkg's programs; /usr/local is 
 SKIP_DIRS = {".git", "build", "devel", ".ci"}
 SUBPROCESS_CALLS = {"Popen", "run", "call", "check_call", "check_output", "run_quiet", "execvp"}
 # words that run the command after them, and builtins/keywords that run no program at all
-SHELL_WRAPPERS = set("if then else elif do while until ! time env exec command nohup sudo { (".split())
+SHELL_WRAPPERS = set(
+    "if then else elif do while until ! time env exec command nohup sudo { (".split())
 SHELL_BUILTINS = set("""fi for done case esac in function select local export set unset shift return
     exit break continue true false read source . cd echo printf eval trap declare readonly wait test
     [ [[ ]] } : pushd popd type builtin let""".split())
@@ -98,8 +99,8 @@ def owners(paths):
     every = sorted({c for v in variants.values() for c in v})
     found = {}
     if every:
-        out = subprocess.run(["dpkg", "-S"] + every, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL,
-                             universal_newlines=True).stdout
+        out = subprocess.run(["dpkg", "-S"] + every, stdout=subprocess.PIPE,
+                             stderr=subprocess.DEVNULL, universal_newlines=True).stdout
         for line in out.splitlines():
             if line.startswith("diversion ") or ": " not in line:
                 continue
@@ -148,7 +149,8 @@ def command_lists(tree):
     """Argument lists given to subprocess-like calls or assigned to a `*cmd*` variable."""
     for node in ast.walk(tree):
         if isinstance(node, ast.Call) and node.args:
-            func = node.func.attr if isinstance(node.func, ast.Attribute) else getattr(node.func, "id", "")
+            func = (node.func.attr if isinstance(node.func, ast.Attribute)
+                    else getattr(node.func, "id", ""))
             if func in SUBPROCESS_CALLS:
                 words = const_list(node.args[0])
                 if words:
@@ -206,7 +208,8 @@ def shell_commands(text):
             if in_array or (tok in ("(", "()") and i > 0 and tokens[i - 1].endswith("=")):
                 in_array = (in_array or tok == "(") and tok != ")"  # `a=(x y)`: words, no command
                 continue
-            if at_start and tok == "command" and i + 1 < len(tokens) and tokens[i + 1] in ("-v", "-V"):
+            if (at_start and tok == "command" and i + 1 < len(tokens)
+                    and tokens[i + 1] in ("-v", "-V")):
                 at_start, words = False, None  # `command -v X` looks X up, it does not run it
             if all(c in "();<>|&" for c in tok):
                 if set(tok) <= set("<>&") and ("<" in tok or ">" in tok):
@@ -351,11 +354,13 @@ def check(needs, provided, mapping, list_name):
             continue
         debs = {f[1]} if isinstance(f, tuple) else owner.get(f, set())
         if not debs:
-            problems[kind].append("%s: %s belongs to no Debian package (needed by %s)" % (name, f, users))
+            problems[kind].append("%s: %s belongs to no Debian package (needed by %s)"
+                                  % (name, f, users))
         elif not debs & provided:
             hint = " (mapped in .ci/rosdep-keys.txt)" if isinstance(f, tuple) else " (%s)" % f
             problems[kind].append("%s: provided by %s%s, which is not in %s or its dependencies "
-                                  "(needed by %s)" % (name, " or ".join(sorted(debs)), hint, list_name, users))
+                                  "(needed by %s)"
+                                  % (name, " or ".join(sorted(debs)), hint, list_name, users))
     return problems
 
 
@@ -365,14 +370,16 @@ def write_junit(path, problems, counts):
     for kind, lines in problems.items():
         case = ET.SubElement(suite, "testcase", classname="install_list", name=kind)
         if lines:
-            fail = ET.SubElement(case, "failure", message="%d missing of %d" % (len(lines), counts[kind]))
+            fail = ET.SubElement(case, "failure",
+                                 message="%d missing of %d" % (len(lines), counts[kind]))
             fail.text = "\n".join(lines)
     os.makedirs(os.path.dirname(os.path.abspath(path)), exist_ok=True)
     ET.ElementTree(suite).write(path, encoding="utf-8", xml_declaration=True)
 
 
 def main():
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap = argparse.ArgumentParser(description=__doc__,
+                                 formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--list", default=os.path.join(ROOT, ".ci", "apt-packages.txt"))
     ap.add_argument("--keys", default=os.path.join(ROOT, ".ci", "rosdep-keys.txt"))
     ap.add_argument("--junit", help="write a JUnit XML result here")

@@ -46,7 +46,8 @@ def main():
                     passed += 1
                 else:
                     failed += 1
-                    print("FAILED %s (%s)\n    %s" % (name, fname, text[:2000].replace("\n", "\n    ")))
+                    print("FAILED %s (%s)\n    %s"
+                          % (name, fname, text[:2000].replace("\n", "\n    ")))
     if passed + failed == 0:
         print("no test results found under %s" % folder)
         failed = 1

@@ -38,7 +38,8 @@ def phase_transitions(bag_path):
     """(task, [(phase name, start time)]) from the ground-truth phase topic, in stamp order."""
     task, phases = None, []
     with rosbag.Bag(bag_path) as bag:
-        for _, msg, stamp in stamps.read_in_stamp_order(bag, [PHASE_TOPIC], keep_duplicates=True)[0]:
+        for _, msg, stamp in stamps.read_in_stamp_order(bag, [PHASE_TOPIC],
+                                                        keep_duplicates=True)[0]:
             task = task or msg.task
             if not phases or phases[-1][0] != msg.name:
                 phases.append((msg.name, stamp))
@@ -72,7 +73,8 @@ def load_truth_file(path):
 def parse_truth(data, base, path):
     """A ground-truth file's content; relative bag paths are taken from `base`."""
     if not isinstance(data, dict) or not isinstance(data.get("demos"), list) or not data["demos"]:
-        raise RuntimeError("%s: expected a 'demos:' list (see evaluate_segmentation.py --help)" % path)
+        raise RuntimeError("%s: expected a 'demos:' list (see evaluate_segmentation.py --help)"
+                           % path)
     demos = []
     for i, d in enumerate(data["demos"]):
         if not isinstance(d, dict) or not d.get("bags") or "changepoints_s" not in d:
@@ -141,7 +143,8 @@ def measure(bag, criterion, base_in_world):
     for topic, msg, stamp in messages:
         if topic in names:
             p, q = msg.pose.position, msg.pose.orientation
-            out["objects"][names[topic]] = {"position": [p.x, p.y, p.z], "orientation": [q.w, q.x, q.y, q.z]}
+            out["objects"][names[topic]] = {"position": [p.x, p.y, p.z],
+                                            "orientation": [q.w, q.x, q.y, q.z]}
         elif topic in JOINT_TOPICS:
             for name, value in zip(msg.name, msg.position):
                 if name in joint_names:
@@ -150,7 +153,8 @@ def measure(bag, criterion, base_in_world):
             touch[round(stamp, 4)] = sum(msg.values) / len(msg.values)
         elif topic == EE_TOPIC:
             p = msg.pose.position
-            tcp[round(stamp, 4)] = [p.x + base_in_world[0], p.y + base_in_world[1], p.z + base_in_world[2]]
+            tcp[round(stamp, 4)] = [p.x + base_in_world[0], p.y + base_in_world[1],
+                                    p.z + base_in_world[2]]
     out["contact"] = [(stamp, touch[stamp], tcp[stamp]) for stamp in sorted(touch) if stamp in tcp]
     return out
 
@@ -162,7 +166,8 @@ def physical_outcome(path, task, scene):
     criterion = tasks.success_criterion(task)
     with rosbag.Bag(path) as bag:
         measured = measure(bag, criterion, tasks.base_in_world())
-    return dict(judge.judge_rules(criterion, measured, scene, tasks.table_top()), warnings=measured["warnings"])
+    return dict(judge.judge_rules(criterion, measured, scene, tasks.table_top()),
+                warnings=measured["warnings"])
 
 
 def demo_outcome(path):
@@ -182,13 +187,15 @@ def demo_outcome(path):
                 return result
             meta = first.message
             scene = json.loads(meta.extra_json)["scene"]
-            result.update(task=meta.task, mode=meta.mode, configuration=meta.configuration, speed=meta.speed)
+            result.update(task=meta.task, mode=meta.mode, configuration=meta.configuration,
+                          speed=meta.speed)
             criterion = tasks.success_criterion(meta.task)
             measured = measure(bag, criterion, tasks.base_in_world())
     except (rosbag.ROSBagException, OSError, ValueError, KeyError, RuntimeError) as exc:
         result["reason"] = "unreadable: %s" % exc
         return result
     outcome = judge.judge_rules(criterion, measured, scene, tasks.table_top())
-    result.update(success=outcome["success"], distance_m=outcome["distance_m"], height_m=outcome["height_m"],
-                  rules=outcome["rules"], reason=outcome["reason"], warnings=measured["warnings"])
+    result.update(success=outcome["success"], distance_m=outcome["distance_m"],
+                  height_m=outcome["height_m"], rules=outcome["rules"], reason=outcome["reason"],
+                  warnings=measured["warnings"])
     return result

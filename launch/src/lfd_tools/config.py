@@ -1,13 +1,10 @@
 """The project's configuration files (config/, the lfd_config package), read and checked once.
-The tasks (their scenes, skills and success criteria) are lfd_tools.tasks."""
+The tasks (their scenes, skills and success criteria) are lfd_tools.tasks, which reads its files
+through this module: the dependency goes one way, and this module imports no other of lfd_tools."""
 import functools
 import os
 
 import yaml
-
-from lfd_tools import judge
-
-DISTANCES = judge.DISTANCES
 
 
 @functools.lru_cache(maxsize=None)
@@ -40,7 +37,8 @@ def robot_dir(name=None):
         return rospkg.RosPack().get_path(package)
     except rospkg.ResourceNotFound:
         raise RuntimeError("robot %r: no package %s (a robot is a <robot>_description package with "
-                           "config/robot.yaml; see README, Adding a robot)" % (name or robot_name(), package))
+                           "config/robot.yaml; see README, Adding a robot)"
+                           % (name or robot_name(), package))
 
 
 def robot_file():
@@ -56,7 +54,8 @@ def sensor_topic(message_type):
     for row in load_yaml(robot_file()).get("sensors") or []:
         if row.get("type") == message_type:
             return row["topic"]
-    raise RuntimeError("robot file %s has no %s row in its sensor table" % (robot_file(), message_type))
+    raise RuntimeError("robot file %s has no %s row in its sensor table"
+                       % (robot_file(), message_type))
 
 
 def load_yaml(path):
@@ -83,7 +82,8 @@ class _BoundedLoader(yaml.SafeLoader):
         self._depth += 1
         try:
             if self._depth > self.max_depth:
-                raise yaml.composer.ComposerError(None, None, "nested deeper than %d levels" % self.max_depth,
+                raise yaml.composer.ComposerError(None, None,
+                                                  "nested deeper than %d levels" % self.max_depth,
                                                   self.peek_event().start_mark)
             return compose(anchor)
         finally:
@@ -108,66 +108,7 @@ def load_evaluation(path=None):
     for key in ("tolerance_s", "methods"):
         if key not in evaluation["segmentation"]:
             raise RuntimeError("%s: segmentation.%s is missing" % (path, key))
-    evaluation = dict(evaluation, reproduction=_legacy_criteria())
     return evaluation
-
-
-# The task's facts live in its task file; these keep their former callers working.
-
-def criteria_of(evaluation, task):
-    """The physical success criterion of a task (tasks.success_criterion)."""
-    from lfd_tools import tasks
-    return tasks.success_criterion(task)
-
-
-def expected_transitions(evaluation, task):
-    """The ground-truth transitions [{from, to}] of a task (tasks.expected_transitions)."""
-    from lfd_tools import tasks
-    return tasks.expected_transitions(task)
-
-
-def segment_names(evaluation, task):
-    """A task's skills in order (tasks.segment_names)."""
-    from lfd_tools import tasks
-    return tasks.segment_names(task)
-
-
-# ---- legacy views for lfd_dmp/scripts until they read lfd_tools.tasks (issue 15): remove then ----
-
-def _single_object_tasks():
-    from lfd_tools import tasks
-    placeable = {n for n, o in tasks.scene()["objects"].items() if not o.get("fixed")}
-    return [t for t in tasks.names()
-            if len(tasks.objects(t)) == 1 and tasks.objects(t)[0] in placeable
-            and tasks.success_criterion(t)["object"] == tasks.objects(t)[0]]
-
-
-def _legacy_criteria():
-    try:
-        from lfd_tools import tasks
-        return {t: tasks.success_criterion(t) for t in _single_object_tasks()}
-    except (RuntimeError, OSError, ImportError):
-        return {}
-
-
-def load_tasks(path=None):
-    """The former config/tasks.yaml layout, built from the task files of the tasks that move one
-    free object: {task: {sim|teleop: [{id, <object>: [x, y, z, yaw], goal}], unseen: {...}},
-    park: {object: [x, y, z, yaw]}, table_top}."""
-    from lfd_tools import tasks
-
-    def flat(p):
-        return p["position"] + [tasks.yaw_of(p)]
-
-    def entries(task, scenes):
-        return [dict({o: flat(p) for o, p in s["objects"].items()}, id=s["id"], goal=flat(s["goal"]))
-                for s in scenes]
-    out = {"table_top": tasks.table_top(),
-           "park": {n: flat(tasks.pose(o["park"])) for n, o in tasks.scene()["objects"].items()}}
-    for t in _single_object_tasks():
-        out[t] = {m: entries(t, tasks.scenes(t, m)) for m in tasks.MODES}
-        out[t]["unseen"] = {m: entries(t, tasks.unseen_scenes(t, m)) for m in tasks.MODES}
-    return out
 
 
 def run_roots(folder):

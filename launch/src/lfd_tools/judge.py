@@ -120,10 +120,12 @@ def summarize_scores(scores, tolerance):
     n = float(len(scores))
     errors = [e for s in scores for e in s["time_errors_s"] if e is not None]
     correct = sum(s["correct"] for s in scores)
-    return {"demos": len(scores), "correct": correct, "success_rate": correct / n, "tolerance_s": tolerance,
-            "covering": sum(s["covering"] for s in scores) / n, "f1": sum(s["f1"] for s in scores) / n,
-            "time_error_median_s": percentile(errors, 0.5), "time_error_p95_s": percentile(errors, 0.95),
-            "transitions_without_changepoint": sum(e is None for s in scores for e in s["time_errors_s"])}
+    return {"demos": len(scores), "correct": correct, "success_rate": correct / n,
+            "tolerance_s": tolerance, "covering": sum(s["covering"] for s in scores) / n,
+            "f1": sum(s["f1"] for s in scores) / n, "time_error_median_s": percentile(errors, 0.5),
+            "time_error_p95_s": percentile(errors, 0.95),
+            "transitions_without_changepoint": sum(e is None for s in scores
+                                                   for e in s["time_errors_s"])}
 
 
 # ---- physical success ----------------------------------------------------------------------------
@@ -141,29 +143,34 @@ def check_rule(rule, objects, joints, max_seconds=math.inf):
     """Raises ValueError naming what is wrong with one rule of a criterion; `objects` are the names
     a rule may judge (the task's objects and their frames), `joints` its articulated joints,
     `max_seconds` the longest time (a parameter named *_s) a task file may give."""
-    if not isinstance(rule, dict) or not isinstance(rule.get("rule"), str) or rule["rule"] not in RULE_PARAMETERS:
+    if (not isinstance(rule, dict) or not isinstance(rule.get("rule"), str)
+            or rule["rule"] not in RULE_PARAMETERS):
         raise ValueError("expected {rule: %s, ...}" % " | ".join(sorted(RULE_PARAMETERS)))
     required, optional = RULE_PARAMETERS[rule["rule"]]
     keys = set(rule) - {"rule"}
     if required - keys:
         raise ValueError("rule %s lacks %s" % (rule["rule"], ", ".join(sorted(required - keys))))
     if keys - required - optional:
-        raise ValueError("rule %s: unknown key(s) %s" % (rule["rule"], ", ".join(sorted(keys - required - optional))))
+        raise ValueError("rule %s: unknown key(s) %s"
+                         % (rule["rule"], ", ".join(sorted(keys - required - optional))))
     if "object" in rule and (not isinstance(rule["object"], str) or rule["object"] not in objects):
         raise ValueError("'%s' is not an object (or object.frame) of the task (%s)"
                          % (rule["object"], ", ".join(sorted(objects)) or "none"))
     if "joint" in rule and rule["joint"] not in joints:
-        raise ValueError("'%s' is not a joint of the task's objects (%s)" % (rule["joint"], ", ".join(joints) or "none"))
+        raise ValueError("'%s' is not a joint of the task's objects (%s)"
+                         % (rule["joint"], ", ".join(joints) or "none"))
     if rule["rule"] == "object_at_goal" and rule["distance"] not in DISTANCES:
-        raise ValueError("distance is '%s', expected one of %s" % (rule["distance"], ", ".join(DISTANCES)))
+        raise ValueError("distance is '%s', expected one of %s"
+                         % (rule["distance"], ", ".join(DISTANCES)))
     if rule["rule"] in ("height", "joint") and not ({"min_m", "max_m", "min", "max"} & keys):
         raise ValueError("rule %s needs a minimum or a maximum" % rule["rule"])
     for key in keys - {"object", "distance", "joint"}:
-        if not isinstance(rule[key], (int, float)) or isinstance(rule[key], bool) or not math.isfinite(rule[key]):
+        if (not isinstance(rule[key], (int, float)) or isinstance(rule[key], bool)
+                or not math.isfinite(rule[key])):
             raise ValueError("%s must be a number" % key)
         if key.endswith("_s") and rule[key] > max_seconds:
-            raise ValueError("%s: %g s is over %g s (task_limits/max_step_seconds of the scene file)"
-                             % (key, rule[key], max_seconds))
+            raise ValueError("%s: %g s is over %g s (task_limits/max_step_seconds of the scene "
+                             "file)" % (key, rule[key], max_seconds))
 
 
 def _yaw(q):
@@ -176,8 +183,8 @@ def _object_at_goal(rule, measured, scene, table_top):
     if p is None:
         return {"success": False, "reason": "%s was not recorded" % rule["object"]}
     goal = scene["goal"]
-    criteria = {"object": rule["object"], "distance": rule["distance"], "tolerance_m": rule["tolerance_m"],
-                "yaw_symmetry": rule.get("yaw_symmetry", 1)}
+    criteria = {"object": rule["object"], "distance": rule["distance"],
+                "tolerance_m": rule["tolerance_m"], "yaw_symmetry": rule.get("yaw_symmetry", 1)}
     return physical_outcome(criteria, p["position"], goal["position"], table_top,
                             _yaw(p["orientation"]), _yaw(goal["orientation"]))
 
@@ -185,9 +192,9 @@ def _object_at_goal(rule, measured, scene, table_top):
 def _bounded(value, lo, hi, unit_scale, unit, what):
     ok = (lo is None or value >= lo) and (hi is None or value <= hi)
     need = " and ".join(s for s in (lo is not None and ">= %g" % (lo * unit_scale),
-                                     hi is not None and "<= %g" % (hi * unit_scale)) if s)
-    return ok, "%s %.3g%s (need %s%s)" % (what, value * unit_scale, (" " + unit) if unit else "", need,
-                                          (" " + unit) if unit else "")
+                                    hi is not None and "<= %g" % (hi * unit_scale)) if s)
+    return ok, "%s %.3g%s (need %s%s)" % (what, value * unit_scale, (" " + unit) if unit else "",
+                                          need, (" " + unit) if unit else "")
 
 
 def _height(rule, measured, scene, table_top):
@@ -204,7 +211,8 @@ def _joint(rule, measured, scene, table_top):
     value = measured["joints"].get(rule["joint"])
     if value is None:
         return {"success": False, "reason": "joint %s was not recorded" % rule["joint"]}
-    ok, why = _bounded(value, rule.get("min"), rule.get("max"), 1, "", "joint %s ends at" % rule["joint"])
+    ok, why = _bounded(value, rule.get("min"), rule.get("max"), 1, "",
+                       "joint %s ends at" % rule["joint"])
     return {"success": ok, "joint_value": value, "reason": why}
 
 
@@ -257,10 +265,10 @@ def _contact_path(rule, measured, scene, table_top):
     passes, duration, beside = best
     ok = passes >= rule["passes"] and beside <= rule["tolerance_m"]
     return {"success": ok, "passes": passes, "contact_s": duration, "beside_m": beside,
-            "reason": "a %.1f s contact (>= %g N) covers the %.0f cm stroke %d time(s) (need %d), at most "
-                      "%.1f cm beside it (need <= %.1f)" % (
-                          duration, rule["min_force_n"], 100 * rule["length_m"], passes, rule["passes"],
-                          100 * beside, 100 * rule["tolerance_m"])}
+            "reason": "a %.1f s contact (>= %g N) covers the %.0f cm stroke %d time(s) (need %d), "
+                      "at most %.1f cm beside it (need <= %.1f)" % (
+                          duration, rule["min_force_n"], 100 * rule["length_m"], passes,
+                          rule["passes"], 100 * beside, 100 * rule["tolerance_m"])}
 
 
 RULES = {"object_at_goal": _object_at_goal, "height": _height, "joint": _joint,
@@ -279,7 +287,7 @@ def judge_rules(criterion, measured, scene, table_top):
         o = RULES[rule["rule"]](rule, measured, scene, table_top)
         o["rule"] = rule["rule"]
         outcomes.append(o)
-    first = lambda key: next((o[key] for o in outcomes if o.get(key) is not None), None)  # noqa: E731
+    first = lambda key: next((o[key] for o in outcomes if o.get(key) is not None), None)
     return {"success": all(o["success"] for o in outcomes), "rules": outcomes,
             "reason": "; ".join(o["reason"] for o in outcomes),
             "distance_m": first("distance_m"), "height_m": first("height_m"),
@@ -290,11 +298,13 @@ def wrap(angle, period):
     return (angle + period / 2) % period - period / 2
 
 
-def physical_outcome(criteria, object_position, goal_position, table_top, object_yaw=None, goal_yaw=None):
+def physical_outcome(criteria, object_position, goal_position, table_top, object_yaw=None,
+                     goal_yaw=None):
     """Judges an object's final pose against its goal: the object_at_goal rule (and, with
     min_lift_m, a height rule) of a task's criterion, as tasks.success_criterion also gives them:
-    {object, distance, tolerance_m, min_lift_m, yaw_symmetry}. Returns success, distance_m, height_m (above the table top),
-    yaw_error_rad (None without both yaws; modulo the object's symmetry) and a reason."""
+    {object, distance, tolerance_m, min_lift_m, yaw_symmetry}. Returns success, distance_m,
+    height_m (above the table top), yaw_error_rad (None without both yaws; modulo the object's
+    symmetry) and a reason."""
     d = [a - b for a, b in zip(object_position[:3], goal_position[:3])]
     horizontal = criteria["distance"] == "xy"
     distance = math.hypot(d[0], d[1]) if horizontal else math.sqrt(sum(v * v for v in d))
@@ -317,16 +327,20 @@ def describe_rule(rule):
     kind = rule["rule"]
     if kind == "object_at_goal":
         return "the %s ends within %.1f cm of its goal (%s)" % (
-            rule["object"], 100 * rule["tolerance_m"], "horizontal distance" if rule["distance"] == "xy" else "3-D")
+            rule["object"], 100 * rule["tolerance_m"],
+            "horizontal distance" if rule["distance"] == "xy" else "3-D")
     if kind == "height":
         return "the %s ends %s above the table" % (rule["object"], " and ".join(
             s for s in ("min_m" in rule and ">= %.0f cm" % (100 * rule["min_m"]),
                         "max_m" in rule and "<= %.0f cm" % (100 * rule["max_m"])) if s))
     if kind == "joint":
         return "the joint %s ends %s" % (rule["joint"], " and ".join(
-            s for s in ("min" in rule and ">= %g" % rule["min"], "max" in rule and "<= %g" % rule["max"]) if s))
+            s
+            for s in ("min" in rule and ">= %g" % rule["min"],
+                      "max" in rule and "<= %g" % rule["max"]) if s))
     return ("a sustained contact (>= %g N) covers the %.0f cm stroke %d times within %.0f cm"
-            % (rule["min_force_n"], 100 * rule["length_m"], rule["passes"], 100 * rule["tolerance_m"]))
+            % (rule["min_force_n"], 100 * rule["length_m"], rule["passes"],
+               100 * rule["tolerance_m"]))
 
 
 def describe_criteria(task, criteria):

@@ -53,7 +53,8 @@ class LiveRecording(object):
     def __init__(self, topics, since):
         import rospy
         self.since, self.messages = since, {t: [] for t in topics}
-        self.subs = [rospy.Subscriber(t, message_type(t), self._on, t, queue_size=10000) for t in topics]
+        self.subs = [rospy.Subscriber(t, message_type(t), self._on, t, queue_size=10000)
+                     for t in topics]
 
     def _on(self, msg, topic):
         if msg.header.stamp.to_sec() >= self.since:
@@ -64,7 +65,8 @@ class LiveRecording(object):
         published state is in (False after `timeout` wall s)."""
         deadline = time.time() + timeout
         while time.time() < deadline:
-            if all(m and m[-1].header.stamp.to_sec() >= stamp - 1e-6 for m in self.messages.values()):
+            if all(m and m[-1].header.stamp.to_sec() >= stamp - 1e-6
+                   for m in self.messages.values()):
                 return True
             time.sleep(0.005)
         return False
@@ -115,10 +117,12 @@ class Cell(object):
         deadline = time.time() + 120
         while not self._server_ready():
             if time.time() > deadline:
-                raise RuntimeError("the executor's action /executor/execute did not come up in 120 s")
+                raise RuntimeError("the executor's action /executor/execute did not come up in "
+                                   "120 s")
             time.sleep(0.01)
         self.goal_handle, self.feedback = None, []
-        # Wall s and calls by activity since the last take_wall() (bench/pipeline/profile_reproduction.py).
+        # Wall s and calls by activity since the last take_wall()
+        # (bench/pipeline/profile_reproduction.py).
         self.wall, self.calls = collections.Counter(), collections.Counter()
         self.srv["/bridge/pause"](data=lockstep)
         self.sim_time = self.step(1) if lockstep else None
@@ -181,7 +185,8 @@ class Cell(object):
         places {name: pose}, lets them settle (sim s)."""
         joints = joints or {}
         with self.timed("scene_calls"):
-            r = self.srv["/bridge/reset"](joint_names=list(joints), positions=[float(v) for v in joints.values()],
+            r = self.srv["/bridge/reset"](joint_names=list(joints),
+                                          positions=[float(v) for v in joints.values()],
                                           reset_objects=True)
         if not r.success:
             raise RuntimeError("reset failed: " + r.message)
@@ -239,7 +244,8 @@ class Cell(object):
         on_moving(feedback): called once the motion is sent (feedback.motion_start), before any
         of it is stepped (e.g. to schedule faults on its clock)."""
         started = time.time()
-        with self.timed("planning"):  # until the executor has planned and sent the motion (or ended)
+        # until the executor has planned and sent the motion (or ended)
+        with self.timed("planning"):
             self.send(goal)
             driven = self.drive(until=self.moving, timeout=timeout)
         if driven and on_moving and not self.done():
@@ -250,5 +256,6 @@ class Cell(object):
         self.wall["motion_step_calls"] += self.wall["step_calls"] - stepped_before
         if not driven:
             self.cancel()
-            raise RuntimeError("the goal took over %.0f s of wall time; cancelled" % (time.time() - started))
+            raise RuntimeError("the goal took over %.0f s of wall time; cancelled"
+                               % (time.time() - started))
         return self.result()[0], time.time() - started

@@ -121,7 +121,8 @@ def graph_for_this_process(launch_args, attach):
     (never another run's master that happens to answer on the default port)."""
     if attach:
         if not master_online():
-            raise RuntimeError("no ROS master answers at %s (--attach)" % os.environ.get("ROS_MASTER_URI"))
+            raise RuntimeError("no ROS master answers at %s (--attach)"
+                               % os.environ.get("ROS_MASTER_URI"))
         yield
         return
     previous = os.environ.get("ROS_MASTER_URI")

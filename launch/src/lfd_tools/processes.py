@@ -57,7 +57,6 @@ def zombie(pid):
     return True
 
 
-
 def session_processes(sid):
     """Pids of live (non-zombie) processes of session sid."""
     pids = []
@@ -86,7 +85,8 @@ def tree_cpu(root_pid):
                 text = f.read()
         except OSError:
             continue
-        name, fields = text[text.index("(") + 1:text.rindex(")")], text[text.rindex(")") + 2:].split()
+        name = text[text.index("(") + 1:text.rindex(")")]
+        fields = text[text.rindex(")") + 2:].split()
         children.setdefault(int(fields[1]), []).append(int(entry))
         stats[int(entry)] = (name, int(fields[11]) / ticks, int(fields[12]) / ticks)
     tree, todo = {}, [root_pid]

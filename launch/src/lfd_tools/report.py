@@ -63,8 +63,10 @@ def goal_record(goal_id, response=None, outcome=None, error="", demo_duration=No
          "planning_time_s": response.planning_time if executed else None,
          "segment_durations_s": list(response.segment_durations) if executed else [],
          "segment_frames": list(response.segment_frames) if response is not None else [],
-         "segment_slope_ridges": list(response.segment_slope_ridges) if response is not None else [],
-         "extrapolation_distance_m": response.extrapolation_distance if response is not None else None,
+         "segment_slope_ridges": (list(response.segment_slope_ridges) if response is not None
+                                  else []),
+         "extrapolation_distance_m": (response.extrapolation_distance if response is not None
+                                      else None),
          "extrapolation_angle_rad": response.extrapolation_angle if response is not None else None,
          "outside_demo_range": bool(response.outside_demo_range) if response is not None else None,
          "monitored": bool(response.monitored) if response is not None else False,
@@ -81,8 +83,8 @@ def reproduction_record(library, library_summary, goals, error=None):
     """A task's reproduction: library_summary = (mean demo duration s, demos, segments)."""
     demo_duration, demos, segments = library_summary
     successes = sum(g["success"] for g in goals)
-    r = {"library": library, "demos": demos, "segments": segments, "mean_demo_duration_s": demo_duration,
-         "goals_total": len(goals), "successes": successes,
+    r = {"library": library, "demos": demos, "segments": segments,
+         "mean_demo_duration_s": demo_duration, "goals_total": len(goals), "successes": successes,
          "success_rate": successes / len(goals) if goals else None,
          "execution_time_ratio": mean([g["time_ratio"] for g in goals]),
          "mean_overhead_ratio": mean([g["overhead_ratio"] for g in goals]),
@@ -90,8 +92,7 @@ def reproduction_record(library, library_summary, goals, error=None):
          "mean_object_yaw_error_rad": mean([g["object_yaw_error_rad"] for g in goals]),
          "mean_tcp_position_error_m": mean([g["tcp_position_error_m"] for g in goals]),
          "mean_planning_time_s": mean([g["planning_time_s"] for g in goals]),
-         "mean_wall_time_s": mean([g.get("wall_time_s") for g in goals]),
-         "goals": goals}
+         "mean_wall_time_s": mean([g.get("wall_time_s") for g in goals]), "goals": goals}
     errors = sorted({g["error"] for g in goals if g["error"]})
     if error or (errors and not successes):
         r["error"] = error or "; ".join(errors)
@@ -104,7 +105,8 @@ def monitor_summary(goals):
     monitored = [g for g in goals if g.get("monitored")]
     if not monitored:
         return "-"
-    return "%d/%d (max %.2f)" % (sum(bool(g.get("monitor_alarm")) for g in monitored), len(monitored),
+    return "%d/%d (max %.2f)" % (sum(bool(g.get("monitor_alarm")) for g in monitored),
+                                 len(monitored),
                                  max(g.get("max_anomaly_score", 0.0) for g in monitored))
 
 
@@ -133,7 +135,8 @@ def run_client(main):
     signal.signal(signal.SIGTERM, lambda *_: signal.default_int_handler(signal.SIGINT, None))
     try:
         return main()
-    except RuntimeError as exc:  # no master, a service that never came up, a bad config: said plainly
+    # no master, a service that never came up, a bad config: said plainly
+    except RuntimeError as exc:
         print("error: %s" % exc, file=sys.stderr)
         return 1
     except KeyboardInterrupt:
@@ -146,7 +149,8 @@ def ridges_note(goals):
     (-1: kernel average), over the goals: " (ridge per segment: 0.01, 100 / ...)" or ""."""
     seen = []
     for g in goals:
-        ridges = ", ".join("kernel" if r < 0 else "%g" % r for r in g.get("segment_slope_ridges") or [])
+        ridges = ", ".join("kernel" if r < 0 else "%g" % r
+                           for r in g.get("segment_slope_ridges") or [])
         if ridges and ridges not in seen:
             seen.append(ridges)
     return " (ridge per segment: %s)" % " / ".join(seen) if seen else ""

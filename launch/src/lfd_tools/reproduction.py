@@ -19,8 +19,10 @@ class NotJudged(RuntimeError):
 
 
 def place_scene(cell, task, scene):
-    """The task's objects where the scene has them (the others parked), its joints at their start."""
-    cell.set_scene(dict(tasks.parked(task), **scene["objects"]), SETTLE_BEFORE_S, scene.get("joints"))
+    """The task's objects where the scene has them (the others parked), its joints at their
+    start."""
+    cell.set_scene(dict(tasks.parked(task), **scene["objects"]), SETTLE_BEFORE_S,
+                   scene.get("joints"))
 
 
 def execute_and_judge(cell, task, scene, library, duration_scale=1.0, allow_extrapolation=False,
@@ -33,7 +35,8 @@ def execute_and_judge(cell, task, scene, library, duration_scale=1.0, allow_extr
         after_scene()
     measured = cell.record(bags.topics_for(criterion))
     try:
-        res, wall = cell.execute(lockstep.execute_goal(library, scene, duration_scale, allow_extrapolation),
+        res, wall = cell.execute(lockstep.execute_goal(library, scene, duration_scale,
+                                                       allow_extrapolation),
                                  on_moving=on_moving)
         if res is None:
             raise RuntimeError("the executor gave no result")
@@ -41,11 +44,13 @@ def execute_and_judge(cell, task, scene, library, duration_scale=1.0, allow_extr
         with cell.timed("judge_waits"):
             arrived = measured.wait_until(cell.now())
         if not arrived:
-            raise NotJudged("the final state was not published (%s)" % ", ".join(measured.messages), res)
+            raise NotJudged("the final state was not published (%s)"
+                            % ", ".join(measured.messages), res)
     finally:
         measured.close()
     with cell.timed("judging"):
-        outcome = judge.judge_rules(criterion, bags.measure(measured, criterion, tasks.base_in_world()),
+        outcome = judge.judge_rules(criterion, bags.measure(measured, criterion,
+                                                            tasks.base_in_world()),
                                     scene, tasks.table_top())
     return res, wall, outcome
 
@@ -53,7 +58,8 @@ def execute_and_judge(cell, task, scene, library, duration_scale=1.0, allow_extr
 def goal_bench_parser(description, goals):
     """The arguments every reproduction benchmark takes: a skill library, its mode, the tasks and
     how many of each task's unseen goals (the first N), and --attach to a running graph."""
-    ap = argparse.ArgumentParser(description=description, formatter_class=argparse.RawTextHelpFormatter)
+    ap = argparse.ArgumentParser(description=description,
+                                 formatter_class=argparse.RawTextHelpFormatter)
     ap.add_argument("--library-dir", required=True)
     ap.add_argument("--mode", default="sim")
     ap.add_argument("--tasks", default=None, help="comma-separated (default: every task)")

@@ -4,11 +4,12 @@ the MJCF robot (to be <include>d) and the MuJoCo workcell scene of config/scene.
 A robot description package (jvrc1_description, arm7_description, ...) keeps only its own data in
 models/generate_models.py -- its links (Link, with revolute/prismatic/fixed joints and geom()s;
 the parallel gripper every robot shares comes from parallel_gripper(), under the robot's own
-names, HandNames), and a Robot naming what is robot-specific: the sensors, the massless frame that becomes the
-force/torque site, the optional IMU site, the finger pads that get the soft contact with the table,
-the include file name -- and calls generate(). The URDF and the MJCF come from the same link
-list, so they cannot drift apart (lfd_sim_bridge/test/test_model_consistency.cpp checks it for
-every robot, and that the committed files are what its generator makes of config/scene.yaml).
+names, HandNames), and a Robot naming what is robot-specific: the sensors, the massless frame
+that becomes the force/torque site, the optional IMU site, the finger pads that get the soft
+contact with the table, the include file name -- and calls generate(). The URDF and the MJCF
+come from the same link list, so they cannot drift apart
+(lfd_sim_bridge/test/test_model_consistency.cpp checks it for every robot, and that the committed
+files are what its generator makes of config/scene.yaml).
 
 Conventions: a link's frame is its joint's frame; a joint origin is a translation and, optionally,
 a fixed rotation (rpy, URDF convention; most tables use none: every joint frame aligned with its
@@ -63,8 +64,8 @@ DRAWER_MASS, DRAWER_DAMPING, DRAWER_FRICTION = 0.4, 8.0, 1.5
 # 28 N and 0 N in turn), and table friction pushed the hand down by the stroke's speed (3-10 N
 # with 0.4): the press must be steady for its touch-down and lift-off to stand out. No grasp
 # touches the table with the fingers.
-FINGER_TABLE_CONTACT = ('solref="0.02 1" solimp="0.5 0.9 0.005" friction="0.05 0.05 0.005 0.0001 0.0001" '
-                        'condim="3"')
+FINGER_TABLE_CONTACT = ('solref="0.02 1" solimp="0.5 0.9 0.005" '
+                        'friction="0.05 0.05 0.005 0.0001 0.0001" condim="3"')
 
 ROBOT_COLOR = '0.75 0.78 0.82 1'
 DARK_COLOR = '0.25 0.27 0.30 1'
@@ -93,7 +94,8 @@ def sphere_inertia(m, r):
 def geom(kind, size, pos=(0.0, 0.0, 0.0), collide=False, color=ROBOT_COLOR, name=None):
     """kind: box (half sizes), cylinder (radius, half length along z), sphere (radius).
     collide: the geom touches the world in the MJCF (never another robot geom)."""
-    return {'kind': kind, 'size': size, 'pos': pos, 'collide': collide, 'color': color, 'name': name}
+    return {'kind': kind, 'size': size, 'pos': pos, 'collide': collide, 'color': color,
+            'name': name}
 
 
 def inertia_of(mass, g):
@@ -110,7 +112,8 @@ class Link:
     (URDF roll-pitch-yaw; zero = aligned with the parent). The first geom carries the inertia.
     sites: (name, pos, box half sizes) of touch sites on this link."""
 
-    def __init__(self, name, parent, joint, origin, mass=0.0, geoms=(), sites=(), rpy=(0.0, 0.0, 0.0)):
+    def __init__(self, name, parent, joint, origin, mass=0.0, geoms=(), sites=(),
+                 rpy=(0.0, 0.0, 0.0)):
         self.name, self.parent, self.joint, self.origin = name, parent, joint, origin
         self.rpy = tuple(rpy)
         self.mass, self.geoms, self.sites = mass, list(geoms), list(sites)
@@ -148,13 +151,13 @@ NY, NZ = (0, -1, 0), (0, 0, -1)
 class HandNames:
     """The names of one robot's parallel gripper (parallel_gripper()): its links, joints, pad geoms
     and touch sites. Only the names differ from robot to robot; the hand is the same."""
-    ft_frame: str       # massless frame of the wrist force/torque sensor (a site of the palm in MJCF)
+    ft_frame: str       # massless frame of the wrist F/T sensor (a site of the palm in MJCF)
     ft_joint: str       # its fixed joint to the parent link (the flange)
     palm: str           # the palm body: everything from it down is the F/T sensor's load
     palm_joint: str     # fixed, at the F/T frame's origin
     finger_left: str    # finger bodies, framed on their pad's inner face
     finger_right: str
-    finger_joint: str   # the driven prismatic joint (left finger, +y): half the opening between the pads
+    finger_joint: str   # the driven prismatic joint (left finger, +y): half the pads' opening
     mimic_joint: str    # the right finger's joint (-y), following finger_joint (an MJCF equality)
     pad_left: str       # the pads' collision geoms (soft contact with the table)
     pad_right: str
@@ -181,17 +184,19 @@ def parallel_gripper(names, parent, ft_origin, drive, ft_rpy=(0.0, 0.0, 0.0)):
         Link(n.ft_frame, parent, fixed(n.ft_joint), tuple(ft_origin), rpy=tuple(ft_rpy)),
         # Palm; everything below it is the load seen by the F/T sensor.
         Link(n.palm, n.ft_frame, fixed(n.palm_joint), (0.0, 0.0, 0.0), 0.35,
-             [geom('box', (0.03, 0.06, 0.0175), (0.0, 0.0, -0.0175), collide=True, color=DARK_COLOR)]),
+             [geom('box', (0.03, 0.06, 0.0175), (0.0, 0.0, -0.0175), collide=True,
+                   color=DARK_COLOR)]),
         # Finger frames sit on the pad (inner face); the finger body extends outwards from it.
         Link(n.finger_left, n.palm, prismatic(n.finger_joint, Y, 0.0, 0.045, drive),
              (0.0, 0.0, -0.035), 0.05,
-             [geom('box', (0.012, 0.006, 0.03), (0.0, 0.006, -0.03), collide=True, color=FINGER_COLOR,
-                   name=n.pad_left)],
+             [geom('box', (0.012, 0.006, 0.03), (0.0, 0.006, -0.03), collide=True,
+                   color=FINGER_COLOR, name=n.pad_left)],
              [(n.touch_left, (0.0, 0.006, -0.03), (0.013, 0.007, 0.031))]),
-        Link(n.finger_right, n.palm, prismatic(n.mimic_joint, NY, 0.0, 0.045, drive, mimic=n.finger_joint),
+        Link(n.finger_right, n.palm,
+             prismatic(n.mimic_joint, NY, 0.0, 0.045, drive, mimic=n.finger_joint),
              (0.0, 0.0, -0.035), 0.05,
-             [geom('box', (0.012, 0.006, 0.03), (0.0, -0.006, -0.03), collide=True, color=FINGER_COLOR,
-                   name=n.pad_right)],
+             [geom('box', (0.012, 0.006, 0.03), (0.0, -0.006, -0.03), collide=True,
+                   color=FINGER_COLOR, name=n.pad_right)],
              [(n.touch_right, (0.0, -0.006, -0.03), (0.013, 0.007, 0.031))]),
         # Tool centre point: between the pads, 12 mm above the finger tips.
         Link(n.tcp, n.palm, fixed(n.tcp_joint), (0.0, 0.0, -0.083)),
@@ -221,34 +226,35 @@ class Robot:
         self.ft_frame, self.imu, self.finger_pads = ft_frame, imu, tuple(finger_pads)
         self.include = include or f'{name}.xml'
         self.option_note = option_note or (
-            '1 kHz physics. Elliptic friction cones with a high impratio keep a pinch grasp from creeping;\n'
+            '1 kHz physics. Elliptic friction cones with a high impratio keep a pinch grasp from '
+            'creeping;\n'
             '       the Euler integrator treats the (large) joint damping implicitly.')
-        names = [l.name for l in self.links]
+        names = [link.name for link in self.links]
         if len(set(names)) != len(names):
             raise ValueError(f'{name}: duplicate link names')
-        roots = [l for l in self.links if l.parent is None]
+        roots = [link for link in self.links if link.parent is None]
         if len(roots) != 1:
             raise ValueError(f'{name}: needs exactly one root link')
         self.root = roots[0]
         if any(self.root.rpy):
             raise ValueError(f'{name}: the root link is mounted without rotation')
-        by_name = {l.name: l for l in self.links}
+        by_name = {link.name: link for link in self.links}
         if ft_frame is not None:
             ft = by_name[ft_frame]
-            kids = [l for l in self.links if l.parent == ft_frame]
+            kids = [link for link in self.links if link.parent == ft_frame]
             if ft.mass != 0 or ft.joint['type'] != 'fixed' or len(kids) != 1 or kids[0].mass == 0 \
                     or kids[0].joint['type'] != 'fixed' or any(kids[0].origin) or any(kids[0].rpy):
-                raise ValueError(f'{name}: the F/T frame {ft_frame} must be a massless fixed frame with '
-                                 'one body fixed at its origin below it')
+                raise ValueError(f'{name}: the F/T frame {ft_frame} must be a massless fixed frame '
+                                 'with one body fixed at its origin below it')
             self.ft_body = kids[0].name
         else:
             self.ft_body = None
 
     def total_mass(self):
-        return sum(l.mass for l in self.links)
+        return sum(link.mass for link in self.links)
 
     def mimic_joints(self):
-        return [l.joint for l in self.links if l.joint and l.joint.get('mimic')]
+        return [link.joint for link in self.links if link.joint and link.joint.get('mimic')]
 
 
 # ----------------------------------------------------------------------------------------------
@@ -277,7 +283,9 @@ def quat_of_rpy(rpy):
     if not any(rpy):
         return IDENTITY
     r, p, y = (a / 2 for a in rpy)
-    cr, sr, cp, sp, cy, sy = math.cos(r), math.sin(r), math.cos(p), math.sin(p), math.cos(y), math.sin(y)
+    cr, sr = math.cos(r), math.sin(r)
+    cp, sp = math.cos(p), math.sin(p)
+    cy, sy = math.cos(y), math.sin(y)
     return (cr * cp * cy + sr * sp * sy, sr * cp * cy - cr * sp * sy,
             cr * sp * cy + sr * cp * sy, cr * cp * sy - sr * sp * cy)
 
@@ -325,6 +333,7 @@ def drawer_cabinet(name, spec):
     fin_x = hx + 2 * DRAWER_FRONT_HALF[0] + DRAWER_FIN_HALF[0]  # the fin starts at the front
     fin = (fin_x - grip[0], 0.0, 0.0)
     wood = 'rgba="0.55 0.4 0.3 1" contype="1" conaffinity="1" condim="3"'
+    # The template is the generated file's text: its long lines are the file's (hence the noqa).
     return f'''    <body name="{name}" mocap="true" pos="{fmt(park[:3])}" quat="{fmt(quat_of_yaw(park[3]))}">
       <geom name="drawer_cabinet" type="box" size="{fmt(half)}" pos="0 0 {hz:.6g}" {wood}/>
       <body name="{name}_tray" pos="0 0 0">
@@ -339,7 +348,7 @@ def drawer_cabinet(name, spec):
                 rgba="0.3 0.3 0.35 1" contype="1" conaffinity="1" condim="4" friction="1.2 0.02 0.001"/>
         </body>
       </body>
-    </body>'''
+    </body>'''  # noqa: E501
 
 
 # ----------------------------------------------------------------------------------------------
@@ -376,14 +385,16 @@ def write_urdf(robot, path):
             out += ['    <inertial>',
                     f'      <origin xyz="{fmt(link.com)}" rpy="0 0 0"/>',
                     f'      <mass value="{link.mass:.6g}"/>',
-                    f'      <inertia ixx="{ixx:.6g}" ixy="0" ixz="0" iyy="{iyy:.6g}" iyz="0" izz="{izz:.6g}"/>',
+                    f'      <inertia ixx="{ixx:.6g}" ixy="0" ixz="0" iyy="{iyy:.6g}" iyz="0" '
+                    f'izz="{izz:.6g}"/>',
                     '    </inertial>']
         for g in link.geoms:
             for tag in ('visual', 'collision'):
                 out += [f'    <{tag}>', f'      <origin xyz="{fmt(g["pos"])}" rpy="0 0 0"/>',
                         f'      <geometry>{urdf_geometry(g)}</geometry>']
                 if tag == 'visual':
-                    out.append(f'      <material name="robot"><color rgba="{g["color"]}"/></material>')
+                    out.append(f'      <material name="robot">'
+                               f'<color rgba="{g["color"]}"/></material>')
                 out.append(f'    </{tag}>')
         out.append('  </link>')
         if link.parent is None:
@@ -394,8 +405,8 @@ def write_urdf(robot, path):
                 f'    <origin xyz="{fmt(link.origin)}" rpy="{urdf_rpy(link.rpy)}"/>']
         if j['type'] != 'fixed':
             out += [f'    <axis xyz="{fmt(j["axis"])}"/>',
-                    f'    <limit lower="{j["lo"]:.6g}" upper="{j["hi"]:.6g}" effort="{j["effort"]:.6g}" '
-                    f'velocity="{j["vel"]:.6g}"/>',
+                    f'    <limit lower="{j["lo"]:.6g}" upper="{j["hi"]:.6g}" '
+                    f'effort="{j["effort"]:.6g}" velocity="{j["vel"]:.6g}"/>',
                     f'    <dynamics damping="{j["damping"]:.6g}"/>']
             if j.get('mimic'):
                 out.append(f'    <mimic joint="{j["mimic"]}" multiplier="1" offset="0"/>')
@@ -415,7 +426,8 @@ def mj_geom(g, indent):
     # Collision on the geoms marked collide only (contype 2 never meets itself: no self-collision).
     cls = 'collide' if g['collide'] else 'visual'
     name = f' name="{g["name"]}"' if g['name'] else ''
-    return f'{indent}<geom{name} class="{cls}" type="{kind}" size="{size}" pos="{fmt(g["pos"])}" rgba="{g["color"]}"/>'
+    return (f'{indent}<geom{name} class="{cls}" type="{kind}" size="{size}" pos="{fmt(g["pos"])}" '
+            f'rgba="{g["color"]}"/>')
 
 
 def mj_quat(q):
@@ -433,7 +445,8 @@ def write_mjcf_robot(robot, path):
     children = {}
     for link in links:
         children.setdefault(link.parent, []).append(link)
-    actuated = [l.joint for l in links if l.joint and l.joint['type'] != 'fixed' and not l.joint.get('mimic')]
+    actuated = [link.joint for link in links
+                if link.joint and link.joint['type'] != 'fixed' and not link.joint.get('mimic')]
 
     body_lines = []
 
@@ -449,10 +462,11 @@ def write_mjcf_robot(robot, path):
         if j is not None and j['type'] == 'fixed':
             # Massless frames fold into their parent as sites; their children shift by the offset.
             if link.mass == 0:
-                # A leaf frame becomes a site; the F/T frame (which has the palm below it) is emitted
-                # as a site of that body instead (see Robot.ft_frame).
+                # A leaf frame becomes a site; the F/T frame (which has the palm below it) is
+                # emitted as a site of that body instead (see Robot.ft_frame).
                 if not children.get(link.name):
-                    body_lines.append(f'{ind}<site name="{link.name}" pos="{fmt(pos)}"{mj_quat(quat)} '
+                    body_lines.append(f'{ind}<site name="{link.name}" '
+                                      f'pos="{fmt(pos)}"{mj_quat(quat)} '
                                       'size="0.01" group="3"/>')
                 for child in children.get(link.name, []):
                     emit(child, depth, pos, quat)
@@ -464,18 +478,21 @@ def write_mjcf_robot(robot, path):
         if j is not None and j['type'] != 'fixed':
             kind = 'hinge' if j['type'] == 'revolute' else 'slide'
             body_lines.append(
-                f'{ind}  <joint name="{j["name"]}" type="{kind}" axis="{fmt(j["axis"])}" limited="true" '
-                f'range="{j["lo"]:.6g} {j["hi"]:.6g}" damping="{j["damping"]:.6g}" armature="{j["armature"]:.6g}"/>')
+                f'{ind}  <joint name="{j["name"]}" type="{kind}" axis="{fmt(j["axis"])}" '
+                f'limited="true" range="{j["lo"]:.6g} {j["hi"]:.6g}" '
+                f'damping="{j["damping"]:.6g}" armature="{j["armature"]:.6g}"/>')
         if robot.imu and link.name == robot.imu[1]:
-            body_lines.append(f'{ind}  <site name="{robot.imu[0]}" pos="0 0 0" size="0.01" group="3"/>')
+            body_lines.append(f'{ind}  <site name="{robot.imu[0]}" pos="0 0 0" size="0.01" '
+                              'group="3"/>')
         if link.name == robot.ft_body:
             # The wrench between this body and its parent carries the gripper and any grasped load.
-            body_lines.append(f'{ind}  <site name="{robot.ft_frame}" pos="0 0 0" size="0.01" group="3"/>')
+            body_lines.append(f'{ind}  <site name="{robot.ft_frame}" pos="0 0 0" size="0.01" '
+                              'group="3"/>')
         for g in link.geoms:
             body_lines.append(mj_geom(g, ind + '  '))
         for name, spos, ssize in link.sites:
-            body_lines.append(f'{ind}  <site name="{name}" type="box" pos="{fmt(spos)}" size="{fmt(ssize)}" '
-                              f'rgba="1 0.3 0.3 0.3" group="3"/>')
+            body_lines.append(f'{ind}  <site name="{name}" type="box" pos="{fmt(spos)}" '
+                              f'size="{fmt(ssize)}" rgba="1 0.3 0.3 0.3" group="3"/>')
         for child in children.get(link.name, []):
             emit(child, depth + 1, (0.0, 0.0, 0.0), IDENTITY)
         body_lines.append(f'{ind}</body>')
@@ -502,14 +519,14 @@ def write_mjcf_robot(robot, path):
     if mimics:
         out.append('  <equality>')
         for j in mimics:
-            out.append(f'    <joint name="{j["mimic"].lower()}_coupling" joint1="{j["name"]}" joint2="{j["mimic"]}" '
-                       'polycoef="0 1 0 0 0" solref="0.004 1"/>')
+            out.append(f'    <joint name="{j["mimic"].lower()}_coupling" joint1="{j["name"]}" '
+                       f'joint2="{j["mimic"]}" polycoef="0 1 0 0 0" solref="0.004 1"/>')
         out.append('  </equality>')
     out.append('  <actuator>')
     for j in actuated:
-        out.append(f'    <position name="{j["name"]}" joint="{j["name"]}" kp="{j["kp"]:.6g}" ctrllimited="true" '
-                   f'ctrlrange="{j["lo"]:.6g} {j["hi"]:.6g}" forcelimited="true" '
-                   f'forcerange="{-j["effort"]:.6g} {j["effort"]:.6g}"/>')
+        out.append(f'    <position name="{j["name"]}" joint="{j["name"]}" kp="{j["kp"]:.6g}" '
+                   f'ctrllimited="true" ctrlrange="{j["lo"]:.6g} {j["hi"]:.6g}" '
+                   f'forcelimited="true" forcerange="{-j["effort"]:.6g} {j["effort"]:.6g}"/>')
     out += ['  </actuator>', '  <sensor>']
     out += [mj_sensor(*s) for s in robot.sensors]
     out += ['  </sensor>', '</mujoco>']
@@ -536,16 +553,19 @@ def write_workcell(robot, scene, path):
             objects.append(drawer_cabinet(name, spec))
         else:
             mass, rgba, condim, friction = FREE_OBJECTS[name]
-            objects.append(free_box(name, spec['park'], mass, spec['half_size'], rgba, condim, friction))
+            objects.append(free_box(name, spec['park'], mass, spec['half_size'], rgba,
+                                    condim, friction))
     objects = '\n'.join(objects)
     # A mocap body counts as welded to the world, so MuJoCo's parent filter does not keep its
     # child from colliding with it: the drawer slides through its solid cabinet by exclusion.
     excludes = [f'    <exclude body1="{name}" body2="{name}_tray"/>'
                 for name, spec in scene['objects'].items() if spec.get('fixed')]
-    for body, geom_name in robot.finger_pads:  # the tips' own contact with the table replaces the default one
+    # the tips' own contact with the table replaces the default one
+    for body, geom_name in robot.finger_pads:
         excludes.append(f'    <exclude body1="{body}" body2="table"/>')
         excludes.append(f'    <pair geom1="{geom_name}" geom2="table_top" {FINGER_TABLE_CONTACT}/>')
     excludes = '\n'.join(excludes)
+    # The template is the generated file's text: its long lines are the file's (hence the noqa).
     out = f'''<!-- GENERATED by generate_models.py from config/scene.yaml; edit those, not this file. -->
 <mujoco model="lfd_workcell">
   <include file="{robot.include}"/>
@@ -579,7 +599,7 @@ def write_workcell(robot, scene, path):
 {excludes}
   </contact>
 </mujoco>
-'''
+'''  # noqa: E501
     with open(path, 'w') as f:
         f.write(out)
 

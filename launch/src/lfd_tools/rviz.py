@@ -116,7 +116,8 @@ def screenshot(bag, out, extra_args=(), timeout=120.0):
     xvfb, display = start_xvfb()
     launch = None
     try:
-        launch = start_inspect(display, os.path.abspath(bag), log_path, extra_args, master.free_port())
+        launch = start_inspect(display, os.path.abspath(bag), log_path, extra_args,
+                               master.free_port())
         deadline, previous = time.time() + timeout, None
         while time.time() < deadline:
             if launch.poll() is not None:

@@ -16,13 +16,14 @@ def score_answer(res, method, inputs, truths, spans, tolerance, elapsed):
     """One segmenter answer scored demo by demo against the true windows (absolute seconds) over
     each demo's span (first, last stamp)."""
     if len(res["demos"]) != len(inputs):
-        raise RuntimeError("segmenter returned %d demos for %d inputs" % (len(res["demos"]), len(inputs)))
+        raise RuntimeError("segmenter returned %d demos for %d inputs"
+                           % (len(res["demos"]), len(inputs)))
     scores = []
     for path, true_windows, (t_start, t_end), demo in zip(inputs, truths, spans, res["demos"]):
         found = list(demo["changepoint_times"])
         s = judge.score_demo(found, true_windows, t_start, t_end, tolerance)
-        s.update({"bag": ",".join(os.path.basename(p) for p in path.split(",")), "changepoints_s": found,
-                  "changepoints_rel_s": [c - t_start for c in found],
+        s.update({"bag": ",".join(os.path.basename(p) for p in path.split(",")),
+                  "changepoints_s": found, "changepoints_rel_s": [c - t_start for c in found],
                   "rejected_s": demo["rejected_times"], "pruned_s": demo["pruned_times"],
                   "zones_s": demo["zones"]})
         scores.append(s)
@@ -40,7 +41,8 @@ def run_and_score_methods(segment, methods, inputs, truths, spans, tolerance):
         start = time.time()
         answers = segment.methods(inputs, methods)
         elapsed = (time.time() - start) / len(methods)
-        return {m: score_answer(answers[m], m, inputs, truths, spans, tolerance, elapsed) for m in methods}
+        return {m: score_answer(answers[m], m, inputs, truths, spans,
+                                tolerance, elapsed) for m in methods}
     out = {}
     for m in methods:
         start = time.time()

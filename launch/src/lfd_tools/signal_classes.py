@@ -78,7 +78,7 @@ class SignalClass:
         return self.generate(rng, self.rate, demos or min(drawn, self.max_demos()))
 
 
-# ---- building blocks ------------------------------------------------------------------------------
+# ---- building blocks -----------------------------------------------------------------------------
 
 
 class Phases:
@@ -129,7 +129,8 @@ def reach(start, touch, n):
     (kinesthetic reaches end with a careful descent)."""
     above = touch + [0, 0, 0.04]
     down = max(2, n // 4)
-    return np.vstack([synthetic.min_jerk(start, above, n - down), synthetic.min_jerk(above, touch, down)])
+    return np.vstack([synthetic.min_jerk(start, above, n - down),
+                      synthetic.min_jerk(above, touch, down)])
 
 
 def sliding_friction(pos, rate, normal, mu):
@@ -156,7 +157,8 @@ def tip_wrench(friction, normal, lever, yaw, twist=None):
 def pose_columns(noise, pos, yaw):
     """POSE columns of a hand pointing down at `pos` turned by `yaw`, with measurement noise."""
     pos = pos + POSITION_NOISE * noise.standard_normal(pos.shape)
-    quat = synthetic.hand_down_quaternion(yaw) + QUATERNION_NOISE * noise.standard_normal((len(yaw), 4))
+    quat = (synthetic.hand_down_quaternion(yaw)
+            + QUATERNION_NOISE * noise.standard_normal((len(yaw), 4)))
     return dict(zip(POSE, np.column_stack([pos, quat]).T))
 
 
@@ -177,11 +179,12 @@ def task_of(rng, demos, state, sensor, shared, demo):
     return task
 
 
-# ---- the wipe (contact_wipe, stale_sensor, drifting_sensor) ---------------------------------------
+# ---- the wipe (contact_wipe, stale_sensor, drifting_sensor) --------------------------------------
 
 
 def wipe_shared(rng):
-    return {"direction": rng.uniform(0, np.pi), "lever": rng.uniform(0.08, 0.15), "mu": rng.uniform(0.3, 0.5)}
+    return {"direction": rng.uniform(0, np.pi), "lever": rng.uniform(0.08, 0.15),
+            "mu": rng.uniform(0.3, 0.5)}
 
 
 def wipe_demo(rate, disturbance):
@@ -201,13 +204,16 @@ def wipe_demo(rate, disturbance):
         wiping = touch + (amp * strokes * np.sin(2 * np.pi * tw / period))[:, None] * along
         on, off = ph.start[1], ph.start[2]
         press = envelope(ph.total, on, off, seconds(rate, p, 0.1, 0.4), seconds(rate, p, 0.1, 0.4))
-        wiping[:, 2] -= p.uniform(0.001, 0.002) * press[on:off]  # the surface gives under the pressure
+        # the surface gives under the pressure
+        wiping[:, 2] -= p.uniform(0.001, 0.002) * press[on:off]
         pos = np.vstack([reach(start, touch, n_reach), wiping,
                          synthetic.min_jerk(wiping[-1], start + [0, 0, 0.05], n_retract)])
         # Pressing harder on one stroke direction than the other; a level per demo.
-        normal = p.uniform(6, 15) * press * (1 + p.uniform(0.1, 0.3) * np.sin(2 * np.pi * (t - t[on]) / period))
+        normal = p.uniform(6, 15) * press * (1 + p.uniform(0.1, 0.3)
+                                             * np.sin(2 * np.pi * (t - t[on]) / period))
         yaw = hand_yaw(p, t)
-        wrench = tip_wrench(sliding_friction(pos, rate, normal, task["mu"]), normal, task["lever"], yaw)
+        wrench = tip_wrench(sliding_friction(pos, rate, normal, task["mu"]), normal,
+                            task["lever"], yaw)
         wrench += disturbance(noise, ph.total, rate)
         cols = pose_columns(noise, pos, yaw)
         cols.update(zip(WRENCH, wrench.T))
@@ -267,12 +273,13 @@ def drifting_sensor(rng, rate, demos):
     return task_of(rng, demos, POSE, WRENCH, wipe_shared, wipe_demo(rate, strong_drift))
 
 
-# ---- snap-fit assembly ----------------------------------------------------------------------------
+# ---- snap-fit assembly ---------------------------------------------------------------------------
 
 
 def snap_demo(rate):
     def demo(p, noise, task):
-        ph = Phases(rate, [p.uniform(2.0, 3.0), p.uniform(2.0, 3.0), p.uniform(0.7, 1.0), p.uniform(1.5, 2.5)])
+        ph = Phases(rate, [p.uniform(2.0, 3.0), p.uniform(2.0, 3.0), p.uniform(0.7, 1.0),
+                           p.uniform(1.5, 2.5)])
         t, (n_app, n_rot, n_ins, n_mate) = ph.t(), ph.n
         start = np.array([0.35, 0.2, 0.30]) + p.uniform(-0.05, 0.05, 3)
         seat = np.array([0.5, 0.05, 0.12]) + p.uniform(-0.03, 0.03, 3)
@@ -293,11 +300,13 @@ def snap_demo(rate):
         # operator's hold with a short ringing of the part.
         normal[ph.start[2]:ph.start[3]] = f_rot + (f_peak - f_rot) * np.linspace(0, 1, n_ins) ** 2
         ring = 3.0 * np.exp(-mate_t / 0.04) * np.sin(2 * np.pi * 25 * mate_t)
-        normal[ph.start[3]:] = f_hold + (f_peak - f_hold) * np.exp(-mate_t / p.uniform(0.03, 0.1)) + ring
+        normal[ph.start[3]:] = (f_hold + (f_peak - f_hold) * np.exp(-mate_t / p.uniform(0.03, 0.1))
+                                + ring)
         normal *= 1 + 0.03 * np.sin(2 * np.pi * t / p.uniform(1.5, 3.0))  # the hand's push wavers
         spin = np.gradient(turned) * rate  # the part turns on its seat only when turned on purpose
         twist = -task["mu"] * 0.015 * normal * np.tanh(spin / 0.05)  # friction on a 15 mm seat
-        side = normal[:, None] * task["tilt"] * (1 + p.normal(0, 0.2))  # the part sits a little askew
+        # the part sits a little askew
+        side = normal[:, None] * task["tilt"] * (1 + p.normal(0, 0.2))
         wrench = tip_wrench(side, normal, task["lever"], yaw, twist)
         wrench += synthetic.ft_disturbance(noise, ph.total, rate)
         cols = pose_columns(noise, pos, yaw)
@@ -308,7 +317,8 @@ def snap_demo(rate):
 
 def snap_shared(rng):
     angle = rng.uniform(0, 2 * np.pi)  # the direction in which the part sits askew
-    return {"turn_sign": rng.choice([-1.0, 1.0]), "mu": rng.uniform(0.3, 0.5), "lever": rng.uniform(0.06, 0.12),
+    return {"turn_sign": rng.choice([-1.0, 1.0]), "mu": rng.uniform(0.3, 0.5),
+            "lever": rng.uniform(0.06, 0.12),
             "tilt": rng.uniform(0.03, 0.08) * np.array([np.cos(angle), np.sin(angle)])}
 
 
@@ -322,7 +332,7 @@ def in_contact_level(rng, rate, demos):
     return task_of(rng, demos, POSE, WRENCH, snap_shared, snap_demo(rate))
 
 
-# ---- a short phase --------------------------------------------------------------------------------
+# ---- a short phase -------------------------------------------------------------------------------
 
 
 def press_demo(rate):
@@ -336,10 +346,12 @@ def press_demo(rate):
         pressed = np.vstack([synthetic.min_jerk(button, button - [0, 0, travel], down),
                              np.tile(button - [0, 0, travel], (n_press - down, 1))])
         away = task["away"] + p.uniform(-0.05, 0.05, 3)
-        pos = np.vstack([reach(start, button, n_reach), pressed, synthetic.min_jerk(pressed[-1], away, n_retract)])
-        # The rise fits the press (0.1-0.3 s of a 0.5-0.9 s phase); the button unloads as the lift starts.
-        normal = p.uniform(8, 15) * envelope(ph.total, ph.start[1], ph.start[2], seconds(rate, p, 0.1, 0.3),
-                                             seconds(rate, p, 0.1, 0.3))
+        pos = np.vstack([reach(start, button, n_reach), pressed,
+                         synthetic.min_jerk(pressed[-1], away, n_retract)])
+        # The rise fits the press (0.1-0.3 s of a 0.5-0.9 s phase); the button unloads as the lift
+        # starts.
+        normal = p.uniform(8, 15) * envelope(ph.total, ph.start[1], ph.start[2],
+                                             seconds(rate, p, 0.1, 0.3), seconds(rate, p, 0.1, 0.3))
         yaw = hand_yaw(p, t)
         wrench = tip_wrench(np.zeros((ph.total, 2)), normal, task["lever"], yaw)
         wrench += synthetic.ft_disturbance(noise, ph.total, rate)
@@ -359,7 +371,7 @@ def short_phase(rng, rate, demos):
                    press_demo(rate))
 
 
-# ---- repeated strokes -----------------------------------------------------------------------------
+# ---- repeated strokes ----------------------------------------------------------------------------
 
 STROKES = 4
 
@@ -368,20 +380,22 @@ def strokes_demo(rate):
     def demo(p, noise, task):
         air = [p.uniform(0.8, 1.3) for _ in range(STROKES - 1)]
         contact = [p.uniform(1.2, 1.8) for _ in range(STROKES)]
-        ph = Phases(rate, [p.uniform(1.5, 2.5)] + [d for pair in zip(contact, air + [p.uniform(1.5, 2.5)])
-                                                   for d in pair])
+        ph = Phases(rate, [p.uniform(1.5, 2.5)]
+                    + [d for pair in zip(contact, air + [p.uniform(1.5, 2.5)]) for d in pair])
         t = ph.t()
         along, across = task["along"], np.array([-task["along"][1], task["along"][0], 0.0])
         first = np.array([0.45, -0.1, 0.1]) + p.uniform(-0.04, 0.04, 3)
         spacing, length = p.uniform(0.02, 0.04), p.uniform(0.10, 0.16)
-        starts = [first + k * spacing * across + p.normal(0, 0.005, 3) * [1, 1, 0] for k in range(STROKES)]
+        starts = [first + k * spacing * across + p.normal(0, 0.005, 3) * [1, 1, 0]
+                  for k in range(STROKES)]
         home = np.array([0.3, -0.25, 0.3]) + p.uniform(-0.04, 0.04, 3)
         path = [reach(home, starts[0], ph.n[0])]
         normal = np.zeros(ph.total)
         for k in range(STROKES):
             on, off = ph.start[1 + 2 * k], ph.start[2 + 2 * k]
             stroke = synthetic.min_jerk(starts[k], starts[k] + length * along, ph.n[1 + 2 * k])
-            press = envelope(ph.total, on, off, seconds(rate, p, 0.1, 0.4), seconds(rate, p, 0.1, 0.4))
+            press = envelope(ph.total, on, off, seconds(rate, p, 0.1, 0.4),
+                             seconds(rate, p, 0.1, 0.4))
             stroke[:, 2] -= 0.0015 * press[on:off]  # the surface gives under the pressure
             normal += p.uniform(6, 14) * press
             n_next = ph.n[2 + 2 * k]
@@ -394,7 +408,8 @@ def strokes_demo(rate):
                 path += [stroke, synthetic.min_jerk(stroke[-1], home + [0, 0, 0.05], n_next)]
         pos = np.vstack(path)
         yaw = hand_yaw(p, t)
-        wrench = tip_wrench(sliding_friction(pos, rate, normal, task["mu"]), normal, task["lever"], yaw)
+        wrench = tip_wrench(sliding_friction(pos, rate, normal, task["mu"]), normal,
+                            task["lever"], yaw)
         wrench += synthetic.ft_disturbance(noise, ph.total, rate)
         cols = pose_columns(noise, pos, yaw)
         cols.update(zip(WRENCH, wrench.T))
@@ -421,21 +436,25 @@ def strokes(rng, rate, demos):
     return task_of(rng, demos, POSE, WRENCH, strokes_shared, strokes_demo(rate))
 
 
-# ---- pose only ------------------------------------------------------------------------------------
+# ---- pose only -----------------------------------------------------------------------------------
 
 
 def grating_demo(rate):
     def demo(p, noise, task):
-        cycles = [(p.uniform(0.6, 1.0), p.uniform(0.03, 0.06)) for _ in range(int(p.integers(3, 7)))]
+        cycles = [(p.uniform(0.6, 1.0), p.uniform(0.03, 0.06))
+                  for _ in range(int(p.integers(3, 7)))]
         ph = Phases(rate, [p.uniform(2.0, 3.0), sum(c[0] for c in cycles), p.uniform(1.5, 2.5)])
         t = ph.t()
         start = np.array([0.3, 0.2, 0.35]) + p.uniform(-0.05, 0.05, 3)
         grater = np.array([0.5, 0.0, 0.2]) + p.uniform(-0.04, 0.04, 3)
         # Each cycle out and back (zero speed at its ends), the hand 2 mm lower at the far end.
-        out = np.concatenate([a * (1 - np.cos(2 * np.pi * np.linspace(0, 1, max(2, int(round(d * rate)))))) / 2
-                              for d, a in cycles])
-        out = np.interp(np.linspace(0, 1, ph.n[1]), np.linspace(0, 1, len(out)), out)  # onto the phase's samples
-        grating = grater + out[:, None] * task["along"] - (0.002 * out / out.max())[:, None] * [0, 0, 1]
+        out = np.concatenate(
+            [a * (1 - np.cos(2 * np.pi * np.linspace(0, 1, max(2, int(round(d * rate)))))) / 2
+             for d, a in cycles])
+        # onto the phase's samples
+        out = np.interp(np.linspace(0, 1, ph.n[1]), np.linspace(0, 1, len(out)), out)
+        grating = (grater + out[:, None] * task["along"]
+                   - (0.002 * out / out.max())[:, None] * [0, 0, 1])
         pos = np.vstack([synthetic.min_jerk(start, grater, ph.n[0]), grating,
                          synthetic.min_jerk(grating[-1], start + [0, 0, 0.05], ph.n[2])])
         return t, pose_columns(noise, pos, hand_yaw(p, t)), ph.boundaries([1, 2])
@@ -475,7 +494,8 @@ def pause_demo(rate):
         for k, targets in enumerate(task["skills"]):
             if k:
                 hold(1.0, 4.0)  # the operator's pause between skills
-                bounds.append(sum(map(len, path)) / rate)  # the skill begins when the arm moves again
+                # the skill begins when the arm moves again
+                bounds.append(sum(map(len, path)) / rate)
             for j, target in enumerate(targets):
                 if j:
                     hold(0.2, 0.5)  # a hesitation inside the skill
@@ -497,7 +517,7 @@ def pause_boundaries(rng, rate, demos):
     return task_of(rng, demos, JOINTS, [], pause_shared, pause_demo(rate))
 
 
-# ---- the registry ---------------------------------------------------------------------------------
+# ---- the registry --------------------------------------------------------------------------------
 
 BASE = {  # name -> (generator, native rate in Hz, longest demo in s)
     "contact_wipe": (contact_wipe, 90.0, 9.5),
@@ -514,7 +534,8 @@ RATE_VARIANTS = {"contact_wipe": (25, 100, 1000), "in_contact_level": (25, 100, 
 
 def registry():
     """{name: SignalClass}: every base class at its native rate, then the rate variants."""
-    out = {name: SignalClass(name, gen, rate, longest) for name, (gen, rate, longest) in BASE.items()}
+    out = {name: SignalClass(name, gen, rate, longest)
+           for name, (gen, rate, longest) in BASE.items()}
     for name, rates in RATE_VARIANTS.items():
         gen, _, longest = BASE[name]
         out.update({"%s@%d" % (name, r): SignalClass("%s@%d" % (name, r), gen, float(r), longest)
@@ -535,7 +556,8 @@ def write_class(name, seed, out, demos=None):
     os.makedirs(folder, exist_ok=True)
     names = task.state_columns + task.sensor_columns
     truth = {"class": name, "seed": seed, "rate_hz": cls.rate, "description": cls.doc,
-             "state_columns": task.state_columns, "sensor_columns": task.sensor_columns, "demos": []}
+             "state_columns": task.state_columns, "sensor_columns": task.sensor_columns,
+             "demos": []}
     for k, demo in enumerate(task.demos):
         path = synthetic.write_demo_csv(folder, k, demo.t, names, [demo.columns[c] for c in names])
         truth["demos"].append({"file": os.path.basename(path),

@@ -6,11 +6,13 @@ message arriving last was taken as an object's final pose, and judged the demo b
 import bisect
 import sys
 
-GAP_FACTOR = 10.0  # lfd::kStampGapFactor: a step over 10 typical steps is a gap (a stall, lost messages)
+# lfd::kStampGapFactor: a step over 10 typical steps is a gap (a stall, lost messages)
+GAP_FACTOR = 10.0
 
 
 def stamp_of(msg, bag_time):
-    """A message's header stamp (s), or the time it was recorded when it has none (or a zero one)."""
+    """A message's header stamp (s), or the time it was recorded when it has none (or a zero
+    one)."""
     header = getattr(msg, "header", None)
     stamp = header.stamp.to_sec() if header is not None else 0.0
     return stamp if stamp > 0 else bag_time.to_sec()

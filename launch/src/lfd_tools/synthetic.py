@@ -12,7 +12,8 @@ import numpy as np
 def parse_demo_args(doc, demos, rate, extra=None):
     """(args, rng): OUT_DIR [--demos N] [--rate HZ] [--seed S], plus what `extra(parser)` adds;
     the output folder is made and the generator seeded."""
-    ap = argparse.ArgumentParser(description=doc, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap = argparse.ArgumentParser(description=doc,
+                                 formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("out")
     ap.add_argument("--demos", type=int, default=demos)
     ap.add_argument("--rate", type=float, default=rate, help="Hz")
@@ -52,8 +53,8 @@ def hand_down_quaternion(yaw):
 
 def ft_disturbance(rng, n, rate, drift=0.01):
     """What a wrist F/T adds to the true wrench (n x 6: fx fy fz tx ty tz): a rest offset (up to
-    2 N, 0.2 N m), a random-walk drift (`drift` per square root of a second) and white noise (0.5-0.7
-    N, 0.02-0.03 N m, a small industrial F/T)."""
+    2 N, 0.2 N m), a random-walk drift (`drift` per square root of a second) and white noise
+    (0.5-0.7 N, 0.02-0.03 N m, a small industrial F/T)."""
     offset = rng.uniform(-2, 2, 6) * [1, 1, 1, 0.1, 0.1, 0.1]
     walk = np.cumsum(rng.standard_normal((n, 6)), axis=0) * drift / np.sqrt(rate)
     noise = rng.standard_normal((n, 6)) * [0.5, 0.5, 0.7, 0.03, 0.03, 0.02]

@@ -109,7 +109,8 @@ def names():
     """Every task with a file, sorted by name (a folder of $LFD_TASKS_PATH shadows config/tasks)."""
     found = set()
     for d in directories():
-        found.update(os.path.splitext(os.path.basename(p))[0] for p in glob.glob(os.path.join(d, "*.yaml")))
+        found.update(os.path.splitext(os.path.basename(p))[0]
+                     for p in glob.glob(os.path.join(d, "*.yaml")))
     return sorted(found)
 
 
@@ -128,7 +129,7 @@ def datasets(tasks=None):
     return ["%s_%s" % (m, t) for m in MODES for t in (tasks or names())]
 
 
-# ---- what a task is --------------------------------------------------------------------------------
+# ---- what a task is ------------------------------------------------------------------------------
 
 
 def description(task):
@@ -149,7 +150,8 @@ def joints(task):
 def phases(task):
     """[{"name", "window"}] in order: the ground-truth phases (a window is the transition between
     the skills around it, e.g. grasp's gripper closing)."""
-    return [{"name": p["name"], "window": bool(p.get("window", False))} for p in _task(task)["phases"]]
+    return [{"name": p["name"], "window": bool(p.get("window", False))}
+            for p in _task(task)["phases"]]
 
 
 def segment_names(task):
@@ -226,7 +228,7 @@ def success_criterion(task):
     return out
 
 
-# ---- checks ---------------------------------------------------------------------------------------
+# ---- checks --------------------------------------------------------------------------------------
 
 
 def read_task_file(path):
@@ -245,7 +247,8 @@ def check_format(path):
     from catkin.find_in_workspaces import find_in_workspaces
     found = find_in_workspaces(search_dirs=["libexec"], project="lfd_sim_bridge", path="check_task")
     if not found:
-        raise RuntimeError("lfd_sim_bridge's check_task is not built (./lfd build): task files cannot be checked")
+        raise RuntimeError("lfd_sim_bridge's check_task is not built (./lfd build): task files "
+                           "cannot be checked")
     try:
         done = subprocess.run([found[0], "--scene", scene_file(), path], stdout=subprocess.DEVNULL,
                               stderr=subprocess.PIPE, universal_newlines=True, errors="replace",
@@ -276,6 +279,7 @@ def _check_success(data, path):
         fail("success", "expected a list of rules")
     for i, rule in enumerate(rules):
         try:
-            judge.check_rule(rule, set(objs) | parts, task_joints, task_limits()["max_step_seconds"])
+            judge.check_rule(rule, set(objs) | parts, task_joints,
+                             task_limits()["max_step_seconds"])
         except ValueError as exc:
             fail("success[%d]" % i, str(exc))

@@ -46,7 +46,7 @@ void checkRequestString(const std::string& field, std::string_view value,
 
 /// checkRequestString for every string of a serialized request (any depth, every array element),
 /// each named by its field path ("bag_paths[2]", "metadata.task"). Nodes call it through
-/// lfd_core/ros_request_strings.hpp before any other work.
+/// lfd_ros/ros_request_strings.hpp before any other work.
 void checkMessageStrings(const rosmsg::MessageSchema& schema, const std::uint8_t* data,
                          std::size_t size, const StringBudget& budget);
 

@@ -1,6 +1,5 @@
 // A bag message read as its type with its bytes checked first, for the nodes' and tools' bag
-// readers. Header-only and, like ros_request_strings.hpp, one of the parts of lfd_core that
-// include ROS headers; the library itself stays ROS-free.
+// readers: lfd_core's ROS-free message reader applied to rosbag's messages (header-only).
 #pragma once
 
 #include <ros/message_traits.h>

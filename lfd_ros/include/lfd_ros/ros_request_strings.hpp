@@ -1,7 +1,6 @@
 // The string budget of a ROS request (service request, action goal), for the nodes: every string
 // field of the message, found through the message's own definition, so a field added later is
-// bounded too. Header-only and the one part of lfd_core that includes roscpp's serialization
-// headers; the library itself stays ROS-free.
+// bounded too: lfd_core's ROS-free budget applied to roscpp's serialization (header-only).
 #pragma once
 
 #include <ros/message_traits.h>
