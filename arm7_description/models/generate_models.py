@@ -8,7 +8,7 @@ Writes, next to this file:
   workcell.xml the MuJoCo scene of config/scene.yaml (floor, table, the stick, the box, the block,
                the drawer cabinet) with this arm in it
 
-The writers are the robot-independent lfd_tools.robot_models (launch/src/lfd_tools, importable
+The writers are the robot-independent lfd_tools.robot_models (lfd_tools/src/lfd_tools, importable
 after `source devel/setup.bash`); this file holds only the arm's tables. The arm stands where
 config/scene.yaml puts the robot (base_link_in_world, the IK and Cartesian frame of every task
 pose): its root link base_link is that mount point, no rotation, on a column down to the floor

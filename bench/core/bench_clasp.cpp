@@ -8,8 +8,8 @@
 #include <cmath>
 #include <random>
 
-#include "lfd_core/clasp.hpp"
-#include "lfd_core/multivariate_segmentation.hpp"
+#include "lfd_core/segmentation/clasp.hpp"
+#include "lfd_core/segmentation/multivariate_segmentation.hpp"
 
 namespace {
 

@@ -2,9 +2,9 @@
 //   bench_dmp                      # all
 //   bench_dmp --benchmark_filter=Rollout
 #include "dmp_test_curves.hpp"
-#include "lfd_core/dmp_generalization.hpp"
-#include "lfd_core/position_dmp.hpp"
-#include "lfd_core/segment_dmp.hpp"
+#include "lfd_core/dmp/dmp_generalization.hpp"
+#include "lfd_core/dmp/position_dmp.hpp"
+#include "lfd_core/dmp/segment_dmp.hpp"
 
 #include <benchmark/benchmark.h>
 

@@ -8,7 +8,7 @@
 #include <random>
 #include <vector>
 
-#include "lfd_core/dtw.hpp"
+#include "lfd_core/segmentation/dtw.hpp"
 
 namespace {
 

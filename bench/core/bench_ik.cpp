@@ -12,9 +12,9 @@
 #include <string>
 #include <vector>
 
-#include "lfd_core/inverse_kinematics.hpp"
-#include "lfd_core/kinematic_chain.hpp"
-#include "lfd_core/robot_setup.hpp"
+#include "lfd_core/kinematics/inverse_kinematics.hpp"
+#include "lfd_core/kinematics/kinematic_chain.hpp"
+#include "lfd_core/kinematics/robot_setup.hpp"
 
 namespace {
 

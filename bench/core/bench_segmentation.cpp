@@ -9,7 +9,7 @@
 #include <cmath>
 #include <random>
 
-#include "lfd_core/segmentation_pipeline.hpp"
+#include "lfd_core/segmentation/segmentation_pipeline.hpp"
 
 namespace {
 
@@ -65,7 +65,8 @@ lfd::SegmentationPipelineConfig yaml_config() {
 void BM_Pipeline(benchmark::State& state) {
   const auto d = demos();
   const auto config = yaml_config();
-  for (auto _ : state) benchmark::DoNotOptimize(lfd::run_segmentation_pipeline(d, sensors(), config));
+  for (auto _ : state)
+    benchmark::DoNotOptimize(lfd::run_segmentation_pipeline(d, sensors(), config));
 }
 BENCHMARK(BM_Pipeline)->Unit(benchmark::kMillisecond)->UseRealTime();
 
@@ -92,7 +93,8 @@ void BM_SensorEventsFitted(benchmark::State& state) {
   const auto config = lfd::in_samples(yaml_config(), 50.0);
   const Eigen::MatrixXd s = d[0].select(sensors()).data;
   const std::vector<std::size_t> groups(kSensors, 0);
-  for (auto _ : state) benchmark::DoNotOptimize(lfd::detect_sensor_events(s, config.events, groups));
+  for (auto _ : state)
+    benchmark::DoNotOptimize(lfd::detect_sensor_events(s, config.events, groups));
 }
 BENCHMARK(BM_SensorEventsFitted)->Unit(benchmark::kMicrosecond);
 

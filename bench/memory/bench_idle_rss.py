@@ -26,7 +26,7 @@ import rosgraph
 from lfd_tools import lockstep, master, tasks
 
 ROOT = os.path.abspath(os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", ".."))
-PIPELINE = os.path.join(ROOT, "launch", "scripts", "pipeline.py")
+PIPELINE = os.path.join(ROOT, "lfd_launch", "scripts", "pipeline.py")
 TASK, MODE = "grasp", "sim"
 IDLE_AFTER_S = 3.0  # the node trims at the end of the request; this is well after it
 

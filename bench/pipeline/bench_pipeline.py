@@ -21,7 +21,7 @@ import tempfile
 import time
 
 ROOT = os.path.abspath(os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", ".."))
-PIPELINE = os.path.join(ROOT, "launch", "scripts", "pipeline.py")
+PIPELINE = os.path.join(ROOT, "lfd_launch", "scripts", "pipeline.py")
 STAGES = ("datasets", "segment", "learn", "reproduce", "figures")
 
 

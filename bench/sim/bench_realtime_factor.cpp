@@ -18,7 +18,7 @@
 #include <string>
 #include <vector>
 
-#include "lfd_core/robot_setup.hpp"
+#include "lfd_core/kinematics/robot_setup.hpp"
 #include "lfd_sim_bridge/workcell_sim.hpp"
 
 namespace {

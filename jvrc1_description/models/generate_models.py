@@ -10,7 +10,7 @@ Writes, next to this file:
 The workcell's shared facts (table, the robot's placement, object sizes, park poses, the drawer's
 joint and handle) are read from config/scene.yaml, which the task files and the demonstrator read
 too; the robot's numbers live in the tables below, and the writers (URDF, MJCF, workcell) are the
-robot-independent lfd_tools.robot_models (launch/src/lfd_tools, importable after
+robot-independent lfd_tools.robot_models (lfd_tools/src/lfd_tools, importable after
 `source devel/setup.bash`). Both robot files are emitted from the same link list, so the URDF and
 MJCF cannot drift apart (lfd_sim_bridge/test/test_model_consistency.cpp checks it, and that
 workcell.xml is what this script makes of scene.yaml).

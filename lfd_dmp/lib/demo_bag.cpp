@@ -1,10 +1,10 @@
 #include "lfd_dmp/demo_bag.hpp"
 #include "lfd_dmp/demo_scene.hpp"
 
+#include <lfd_core/io/safe_paths.hpp>
+#include <lfd_core/io/stamp_order.hpp>
+#include <lfd_core/io/user_text.hpp>
 #include <lfd_ros/ros_bag_message.hpp>
-#include <lfd_core/safe_paths.hpp>
-#include <lfd_core/stamp_order.hpp>
-#include <lfd_core/user_text.hpp>
 
 #include <geometry_msgs/PoseStamped.h>
 #include <lfd_msgs/DemoMetadata.h>

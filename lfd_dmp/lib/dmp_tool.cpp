@@ -3,8 +3,8 @@
 #include "lfd_dmp/skill_library.hpp"
 #include "lfd_dmp/trajectory_csv.hpp"
 
-#include <lfd_core/dmp_generalization.hpp>
-#include <lfd_core/safe_paths.hpp>
+#include <lfd_core/dmp/dmp_generalization.hpp>
+#include <lfd_core/io/safe_paths.hpp>
 
 #include <cmath>
 #include <cstdlib>

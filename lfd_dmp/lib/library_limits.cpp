@@ -2,7 +2,7 @@
 
 #include "lfd_dmp/skill_library.hpp"
 
-#include <lfd_core/user_text.hpp>
+#include <lfd_core/io/user_text.hpp>
 
 #include <cmath>
 #include <sstream>

@@ -2,7 +2,7 @@
 
 #include <algorithm>
 
-#include "lfd_core/ros_message_schema.hpp"
+#include "lfd_core/io/ros_message_schema.hpp"
 
 namespace lfd_dmp {
 

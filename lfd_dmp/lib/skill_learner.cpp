@@ -1,9 +1,9 @@
 #include "lfd_dmp/skill_learner.hpp"
 
-#include <lfd_core/dmp_generalization.hpp>
-#include <lfd_core/quaternion_log.hpp>
-#include <lfd_core/smooth_derivatives.hpp>
-#include <lfd_core/time_alignment.hpp>
+#include <lfd_core/dmp/dmp_generalization.hpp>
+#include <lfd_core/dmp/quaternion_log.hpp>
+#include <lfd_core/segmentation/smooth_derivatives.hpp>
+#include <lfd_core/segmentation/time_alignment.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -161,8 +161,8 @@ void learnSegment(const std::vector<UsedDemo>& used, size_t s, const LearnOption
   }
 }
 
-// The demos' sensations per segment (lfd_core/sensory_signature.hpp), cut where their DMPs were.
-// Demos without the same sensors are left out of it, with a warning; fewer than two: none.
+// The demos' sensations per segment (lfd_core/dmp/sensory_signature.hpp), cut where their DMPs
+// were. Demos without the same sensors are left out of it, with a warning; fewer than two: none.
 void learnSignature(const std::vector<UsedDemo>& used, const lfd::SignatureOptions& options,
                     LearnOutcome* out) {
   std::vector<lfd::SegmentedRecording> recordings;

@@ -3,8 +3,8 @@
 #include "json_fields.hpp"
 #include "lfd_dmp/signature_json.hpp"
 
-#include <lfd_core/safe_paths.hpp>
-#include <lfd_core/user_text.hpp>
+#include <lfd_core/io/safe_paths.hpp>
+#include <lfd_core/io/user_text.hpp>
 
 #include <cmath>
 #include <cstdio>

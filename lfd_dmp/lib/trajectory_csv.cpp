@@ -1,8 +1,8 @@
 #include "lfd_dmp/trajectory_csv.hpp"
 
-#include <lfd_core/csv_table.hpp>
-#include <lfd_core/safe_paths.hpp>
-#include <lfd_core/user_text.hpp>
+#include <lfd_core/io/csv_table.hpp>
+#include <lfd_core/io/safe_paths.hpp>
+#include <lfd_core/io/user_text.hpp>
 
 #include <algorithm>
 #include <iomanip>

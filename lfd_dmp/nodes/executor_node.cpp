@@ -10,18 +10,18 @@
 // Every wait is bounded in wall time (a clock that stops fails the goal instead of hanging it), and
 // a preemption or cancel is served at any moment (planning, moving, settling).
 // The logic is lfd_dmp::TaskPlanner (lib/executor.cpp); this file is ROS I/O and monitoring.
-// Parameters: config/executor.yaml (loaded by launch/reproduce.launch).
+// Parameters: config/executor.yaml (loaded by lfd_launch/reproduce.launch).
 #include "lfd_dmp/execution_monitor.hpp"
 #include "lfd_dmp/execution_request.hpp"
 #include "lfd_dmp/executor.hpp"
 #include "lfd_dmp/plan_messages.hpp"
 
 #include <lfd_msgs/ExecuteTaskAction.h>
-#include <lfd_core/heap_trim.hpp>
-#include <lfd_core/robot_setup.hpp>
-#include <lfd_ros/ros_request_strings.hpp>
-#include <lfd_core/safe_paths.hpp>
+#include <lfd_core/io/safe_paths.hpp>
+#include <lfd_core/kinematics/robot_setup.hpp>
+#include <lfd_core/util/heap_trim.hpp>
 #include <lfd_ros/master_watch.hpp>
+#include <lfd_ros/ros_request_strings.hpp>
 
 #include <actionlib/server/simple_action_server.h>
 #include <ros/ros.h>

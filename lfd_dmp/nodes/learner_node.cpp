@@ -18,12 +18,12 @@
 #include <tf2_ros/buffer.h>
 #include <tf2_ros/transform_listener.h>
 
-#include <lfd_core/heap_trim.hpp>
-#include <lfd_core/input_budget.hpp>
-#include <lfd_ros/ros_request_strings.hpp>
-#include <lfd_core/safe_paths.hpp>
-#include <lfd_core/time_alignment.hpp>
+#include <lfd_core/io/input_budget.hpp>
+#include <lfd_core/io/safe_paths.hpp>
+#include <lfd_core/segmentation/time_alignment.hpp>
+#include <lfd_core/util/heap_trim.hpp>
 #include <lfd_ros/master_watch.hpp>
+#include <lfd_ros/ros_request_strings.hpp>
 
 #include <algorithm>
 #include <chrono>

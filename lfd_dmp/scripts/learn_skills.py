@@ -16,7 +16,7 @@ number of segments and whether the names fit (otherwise they are left unnamed, w
 Boundaries are never made up. Each segment's goal frame is learned from the demos' scenes; the
 record lists, per segment, the frames chosen and their spread across the demos.
 
-Starts a private master with launch/learn.launch for the run, or with --attach uses the services
+Starts a private master with lfd_launch/learn.launch for the run, or with --attach uses the services
 running at ROS_MASTER_URI (the pipeline's learn stage, which runs learn.launch once).
 Writes {"learning": {"<mode>_<task>": record}} (lfd_tools.report.learning_record) to --out, also
 after an error or Ctrl-C with what was done. A task whose learning fails is reported with its error;

@@ -19,8 +19,8 @@ whatever the load. The executor knows no simulator: it follows sim time. --real-
 bridge running, paced at wall-clock time (real_time_factor 1, for watching in rviz). Time ratio =
 executed time (sim) / mean demonstrated duration of the learned segments (same span).
 
-Starts a private master with launch/reproduce.launch for the run, or with --attach uses the nodes
-running at ROS_MASTER_URI (the pipeline's reproduce stage, which runs reproduce.launch once).
+Starts a private master with lfd_launch/reproduce.launch for the run, or with --attach uses the
+nodes running at ROS_MASTER_URI (the pipeline's reproduce stage, which runs reproduce.launch once).
 Writes {"<reproduction key>": {task: record}} (lfd_tools.report.reproduction_record; the key is
 `reproduction` for sim, `reproduction_<mode>` otherwise) to --out, also after an error or Ctrl-C
 with the goals done ("complete": false). Exit status 0 only if every goal was reached.

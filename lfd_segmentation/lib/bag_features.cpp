@@ -13,12 +13,12 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "lfd_core/bag_errors.hpp"
-#include "lfd_core/input_budget.hpp"
-#include "lfd_core/ros_message_reader.hpp"
-#include "lfd_core/safe_paths.hpp"
-#include "lfd_core/stamp_order.hpp"
-#include "lfd_core/user_text.hpp"
+#include "lfd_core/io/bag_errors.hpp"
+#include "lfd_core/io/input_budget.hpp"
+#include "lfd_core/io/ros_message_reader.hpp"
+#include "lfd_core/io/safe_paths.hpp"
+#include "lfd_core/io/stamp_order.hpp"
+#include "lfd_core/io/user_text.hpp"
 
 namespace lfd_segmentation {
 

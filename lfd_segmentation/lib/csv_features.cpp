@@ -3,9 +3,9 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "lfd_core/csv_table.hpp"
-#include "lfd_core/segmentation_pipeline.hpp"
-#include "lfd_core/user_text.hpp"
+#include "lfd_core/io/csv_table.hpp"
+#include "lfd_core/io/user_text.hpp"
+#include "lfd_core/segmentation/segmentation_pipeline.hpp"
 
 namespace lfd_segmentation {
 

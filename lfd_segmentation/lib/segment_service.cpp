@@ -5,8 +5,8 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "lfd_core/io/safe_paths.hpp"
 #include "lfd_ros/ros_request_strings.hpp"
-#include "lfd_core/safe_paths.hpp"
 #include "lfd_segmentation/bag_features.hpp"
 
 namespace lfd_segmentation {

@@ -1,11 +1,11 @@
 // Segmentation service node: advertises ~segment (/segmentation/segment when the node is named
-// "segmentation", as in launch/segment.launch) of type lfd_msgs/Segment. Parameters are the
+// "segmentation", as in lfd_launch/segment.launch) of type lfd_msgs/Segment. Parameters are the
 // node's private namespace, loaded from config/segmentation.yaml. A failing request returns
 // success=false with an error; the node stays up.
 #include <ros/ros.h>
 #include <yaml-cpp/yaml.h>
 
-#include "lfd_core/heap_trim.hpp"
+#include "lfd_core/util/heap_trim.hpp"
 #include "lfd_ros/master_watch.hpp"
 #include "lfd_segmentation/segment_service.hpp"
 

@@ -10,8 +10,8 @@
 
 #include <nlohmann/json.hpp>
 
-#include "lfd_core/sensory_signature.hpp"
-#include "lfd_core/user_text.hpp"
+#include "lfd_core/dmp/sensory_signature.hpp"
+#include "lfd_core/io/user_text.hpp"
 #include "lfd_segmentation/bag_features.hpp"
 #include "lfd_segmentation/cli_args.hpp"
 #include "lfd_segmentation/csv_features.hpp"

@@ -135,7 +135,7 @@ TEST(BagFeatures, LinkSwappedToFifoNeverHangsTheReader) {
 }
 
 // Regression: one /ee_pose stamped 5 s late is kept, in stamp order, and warned about by the
-// same policy as the learner's reader (lfd_core/stamp_order.hpp).
+// same policy as the learner's reader (lfd_core/io/stamp_order.hpp).
 TEST(BagFeatures, AMessageStampedLateIsPutInOrderAndWarned) {
   const std::string bag = (temp_dir() / "late_pose.bag").string();
   lfd_segmentation_test::DemoBagOptions o;

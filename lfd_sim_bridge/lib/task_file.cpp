@@ -2,7 +2,7 @@
 
 #include <yaml-cpp/depthguard.h>
 #include <yaml-cpp/yaml.h>
-#include <lfd_core/safe_paths.hpp>
+#include <lfd_core/io/safe_paths.hpp>
 
 #include <algorithm>
 #include <cmath>

@@ -49,9 +49,9 @@
 #include <utility>
 #include <vector>
 
-#include "lfd_core/robot_setup.hpp"
-#include "lfd_ros/ros_request_strings.hpp"
+#include "lfd_core/kinematics/robot_setup.hpp"
 #include "lfd_ros/master_watch.hpp"
+#include "lfd_ros/ros_request_strings.hpp"
 #include "lfd_sim_bridge/fault_schedule.hpp"
 #include "lfd_sim_bridge/sensor_publishers.hpp"
 #include "lfd_sim_bridge/sensor_table.hpp"

@@ -49,8 +49,8 @@
 #include <tf2_ros/transform_listener.h>
 #include <trajectory_msgs/JointTrajectory.h>
 
-#include "lfd_core/heap_trim.hpp"
-#include "lfd_core/robot_setup.hpp"
+#include "lfd_core/kinematics/robot_setup.hpp"
+#include "lfd_core/util/heap_trim.hpp"
 #include "lfd_ros/master_watch.hpp"
 #include "lfd_sim_bridge/demo_jobs.hpp"
 #include "lfd_sim_bridge/demo_metadata.hpp"

@@ -27,10 +27,10 @@
 #include <rosgraph_msgs/Clock.h>
 #include <topic_tools/shape_shifter.h>
 
-#include <lfd_core/heap_trim.hpp>
-#include <lfd_core/robot_setup.hpp>
+#include <lfd_core/io/safe_paths.hpp>
+#include <lfd_core/kinematics/robot_setup.hpp>
+#include <lfd_core/util/heap_trim.hpp>
 #include <lfd_ros/ros_request_strings.hpp>
-#include <lfd_core/safe_paths.hpp>
 
 #include "lfd_ros/master_watch.hpp"
 #include "lfd_sim_bridge/bag_recorder.hpp"

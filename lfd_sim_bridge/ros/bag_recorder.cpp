@@ -15,7 +15,7 @@
 #include <vector>
 
 #include <ros/serialization.h>
-#include <lfd_core/user_text.hpp>
+#include <lfd_core/io/user_text.hpp>
 
 namespace lfd_sim_bridge {
 namespace {

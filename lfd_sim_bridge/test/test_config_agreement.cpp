@@ -9,7 +9,7 @@
 #include <map>
 #include <string>
 
-#include "lfd_core/robot_setup.hpp"
+#include "lfd_core/kinematics/robot_setup.hpp"
 
 namespace {
 

@@ -7,8 +7,8 @@
 
 #include <gtest/gtest.h>
 
-#include "lfd_core/cartesian_path.hpp"
-#include "lfd_core/robot_setup.hpp"
+#include "lfd_core/kinematics/cartesian_path.hpp"
+#include "lfd_core/kinematics/robot_setup.hpp"
 #include "lfd_sim_bridge/demo_plan.hpp"
 
 namespace demo = lfd_sim_bridge::demo;

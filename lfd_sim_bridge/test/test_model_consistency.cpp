@@ -23,8 +23,8 @@
 #include <fstream>
 #include <iterator>
 
-#include "lfd_core/kinematic_chain.hpp"
-#include "lfd_core/robot_setup.hpp"
+#include "lfd_core/kinematics/kinematic_chain.hpp"
+#include "lfd_core/kinematics/robot_setup.hpp"
 #include "lfd_sim_bridge/sensor_table.hpp"
 #include "lfd_sim_bridge/task_file.hpp"
 

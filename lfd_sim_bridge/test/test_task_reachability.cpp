@@ -19,7 +19,7 @@
 
 #include <yaml-cpp/yaml.h>
 
-#include "lfd_core/robot_setup.hpp"
+#include "lfd_core/kinematics/robot_setup.hpp"
 #include "lfd_sim_bridge/demo_plan.hpp"
 
 namespace demo = lfd_sim_bridge::demo;

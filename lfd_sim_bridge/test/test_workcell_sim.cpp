@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "lfd_core/robot_setup.hpp"
+#include "lfd_core/kinematics/robot_setup.hpp"
 #include "lfd_sim_bridge/sensor_table.hpp"
 #include "lfd_sim_bridge/trajectory_interpolator.hpp"
 #include "lfd_sim_bridge/workcell_sim.hpp"

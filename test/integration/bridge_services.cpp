@@ -18,7 +18,7 @@
 #include <cmath>
 
 #include "bridge_test_utils.hpp"
-#include "lfd_core/robot_setup.hpp"
+#include "lfd_core/kinematics/robot_setup.hpp"
 
 namespace {
 

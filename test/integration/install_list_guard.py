@@ -39,7 +39,7 @@ class InstallListGuard(unittest.TestCase):
         line = [x for x in out.splitlines() if x.strip().startswith("MISSING rosrun:")]
         self.assertEqual(len(line), 1, out)
         self.assertIn("rosbash", line[0])
-        self.assertIn("launch/scripts/pipeline.py", line[0])  # the file that needs it
+        self.assertIn("lfd_launch/scripts/pipeline.py", line[0])  # the file that needs it
 
     def test_without_matplotlib_its_imports_are_missing(self):
         rc, out = guard([p for p in self.listed if p != "python3-matplotlib"])
@@ -50,7 +50,7 @@ class InstallListGuard(unittest.TestCase):
     def test_without_a_ros_package_its_key_is_missing(self):
         rc, out = guard([p for p in self.listed if p != "ros-robot-state-publisher"])
         self.assertEqual(rc, 1, out)
-        self.assertRegex(out, r"MISSING robot_state_publisher: .*launch/sim.launch")
+        self.assertRegex(out, r"MISSING robot_state_publisher: .*lfd_launch/sim.launch")
 
 
 if __name__ == "__main__":

@@ -95,7 +95,7 @@ class ClientDiesAtOnce(FailingStage, unittest.TestCase):
     """The fresh-machine failure: the evaluation client cannot import its messages and dies while
     roslaunch is still starting the segmentation node. Only lfd_tools (the pipeline's own package,
     from its source folder) is importable: no message package."""
-    ENV = {"PYTHONPATH": os.path.join(rospkg.RosPack().get_path("lfd_launch"), "src")}
+    ENV = {"PYTHONPATH": os.path.join(rospkg.RosPack().get_path("lfd_tools"), "src")}
     SAYS = "ModuleNotFoundError: No module named 'lfd_msgs'"
 
 

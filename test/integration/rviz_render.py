@@ -1,6 +1,6 @@
 #!/usr/bin/python3
-"""rostest: launch/inspect.launch draws the robot, the end-effector path and the segment markers in
-rviz (config/lfd.rviz).
+"""rostest: lfd_launch/inspect.launch draws the robot, the end-effector path and the segment markers
+in rviz (config/lfd.rviz).
 
 CI has no display, so the test starts its own Xvfb (Xvfb picks a free display number and reports it
 through -displayfd), runs `roslaunch lfd_launch inspect.launch` with rviz on a synthetic
@@ -8,7 +8,7 @@ demonstration bag, grabs the screen (PIL.ImageGrab over XCB) until the scene is 
 pixels by colour inside rviz's 3-D view (found as the area of its background colour):
   robot   unsaturated grey of the robot's links, mostly in the upper half of the view (head, torso)
   path    the "Executed path" orange (255, 120, 0)
-  markers the segment boundary green of launch/scripts/replay_trajectory.py
+  markers the segment boundary green of lfd_launch/scripts/replay_trajectory.py
 Leaving /ee_pose out of the bag (~drop_topics) must fail the path check, leaving /joint_states out
 must fail the robot check (robot_state_publisher then has no transform for the moving links).
 Every process started here (Xvfb, the roslaunch session with rviz) is stopped and checked gone.

@@ -29,7 +29,7 @@ using TransformLookup =
     std::function<Eigen::Isometry3d(const std::string& target, const std::string& source)>;
 
 /// Throws std::runtime_error naming the bag and topic on missing/unusable data. Poses and gripper
-/// states are put in stamp order by the shared policy (lfd_core/stamp_order.hpp: the first of a
+/// states are put in stamp order by the shared policy (lfd_core/io/stamp_order.hpp: the first of a
 /// duplicated stamp kept), and what it found is in the recording's `warnings`; NaN poses are an
 /// error. The scene is brought
 /// into the poses' frame with the bag's /tf_static, else with `fallback` (bags recorded before

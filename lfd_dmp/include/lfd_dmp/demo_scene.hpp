@@ -8,7 +8,7 @@
 // POSE = {"position": [x, y, z], "orientation": [w, x, y, z]}; "frame" defaults to "world".
 #pragma once
 
-#include <lfd_core/task_frames.hpp>
+#include <lfd_core/dmp/task_frames.hpp>
 
 #include <Eigen/Geometry>
 

@@ -1,8 +1,9 @@
 // Live execution monitoring: every reading of the library's monitored sensors is judged
-// against the sensory signature of the segment the motion is in (lfd_core/sensory_signature.hpp),
-// at the phase the plan has reached at the reading's stamp. It keeps the worst anomaly score and
-// the first alarm (a deviation beyond what the demonstrations showed, lasting the signature's
-// persistence); the executor decides what an alarm does (config: stop or report).
+// against the sensory signature of the segment the motion is in
+// (lfd_core/dmp/sensory_signature.hpp), at the phase the plan has reached at the reading's stamp.
+// It keeps the worst anomaly score and the first alarm (a deviation beyond what the demonstrations
+// showed, lasting the signature's persistence); the executor decides what an alarm does (config:
+// stop or report).
 #pragma once
 
 #include <ros/ros.h>
@@ -14,7 +15,7 @@
 #include <utility>
 #include <vector>
 
-#include "lfd_core/sensory_signature.hpp"
+#include "lfd_core/dmp/sensory_signature.hpp"
 #include "lfd_dmp/executor.hpp"
 #include "lfd_dmp/sensor_channels.hpp"
 

@@ -2,7 +2,7 @@
 // limit stated in config (config/executor.yaml `limits:`) and named in its refusal.
 #pragma once
 
-#include <lfd_core/pose.hpp>
+#include <lfd_core/kinematics/pose.hpp>
 
 #include <Eigen/Core>
 

@@ -11,9 +11,9 @@
 
 #include "lfd_dmp/skill_library.hpp"
 
-#include <lfd_core/cartesian_path.hpp>
-#include <lfd_core/dmp_generalization.hpp>
-#include <lfd_core/task_frames.hpp>
+#include <lfd_core/dmp/dmp_generalization.hpp>
+#include <lfd_core/dmp/task_frames.hpp>
+#include <lfd_core/kinematics/cartesian_path.hpp>
 
 #include <Eigen/Geometry>
 

@@ -7,7 +7,7 @@
 
 #include <lfd_msgs/GripperCommand.h>
 #include <lfd_msgs/pose_msg.h>
-#include <lfd_core/robot_setup.hpp>
+#include <lfd_core/kinematics/robot_setup.hpp>
 
 #include <geometry_msgs/Pose.h>
 #include <nav_msgs/Path.h>

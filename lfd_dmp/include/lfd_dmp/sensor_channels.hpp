@@ -1,6 +1,6 @@
-// Live readings of a sensory signature's channels (lfd_core/sensory_signature.hpp) from topics of
-// any message type: one subscription per source topic (topic_tools::ShapeShifter), each channel's
-// field read by its path with the publisher's own message definition (lfd_core
+// Live readings of a sensory signature's channels (lfd_core/dmp/sensory_signature.hpp) from topics
+// of any message type: one subscription per source topic (topic_tools::ShapeShifter), each
+// channel's field read by its path with the publisher's own message definition (lfd_core
 // ros_message_reader.hpp), exactly as the learner's bag reader read the demonstrations.
 #pragma once
 
@@ -16,8 +16,8 @@
 #include <string>
 #include <vector>
 
-#include "lfd_core/ros_message_reader.hpp"
-#include "lfd_core/sensory_signature.hpp"
+#include "lfd_core/dmp/sensory_signature.hpp"
+#include "lfd_core/io/ros_message_reader.hpp"
 
 namespace lfd_dmp {
 

@@ -1,4 +1,4 @@
-// The sensory signature (lfd_core/sensory_signature.hpp) as JSON, stored with the skill library
+// The sensory signature (lfd_core/dmp/sensory_signature.hpp) as JSON, stored with the skill library
 // under "sensory_signature": what each segment's sensors showed in the demonstrations, for the
 // executor's live monitoring.
 #pragma once
@@ -7,7 +7,7 @@
 
 #include <string>
 
-#include "lfd_core/sensory_signature.hpp"
+#include "lfd_core/dmp/sensory_signature.hpp"
 
 namespace lfd_dmp {
 

@@ -3,8 +3,8 @@
 // ROS-free apart from the bag reader (demo_bag.hpp), so it is unit-tested without a master.
 #pragma once
 
-#include "lfd_core/sensory_signature.hpp"
-#include "lfd_core/time_series.hpp"
+#include "lfd_core/dmp/sensory_signature.hpp"
+#include "lfd_core/segmentation/time_series.hpp"
 #include "lfd_dmp/skill_library.hpp"
 
 #include <optional>

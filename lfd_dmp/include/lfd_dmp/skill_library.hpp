@@ -40,14 +40,14 @@
 // is refused with a request to relearn.
 #pragma once
 
-#include <lfd_core/segment_dmp.hpp>
-#include <lfd_core/sensory_signature.hpp>
-#include <lfd_core/task_frames.hpp>
-#include <lfd_core/time_alignment.hpp>
+#include <lfd_core/dmp/segment_dmp.hpp>
+#include <lfd_core/dmp/sensory_signature.hpp>
+#include <lfd_core/dmp/task_frames.hpp>
+#include <lfd_core/segmentation/time_alignment.hpp>
 
 #include "lfd_dmp/library_limits.hpp"
 
-#include <lfd_core/safe_paths.hpp>
+#include <lfd_core/io/safe_paths.hpp>
 
 #include <nlohmann/json.hpp>
 

@@ -4,8 +4,8 @@
 // lfd's (--overwrite replaces only such a file) and which the reader skips.
 #pragma once
 
-#include <lfd_core/safe_paths.hpp>
-#include <lfd_core/segment_dmp.hpp>
+#include <lfd_core/dmp/segment_dmp.hpp>
+#include <lfd_core/io/safe_paths.hpp>
 
 #include <string>
 #include <vector>

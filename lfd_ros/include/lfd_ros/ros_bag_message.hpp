@@ -13,8 +13,8 @@
 #include <string>
 #include <vector>
 
-#include "lfd_core/bag_errors.hpp"
-#include "lfd_core/ros_message_reader.hpp"
+#include "lfd_core/io/bag_errors.hpp"
+#include "lfd_core/io/ros_message_reader.hpp"
 
 namespace lfd {
 

@@ -9,7 +9,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "lfd_core/input_budget.hpp"
+#include "lfd_core/io/input_budget.hpp"
 
 namespace lfd {
 

@@ -11,8 +11,8 @@
 #include <string>
 #include <vector>
 
-#include "lfd_core/safe_paths.hpp"
-#include "lfd_core/time_series.hpp"
+#include "lfd_core/io/safe_paths.hpp"
+#include "lfd_core/segmentation/time_series.hpp"
 #include "lfd_segmentation/segmentation_params.hpp"
 
 namespace lfd_segmentation {
@@ -56,7 +56,7 @@ void check_request_budget(const std::vector<std::string>& entries, const Request
 /// missing topic, a field that does not exist (listing the topic's numeric fields), a field no
 /// message carries, the ground-truth topic, or more features than `max_features` (0 = no bound;
 /// counted as the first message of each topic expands its fields, before the rest is read). Each
-/// stream is in stamp order (lfd_core/stamp_order.hpp); `warnings` gets one line per topic whose
+/// stream is in stamp order (lfd_core/io/stamp_order.hpp); `warnings` gets one line per topic whose
 /// stamps were out of order, duplicated or had a gap.
 std::vector<lfd::Stream> read_bag_streams(const DemoFiles& files,
                                           const std::vector<TopicConfig>& topics,

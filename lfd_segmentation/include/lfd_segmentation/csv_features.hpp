@@ -5,7 +5,7 @@
 
 #include <string>
 
-#include "lfd_core/time_series.hpp"
+#include "lfd_core/segmentation/time_series.hpp"
 #include "lfd_segmentation/segmentation_params.hpp"
 
 namespace lfd_segmentation {

@@ -5,7 +5,7 @@
 
 #include <lfd_msgs/Segment.h>
 
-#include "lfd_core/segmentation_pipeline.hpp"
+#include "lfd_core/segmentation/segmentation_pipeline.hpp"
 #include "lfd_segmentation/bag_features.hpp"
 #include "lfd_segmentation/segmentation_params.hpp"
 

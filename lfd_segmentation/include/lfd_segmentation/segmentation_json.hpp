@@ -9,8 +9,8 @@
 #include <string>
 #include <vector>
 
-#include "lfd_core/safe_paths.hpp"
-#include "lfd_core/segmentation_pipeline.hpp"
+#include "lfd_core/io/safe_paths.hpp"
+#include "lfd_core/segmentation/segmentation_pipeline.hpp"
 
 namespace lfd_segmentation {
 

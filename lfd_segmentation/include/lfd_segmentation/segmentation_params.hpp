@@ -7,10 +7,10 @@
 #include <string>
 #include <vector>
 
-#include "lfd_core/input_budget.hpp"
-#include "lfd_core/safe_paths.hpp"
-#include "lfd_core/segmentation_pipeline.hpp"
-#include "lfd_core/time_series.hpp"
+#include "lfd_core/io/input_budget.hpp"
+#include "lfd_core/io/safe_paths.hpp"
+#include "lfd_core/segmentation/segmentation_pipeline.hpp"
+#include "lfd_core/segmentation/time_series.hpp"
 
 namespace lfd_segmentation {
 

@@ -7,7 +7,7 @@
 
 #include <Eigen/Geometry>
 
-#include "lfd_core/pose.hpp"
+#include "lfd_core/kinematics/pose.hpp"
 
 namespace lfd_sim_bridge {
 namespace demo {

@@ -15,7 +15,7 @@
 #include <string>
 #include <vector>
 
-#include "lfd_core/robot_setup.hpp"
+#include "lfd_core/kinematics/robot_setup.hpp"
 #include "lfd_sim_bridge/demo_motion.hpp"
 #include "lfd_sim_bridge/task_file.hpp"
 

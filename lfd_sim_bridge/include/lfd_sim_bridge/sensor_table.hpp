@@ -9,7 +9,7 @@
 #include <utility>
 #include <vector>
 
-#include "lfd_core/robot_setup.hpp"
+#include "lfd_core/kinematics/robot_setup.hpp"
 #include "lfd_sim_bridge/workcell_sim.hpp"
 
 namespace lfd_sim {

@@ -11,7 +11,7 @@
 #include <utility>
 #include <vector>
 
-#include "lfd_core/pose.hpp"
+#include "lfd_core/kinematics/pose.hpp"
 
 namespace lfd_sim_bridge {
 namespace task {

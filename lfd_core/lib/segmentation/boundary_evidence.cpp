@@ -1,0 +1,194 @@
+#include "lfd_core/segmentation/boundary_evidence.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+#include "lfd_core/segmentation/smooth_derivatives.hpp"
+
+namespace lfd {
+
+namespace {
+
+double percentile(Eigen::VectorXd values, double fraction) {
+  if (values.size() == 0) return 0.0;
+  std::vector<double> v(values.data(), values.data() + values.size());
+  const std::size_t k = static_cast<std::size_t>(fraction * static_cast<double>(v.size() - 1));
+  std::nth_element(v.begin(), v.begin() + static_cast<long>(k), v.end());
+  return v[k];
+}
+
+// Samples in motion: above the rest threshold, in a bout whose peak reaches the small-motion
+// level.
+std::vector<bool> moving_samples(const Eigen::VectorXd& speed, double rest, double small) {
+  const std::size_t n = static_cast<std::size_t>(speed.size());
+  std::vector<bool> moving(n, false);
+  for (std::size_t i = 0; i < n;) {
+    if (speed[static_cast<Eigen::Index>(i)] < rest) {
+      ++i;
+      continue;
+    }
+    std::size_t j = i;
+    double peak = 0.0;
+    for (; j < n && speed[static_cast<Eigen::Index>(j)] >= rest; ++j)
+      peak = std::max(peak, speed[static_cast<Eigen::Index>(j)]);
+    if (peak >= small)
+      std::fill(moving.begin() + static_cast<long>(i), moving.begin() + static_cast<long>(j), true);
+    i = j;
+  }
+  return moving;
+}
+
+// Peak speed in [from, time[from] + window).
+double peak_speed_after(const Eigen::VectorXd& speed, const std::vector<double>& time,
+                        std::size_t from, double window) {
+  double peak = 0.0;
+  for (std::size_t i = from; i < time.size() && time[i] < time[from] + window; ++i)
+    peak = std::max(peak, speed[static_cast<Eigen::Index>(i)]);
+  return peak;
+}
+
+// Every rest run [begin, end) of the speed, the demo's first and last included.
+std::vector<Pause> rest_runs(const Eigen::VectorXd& speed, const std::vector<double>& time,
+                             const PauseConfig& config) {
+  std::vector<Pause> runs;
+  const double typical = percentile(speed, 0.95);
+  if (!(typical > 0) || time.size() != static_cast<std::size_t>(speed.size())) return runs;
+  const std::vector<bool> moving =
+      moving_samples(speed, config.rest_fraction * typical, config.small_motion_fraction * typical);
+  for (std::size_t i = 0; i < moving.size();) {
+    std::size_t j = i;
+    while (j < moving.size() && !moving[j]) ++j;
+    if (j > i) runs.push_back({i, j});
+    i = std::max(j, i + 1);
+  }
+  return runs;
+}
+
+double duration(const Pause& run, const std::vector<double>& time) {
+  return (run.end < time.size() ? time[run.end] : time.back()) - time[run.begin];
+}
+
+bool at_an_end(const Pause& run, std::size_t samples) {
+  return run.begin == 0 || run.end >= samples;
+}
+
+}  // namespace
+
+std::string to_string(EvidenceKind kind) {
+  switch (kind) {
+    case EvidenceKind::kContact:
+      return "contact";
+    case EvidenceKind::kSensorLevel:
+      return "sensor_level";
+    case EvidenceKind::kMotionOnset:
+      return "motion_onset";
+    case EvidenceKind::kMotionStop:
+      return "motion_stop";
+    case EvidenceKind::kClasp:
+      return "clasp";
+  }
+  return "clasp";
+}
+
+Eigen::VectorXd state_speed(const Eigen::MatrixXd& scaled_states, const std::vector<double>& time,
+                            double smoothing_seconds) {
+  const Eigen::Index n = scaled_states.rows();
+  if (static_cast<std::size_t>(n) != time.size())
+    throw std::invalid_argument("state_speed: " + std::to_string(n) + " samples but " +
+                                std::to_string(time.size()) + " timestamps");
+  Eigen::VectorXd speed = Eigen::VectorXd::Zero(n);
+  if (n < 3 || scaled_states.cols() == 0) return speed;
+  const Eigen::VectorXd t = Eigen::Map<const Eigen::VectorXd>(time.data(), n);
+  const Eigen::MatrixXd smooth = gaussianSmooth(t, scaled_states, smoothing_seconds);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const Eigen::Index a = std::max<Eigen::Index>(0, i - 1), b = std::min(n - 1, i + 1);
+    speed[i] = (smooth.row(b) - smooth.row(a)).norm() / (t[b] - t[a]);
+  }
+  return speed;
+}
+
+std::vector<Pause> find_pauses(const Eigen::VectorXd& speed, const std::vector<double>& time,
+                               const PauseConfig& config) {
+  std::vector<Pause> pauses;
+  for (const Pause& run : rest_runs(speed, time, config))
+    if (duration(run, time) >= config.min_pause || at_an_end(run, time.size()))
+      pauses.push_back(run);
+  return pauses;
+}
+
+std::vector<BoundaryEvidence> motion_stop_evidence(const Eigen::VectorXd& speed,
+                                                   const std::vector<double>& time,
+                                                   const PauseConfig& config, double weight) {
+  std::vector<BoundaryEvidence> out;
+  for (const Pause& run : rest_runs(speed, time, config)) {
+    if (duration(run, time) >= config.min_pause || at_an_end(run, time.size())) continue;
+    Eigen::Index slowest = 0;
+    speed
+        .segment(static_cast<Eigen::Index>(run.begin),
+                 static_cast<Eigen::Index>(run.end - run.begin))
+        .minCoeff(&slowest);
+    out.push_back(
+        {run.begin + static_cast<std::size_t>(slowest), weight, EvidenceKind::kMotionStop});
+  }
+  return out;
+}
+
+std::vector<BoundaryEvidence> motion_onset_evidence(const Eigen::VectorXd& speed,
+                                                    const std::vector<double>& time,
+                                                    const std::vector<Pause>& pauses,
+                                                    const PauseConfig& config, double weight) {
+  std::vector<BoundaryEvidence> out;
+  const double typical = percentile(speed, 0.95);
+  if (!(typical > 0)) return out;
+  for (const Pause& p : pauses) {
+    // The demo starts and ends at rest: neither is a boundary between skills.
+    if (p.begin == 0 || p.end >= time.size()) continue;
+    const double pause = time[p.end] - time[p.begin];
+    const double motion = std::min(1.0, peak_speed_after(speed, time, p.end, config.motion_window) /
+                                            (config.full_motion_fraction * typical));
+    out.push_back({p.end, weight * (1.0 - std::exp(-pause / config.pause_scale)) * motion,
+                   EvidenceKind::kMotionOnset});
+  }
+  return out;
+}
+
+void gather_into_pauses(const std::vector<Pause>& pauses, std::size_t samples,
+                        std::size_t start_samples, std::vector<BoundaryEvidence>* evidence) {
+  for (const Pause& p : pauses) {
+    if (p.begin == 0 || p.end >= samples) continue;
+    for (BoundaryEvidence& e : *evidence)
+      if (e.index > p.begin + start_samples && e.index <= p.end) e.index = p.end;
+  }
+}
+
+std::vector<BoundaryEvidence> sensory_evidence(const SensorEvents& events,
+                                               const EvidenceWeights& weights,
+                                               std::size_t fold_samples) {
+  std::vector<BoundaryEvidence> out;
+  for (const SensoryEvent& e : events.details) {
+    if (e.rest_edge) {
+      out.push_back({e.index, weights.contact, EvidenceKind::kContact});
+      continue;
+    }
+    std::size_t index = e.index, nearest = fold_samples + 1;
+    for (const SensoryEvent& edge : events.details) {
+      const std::size_t distance =
+          edge.index > e.index ? edge.index - e.index : e.index - edge.index;
+      if (edge.rest_edge && distance <= fold_samples && distance < nearest) {
+        nearest = distance;
+        index = edge.index;
+      }
+    }
+    out.push_back({index, weights.sensor_level, EvidenceKind::kSensorLevel});
+  }
+  return out;
+}
+
+std::vector<BoundaryEvidence> clasp_evidence(const MultivariateSegmentation& clasp, double weight) {
+  std::vector<BoundaryEvidence> out;
+  for (std::size_t cp : clasp.changepoints) out.push_back({cp, weight, EvidenceKind::kClasp});
+  return out;
+}
+
+}  // namespace lfd

@@ -1,0 +1,573 @@
+// Sensory events, confidence zones (paper eq. 1) and changepoint validation. The rule and the
+// robustness options are documented in sensory_events.hpp.
+#include "lfd_core/segmentation/sensory_events.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <stdexcept>
+#include <string>
+
+#include "lfd_core/segmentation/ramp_fit.hpp"
+
+namespace lfd {
+namespace {
+
+void check_config(const SensoryEventConfig& c) {
+  if (!(c.relative_floor >= 0.0 && c.relative_floor <= 1.0))
+    throw std::invalid_argument("sensory events: relative_floor must be in [0, 1]");
+  if (!(c.threshold_ratio > 0.0 && c.threshold_ratio <= 1.0))
+    throw std::invalid_argument("sensory events: threshold_ratio must be in (0, 1], got " +
+                                std::to_string(c.threshold_ratio));
+  if (!(c.hysteresis > 0.0 && c.hysteresis <= 1.0))
+    throw std::invalid_argument("sensory events: hysteresis must be in (0, 1], got " +
+                                std::to_string(c.hysteresis));
+  if (!(c.noise_floor_sigmas >= 0.0) || !(c.noise_floor_excursions >= 0.0) ||
+      !(c.rest_edge_sigmas >= 0.0))
+    throw std::invalid_argument(
+        "sensory events: noise_floor_sigmas, noise_floor_excursions and rest_edge_sigmas must be "
+        ">= 0");
+  if (c.difference_lag < 1)
+    throw std::invalid_argument("sensory events: difference_lag must be >= 1");
+}
+
+double median_of(std::vector<double> v);
+
+// Robust sigma (1.4826 x MAD about the median) of v.
+double robust_sigma(std::vector<double> v) {
+  const double med = median_of(v);
+  for (double& x : v) x = std::abs(x - med);
+  return 1.4826 * median_of(v);
+}
+
+// SensoryEventConfig::noise_block: the quiet blocks' sigma (10th percentile of the blocks that
+// move at all); block 0 = one sigma over everything.
+double noise_sigma(const std::vector<double>& d, std::size_t block) {
+  if (block == 0 || d.size() < 2 * block) return robust_sigma(d);
+  std::vector<double> sigmas;
+  for (std::size_t b = 0; b + block <= d.size(); b += block) {
+    const double s = robust_sigma(std::vector<double>(d.begin() + b, d.begin() + b + block));
+    if (s > 0.0) sigmas.push_back(s);
+  }
+  if (sigmas.empty()) return 0.0;
+  const std::size_t k = sigmas.size() / 10;
+  std::nth_element(sigmas.begin(), sigmas.begin() + static_cast<std::ptrdiff_t>(k), sigmas.end());
+  return sigmas[k];
+}
+
+// SensoryEventConfig::noise_floor_excursions: how far the detector's own statistic (the lagged
+// difference `mag`) goes when nothing happens. Each block of `block` samples gives its largest
+// |lagged difference|, 0 for a block whose raw signal does not move at all; the 10th percentile
+// of those is the quiet excursion. Unlike a sigma of the raw differences it needs no noise model:
+// drift, clipped (a touch pad's force cannot go below 0), quantized or correlated noise is
+// measured as the detector sees it. A noise-free signal (constant between its changes) has a
+// quiet excursion of 0.
+double quiet_excursion(const Eigen::Ref<const Eigen::VectorXd>& signal,
+                       const std::vector<double>& mag, std::size_t block) {
+  const std::size_t n = mag.size();
+  if (block == 0 || n < 2 * block) return 0.0;
+  std::vector<double> maxima;
+  for (std::size_t b = 0; b + block <= n; b += block) {
+    const auto part =
+        signal.segment(static_cast<Eigen::Index>(b), static_cast<Eigen::Index>(block));
+    const bool still = !(part.maxCoeff() > part.minCoeff());
+    maxima.push_back(still ? 0.0 : *std::max_element(mag.begin() + b, mag.begin() + b + block));
+  }
+  const std::size_t k = maxima.size() / 10;
+  std::nth_element(maxima.begin(), maxima.begin() + static_cast<std::ptrdiff_t>(k), maxima.end());
+  return maxima[k];
+}
+
+double median_of(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  const std::size_t mid = v.size() / 2;
+  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(mid), v.end());
+  double m = v[mid];
+  if (v.size() % 2 == 0) m = 0.5 * (m + *std::max_element(v.begin(), v.begin() + mid));
+  return m;
+}
+
+// Running median with a window shrunk symmetrically at the ends (so edges are not invented).
+std::vector<double> running_median(const Eigen::Ref<const Eigen::VectorXd>& x, std::size_t window) {
+  const std::size_t n = static_cast<std::size_t>(x.size());
+  std::vector<double> out(n);
+  if (window < 2) {
+    for (std::size_t i = 0; i < n; ++i) out[i] = x[static_cast<Eigen::Index>(i)];
+    return out;
+  }
+  const std::size_t half = window / 2;
+  std::vector<double> buf;
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::size_t h = std::min({half, i, n - 1 - i});
+    buf.assign(x.data() + (i - h), x.data() + (i + h + 1));
+    std::nth_element(buf.begin(), buf.begin() + static_cast<std::ptrdiff_t>(h), buf.end());
+    out[i] = buf[h];
+  }
+  return out;
+}
+
+}  // namespace
+
+EventThreshold parse_event_threshold(const std::string& name) {
+  if (name == "ratio_of_max") return EventThreshold::kRatioOfMax;
+  if (name == "noise") return EventThreshold::kNoise;
+  throw std::invalid_argument("unknown event threshold '" + name + "' (ratio_of_max, noise)");
+}
+
+std::string to_string(EventThreshold threshold) {
+  return threshold == EventThreshold::kNoise ? "noise" : "ratio_of_max";
+}
+
+namespace {
+
+struct Burst {
+  std::size_t begin, end;  // end = first quiet sample, or n if still active at the end
+  double peak;             // largest lagged difference inside
+};
+
+// An event and on which side its channel is at rest (kFit).
+struct PlacedEvent {
+  SensoryEvent event;
+  bool from_rest = false, to_rest = false;
+};
+
+struct Channel {
+  std::vector<double> y;  // median-smoothed signal
+  double rest = 0.0;      // rest level
+  double on = 0.0;        // activity threshold
+  // The threshold is the noise floor, above the ratio of the largest change: the channel's
+  // contact is within a few noise levels (a torque the press barely moves), so its drift can keep
+  // it off its rest level for good.
+  bool noise_limited = false;
+  std::vector<PlacedEvent> events;
+};
+
+// The detector's statistic: |y[t + ahead] - y[t - behind]| of the smoothed y, 0 where it would
+// use the median's shrunk edges (a single noisy sample there would look like a level change).
+std::vector<double> lagged_differences(const std::vector<double>& y, std::size_t lag,
+                                       std::size_t edge) {
+  const std::size_t n = y.size(), ahead = lag / 2, behind = lag - ahead;
+  std::vector<double> mag(n, 0.0);
+  for (std::size_t t = behind + edge; t + ahead + edge < n; ++t)
+    mag[t] = std::abs(y[t + ahead] - y[t - behind]);
+  return mag;
+}
+
+// On-threshold of the activity: the paper's ratio of the largest difference (or the noise rule),
+// never below the noise floors.
+void set_activity_threshold(const Eigen::Ref<const Eigen::VectorXd>& signal,
+                            const std::vector<double>& mag, double peak,
+                            const SensoryEventConfig& config, Channel* c) {
+  // The sigma floor is measured on the RAW first differences (nearly independent samples) and
+  // scaled to the lagged differences of a median of w samples (white noise: x 1.2533 / sqrt(w)).
+  double sigma = 0.0;
+  if (config.noise_floor_sigmas > 0.0) {
+    std::vector<double> diffs;
+    for (Eigen::Index t = 1; t < signal.size(); ++t) diffs.push_back(signal[t] - signal[t - 1]);
+    const double smoothing = config.difference_lag > 1 && config.median_window > 1
+                                 ? 1.2533 / std::sqrt(static_cast<double>(config.median_window))
+                                 : 1.0;
+    sigma = smoothing * noise_sigma(diffs, config.noise_block);
+  }
+  const double excursion =
+      config.noise_floor_excursions > 0.0 ? quiet_excursion(signal, mag, config.noise_block) : 0.0;
+  const double floor =
+      std::max(config.noise_floor_sigmas * sigma, config.noise_floor_excursions * excursion);
+  const double ratio =
+      config.threshold == EventThreshold::kNoise ? config.relative_floor : config.threshold_ratio;
+  c->on = std::max(floor, ratio * peak);
+  c->noise_limited = floor > ratio * peak;
+}
+
+std::vector<Burst> find_bursts(const std::vector<double>& mag, double on, double off,
+                               bool walk_back) {
+  const std::size_t n = mag.size();
+  std::vector<Burst> bursts;
+  bool active = false;
+  for (std::size_t t = 1; t < n; ++t) {
+    if (!active && mag[t] > on) {
+      // The activity began where it left the off level, not where it crossed the on level: a
+      // force that builds up slowly crosses `on` late (symmetric to the off-event below).
+      std::size_t begin = t;
+      const std::size_t floor_at = bursts.empty() ? 1 : bursts.back().end + 1;
+      while (walk_back && begin > floor_at && mag[begin - 1] > off) --begin;
+      bursts.push_back({begin, n, 0.0});
+      active = true;
+    } else if (active && mag[t] <= off) {
+      bursts.back().end = t;
+      active = false;
+    }
+    if (active) bursts.back().peak = std::max(bursts.back().peak, mag[t]);
+  }
+  return bursts;
+}
+
+std::vector<Burst> merge_bursts(const std::vector<Burst>& bursts, std::size_t gap, std::size_t n) {
+  std::vector<Burst> merged;
+  for (const Burst& b : bursts) {
+    if (!merged.empty() && merged.back().end != n && b.begin - merged.back().end <= gap) {
+      merged.back().end = b.end;
+      merged.back().peak = std::max(merged.back().peak, b.peak);
+    } else {
+      merged.push_back(b);
+    }
+  }
+  return merged;
+}
+
+// EventPlacement::kFit: the burst's start where the level starts to change and its end where it
+// settles (fit_ramp around each end); the ends of a short ramp or step are one event. An event
+// whose outer level is the rest level (the level at the demo's start, within the activity
+// threshold) leaves or regains rest on this channel.
+void place_by_fit(const Burst& b, const Channel& c, const SensoryEventConfig& config,
+                  std::vector<PlacedEvent>* events) {
+  const std::size_t n = c.y.size(), lag = config.difference_lag;
+  const double strength = b.peak / c.on;
+  const std::size_t lo = b.begin > lag ? b.begin - lag : 0;
+  const RampFit first = fit_ramp(c.y, lo, std::min(n, b.begin + 2 * lag + 1));
+  const bool from_rest = std::abs(first.before - c.rest) < c.on;
+  if (b.end == n) {
+    events->push_back({{first.start, from_rest, strength}, from_rest, false});
+    return;
+  }
+  const std::size_t hi = std::min(n, b.end + lag + 1);
+  const RampFit last = fit_ramp(c.y, b.end > 2 * lag + lo ? b.end - 2 * lag : lo, hi);
+  const bool to_rest = std::abs(last.after - c.rest) < c.on;
+  if (last.end <= first.start + lag / 2) {  // one step: the rest side says where
+    const std::size_t at = !from_rest && to_rest ? last.end : first.start;
+    events->push_back({{at, from_rest || to_rest, strength}, from_rest, to_rest});
+    return;
+  }
+  events->push_back({{first.start, from_rest, strength}, from_rest, false});
+  events->push_back({{last.end, to_rest, strength}, false, to_rest});
+}
+
+// EventPlacement::kThreshold and kShift: at the burst's ends, shifted back onto the change by
+// half a lag (kShift; a burst that spans less than half a lag after the shifts is one step).
+void place_at_burst_ends(const Burst& b, std::size_t n, const SensoryEventConfig& config,
+                         double strength, std::vector<PlacedEvent>* events) {
+  const std::size_t lag = config.difference_lag, ahead = lag / 2, behind = lag - ahead;
+  const bool shift = config.placement == EventPlacement::kShift && lag > 1;
+  const std::size_t begin = std::min(b.begin + (shift ? ahead : 0), n - 1);
+  events->push_back({{begin, false, strength}, false, false});
+  if (b.end != n && b.end - (shift ? behind : 0) >= begin + (shift ? ahead : 1))
+    events->push_back({{b.end - (shift ? behind : 0), false, strength}, false, false});
+}
+
+// SensoryEventConfig::rest_edge_sigmas: Page's CUSUM change time of the raw samples x against
+// the rest level. S accumulates x - reference and is reset at 0, the reference lying
+// rest_edge_sigmas rest sigmas above the rest mean: at rest S keeps returning to 0, in contact it
+// grows. A contact's onset is then the sample after S's last reset before the fitted ramp is under
+// way, and its release (time reversed) the first sample of the last stretch that looks like rest.
+// A weak first touch (or a fading last one) under noise moves S long before one sample or the
+// smoothed level shows it, where the fit sees only the main change. The edge moves only outwards
+// (an earlier onset, a later release), within merge_gap (activity separated by less is one
+// activity) and never past the channel's neighbouring events.
+void place_rest_edges_by_cusum(const Eigen::Ref<const Eigen::VectorXd>& x, std::size_t head,
+                               double peak, const SensoryEventConfig& config, Channel* c) {
+  const std::size_t n = static_cast<std::size_t>(x.size()), lag = config.difference_lag,
+                    gap = config.merge_gap;
+  const auto rest = x.head(static_cast<Eigen::Index>(head));
+  const double mean = rest.mean();
+  const double sigma = std::sqrt((rest.array() - mean).square().mean());
+  // A noise-free sensor has no statistical band: its exponential settling would otherwise look
+  // like contact for ever; relative_floor x the largest difference stands for its resolution.
+  const double reference =
+      mean + std::max(config.rest_edge_sigmas * sigma, config.relative_floor * peak);
+  std::vector<PlacedEvent>& events = c->events;
+  for (std::size_t i = 0; i < events.size(); ++i) {
+    PlacedEvent& p = events[i];
+    const std::size_t e = p.event.index;
+    const std::size_t previous = i > 0 ? events[i - 1].event.index : 0;
+    const std::size_t next = i + 1 < events.size() ? events[i + 1].event.index : n;
+    double s = 0.0;
+    bool reset = false;
+    if (p.from_rest && !p.to_rest) {
+      const std::size_t lo = std::max(i > 0 ? previous + 1 : 0, e > gap ? e - gap : 0);
+      std::size_t last_reset = lo;
+      for (std::size_t t = lo; t < std::min(n, e + lag); ++t) {
+        s = std::max(0.0, s + x[static_cast<Eigen::Index>(t)] - reference);
+        if (s == 0.0) reset = true, last_reset = t;
+      }
+      if (s > 0.0 && reset && last_reset + 1 < e) p.event.index = last_reset + 1;
+    } else if (p.to_rest && !p.from_rest) {
+      const std::size_t lo = std::max(previous, e > lag ? e - lag : 0);
+      const std::size_t hi = std::min(next, e + gap + 1);
+      std::size_t first_reset = hi;
+      for (std::size_t t = hi; t-- > lo;) {
+        s = std::max(0.0, s + x[static_cast<Eigen::Index>(t)] - reference);
+        if (s == 0.0) reset = true, first_reset = t;
+      }
+      if (s > 0.0 && reset && first_reset > e) p.event.index = first_reset;
+    }
+  }
+}
+
+// One channel: smoothed signal, rest level, activity threshold and its events.
+Channel analyse_channel(const Eigen::Ref<const Eigen::VectorXd>& signal,
+                        const SensoryEventConfig& config) {
+  if (!signal.allFinite()) throw std::invalid_argument("sensory events: signal has NaN/Inf values");
+  Channel c;
+  const std::size_t n = static_cast<std::size_t>(signal.size());
+  if (n < 2) return c;
+  c.y = running_median(signal, config.median_window);
+  const std::size_t edge = config.median_window > 1 ? config.median_window / 2 : 0;
+  const std::vector<double> mag = lagged_differences(c.y, config.difference_lag, edge);
+  const double peak = *std::max_element(mag.begin(), mag.end());
+  if (!(peak > 0.0)) return c;
+  set_activity_threshold(signal, mag, peak, config, &c);
+  const bool walk_back = config.placement != EventPlacement::kThreshold;
+  const std::vector<Burst> bursts = merge_bursts(
+      find_bursts(mag, c.on, config.hysteresis * c.on, walk_back), config.merge_gap, n);
+  // The rest level: where the sensor starts, before the robot interacts with anything.
+  const std::size_t head =
+      std::min(n, std::max<std::size_t>(config.noise_block, config.difference_lag));
+  c.rest = median_of(std::vector<double>(c.y.begin(), c.y.begin() + head));
+  const bool fit = config.placement == EventPlacement::kFit && config.difference_lag > 1;
+  for (const Burst& b : bursts) {
+    if (b.end != n && b.end - b.begin < config.min_active_samples) continue;
+    if (fit)
+      place_by_fit(b, c, config, &c.events);
+    else
+      place_at_burst_ends(b, n, config, b.peak / c.on, &c.events);
+  }
+  std::sort(c.events.begin(), c.events.end(), [](const PlacedEvent& a, const PlacedEvent& b) {
+    return a.event.index < b.event.index;
+  });
+  if (fit && config.rest_edge_sigmas > 0.0)
+    place_rest_edges_by_cusum(signal, head, peak, config, &c);
+  return c;
+}
+
+// Whether channel c sits at its rest level over [from, to) (median distance within its threshold).
+bool at_rest(const Channel& c, std::size_t from, std::size_t to) {
+  if (c.events.empty()) return true;  // never active
+  to = std::min(to, c.y.size());
+  if (from >= to) return true;
+  std::vector<double> d;
+  for (std::size_t t = from; t < to; ++t) d.push_back(std::abs(c.y[t] - c.rest));
+  return median_of(d) < c.on;
+}
+
+// Whether channel c leaves its rest level (`leaving`) or regains it at a sample of [from, to).
+bool rest_edge_within(const Channel& c, bool leaving, std::size_t from, std::size_t to) {
+  return std::any_of(c.events.begin(), c.events.end(), [&](const PlacedEvent& p) {
+    return (leaving ? p.from_rest : p.to_rest) && p.event.index >= from && p.event.index < to;
+  });
+}
+
+// For every sample, the length of the run of samples around it where the whole group sits at
+// rest (0 where it does not).
+std::vector<std::size_t> rest_run_lengths(const std::vector<Channel>& channels,
+                                          const std::vector<std::size_t>& group) {
+  const std::size_t n = channels[group.front()].y.size();
+  std::vector<std::size_t> run(n, 0);
+  std::size_t t = 0;
+  while (t < n) {
+    const auto quiet = [&](std::size_t i) {
+      for (std::size_t c : group)
+        if (!channels[c].events.empty() &&
+            !(std::abs(channels[c].y[i] - channels[c].rest) < channels[c].on))
+          return false;
+      return true;
+    };
+    if (!quiet(t)) {
+      ++t;
+      continue;
+    }
+    std::size_t end = t;
+    while (end < n && quiet(end)) ++end;
+    std::fill(run.begin() + static_cast<std::ptrdiff_t>(t),
+              run.begin() + static_cast<std::ptrdiff_t>(end), end - t);
+    t = end;
+  }
+  return run;
+}
+
+// The channels that say when the sensor is at rest: those whose contact stands clear of their
+// noise, when it has any (else all of them).
+std::vector<std::size_t> deciding_channels(const std::vector<Channel>& channels,
+                                           const std::vector<std::size_t>& group) {
+  std::vector<std::size_t> clear;
+  for (std::size_t c : group)
+    if (!channels[c].events.empty() && !channels[c].noise_limited) clear.push_back(c);
+  return clear.empty() ? group : clear;
+}
+
+// A sensor of several channels (a touch pad per finger, a force vector) is at rest only when
+// all of them are: one pad letting go while the other takes over is not the contact's end, and the
+// sensor leaves rest with its first channel and regains it with its last (a channel's edge is
+// none when another leaves rest up to a lag before it, or regains it up to a lag after it: the
+// friction of a wiping hand that flips one last time while the press force still fades). And
+// a rest shorter than `min_rest` samples (the merge gap: activity separated by less is one
+// activity) is a pause within the interaction, not its end: a teleoperator's hesitation, an arm
+// slowing between two strokes. Only the deciding channels (above) can hold the sensor off rest.
+void flag_rest_edges_of_group(std::vector<Channel>* channels, const std::vector<std::size_t>& group,
+                              std::size_t lag, std::size_t min_rest) {
+  const std::vector<std::size_t> deciding = deciding_channels(*channels, group);
+  const std::vector<std::size_t> run = rest_run_lengths(*channels, deciding);
+  const auto longest = [&](std::size_t from, std::size_t to) {
+    std::size_t best = 0;
+    for (std::size_t t = from; t < std::min(to, run.size()); ++t) best = std::max(best, run[t]);
+    return best;
+  };
+  for (std::size_t c : group) {
+    for (PlacedEvent& p : (*channels)[c].events) {
+      const std::size_t e = p.event.index, lo = e > lag ? e - lag : 0;
+      bool before = p.from_rest && longest(lo, e) >= min_rest;
+      bool after = p.to_rest && longest(e, e + lag) >= min_rest;
+      for (std::size_t o : deciding) {
+        if (o == c) continue;
+        const Channel& other = (*channels)[o];
+        before = before && at_rest(other, lo, e) && !rest_edge_within(other, true, lo, e);
+        after = after && at_rest(other, e, e + lag) &&
+                !rest_edge_within(other, false, e + 1, e + lag + 1);
+      }
+      p.event.rest_edge = before || after;
+    }
+  }
+}
+
+std::vector<SensoryEvent> unique_by_index(std::vector<SensoryEvent> events) {
+  std::stable_sort(events.begin(), events.end(),
+                   [](const SensoryEvent& a, const SensoryEvent& b) { return a.index < b.index; });
+  std::vector<SensoryEvent> unique;
+  for (const SensoryEvent& e : events) {
+    if (!unique.empty() && unique.back().index == e.index) {
+      unique.back().rest_edge = unique.back().rest_edge || e.rest_edge;
+      unique.back().strength = std::max(unique.back().strength, e.strength);
+    } else {
+      unique.push_back(e);
+    }
+  }
+  return unique;
+}
+
+}  // namespace
+
+EventPlacement parse_event_placement(const std::string& name) {
+  if (name == "threshold") return EventPlacement::kThreshold;
+  if (name == "shift") return EventPlacement::kShift;
+  if (name == "fit") return EventPlacement::kFit;
+  throw std::invalid_argument("unknown event placement '" + name + "' (threshold, shift, fit)");
+}
+
+std::string to_string(EventPlacement placement) {
+  switch (placement) {
+    case EventPlacement::kThreshold:
+      return "threshold";
+    case EventPlacement::kShift:
+      return "shift";
+    case EventPlacement::kFit:
+      return "fit";
+  }
+  return "?";
+}
+
+std::vector<SensoryEvent> detect_sensory_event_details(
+    const Eigen::Ref<const Eigen::VectorXd>& signal, const SensoryEventConfig& config) {
+  check_config(config);
+  std::vector<SensoryEvent> events;
+  for (const PlacedEvent& p : analyse_channel(signal, config).events) events.push_back(p.event);
+  return unique_by_index(events);
+}
+
+std::vector<std::size_t> detect_sensory_events(const Eigen::Ref<const Eigen::VectorXd>& signal,
+                                               const SensoryEventConfig& config) {
+  std::vector<std::size_t> out;
+  for (const SensoryEvent& e : detect_sensory_event_details(signal, config)) out.push_back(e.index);
+  return out;
+}
+
+std::vector<Interval> confidence_zones(const std::vector<std::size_t>& events, std::size_t min_s,
+                                       std::size_t length) {
+  const std::size_t half = min_s / 2;
+  std::vector<Interval> raw;
+  raw.reserve(events.size());
+  for (std::size_t s : events) raw.push_back({s > half ? s - half : 0, std::min(s + half, length)});
+  std::sort(raw.begin(), raw.end(),
+            [](const Interval& a, const Interval& b) { return a.begin < b.begin; });
+  std::vector<Interval> zones;
+  for (const Interval& z : raw) {
+    // Integer intervals that overlap or touch ([0,5] and [6,9]) form one contiguous zone.
+    if (!zones.empty() && z.begin <= zones.back().end + 1)
+      zones.back().end = std::max(zones.back().end, z.end);
+    else
+      zones.push_back(z);
+  }
+  return zones;
+}
+
+ChangepointValidation validate_with_zones(const std::vector<std::size_t>& candidates,
+                                          const std::vector<Interval>& zones) {
+  ChangepointValidation out;
+  out.zones = zones;
+  std::vector<std::size_t> sorted = candidates;
+  std::sort(sorted.begin(), sorted.end());
+  for (std::size_t c : sorted) {
+    const bool inside =
+        std::any_of(zones.begin(), zones.end(), [c](const Interval& z) { return z.contains(c); });
+    (inside ? out.accepted : out.rejected).push_back(c);
+  }
+  return out;
+}
+
+SensorEvents detect_sensor_events(const Eigen::MatrixXd& sensors, const SensoryEventConfig& config,
+                                  const std::vector<std::size_t>& groups) {
+  check_config(config);
+  const std::size_t cols = static_cast<std::size_t>(sensors.cols());
+  if (!groups.empty() && groups.size() != cols)
+    throw std::invalid_argument("sensory events: " + std::to_string(groups.size()) +
+                                " group ids for " + std::to_string(cols) + " sensor columns");
+  std::vector<Channel> channels;
+  for (std::size_t c = 0; c < cols; ++c) {
+    try {
+      channels.push_back(analyse_channel(sensors.col(static_cast<Eigen::Index>(c)), config));
+    } catch (const std::invalid_argument&) {
+      throw std::invalid_argument("sensory events: sensor column " + std::to_string(c) +
+                                  " has NaN/Inf values");
+    }
+  }
+  std::map<std::size_t, std::vector<std::size_t>> members;  // group id -> its columns
+  for (std::size_t c = 0; c < cols; ++c) members[groups.empty() ? c : groups[c]].push_back(c);
+  SensorEvents out;
+  for (const auto& [id, group] : members) {
+    flag_rest_edges_of_group(&channels, group, config.difference_lag, config.merge_gap);
+    // zone_events: a sensor's rest edges, or all its events when it never leaves rest cleanly.
+    bool any_rest_edge = false;
+    for (std::size_t c : group)
+      for (const PlacedEvent& p : channels[c].events)
+        any_rest_edge = any_rest_edge || p.event.rest_edge;
+    for (std::size_t c : group)
+      for (const PlacedEvent& p : channels[c].events)
+        if (p.event.rest_edge || !any_rest_edge) out.zone_events.push_back(p.event.index);
+  }
+  std::sort(out.zone_events.begin(), out.zone_events.end());
+  out.zone_events.erase(std::unique(out.zone_events.begin(), out.zone_events.end()),
+                        out.zone_events.end());
+  for (const Channel& c : channels) {
+    out.per_sensor.emplace_back();
+    for (const PlacedEvent& p : c.events) {
+      out.per_sensor.back().push_back(p.event.index);
+      out.details.push_back(p.event);
+    }
+    out.all.insert(out.all.end(), out.per_sensor.back().begin(), out.per_sensor.back().end());
+  }
+  std::sort(out.all.begin(), out.all.end());
+  out.all.erase(std::unique(out.all.begin(), out.all.end()), out.all.end());
+  out.details = unique_by_index(out.details);
+  return out;
+}
+
+ChangepointValidation validate_changepoints(const std::vector<std::size_t>& candidates,
+                                            const Eigen::MatrixXd& sensors, std::size_t min_s,
+                                            const SensoryEventConfig& config) {
+  SensorEvents events = detect_sensor_events(sensors, config);
+  ChangepointValidation out = validate_with_zones(
+      candidates, confidence_zones(events.all, min_s, static_cast<std::size_t>(sensors.rows())));
+  out.events = std::move(events.all);
+  out.events_per_sensor = std::move(events.per_sensor);
+  return out;
+}
+
+}  // namespace lfd

@@ -1,0 +1,183 @@
+// Demos aligned on a common axis (demo_alignment.hpp): the uniform grid, multivariate DTW maps
+// (free and anchored), the medoid, and the interpolation of a map.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <stdexcept>
+#include <vector>
+
+#include "lfd_core/segmentation/demo_alignment.hpp"
+
+namespace {
+
+// A two-feature curve at phase u in [0, 1] whose rows all differ (no ambiguity for DTW).
+Eigen::RowVector2d curve(double u) {
+  return {u + 0.3 * std::sin(2.0 * M_PI * u), std::cos(1.5 * M_PI * u)};
+}
+
+// The curve sampled on `rows` rows, stretched uniformly in time.
+Eigen::MatrixXd sampled(int rows) {
+  Eigen::MatrixXd m(rows, 2);
+  for (int i = 0; i < rows; ++i) m.row(i) = curve(static_cast<double>(i) / (rows - 1));
+  return m;
+}
+
+// ---- on_uniform_grid
+
+TEST(OnUniformGrid, InterpolatesLinearlyBetweenSamples) {
+  const std::vector<double> time = {0.0, 0.5, 1.0, 2.0, 2.35};
+  Eigen::MatrixXd features(5, 2);
+  features << 0.0, 10.0,  //
+      1.0, 10.0,          //
+      0.0, 20.0,          //
+      4.0, 20.0,          //
+      5.0, 30.0;
+  const Eigen::MatrixXd grid = lfd::on_uniform_grid(features, time, 0.3);
+  ASSERT_EQ(grid.rows(), 8);  // floor(2.35 / 0.3) + 1
+  ASSERT_EQ(grid.cols(), 2);
+  const std::vector<double> first = {0.0, 0.6, 0.8, 0.2, 0.8, 2.0, 3.2, 4.0 + 0.1 / 0.35};
+  const std::vector<double> second = {10.0, 10.0, 12.0, 18.0, 20.0, 20.0, 20.0, 20.0 + 1.0 / 0.35};
+  for (Eigen::Index k = 0; k < grid.rows(); ++k) {
+    EXPECT_NEAR(grid(k, 0), first[static_cast<std::size_t>(k)], 1e-9) << "row " << k;
+    EXPECT_NEAR(grid(k, 1), second[static_cast<std::size_t>(k)], 1e-9) << "row " << k;
+  }
+}
+
+TEST(OnUniformGrid, StartsAtTheFirstTimestamp) {
+  const std::vector<double> time = {10.0, 10.4, 11.0};
+  Eigen::MatrixXd features(3, 1);
+  features << 1.0, 2.0, 3.0;
+  const Eigen::MatrixXd grid = lfd::on_uniform_grid(features, time, 0.5);
+  ASSERT_EQ(grid.rows(), 3);
+  EXPECT_NEAR(grid(0, 0), 1.0, 1e-12);
+  EXPECT_NEAR(grid(1, 0), 2.0 + 0.1 / 0.6, 1e-9);
+  EXPECT_NEAR(grid(2, 0), 3.0, 1e-12);
+}
+
+TEST(OnUniformGrid, ThrowsOnABadStepOrAMissingTimestamp) {
+  const std::vector<double> time = {0.0, 1.0, 2.0};
+  const Eigen::MatrixXd features = Eigen::MatrixXd::Ones(3, 1);
+  EXPECT_THROW(lfd::on_uniform_grid(features, time, 0.0), std::invalid_argument);
+  EXPECT_THROW(lfd::on_uniform_grid(features, time, -0.1), std::invalid_argument);
+  EXPECT_THROW(lfd::on_uniform_grid(features, {0.0, 1.0}, 0.1), std::invalid_argument);
+}
+
+// ---- multivariate_dtw_map
+
+TEST(MultivariateDtwMap, MapsEachRowNearItsStretchedPosition) {
+  const Eigen::MatrixXd a = sampled(60);
+  const Eigen::MatrixXd b = sampled(90);  // the same motion, 1.5 times slower
+  const std::vector<double> map = lfd::multivariate_dtw_map(a, b);
+  ASSERT_EQ(map.size(), 60u);
+  for (std::size_t i = 0; i < map.size(); ++i)
+    EXPECT_NEAR(map[i], static_cast<double>(i) * 89.0 / 59.0, 2.0) << "row " << i;
+  EXPECT_DOUBLE_EQ(map.front(), 0.0);
+  EXPECT_DOUBLE_EQ(map.back(), 89.0);
+}
+
+TEST(MultivariateDtwMap, MapsIdenticalSeriesOnTheDiagonal) {
+  const Eigen::MatrixXd a = sampled(40);
+  const std::vector<double> map = lfd::multivariate_dtw_map(a, a);
+  ASSERT_EQ(map.size(), 40u);
+  for (std::size_t i = 0; i < map.size(); ++i) EXPECT_DOUBLE_EQ(map[i], static_cast<double>(i));
+  EXPECT_NEAR(lfd::multivariate_dtw_cost(a, a), 0.0, 1e-12);
+}
+
+TEST(MultivariateDtwMap, ThrowsOnDifferentFeatureCounts) {
+  EXPECT_THROW(lfd::multivariate_dtw_map(sampled(10), Eigen::MatrixXd::Zero(10, 3)),
+               std::invalid_argument);
+}
+
+// ---- anchored_dtw_map
+
+bool monotone(const std::vector<double>& map) {
+  for (std::size_t i = 1; i < map.size(); ++i)
+    if (map[i] < map[i - 1]) return false;
+  return true;
+}
+
+TEST(AnchoredDtwMap, HoldsTheAnchorsExactlyAndIsMonotone) {
+  const Eigen::MatrixXd a = sampled(60);
+  const Eigen::MatrixXd b = sampled(90);
+  // Free DTW puts row 20 near 30 and row 40 near 60; the anchors say 38 and 70.
+  const std::vector<double> map = lfd::anchored_dtw_map(a, b, {20, 40}, {38, 70});
+  ASSERT_EQ(map.size(), 60u);
+  EXPECT_TRUE(monotone(map));
+  EXPECT_DOUBLE_EQ(map[20], 38.0);
+  EXPECT_DOUBLE_EQ(map[40], 70.0);
+  // The anchors cut both series: rows before an anchor map before its partner.
+  EXPECT_LT(map[19], 38.0);
+  EXPECT_LT(map[39], 70.0);
+  EXPECT_DOUBLE_EQ(map.front(), 0.0);
+  EXPECT_DOUBLE_EQ(map.back(), 89.0);
+}
+
+TEST(AnchoredDtwMap, WithoutAnchorsEqualsTheFreeMap) {
+  const Eigen::MatrixXd a = sampled(50), b = sampled(70);
+  EXPECT_EQ(lfd::anchored_dtw_map(a, b, {}, {}), lfd::multivariate_dtw_map(a, b));
+}
+
+TEST(AnchoredDtwMap, SkipsAnchorsOutOfOrderOrOutside) {
+  const Eigen::MatrixXd a = sampled(60), b = sampled(90);
+  const std::vector<double> one = lfd::anchored_dtw_map(a, b, {20}, {38});
+  // (10, 50) goes back in a; (30, 20) goes back in b; (70, 80) lies outside a.
+  const std::vector<double> skipped =
+      lfd::anchored_dtw_map(a, b, {20, 10, 30, 70}, {38, 50, 20, 80});
+  EXPECT_EQ(skipped, one);
+  EXPECT_TRUE(monotone(skipped));
+}
+
+TEST(AnchoredDtwMap, ThrowsWhenTheAnchorListsDifferInLength) {
+  EXPECT_THROW(lfd::anchored_dtw_map(sampled(20), sampled(30), {5, 10}, {7}),
+               std::invalid_argument);
+}
+
+// ---- align_to_medoid
+
+TEST(AlignToMedoid, TheOutlierIsNotTheMedoid) {
+  Eigen::MatrixXd outlier(60, 2);
+  for (int i = 0; i < 60; ++i) {
+    const double u = i / 59.0;
+    outlier.row(i) << 1.0 - u, 0.5 * std::sin(6.0 * M_PI * u);
+  }
+  // The outlier first: taking the first demo would pick it.
+  const std::vector<Eigen::MatrixXd> demos = {outlier, sampled(50), sampled(60), sampled(75)};
+  const lfd::DemoAlignment alignment = lfd::align_to_medoid(demos, 1);
+  EXPECT_NE(alignment.reference, 0u);
+  ASSERT_EQ(alignment.to_reference.size(), demos.size());
+  ASSERT_EQ(alignment.from_reference.size(), demos.size());
+  ASSERT_EQ(alignment.mean_cost.size(), demos.size());
+  const std::size_t ref = alignment.reference;
+  const auto ref_rows = static_cast<std::size_t>(demos[ref].rows());
+  for (std::size_t d = 0; d < demos.size(); ++d) {
+    EXPECT_EQ(alignment.to_reference[d].size(), static_cast<std::size_t>(demos[d].rows()));
+    EXPECT_EQ(alignment.from_reference[d].size(), ref_rows);
+    if (d != 0 && d != ref) {
+      EXPECT_LT(alignment.mean_cost[d], alignment.mean_cost[0]);
+    }
+  }
+  for (std::size_t i = 0; i < ref_rows; ++i)
+    EXPECT_DOUBLE_EQ(alignment.to_reference[ref][i], static_cast<double>(i));
+}
+
+TEST(AlignToMedoid, ThrowsOnNoDemoOrDifferentFeatureCounts) {
+  EXPECT_THROW(lfd::align_to_medoid({}, 1), std::invalid_argument);
+  EXPECT_THROW(lfd::align_to_medoid({sampled(10), Eigen::MatrixXd::Zero(10, 3)}, 1),
+               std::invalid_argument);
+  EXPECT_THROW(lfd::align_to_medoid({sampled(10), Eigen::MatrixXd(0, 2)}, 1),
+               std::invalid_argument);
+}
+
+// ---- map_row
+
+TEST(MapRow, InterpolatesBetweenRowsAndClampsAtTheEnds) {
+  const std::vector<double> map = {0.0, 2.0, 6.0};
+  EXPECT_DOUBLE_EQ(lfd::map_row(map, 0.5), 1.0);
+  EXPECT_DOUBLE_EQ(lfd::map_row(map, 1.25), 3.0);
+  EXPECT_DOUBLE_EQ(lfd::map_row(map, 1.0), 2.0);
+  EXPECT_DOUBLE_EQ(lfd::map_row(map, -1.0), 0.0);
+  EXPECT_DOUBLE_EQ(lfd::map_row(map, 2.0), 6.0);
+  EXPECT_DOUBLE_EQ(lfd::map_row(map, 7.5), 6.0);
+}
+
+}  // namespace
