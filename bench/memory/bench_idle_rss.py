@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Memory a node gives back after a large request (issue 23: after one, the probe saw the
+"""Memory a node gives back after a large request (after one, the probe saw the
 segmentation node idle at 264 MB and the executor at 829 MB). Sends one large request to the
 segmentation service and one long goal to the executor, and prints each node's VmRSS before it
 (idle after start-up), at its peak (VmHWM) and idle after it (IDLE_AFTER_S later).

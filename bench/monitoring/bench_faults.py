@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Execution monitoring against injected faults (issue 25, "Detection"): how many faults the
+"""Execution monitoring against injected faults (docs/results.md, "Detection"): how many faults the
 executor's monitor raises, how soon after the fault, and how well its anomaly score separates
 faulty runs from nominal ones (ROC AUC).
 

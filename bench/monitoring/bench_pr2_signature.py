@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
-"""Offline execution monitoring on the PR2 IKEA runs (issue 25, "PR2 offline scoring"): each failed
-run should score above every successful one on the segment where it failed.
+"""Offline execution monitoring on the PR2 IKEA runs (docs/results.md, "PR2 offline scoring"): each
+failed run should score above every successful one on the segment where it failed.
 
 Protocol (nothing learned from the run being scored): for each pair of successful runs, the
 `signature` CLI learns the sensory signature of the four labelled phases from that pair and scores

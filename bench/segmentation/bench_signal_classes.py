@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""The segmentation per real-world signal class (issue 22): for every class of
+"""The segmentation per real-world signal class: for every class of
 lfd_tools/signal_classes.py (make_signal_classes.py documents them) and every seed, generates the
 class's task, runs the `segment` CLI once on all its demos with the shipped configuration (no
 per-class option: only the class's state and sensor columns) and scores each demo against its

@@ -204,6 +204,153 @@ void appendRollout(const lfd::SegmentTrajectory& traj, bool first, double t_offs
   }
 }
 
+void checkPlanRequest(const SkillLibrary& library, const std::vector<SegmentTarget>& targets,
+                      const Eigen::VectorXd& q_start, Eigen::Index dof,
+                      const ExecutorOptions& options) {
+  if (library.segments.empty()) throw std::invalid_argument("the skill library has no segments");
+  if (targets.size() != library.segments.size()) {
+    std::ostringstream m;
+    m << "the skill library '" << library.task << "' has " << library.segments.size()
+      << " segments but " << targets.size() << " segment goals were given";
+    throw std::invalid_argument(m.str());
+  }
+  if (q_start.size() != dof)
+    throw std::invalid_argument("start joint vector has " + std::to_string(q_start.size()) +
+                                " values, the IK chain has " + std::to_string(dof));
+  if (!(options.dt > 0.0) || !(options.duration_scale > 0.0) ||
+      !std::isfinite(options.duration_scale))
+    throw std::invalid_argument("dt and duration_scale must be finite and > 0");
+}
+
+// What each segment generalizes over: its own goal, or every segment's goal together
+// (options.all_segment_goals), with the demos' parameters to match.
+struct GoalQuery {
+  std::map<std::string, Eigen::VectorXd> all_params;
+  bool use_all = false;
+  Eigen::VectorXd all_query;
+};
+
+GoalQuery goalQuery(const SkillLibrary& library, const std::vector<SegmentTarget>& targets,
+                    bool all_segment_goals) {
+  GoalQuery g;
+  g.all_params = allSegmentParameters(library);
+  g.use_all = all_segment_goals && !g.all_params.empty();
+  if (g.use_all) {
+    g.all_query.resize(3 * static_cast<Eigen::Index>(targets.size()));
+    for (size_t s = 0; s < targets.size(); ++s)
+      g.all_query.segment<3>(3 * s) = targets[s].goal.position;
+  }
+  return g;
+}
+
+// One segment's DMP for its target, mixed from the demos that can serve it (records which in
+// `planned`).
+lfd::GeneralizationResult generalizeForTarget(const SegmentSkills& seg, const SegmentTarget& target,
+                                              const GoalQuery& goals,
+                                              const ExecutorOptions& options,
+                                              PlannedSegment& planned, ExecutionPlan& plan) {
+  std::vector<lfd::SegmentDmp> dmps;
+  std::vector<Eigen::VectorXd> params;
+  const HeadingFrame* heading = target.heading ? &*target.heading : nullptr;
+  for (const DemoSkill& d : seg.demos) {
+    if (heading && !heading->demo_yaw.count(d.demo_id)) continue;
+    if (goals.use_all) {
+      const auto it = goals.all_params.find(d.demo_id);
+      if (it == goals.all_params.end()) continue;
+      params.push_back(it->second);
+    } else {
+      params.push_back(d.parameters);
+    }
+    dmps.push_back(heading ? d.dmp.rotated(yawMatrix(-heading->demo_yaw.at(d.demo_id))) : d.dmp);
+    planned.demos.push_back(d.demo_id);
+  }
+  if (dmps.empty())
+    throw std::invalid_argument("segment '" + seg.name + "' has no usable demonstration");
+  const Eigen::VectorXd query =
+      goals.use_all ? goals.all_query : Eigen::VectorXd(target.goal.position);
+  // Beyond the demos' goals the local linear fit would extrapolate the motion's shape (a teleop
+  // approach to a side demonstrated once swept through the box); the kernel average is a convex
+  // mix of demonstrated shapes, only its end moves to the new goal.
+  lfd::GeneralizationOptions gen_options = options.generalization;
+  if (target.shape_distance > target.shape_margin) {
+    gen_options.local_linear = false;
+    plan.warnings.push_back("segment '" + seg.name +
+                            "': its goal lies beyond the demos' goals: "
+                            "generalized by the kernel average");
+  }
+  // The demos' sub-motions come at the same phases (the learner aligned their timing), so
+  // their mix keeps them: a wipe's three strokes stay three full strokes.
+  lfd::GeneralizationResult gen = lfd::generalizeSegment(dmps, params, query, gen_options);
+  if (heading) gen.dmp = gen.dmp.rotated(yawMatrix(heading->yaw));
+  if (gen_options.local_linear) planned.slope_ridge = gen.slope_ridge;
+  return gen;
+}
+
+// Where the previous segment left the tool: the next one starts there.
+struct RolloutState {
+  Eigen::Vector3d position;
+  Eigen::Quaterniond orientation;
+  Eigen::Vector3d velocity = Eigen::Vector3d::Zero();
+  std::optional<double> gripper;
+  double t_offset = 0.0;
+  double samples = 0.0;
+};
+
+lfd::SegmentRolloutOptions rolloutOptions(const lfd::SegmentDmp& dmp, const SegmentTarget& target,
+                                          const ExecutorOptions& options, RolloutState& state) {
+  lfd::SegmentRolloutOptions ro;
+  ro.dt = options.dt;
+  ro.tau = dmp.tau * options.duration_scale;
+  // Refuse before allocating: the rollout, IK and trajectory all grow with the samples.
+  state.samples += *ro.tau / options.dt;
+  if (!(state.samples <= static_cast<double>(options.max_samples))) {
+    std::ostringstream m;
+    m << "the plan would have over " << options.max_samples << " samples ("
+      << state.t_offset + *ro.tau << " s at dt " << options.dt
+      << " s): over the limit (~limits/max_plan_seconds; duration_scale " << options.duration_scale
+      << ")";
+    throw std::invalid_argument(m.str());
+  }
+  ro.start_position = Eigen::VectorXd(state.position);
+  ro.goal_position = Eigen::VectorXd(target.goal.position);
+  ro.start_velocity = Eigen::VectorXd(state.velocity);
+  if (dmp.orientation) {
+    ro.start_orientation = state.orientation;
+    ro.start_angular_velocity = Eigen::Vector3d::Zero();
+    ro.goal_orientation = target.goal.orientation;
+  }
+  if (dmp.gripper && state.gripper) ro.start_gripper = *state.gripper;
+  return ro;
+}
+
+// Reachability of the WHOLE path before anything moves, in pieces (a cancel is seen between).
+void solveIk(lfd::CartesianToJoints& ik, const Eigen::VectorXd& q_start,
+             const std::function<void(const std::string&)>& poll, ExecutionPlan& plan) {
+  Eigen::VectorXd seed = q_start;
+  plan.joints.reserve(plan.poses.size());
+  for (const PlannedSegment& ps : plan.segments) {
+    for (size_t a = ps.begin; a < ps.end; a += kIkChunk) {
+      poll("IK of segment " + ps.name);
+      std::vector<lfd::TimedPose> samples;
+      for (size_t k = a; k < std::min(ps.end, a + kIkChunk); ++k)
+        samples.push_back({plan.times[k], plan.poses[k]});
+      lfd::JointPath path;
+      try {
+        path = ik.convert(samples, seed);
+      } catch (const std::exception& e) {
+        throw std::runtime_error("unreachable in segment '" + ps.name + "' (goal " +
+                                 vec(ps.goal.position) + "): " + e.what());
+      }
+      plan.max_ik_position_error = std::max(plan.max_ik_position_error, path.max_position_error);
+      plan.max_ik_orientation_error =
+          std::max(plan.max_ik_orientation_error, path.max_orientation_error);
+      plan.max_speed_ratio = std::max(plan.max_speed_ratio, path.max_speed_ratio);
+      for (Eigen::VectorXd& q : path.positions) plan.joints.push_back(std::move(q));
+      seed = plan.joints.back();
+    }
+  }
+}
+
 }  // namespace
 
 std::vector<GripperEvent> gripperEvents(const std::vector<double>& values, double fraction,
@@ -268,147 +415,43 @@ ExecutionPlan TaskPlanner::plan(const SkillLibrary& library,
                                 const Eigen::VectorXd& q_start, std::optional<double> gripper_start,
                                 const ExecutorOptions& options,
                                 const std::function<bool()>& cancelled) {
-  auto poll = [&](const std::string& where) {
+  const auto poll = [&](const std::string& where) {
     if (cancelled && cancelled())
       throw PlanningCancelled("cancelled while planning (" + where + ")");
   };
-  if (library.segments.empty()) throw std::invalid_argument("the skill library has no segments");
-  if (targets.size() != library.segments.size()) {
-    std::ostringstream m;
-    m << "the skill library '" << library.task << "' has " << library.segments.size()
-      << " segments but " << targets.size() << " segment goals were given";
-    throw std::invalid_argument(m.str());
-  }
-  if (q_start.size() != chain().dof())
-    throw std::invalid_argument("start joint vector has " + std::to_string(q_start.size()) +
-                                " values, the IK chain has " + std::to_string(chain().dof()));
-  if (!(options.dt > 0.0) || !(options.duration_scale > 0.0) ||
-      !std::isfinite(options.duration_scale))
-    throw std::invalid_argument("dt and duration_scale must be finite and > 0");
-
+  checkPlanRequest(library, targets, q_start, chain().dof(), options);
   ExecutionPlan plan;
   checkRange(targets, options.allow_extrapolation, &plan);
-  const auto all_params = allSegmentParameters(library);
-  const bool use_all = options.all_segment_goals && !all_params.empty();
-  Eigen::VectorXd all_query;
-  if (use_all) {
-    all_query.resize(3 * static_cast<Eigen::Index>(targets.size()));
-    for (size_t s = 0; s < targets.size(); ++s)
-      all_query.segment<3>(3 * s) = targets[s].goal.position;
-  }
-
+  const GoalQuery goals = goalQuery(library, targets, options.all_segment_goals);
   plan.joint_names = chain().jointNames();
   plan.dt = options.dt;
   const TcpPose start = forward(q_start);
-  Eigen::Vector3d position = start.position;
-  Eigen::Quaterniond orientation = start.orientation;
-  Eigen::Vector3d velocity = Eigen::Vector3d::Zero();
-  std::optional<double> gripper = gripper_start;
-  double t_offset = 0.0;
-  double samples = 0.0;
-
+  RolloutState state{start.position, start.orientation};
+  state.gripper = gripper_start;
   for (size_t s = 0; s < library.segments.size(); ++s) {
     poll("segment " + library.segments[s].name);
-    const SegmentSkills& seg = library.segments[s];
     const SegmentTarget& target = targets[s];
-    std::vector<lfd::SegmentDmp> dmps;
-    std::vector<Eigen::VectorXd> params;
     PlannedSegment planned;
-    planned.name = seg.name;
+    planned.name = library.segments[s].name;
     planned.frames = target.frames;
-    const HeadingFrame* heading = target.heading ? &*target.heading : nullptr;
-    for (const DemoSkill& d : seg.demos) {
-      if (heading && !heading->demo_yaw.count(d.demo_id)) continue;
-      if (use_all) {
-        const auto it = all_params.find(d.demo_id);
-        if (it == all_params.end()) continue;
-        params.push_back(it->second);
-      } else {
-        params.push_back(d.parameters);
-      }
-      dmps.push_back(heading ? d.dmp.rotated(yawMatrix(-heading->demo_yaw.at(d.demo_id))) : d.dmp);
-      planned.demos.push_back(d.demo_id);
-    }
-    if (dmps.empty())
-      throw std::invalid_argument("segment '" + seg.name + "' has no usable demonstration");
-    const Eigen::VectorXd query = use_all ? all_query : Eigen::VectorXd(target.goal.position);
-    // Beyond the demos' goals the local linear fit would extrapolate the motion's shape (a teleop
-    // approach to a side demonstrated once swept through the box); the kernel average is a convex
-    // mix of demonstrated shapes, only its end moves to the new goal.
-    lfd::GeneralizationOptions gen_options = options.generalization;
-    if (target.shape_distance > target.shape_margin) {
-      gen_options.local_linear = false;
-      plan.warnings.push_back("segment '" + seg.name +
-                              "': its goal lies beyond the demos' goals: "
-                              "generalized by the kernel average");
-    }
-    // The demos' sub-motions come at the same phases (the learner aligned their timing), so
-    // their mix keeps them: a wipe's three strokes stay three full strokes.
-    lfd::GeneralizationResult gen = lfd::generalizeSegment(dmps, params, query, gen_options);
-    if (heading) gen.dmp = gen.dmp.rotated(yawMatrix(heading->yaw));
-    if (gen_options.local_linear) planned.slope_ridge = gen.slope_ridge;
-
-    lfd::SegmentRolloutOptions ro;
-    ro.dt = options.dt;
-    ro.tau = gen.dmp.tau * options.duration_scale;
-    // Refuse before allocating: the rollout, IK and trajectory all grow with the samples.
-    samples += *ro.tau / options.dt;
-    if (!(samples <= static_cast<double>(options.max_samples))) {
-      std::ostringstream m;
-      m << "the plan would have over " << options.max_samples << " samples (" << t_offset + *ro.tau
-        << " s at dt " << options.dt
-        << " s): over the limit (~limits/max_plan_seconds; duration_scale "
-        << options.duration_scale << ")";
-      throw std::invalid_argument(m.str());
-    }
-    ro.start_position = Eigen::VectorXd(position);
-    ro.goal_position = Eigen::VectorXd(target.goal.position);
-    ro.start_velocity = Eigen::VectorXd(velocity);
-    if (gen.dmp.orientation) {
-      ro.start_orientation = orientation;
-      ro.start_angular_velocity = Eigen::Vector3d::Zero();
-      ro.goal_orientation = target.goal.orientation;
-    }
-    if (gen.dmp.gripper && gripper) ro.start_gripper = *gripper;
-    const lfd::SegmentTrajectory traj = gen.dmp.rollout(ro);
-
+    const lfd::GeneralizationResult gen =
+        generalizeForTarget(library.segments[s], target, goals, options, planned, plan);
+    const lfd::SegmentTrajectory traj =
+        gen.dmp.rollout(rolloutOptions(gen.dmp, target, options, state));
     planned.begin = plan.times.size();
     planned.goal = target.goal;
-    appendRollout(traj, s == 0, t_offset, orientation, gripper, &plan);
+    appendRollout(traj, s == 0, state.t_offset, state.orientation, state.gripper, &plan);
     planned.end = plan.times.size();
-    planned.duration = plan.times.back() - t_offset;  // as sampled: the durations sum to the plan's
-    t_offset = plan.times.back();
-    position = plan.poses.back().position;
-    orientation = plan.poses.back().orientation;
-    velocity = traj.velocities.row(traj.velocities.rows() - 1).transpose();
-    if (traj.gripper.size()) gripper = traj.gripper[traj.gripper.size() - 1];
+    // as sampled: the durations sum to the plan's
+    planned.duration = plan.times.back() - state.t_offset;
+    state.t_offset = plan.times.back();
+    state.position = plan.poses.back().position;
+    state.orientation = plan.poses.back().orientation;
+    state.velocity = traj.velocities.row(traj.velocities.rows() - 1).transpose();
+    if (traj.gripper.size()) state.gripper = traj.gripper[traj.gripper.size() - 1];
     plan.segments.push_back(planned);
   }
-
-  // Reachability of the WHOLE path before anything moves, in pieces (a cancel is seen between).
-  Eigen::VectorXd seed = q_start;
-  plan.joints.reserve(plan.poses.size());
-  for (const PlannedSegment& ps : plan.segments) {
-    for (size_t a = ps.begin; a < ps.end; a += kIkChunk) {
-      poll("IK of segment " + ps.name);
-      std::vector<lfd::TimedPose> samples;
-      for (size_t k = a; k < std::min(ps.end, a + kIkChunk); ++k)
-        samples.push_back({plan.times[k], plan.poses[k]});
-      lfd::JointPath path;
-      try {
-        path = ik_.convert(samples, seed);
-      } catch (const std::exception& e) {
-        throw std::runtime_error("unreachable in segment '" + ps.name + "' (goal " +
-                                 vec(ps.goal.position) + "): " + e.what());
-      }
-      plan.max_ik_position_error = std::max(plan.max_ik_position_error, path.max_position_error);
-      plan.max_ik_orientation_error =
-          std::max(plan.max_ik_orientation_error, path.max_orientation_error);
-      plan.max_speed_ratio = std::max(plan.max_speed_ratio, path.max_speed_ratio);
-      for (Eigen::VectorXd& q : path.positions) plan.joints.push_back(std::move(q));
-      seed = plan.joints.back();
-    }
-  }
+  solveIk(ik_, q_start, poll, plan);
   plan.gripper_events = gripperEvents(plan.gripper, options.gripper_threshold_fraction,
                                       options.gripper_hysteresis, options.gripper_min_range);
   return plan;

@@ -1,7 +1,7 @@
 #include "lfd_segmentation/segmentation_params.hpp"
 
-#include "lfd_core/safe_paths.hpp"
-#include "lfd_core/user_text.hpp"
+#include "lfd_core/io/safe_paths.hpp"
+#include "lfd_core/io/user_text.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -147,33 +147,9 @@ void parse_joint(const YAML::Node& node, lfd::JointSegmentationConfig* joint) {
                "joint/extra_event_weight");
 }
 
-}  // namespace
-
-lfd::SegmentationPipelineConfig SegmentationParams::pipeline_config() const {
-  lfd::SegmentationPipelineConfig config = pipeline;
-  config.seconds = time;
-  config.seconds->min_segment = min_segment_seconds;
-  config.seconds->window = window_seconds;
-  lfd::SegmentationPipelineConfig nominal = lfd::in_samples(config, rate);
-  nominal.seconds = config.seconds;
-  return nominal;
-}
-
-SegmentationParams params_from_yaml(const YAML::Node& root) {
-  SegmentationParams p;
-  p.rate = get<double>(root, "rate", p.rate);
-  if (!(p.rate > 0) || !std::isfinite(p.rate)) {
-    throw std::invalid_argument("segmentation parameter 'rate' must be > 0");
-  }
-  auto& relevance = p.pipeline.relevance;
-  relevance.threshold = get<double>(root, "threshold", relevance.threshold);
-  if (!(relevance.threshold > 0 && relevance.threshold <= 1)) {
-    throw std::invalid_argument("segmentation parameter 'threshold' must be in (0,1]");
-  }
-  relevance.band_fraction = get<double>(root, "dtw_band_fraction", relevance.band_fraction);
-  relevance.normalize_per_demo =
-      get<bool>(root, "normalize_per_demo", relevance.normalize_per_demo);
-
+// The ClaSP profile and its significance test (segmentation.yaml `clasp`, and the combination,
+// window and changepoint keys at the top level).
+void parse_clasp(const YAML::Node& root, SegmentationParams& p) {
   auto& seg = p.pipeline.segmentation;
   seg.combination = lfd::parse_profile_combination(
       get<std::string>(root, "combination", lfd::to_string(seg.combination)));
@@ -189,6 +165,29 @@ SegmentationParams params_from_yaml(const YAML::Node& root) {
   seg.rest_edge_p_value_threshold = non_negative(
       get<double>(root, "rest_edge_p_value_threshold", seg.rest_edge_p_value_threshold),
       "rest_edge_p_value_threshold");
+  const YAML::Node clasp = root["clasp"];
+  auto& cc = seg.clasp;
+  cc.window_selection = lfd::parse_window_selection(
+      get<std::string>(clasp, "window_selection", lfd::to_string(cc.window_selection)));
+  p.time.min_window = non_negative(get<double>(clasp, "min_window_seconds", p.time.min_window),
+                                   "clasp/min_window_seconds");
+  cc.k = get<std::size_t>(clasp, "k", cc.k);
+  cc.distance =
+      lfd::parse_clasp_distance(get<std::string>(clasp, "distance", lfd::to_string(cc.distance)));
+  cc.score = lfd::parse_clasp_score(get<std::string>(clasp, "score", lfd::to_string(cc.score)));
+  cc.p_value_threshold = get<double>(clasp, "p_value_threshold", cc.p_value_threshold);
+  seg.significance_per_sample =
+      non_negative(get<double>(clasp, "significance_per_sample", seg.significance_per_sample),
+                   "clasp/significance_per_sample");
+  cc.tie_jitter = non_negative(get<double>(clasp, "tie_jitter", cc.tie_jitter), "clasp/tie_jitter");
+
+  if (clasp && clasp["min_window"])
+    throw std::invalid_argument(
+        "segmentation parameter 'clasp/min_window' counts samples; give clasp/min_window_seconds");
+}
+
+// The procedure that combines candidates, zones and consensus (top-level keys).
+void parse_procedure(const YAML::Node& root, SegmentationParams& p) {
   p.pipeline.validate_with_sensors =
       get<bool>(root, "validate_with_sensors", p.pipeline.validate_with_sensors);
   p.pipeline.procedure = lfd::parse_segmentation_procedure(
@@ -211,24 +210,10 @@ SegmentationParams params_from_yaml(const YAML::Node& root) {
     throw std::invalid_argument(
         "segmentation parameter 'consensus_fill_p_value' must be in [0, 1)");
   p.pipeline.threads = get<int>(root, "threads", p.pipeline.threads);
-  parse_joint(root["joint"], &p.pipeline.joint);
+}
 
-  const YAML::Node clasp = root["clasp"];
-  auto& cc = seg.clasp;
-  cc.window_selection = lfd::parse_window_selection(
-      get<std::string>(clasp, "window_selection", lfd::to_string(cc.window_selection)));
-  p.time.min_window = non_negative(get<double>(clasp, "min_window_seconds", p.time.min_window),
-                                   "clasp/min_window_seconds");
-  cc.k = get<std::size_t>(clasp, "k", cc.k);
-  cc.distance =
-      lfd::parse_clasp_distance(get<std::string>(clasp, "distance", lfd::to_string(cc.distance)));
-  cc.score = lfd::parse_clasp_score(get<std::string>(clasp, "score", lfd::to_string(cc.score)));
-  cc.p_value_threshold = get<double>(clasp, "p_value_threshold", cc.p_value_threshold);
-  seg.significance_per_sample =
-      non_negative(get<double>(clasp, "significance_per_sample", seg.significance_per_sample),
-                   "clasp/significance_per_sample");
-  cc.tie_jitter = non_negative(get<double>(clasp, "tie_jitter", cc.tie_jitter), "clasp/tie_jitter");
-
+// Sensory events and their confidence zones (segmentation.yaml `events`).
+void parse_events(const YAML::Node& root, SegmentationParams& p) {
   const YAML::Node events = root["events"];
   auto& ev = p.pipeline.events;
   ev.threshold = lfd::parse_event_threshold(
@@ -266,10 +251,10 @@ SegmentationParams params_from_yaml(const YAML::Node& root) {
     if (events && events[key])
       throw std::invalid_argument(std::string("segmentation parameter 'events/") + key +
                                   "' counts samples; give it in seconds (events/*_seconds)");
-  if (clasp && clasp["min_window"])
-    throw std::invalid_argument(
-        "segmentation parameter 'clasp/min_window' counts samples; give clasp/min_window_seconds");
+}
 
+// Request limits (segmentation.yaml `limits`) and the folders a request may name.
+void parse_limits(const YAML::Node& root, SegmentationParams& p) {
   const YAML::Node limits = root["limits"];
   auto& lim = p.limits;
   lim.max_bags = get<std::size_t>(limits, "max_bags", lim.max_bags);
@@ -287,13 +272,50 @@ SegmentationParams params_from_yaml(const YAML::Node& root) {
   lim.max_request_string_bytes =
       get<std::size_t>(limits, "max_request_string_bytes", lim.max_request_string_bytes);
   p.paths.allowed_roots = get<std::vector<std::string>>(root, "allowed_roots", {});
+}
 
+void parse_topics(const YAML::Node& root, SegmentationParams& p) {
   const YAML::Node topics = root["topics"];
   if (topics) {
     if (!topics.IsSequence())
       throw std::invalid_argument("segmentation parameter 'topics' must be a list");
     for (std::size_t k = 0; k < topics.size(); ++k) p.topics.push_back(parse_topic(topics[k], k));
   }
+}
+
+}  // namespace
+
+lfd::SegmentationPipelineConfig SegmentationParams::pipeline_config() const {
+  lfd::SegmentationPipelineConfig config = pipeline;
+  config.seconds = time;
+  config.seconds->min_segment = min_segment_seconds;
+  config.seconds->window = window_seconds;
+  lfd::SegmentationPipelineConfig nominal = lfd::in_samples(config, rate);
+  nominal.seconds = config.seconds;
+  return nominal;
+}
+
+SegmentationParams params_from_yaml(const YAML::Node& root) {
+  SegmentationParams p;
+  p.rate = get<double>(root, "rate", p.rate);
+  if (!(p.rate > 0) || !std::isfinite(p.rate)) {
+    throw std::invalid_argument("segmentation parameter 'rate' must be > 0");
+  }
+  auto& relevance = p.pipeline.relevance;
+  relevance.threshold = get<double>(root, "threshold", relevance.threshold);
+  if (!(relevance.threshold > 0 && relevance.threshold <= 1)) {
+    throw std::invalid_argument("segmentation parameter 'threshold' must be in (0,1]");
+  }
+  relevance.band_fraction = get<double>(root, "dtw_band_fraction", relevance.band_fraction);
+  relevance.normalize_per_demo =
+      get<bool>(root, "normalize_per_demo", relevance.normalize_per_demo);
+
+  parse_clasp(root, p);
+  parse_procedure(root, p);
+  parse_joint(root["joint"], &p.pipeline.joint);
+  parse_events(root, p);
+  parse_limits(root, p);
+  parse_topics(root, p);
   return p;
 }
 

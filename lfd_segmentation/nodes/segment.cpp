@@ -12,8 +12,8 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "lfd_core/safe_paths.hpp"
-#include "lfd_core/user_text.hpp"
+#include "lfd_core/io/safe_paths.hpp"
+#include "lfd_core/io/user_text.hpp"
 #include "lfd_segmentation/bag_features.hpp"
 #include "lfd_segmentation/cli_args.hpp"
 #include "lfd_segmentation/csv_features.hpp"
@@ -192,8 +192,8 @@ lfd::FeatureMatrix resample_within_limits(const lfd::FeatureMatrix& m, double ra
   }
 }
 
-nlohmann::json run(const Options& o) {
-  const auto start = std::chrono::steady_clock::now();
+// The shipped configuration with the command line's overrides.
+lfd_segmentation::SegmentationParams params_for(const Options& o) {
   lfd_segmentation::SegmentationParams params = lfd_segmentation::load_params_file(o.config);
   if (!o.topics.empty()) {
     params.topics = lfd_segmentation::load_params_file(o.topics).topics;
@@ -214,106 +214,148 @@ nlohmann::json run(const Options& o) {
   if (o.min_seconds > 0) params.min_segment_seconds = o.min_seconds;
   if (o.window_seconds > 0) params.window_seconds = o.window_seconds;
   if (o.threads >= 0) params.pipeline.threads = static_cast<int>(o.threads);
-  lfd::SegmentationPipelineConfig config = params.pipeline_config();
-  if (o.num_changepoints > 0)
-    config.segmentation.num_changepoints = static_cast<int>(o.num_changepoints);
+  return params;
+}
 
-  // Load every file (all bags or all CSV).
+// Every input file read (all bags or all CSV), with the feature roles and the clock warnings.
+struct LoadedDemos {
+  bool bags = false;
+  std::vector<lfd::FeatureMatrix> demos;
+  std::vector<std::string> sensors, states, clock_warnings;
+};
+
+LoadedDemos load_demos(const Options& o, const lfd_segmentation::SegmentationParams& params) {
+  LoadedDemos in;
   std::size_t bags = 0;
   for (const std::string& f : o.files) bags += ends_with(f, ".bag") ? 1 : 0;
   if (bags != 0 && bags != o.files.size())
     throw std::invalid_argument("do not mix bags and CSV files");
+  in.bags = bags != 0;
   // The CLI skips the roots (its user owns the shell) but not the budget.
   lfd_segmentation::check_request_budget(o.files, params.limits, lfd::PathPolicy{},
-                                         bags ? "bag" : "CSV file");
-  if (bags != 0 && o.resample > 0)
+                                         in.bags ? "bag" : "CSV file");
+  if (in.bags && o.resample > 0)
     throw std::invalid_argument("--resample is for CSV files: a bag's clock is set by --rate");
-  std::vector<lfd::FeatureMatrix> demos;
-  std::vector<std::string> sensors = o.sensors, states = o.states;
-  std::vector<std::string> clock_warnings;
+  in.sensors = o.sensors;
+  in.states = o.states;
   for (const std::string& f : o.files) {
-    if (bags) {
+    if (in.bags) {
       lfd_segmentation::DemoFeatures demo =
           lfd_segmentation::read_bag_features(f, params.topics, params.rate, params.limits);
-      if (demos.empty() && o.sensors.empty()) sensors = demo.sensor_features;
-      if (demos.empty() && o.states.empty()) states = demo.state_features;
-      clock_warnings.insert(clock_warnings.end(), demo.warnings.begin(), demo.warnings.end());
-      demos.push_back(std::move(demo.matrix));
-    } else {
-      demos.push_back(lfd_segmentation::read_csv_features(f, o.time_column, o.rate, params.limits));
-      if (demos.back().time.empty())
-        throw std::invalid_argument(
-            "CSV file " + lfd::quoted(f) +
-            " has no time column (time, t, timestamp, stamp or --time-column): give its sample "
-            "rate with --rate, the time parameters are in seconds");
-      if (o.resample > 0)
-        demos.back() = resample_within_limits(demos.back(), o.resample, f, params);
-      const std::string gap = lfd_segmentation::clock_gap_warning(demos.back(), f);
-      if (!gap.empty()) clock_warnings.push_back(gap);
+      if (in.demos.empty() && o.sensors.empty()) in.sensors = demo.sensor_features;
+      if (in.demos.empty() && o.states.empty()) in.states = demo.state_features;
+      in.clock_warnings.insert(in.clock_warnings.end(), demo.warnings.begin(), demo.warnings.end());
+      in.demos.push_back(std::move(demo.matrix));
+      continue;
     }
+    in.demos.push_back(
+        lfd_segmentation::read_csv_features(f, o.time_column, o.rate, params.limits));
+    if (in.demos.back().time.empty())
+      throw std::invalid_argument(
+          "CSV file " + lfd::quoted(f) +
+          " has no time column (time, t, timestamp, stamp or --time-column): give its sample "
+          "rate with --rate, the time parameters are in seconds");
+    if (o.resample > 0)
+      in.demos.back() = resample_within_limits(in.demos.back(), o.resample, f, params);
+    const std::string gap = lfd_segmentation::clock_gap_warning(in.demos.back(), f);
+    if (!gap.empty()) in.clock_warnings.push_back(gap);
   }
-  lfd_segmentation::check_demos_fit(params, demos, o.files);
-  const double load_time = seconds_since(start);
+  lfd_segmentation::check_demos_fit(params, in.demos, o.files);
+  return in;
+}
+
+// The segmentation's JSON, and the columns it used as states and as sensors.
+struct Segmented {
+  nlohmann::json out;
+  std::vector<std::string> states, sensors;
+};
+
+// One CSV without sensors: plain parameter-free multivariate ClaSP over the chosen columns.
+Segmented segment_single_series(const Options& o, const LoadedDemos& in,
+                                const lfd::SegmentationPipelineConfig& config,
+                                const lfd_segmentation::JsonOptions& json_options) {
+  lfd::FeatureMatrix demo = in.states.empty() ? in.demos[0] : in.demos[0].select(in.states);
+  lfd::check_finite(demo, o.files[0]);
+  const lfd::SegmentationPipelineConfig own = lfd::in_samples(config, lfd::sample_rate_of(demo));
+  lfd::MultivariateSegmentationConfig seg = own.segmentation;
+  if (own.window_size > 0) seg.window_sizes.assign(demo.cols(), own.window_size);
+  const lfd::MultivariateSegmentation s = lfd::segment_multivariate(demo.data, {}, seg);
+  Segmented r{lfd_segmentation::to_json(s, demo, o.files[0], json_options), demo.names, {}};
+  r.out["mode"] = "clasp";
+  return r;
+}
+
+// Several combinations: the features are selected once, each combination segments them.
+Segmented segment_each_combination(const Options& o, const LoadedDemos& in,
+                                   const lfd::SegmentationPipelineConfig& config,
+                                   const std::vector<lfd::ProfileCombination>& combinations,
+                                   const lfd_segmentation::JsonOptions& json_options) {
+  const lfd::PreparedSegmentation prepared =
+      lfd::prepare_segmentation(in.demos, in.sensors, config, in.states);
+  Segmented r{nlohmann::json::object(), prepared.base.state_features,
+              prepared.base.sensor_features};
+  r.out["methods"] = nlohmann::json::object();
+  for (lfd::ProfileCombination c : combinations) {
+    lfd::SegmentationPipelineConfig own = config;
+    own.segmentation.combination = c;
+    r.out["methods"][lfd::to_string(c)] = lfd_segmentation::to_json(
+        lfd::segment_prepared(prepared, in.demos, own), in.demos, o.files, json_options);
+  }
+  r.out["mode"] = "pipeline";
+  return r;
+}
+
+Segmented segment(const Options& o, const LoadedDemos& in,
+                  const lfd::SegmentationPipelineConfig& config) {
+  const std::vector<lfd::ProfileCombination> combinations = parse_combinations(o.combination);
   lfd_segmentation::JsonOptions json_options;
   json_options.profiles = o.profiles;
   json_options.feature_profiles = o.feature_profiles;
-
-  nlohmann::json out;
-  std::vector<std::string> used_states, used_sensors;  // the roles the segmentation gave columns
-  const auto compute_start = std::chrono::steady_clock::now();
-  if (!bags && demos.size() == 1 && o.sensors.empty()) {
+  if (!in.bags && in.demos.size() == 1 && o.sensors.empty()) {
     if (combinations.size() > 1)
       throw std::invalid_argument(
           "several combinations need the pipeline (bags, several CSV files or --sensor-columns)");
-    // Plain parameter-free multivariate ClaSP over the chosen columns, equal weights.
-    lfd::FeatureMatrix demo = states.empty() ? demos[0] : demos[0].select(states);
-    lfd::check_finite(demo, o.files[0]);
-    const lfd::SegmentationPipelineConfig own = lfd::in_samples(config, lfd::sample_rate_of(demo));
-    lfd::MultivariateSegmentationConfig seg = own.segmentation;
-    if (own.window_size > 0) seg.window_sizes.assign(demo.cols(), own.window_size);
-    const lfd::MultivariateSegmentation s = lfd::segment_multivariate(demo.data, {}, seg);
-    out = lfd_segmentation::to_json(s, demo, o.files[0], json_options);
-    out["mode"] = "clasp";
-    used_states = demo.names;
-  } else if (combinations.size() <= 1) {
-    const lfd::SegmentationPipelineResult r =
-        lfd::run_segmentation_pipeline(demos, sensors, config, states);
-    out = lfd_segmentation::to_json(r, demos, o.files, json_options);
-    out["mode"] = "pipeline";
-    used_states = r.state_features;
-    used_sensors = r.sensor_features;
-  } else {
-    const lfd::PreparedSegmentation prepared =
-        lfd::prepare_segmentation(demos, sensors, config, states);
-    out["methods"] = nlohmann::json::object();
-    for (lfd::ProfileCombination c : combinations) {
-      lfd::SegmentationPipelineConfig own = config;
-      own.segmentation.combination = c;
-      out["methods"][lfd::to_string(c)] = lfd_segmentation::to_json(
-          lfd::segment_prepared(prepared, demos, own), demos, o.files, json_options);
-    }
-    out["mode"] = "pipeline";
-    used_states = prepared.base.state_features;
-    used_sensors = prepared.base.sensor_features;
+    return segment_single_series(o, in, config, json_options);
   }
+  if (combinations.size() > 1)
+    return segment_each_combination(o, in, config, combinations, json_options);
+  const lfd::SegmentationPipelineResult r =
+      lfd::run_segmentation_pipeline(in.demos, in.sensors, config, in.states);
+  Segmented s{lfd_segmentation::to_json(r, in.demos, o.files, json_options), r.state_features,
+              r.sensor_features};
+  s.out["mode"] = "pipeline";
+  return s;
+}
+
+nlohmann::json timing_json(const std::vector<lfd::FeatureMatrix>& demos, double load_time,
+                           double compute_time, double total_time) {
+  std::size_t samples = 0;
+  for (const auto& d : demos) samples += d.rows();
+  std::cerr << "segment: " << demos.size() << " demo(s), " << demos[0].cols() << " features, "
+            << samples << " samples: load " << load_time << " s, segmentation " << compute_time
+            << " s, total " << total_time << " s\n";
+  return {{"load_s", load_time},   {"segmentation_s", compute_time}, {"total_s", total_time},
+          {"demos", demos.size()}, {"features", demos[0].cols()},    {"samples", samples}};
+}
+
+nlohmann::json run(const Options& o) {
+  const auto start = std::chrono::steady_clock::now();
+  const lfd_segmentation::SegmentationParams params = params_for(o);
+  lfd::SegmentationPipelineConfig config = params.pipeline_config();
+  if (o.num_changepoints > 0)
+    config.segmentation.num_changepoints = static_cast<int>(o.num_changepoints);
+  const LoadedDemos in = load_demos(o, params);
+  const double load_time = seconds_since(start);
+  const auto compute_start = std::chrono::steady_clock::now();
+  Segmented s = segment(o, in, config);
   const double compute_time = seconds_since(compute_start);
+  nlohmann::json& out = s.out;
   if (o.features)
     out["feature_matrices"] =
-        lfd_segmentation::feature_matrices_json(demos, used_states, used_sensors);
-  if (o.timing) {
-    std::size_t samples = 0;
-    for (const auto& d : demos) samples += d.rows();
-    out["timing"] = {{"load_s", load_time},
-                     {"segmentation_s", compute_time},
-                     {"total_s", seconds_since(start)},
-                     {"demos", demos.size()},
-                     {"features", demos[0].cols()},
-                     {"samples", samples}};
-    std::cerr << "segment: " << demos.size() << " demo(s), " << demos[0].cols() << " features, "
-              << samples << " samples: load " << load_time << " s, segmentation " << compute_time
-              << " s, total " << seconds_since(start) << " s\n";
-  }
-  for (const std::string& w : clock_warnings) {
+        lfd_segmentation::feature_matrices_json(in.demos, s.states, s.sensors);
+  if (o.timing)
+    out["timing"] = timing_json(in.demos, load_time, compute_time, seconds_since(start));
+  for (const std::string& w : in.clock_warnings) {
     out["warnings"].push_back(w);
     std::cerr << "segment: warning: " << w << "\n";
   }

@@ -1,6 +1,6 @@
 #!/usr/bin/python3
-"""Synthetic demonstrations of the real-world signal classes that break segmentations (issue 22;
-generators in lfd_tools/signal_classes.py): one task of 6-8 demos per class, sharing one phase
+"""Synthetic demonstrations of the real-world signal classes that break segmentations
+(generators in lfd_tools/signal_classes.py): one task of 6-8 demos per class, sharing one phase
 sequence, each demo with its own durations and poses (minimum-jerk motions, position noise; a
 wrist F/T with offset, white noise and drift; contact forces building up over 0.1-0.4 s):
 

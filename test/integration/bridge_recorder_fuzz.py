@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""rostest (issue 12): the bridge and the recorder on random and extreme inputs. Every answer is a
+"""rostest: the bridge and the recorder on random and extreme inputs. Every answer is a
 clear error or a sane result, the nodes stay up, and nothing outside the request changes.
 Seeded (12), bounded iterations: 200 set_scene requests, 40 trajectories, 30 recorder starts."""
 import math

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""rostest (cli_byte_fuzz.test): the master-free CLIs on fuzzed bytes (issue 23). Seeded mutations
+"""rostest (cli_byte_fuzz.test): the master-free CLIs on fuzzed bytes. Seeded mutations
 of a valid demo CSV go through `segment`, of a valid trajectory CSV through `dmp_tool learn`, and of
 a valid skill library JSON through `dmp_tool info` and `dmp_tool rollout`: byte flips, truncation,
 NUL and non-UTF-8 bytes, UTF-8 and UTF-16 byte-order marks, a 2 MB field, a 2 MB header, a

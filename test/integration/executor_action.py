@@ -2,7 +2,7 @@
 """rostest (executor_action.test): the executor's action on a library learned from a freshly
 recorded tiny grasp dataset, the simulation driven in lockstep (lfd_tools.lockstep). Covers an
 unseen goal reproduced with its feedback, preemption while moving and while planning, an
-out-of-range and an unreachable goal, sim time stopping during the final settle (issue 12), bad
+out-of-range and an unreachable goal, sim time stopping during the final settle, bad
 requests and a seeded fuzz of random and extreme goals; after each the node still answers."""
 import copy
 import glob
@@ -200,7 +200,7 @@ class ExecutorAction(unittest.TestCase):
         self.assert_alive()
 
     def test_5_sim_time_stopping_during_the_settle_fails_the_goal(self):
-        # Issue 12: the call never returned, cancel did nothing, later requests were refused
+        # Regression: the call never returned, cancel did nothing, later requests were refused
         # "busy", and when time resumed it reported success.
         self.place()
         self.cell.send(self.goal())
@@ -257,11 +257,11 @@ class ExecutorAction(unittest.TestCase):
         case("missing.json",
              lambda x: setattr(x, "library", os.path.join(self.out, "missing.json")))
         case("~limits/max_name_length", lambda x: setattr(x, "library", "x" * 5000))
-        # Issue 23: a library path must be absolute (the node's working directory is not the
+        # Regression: a library path must be absolute (the node's working directory is not the
         # caller's).
         case("library: path 'libraries/grasp.json' is relative",
              lambda x: setattr(x, "library", "libraries/grasp.json"))
-        # Issue 23: every goal string within ~limits/max_request_string_bytes before any work,
+        # Regression: every goal string within ~limits/max_request_string_bytes before any work,
         # quoted short.
         case("library: a string of 300000 bytes, over the limit of 262207 "
              "(~limits/max_request_string_bytes)", lambda x: setattr(x, "library", "x" * 300000))

@@ -387,7 +387,7 @@ class DemoBagJudged(unittest.TestCase):
         self.assertAlmostEqual(dropped["height_m"], 0.015)
 
     def test_a_pose_stamped_out_of_order_is_judged_in_stamp_order(self):
-        """Issue 23 (the C++ readers' stamp policy, lfd_tools.stamps): a pose of the stick on the
+        """Regression (the C++ readers' stamp policy, lfd_tools.stamps): a pose of the stick on the
         table stamped 11 s arrives last, after the lifted one of 18.5 s. By arrival it was the final
         pose (the demo failed); by stamp the demo is judged as the sorted bag, with a warning."""
         folder = tempfile.mkdtemp()

@@ -1,9 +1,9 @@
 #!/usr/bin/python3
-"""rostest (issue 12): /learner/learn never destroys a file and stays up on any request. Safe paths
+"""rostest: /learner/learn never destroys a file and stays up on any request. Safe paths
 (a bag is never overwritten, an existing library only with overwrite, a FIFO is refused at once,
 paths outside ~allowed_roots or with '..' are refused), limits (~limits/max_num_basis,
 ~limits/max_bags), 150 seeded random requests of extreme values (seed 12, about 10 s), and a link
-swapped between a bag and a FIFO for 3 s while requests run (issue 23). Issue 23: overwrite
+swapped between a bag and a FIFO for 3 s while requests run. Regression: overwrite
 replaces only a library lfd wrote; relative paths are refused; overlong strings are refused."""
 import hashlib
 import math
@@ -131,7 +131,7 @@ class LearnerFuzz(unittest.TestCase):
         self.assertRefused(self.call(req), "limits/max_bags")
 
     def test_8_overwrite_replaces_only_a_library_lfd_wrote(self):
-        """Issue 23: overwrite: true replaced any regular file under the roots (a test .bashrc)."""
+        """Regression: overwrite: true replaced any regular file under the roots (a .bashrc)."""
         bashrc = os.path.join(self.dir, ".bashrc")
         with open(bashrc, "w") as f:
             f.write("export PATH=$HOME/bin:$PATH\n")
@@ -146,7 +146,7 @@ class LearnerFuzz(unittest.TestCase):
         self.assertTrue(res.success, res.error)
 
     def test_9_relative_paths_are_refused_naming_the_field(self):
-        """Issue 23: a relative path resolved against the node's own working directory."""
+        """Regression: a relative path resolved against the node's own working directory."""
         self.assertRefused(self.call(self.valid("relative.json")),
                            "output_path: path 'relative.json' is relative")
         req = self.valid(os.path.join(self.dir, "rel.json"))
@@ -155,7 +155,7 @@ class LearnerFuzz(unittest.TestCase):
         self.assertFalse(os.path.exists(os.path.join(self.dir, "rel.json")))
 
     def test_9b_overlong_strings_are_refused_before_any_work(self):
-        """Issue 23: every request string within ~limits/max_request_string_bytes; the error
+        """Regression: every request string within ~limits/max_request_string_bytes; the error
         quotes at most 200 characters (a 10 MB string was echoed into errors and logs)."""
         t0 = time.time()
         res = self.call(self.valid(os.path.join(self.dir, "long.json"), task="x" * 300000))
@@ -168,7 +168,7 @@ class LearnerFuzz(unittest.TestCase):
         self.assertFalse(os.path.exists(os.path.join(self.dir, "long.json")))
 
     def test_7_link_swapped_to_fifo_never_hangs(self):
-        """Issue 23 row 1: a link swapped between a bag and a FIFO while requests run (3 s) never
+        """Regression: a link swapped between a bag and a FIFO while requests run (3 s) never
         hangs the learner in open() (it checked the path, then opened it again by name). A call
         over 2 s counts as hung; opening the FIFO for writing then lets the node go on."""
         link = os.path.join(self.dir, "race_link.bag")

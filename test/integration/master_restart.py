@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""rostest (issue 23, round two): a node outlives a restart of the ROS master. The test runs its own
+"""rostest (round two): a node outlives a restart of the ROS master. The test runs its own
 roscore on a free port (rostest's master is not used), launches lfd_launch/segment.launch on it (the
 segmentation node, respawn="true"), waits for /segmentation/segment, kills roscore, starts another
 on the same port, and asks that the service be advertised again within RE_REGISTER_S, by a new

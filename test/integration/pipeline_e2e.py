@@ -45,7 +45,7 @@ class PipelineE2E(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
         # /var/tmp lies outside the services' configured allowed_roots (~, /tmp, /work): the run
-        # works only because the stages let their services use the run's own folder (issue 12).
+        # works only because the stages let their services use the run's own folder.
         cls.out = tempfile.mkdtemp(prefix="lfd_pipeline_e2e_", dir="/var/tmp")
         cls.status, cls.log = pipeline("--out", cls.out, "--datasets", "sim_grasp",
                                        "--demos", str(DEMOS), "--goals", str(GOALS),

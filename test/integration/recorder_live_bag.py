@@ -71,13 +71,13 @@ class RecorderLiveBag(unittest.TestCase):
         self.assertFalse(os.path.exists("/var/lib/lfd_recorder_live_bag"))
 
     def test_4_relative_paths_are_refused_naming_the_field(self):
-        """Issue 23: a service request path must be absolute."""
+        """Regression: a service request path must be absolute."""
         res = self.start("recorder_b", "relative.bag")
         self.assertFalse(res.success)
         self.assertIn("bag_path: path 'relative.bag' is relative", res.message)
 
     def test_5_overlong_strings_are_refused_naming_the_field(self):
-        """Issue 23: every request string is within ~limits/max_request_string_bytes (the error
+        """Regression: every request string is within ~limits/max_request_string_bytes (the error
         quotes it short)."""
         long_path = os.path.join(self.dir, "x" * 300000 + ".bag")
         res = self.start("recorder_b", long_path)

@@ -1,6 +1,6 @@
 #!/usr/bin/python3
 """rostest (signal_classes_bench.test): the segmentation, with the shipped configuration, on the
-real-world signal classes of lfd_tools/signal_classes.py (issue 22), seed 0, scored by
+real-world signal classes of lfd_tools/signal_classes.py, seed 0, scored by
 bench/segmentation/bench_signal_classes.py at 0.5 s. A regression guard: each class must keep the
 demos it got right when the joint segmentation became the default, less one (a fresh build on
 another machine may move a changepoint by a sample). The classes it does not segment yet

@@ -1,14 +1,13 @@
 #!/usr/bin/python3
 """rostest (signal_classes_units.test): the generators of the real-world signal classes
 (lfd_tools/signal_classes.py, written by lfd_segmentation/scripts/make_signal_classes.py) against
-what issue 22 asks of them, written out here rather than read from the module: the same seed
-writes the same files and another seed other files; every class writes its declared columns on an
-even clock at its rate; the truth's boundaries are as many as the class has, strictly increasing
-and inside the demo; 6-8 demos per task; the 1000 Hz variants within the `segment` CLI's sample
-limits (config/segmentation.yaml); the phases the classes promise (a short middle phase, a short
-insertion, contact never lost, continuous motions, long pauses before the PR2-like boundaries,
-stale and dead F/T).
-Pure Python, no node and no segmentation: a few seconds."""
+what the segmentation's acceptance asks of them, written out here rather than read from the module:
+the same seed writes the same files and another seed other files; every class writes its declared
+columns on an even clock at its rate; the truth's boundaries are as many as the class has, strictly
+increasing and inside the demo; 6-8 demos per task; the 1000 Hz variants within the `segment` CLI's
+sample limits (config/segmentation.yaml); the phases the classes promise (a short middle phase, a
+short insertion, contact never lost, continuous motions, long pauses before the PR2-like boundaries,
+stale and dead F/T). Pure Python, no node and no segmentation: a few seconds."""
 import json
 import os
 import subprocess

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""rostest (issue 23, round two): the two task file loaders, lfd_sim_bridge's (the demonstrator's,
+"""rostest (round two): the two task file loaders, lfd_sim_bridge's (the demonstrator's,
 run as check_task) and lfd_tools.tasks (the scripts'), on bad files. Each refuses a NaN pose, a
 nesting deeper than the scene's task_limits/max_nesting_depth (PyYAML died of a RecursionError)
 and a time over its max_step_seconds (a step of 1e9 s recorded without end) with an error naming

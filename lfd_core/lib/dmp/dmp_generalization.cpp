@@ -6,9 +6,11 @@
 #include <cmath>
 #include <limits>
 #include <numeric>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 namespace lfd {
 namespace {
@@ -215,20 +217,15 @@ double chooseSlopeRidge(const std::vector<SegmentDmp>& demos,
   return chosen;
 }
 
-}  // namespace
-
-GeneralizationResult generalizeSegment(const std::vector<SegmentDmp>& demos,
-                                       const std::vector<Eigen::VectorXd>& params,
-                                       const Eigen::VectorXd& query,
-                                       const GeneralizationOptions& options) {
+void checkInputs(const std::vector<SegmentDmp>& demos, const std::vector<Eigen::VectorXd>& params,
+                 const Eigen::VectorXd& query, const GeneralizationOptions& options) {
   if (demos.empty()) throw std::invalid_argument("generalizeSegment: no demonstrations");
   if (params.size() != demos.size()) {
     throw std::invalid_argument("generalizeSegment: " + std::to_string(demos.size()) +
                                 " demos but " + std::to_string(params.size()) +
                                 " parameter vectors");
   }
-  const Eigen::Index dim = query.size();
-  if (dim == 0) throw std::invalid_argument("generalizeSegment: empty query");
+  if (query.size() == 0) throw std::invalid_argument("generalizeSegment: empty query");
   requireFinite(query, "generalizeSegment query");
   bool ridges_ok = options.slope_ridge >= 0.0;
   for (double r : options.slope_ridge_candidates)
@@ -237,27 +234,27 @@ GeneralizationResult generalizeSegment(const std::vector<SegmentDmp>& demos,
     throw std::invalid_argument(
         "generalizeSegment: bandwidth, slope_ridge (and its candidates), range_margin >= 0");
   }
-  const size_t nd = demos.size();
-  for (size_t j = 0; j < nd; ++j) {
+  for (size_t j = 0; j < demos.size(); ++j) {
     checkCompatible(demos[0], demos[j], j);
-    if (params[j].size() != dim) {
+    if (params[j].size() != query.size()) {
       throw std::invalid_argument("generalizeSegment: demo " + std::to_string(j) + " has " +
                                   std::to_string(params[j].size()) + " parameters, the query has " +
-                                  std::to_string(dim));
+                                  std::to_string(query.size()));
     }
     requireFinite(params[j], "generalizeSegment demo parameters");
   }
-  const Eigen::MatrixXd points = parameterMatrix(params);
+}
 
-  GeneralizationResult result;
-  // Bandwidth and diameter from pairwise distances.
+// The kernel bandwidth (the option, else the median pairwise distance) and the demos' diameter.
+std::pair<double, double> bandwidthAndDiameter(const std::vector<Eigen::VectorXd>& params,
+                                               double bandwidth) {
   std::vector<double> dists;
-  for (size_t a = 0; a < nd; ++a) {
-    for (size_t b = a + 1; b < nd; ++b) dists.push_back((params[a] - params[b]).norm());
+  for (size_t a = 0; a < params.size(); ++a) {
+    for (size_t b = a + 1; b < params.size(); ++b) dists.push_back((params[a] - params[b]).norm());
   }
   double diameter = 0.0;
   for (double d : dists) diameter = std::max(diameter, d);
-  double h = options.bandwidth;
+  double h = bandwidth;
   if (h <= 0.0) {
     if (!dists.empty()) {
       std::nth_element(dists.begin(), dists.begin() + dists.size() / 2, dists.end());
@@ -265,74 +262,49 @@ GeneralizationResult generalizeSegment(const std::vector<SegmentDmp>& demos,
     }
     if (!(h > 0.0)) h = 1.0;  // a single (or repeated) demo: any bandwidth gives the same answer
   }
-  result.bandwidth = h;
+  return {h, diameter};
+}
 
-  result.kernel_weights = kernelWeights(points, query, h);
-  if (options.local_linear && nd > 1) {
-    result.slope_ridge = chooseSlopeRidge(demos, params, h, options, &result.loo_rms);
-    result.coefficients =
-        localLinearCoefficients(points, query, h, result.kernel_weights, result.slope_ridge);
-  } else {
-    result.coefficients = result.kernel_weights;
+// The demos' position-like DMPs (the position, or the gripper) mixed with `coefficients`.
+PositionDmp mixPositionDmps(const std::vector<SegmentDmp>& demos,
+                            const std::optional<PositionDmp> SegmentDmp::*which,
+                            const Eigen::VectorXd& coefficients, double tau) {
+  const PositionDmp& ref = *(demos[0].*which);
+  Eigen::MatrixXd w = Eigen::MatrixXd::Zero(ref.weights().rows(), ref.dims());
+  Eigen::VectorXd s = Eigen::VectorXd::Zero(ref.dims()), g = s, v = s;
+  for (size_t j = 0; j < demos.size(); ++j) {
+    const PositionDmp& p = *(demos[j].*which);
+    const double cj = coefficients[static_cast<Eigen::Index>(j)];
+    w += cj * p.weights();
+    s += cj * p.start();
+    g += cj * p.goal();
+    v += cj * p.startVelocity() * (demos[j].tau / tau);  // keep v = tau * dy/dt consistent
   }
-  const Eigen::VectorXd& c = result.coefficients;
-  const Eigen::VectorXd& kw = result.kernel_weights;
+  return PositionDmp(demos[0].params, tau, w, s, g, v);
+}
 
-  // Combine the demos.
-  const SegmentDmp& ref = demos[0];
-  SegmentDmp& out = result.dmp;
-  out.params = ref.params;
-  out.tau = 0.0;
-  for (size_t j = 0; j < nd; ++j) out.tau += kw[static_cast<Eigen::Index>(j)] * demos[j].tau;
-  if (ref.position) {
-    Eigen::MatrixXd w = Eigen::MatrixXd::Zero(ref.position->weights().rows(), ref.position->dims());
-    Eigen::VectorXd s = Eigen::VectorXd::Zero(ref.position->dims()), g = s, v = s;
-    for (size_t j = 0; j < nd; ++j) {
-      const PositionDmp& p = *demos[j].position;
-      const double cj = c[static_cast<Eigen::Index>(j)];
-      w += cj * p.weights();
-      s += cj * p.start();
-      g += cj * p.goal();
-      v += cj * p.startVelocity() * (demos[j].tau / out.tau);  // keep v = tau * dy/dt consistent
-    }
-    out.position.emplace(ref.params, out.tau, w, s, g, v);
+OrientationDmp mixOrientationDmps(const std::vector<SegmentDmp>& demos,
+                                  const Eigen::VectorXd& coefficients,
+                                  const Eigen::VectorXd& kernel_weights, double tau) {
+  Eigen::MatrixXd w = Eigen::MatrixXd::Zero(demos[0].orientation->weights().rows(), 3);
+  Eigen::Vector3d v = Eigen::Vector3d::Zero();
+  std::vector<Eigen::Quaterniond> starts, goals;
+  for (size_t j = 0; j < demos.size(); ++j) {
+    const OrientationDmp& o = *demos[j].orientation;
+    const double cj = coefficients[static_cast<Eigen::Index>(j)];
+    w += cj * o.weights();
+    v += cj * o.startAngularVelocity() * (demos[j].tau / tau);
+    starts.push_back(o.start());
+    goals.push_back(o.goal());
   }
-  if (ref.orientation) {
-    Eigen::MatrixXd w = Eigen::MatrixXd::Zero(ref.orientation->weights().rows(), 3);
-    Eigen::Vector3d v = Eigen::Vector3d::Zero();
-    std::vector<Eigen::Quaterniond> starts, goals;
-    for (size_t j = 0; j < nd; ++j) {
-      const OrientationDmp& o = *demos[j].orientation;
-      const double cj = c[static_cast<Eigen::Index>(j)];
-      w += cj * o.weights();
-      v += cj * o.startAngularVelocity() * (demos[j].tau / out.tau);
-      starts.push_back(o.start());
-      goals.push_back(o.goal());
-    }
-    out.orientation.emplace(ref.params, out.tau, w, weightedQuaternionMean(starts, kw),
-                            weightedQuaternionMean(goals, kw), v);
-  }
-  if (ref.gripper) {
-    // The gripper, whole (levels, forcing weights, start velocity), is a convex average: its shape
-    // does not follow the goal linearly (the reason for the local linear fit), and the DMP being
-    // linear in all four, the mix is then a convex mix of the demos' gripper motions, which cannot
-    // open where no demo opens. An affine mix turned one demo's closing into an opening.
-    Eigen::MatrixXd w = Eigen::MatrixXd::Zero(ref.gripper->weights().rows(), 1);
-    Eigen::VectorXd s = Eigen::VectorXd::Zero(1), g = s, v = s;
-    for (size_t j = 0; j < nd; ++j) {
-      const PositionDmp& p = *demos[j].gripper;
-      const double kj = kw[static_cast<Eigen::Index>(j)];
-      w += kj * p.weights();
-      s += kj * p.start();
-      g += kj * p.goal();
-      v += kj * p.startVelocity() * (demos[j].tau / out.tau);
-    }
-    out.gripper.emplace(ref.params, out.tau, w, s, g, v);
-  }
+  return OrientationDmp(demos[0].params, tau, w, weightedQuaternionMean(starts, kernel_weights),
+                        weightedQuaternionMean(goals, kernel_weights), v);
+}
 
-  // Coverage check.
+void checkCoverage(const Eigen::MatrixXd& points, const Eigen::VectorXd& query, double diameter,
+                   double range_margin, GeneralizationResult& result) {
   result.hull_distance = convexHullDistance(points, query);
-  result.margin = std::max(options.range_margin * diameter, 1e-9);
+  result.margin = std::max(range_margin * diameter, 1e-9);
   result.outside_demo_range = result.hull_distance > result.margin;
   if (result.outside_demo_range) {
     std::ostringstream msg;
@@ -341,6 +313,43 @@ GeneralizationResult generalizeSegment(const std::vector<SegmentDmp>& demos,
         << result.margin << "); the DMP is extrapolated";
     result.warning = msg.str();
   }
+}
+
+}  // namespace
+
+GeneralizationResult generalizeSegment(const std::vector<SegmentDmp>& demos,
+                                       const std::vector<Eigen::VectorXd>& params,
+                                       const Eigen::VectorXd& query,
+                                       const GeneralizationOptions& options) {
+  checkInputs(demos, params, query, options);
+  const size_t nd = demos.size();
+  const Eigen::MatrixXd points = parameterMatrix(params);
+  GeneralizationResult result;
+  const auto [h, diameter] = bandwidthAndDiameter(params, options.bandwidth);
+  result.bandwidth = h;
+  result.kernel_weights = kernelWeights(points, query, h);
+  if (options.local_linear && nd > 1) {
+    result.slope_ridge = chooseSlopeRidge(demos, params, h, options, &result.loo_rms);
+    result.coefficients =
+        localLinearCoefficients(points, query, h, result.kernel_weights, result.slope_ridge);
+  } else {
+    result.coefficients = result.kernel_weights;
+  }
+  const Eigen::VectorXd& kw = result.kernel_weights;
+  SegmentDmp& out = result.dmp;
+  out.params = demos[0].params;
+  out.tau = 0.0;
+  for (size_t j = 0; j < nd; ++j) out.tau += kw[static_cast<Eigen::Index>(j)] * demos[j].tau;
+  if (demos[0].position)
+    out.position = mixPositionDmps(demos, &SegmentDmp::position, result.coefficients, out.tau);
+  if (demos[0].orientation)
+    out.orientation = mixOrientationDmps(demos, result.coefficients, kw, out.tau);
+  // The gripper, whole (levels, forcing weights, start velocity), is a convex average: its shape
+  // does not follow the goal linearly (the reason for the local linear fit), and the DMP being
+  // linear in all four, the mix is then a convex mix of the demos' gripper motions, which cannot
+  // open where no demo opens. An affine mix turned one demo's closing into an opening.
+  if (demos[0].gripper) out.gripper = mixPositionDmps(demos, &SegmentDmp::gripper, kw, out.tau);
+  checkCoverage(points, query, diameter, options.range_margin, result);
   return result;
 }
 

@@ -55,6 +55,161 @@ std::vector<std::size_t> select_by_threshold(const std::vector<double>& scores,
   return selected;
 }
 
+namespace {
+
+// Every demonstration's features as plain vectors (signal[d][f]), min-max normalized per feature
+// (over all demonstrations, or per demonstration), and which are constant in which demonstration.
+struct NormalizedSignals {
+  std::vector<std::vector<std::vector<double>>> signal;
+  std::vector<std::vector<bool>> constant_in;
+  std::size_t longest = 0;
+};
+
+NormalizedSignals read_signals(const std::vector<FeatureMatrix>& demos,
+                               const std::vector<std::string>& features) {
+  NormalizedSignals n;
+  n.signal.resize(demos.size());
+  n.constant_in.resize(demos.size());
+  for (std::size_t d = 0; d < demos.size(); ++d) {
+    const FeatureMatrix& demo = demos[d];
+    const std::string context = "demonstration " + std::to_string(d);
+    demo.validate_shape();
+    if (demo.rows() < 2) throw std::invalid_argument(context + " has fewer than 2 samples");
+    n.longest = std::max<std::size_t>(n.longest, demo.rows());
+    for (const std::string& name : features) {
+      const int col = demo.index_of(name);
+      if (col < 0) throw std::invalid_argument(context + " has no feature '" + name + "'");
+      Eigen::VectorXd x = demo.data.col(col);
+      for (Eigen::Index r = 0; r < x.size(); ++r) {
+        if (!std::isfinite(x[r])) {
+          throw std::invalid_argument(context + ": feature '" + name + "' has " +
+                                      (std::isnan(x[r]) ? "NaN" : "Inf") + " at sample " +
+                                      std::to_string(r));
+        }
+      }
+      n.signal[d].emplace_back(x.data(), x.data() + x.size());
+    }
+  }
+  return n;
+}
+
+void normalize(NormalizedSignals& n, std::size_t num_features, bool per_demo) {
+  const std::size_t num_demos = n.signal.size();
+  for (std::size_t f = 0; f < num_features; ++f) {
+    double lo = INFINITY, hi = -INFINITY;
+    if (!per_demo) {
+      for (std::size_t d = 0; d < num_demos; ++d) {
+        const auto [mn, mx] = std::minmax_element(n.signal[d][f].begin(), n.signal[d][f].end());
+        lo = std::min(lo, *mn), hi = std::max(hi, *mx);
+      }
+    }
+    for (std::size_t d = 0; d < num_demos; ++d) {
+      std::vector<double>& x = n.signal[d][f];
+      const auto [mn, mx] = std::minmax_element(x.begin(), x.end());
+      const bool flat = !(*mx - *mn > 1e-12 * (1.0 + std::max(std::abs(*mx), std::abs(*mn))));
+      n.constant_in[d].push_back(flat);
+      const double offset = per_demo ? *mn : lo;
+      const double range = per_demo ? *mx - *mn : hi - lo;
+      const bool zero = per_demo ? flat : !(range > 1e-12 * (1.0 + std::abs(hi)));
+      for (double& v : x) v = zero ? 0.0 : (v - offset) / range;
+    }
+  }
+}
+
+// Each feature's pairwise correlation (after DTW) and distance matrices. Every (pair, feature)
+// alignment runs in one batch; pairs of one demonstration pair share shapes, so they fill the
+// SIMD lanes without padding.
+void align_pairs(const NormalizedSignals& n, const FeatureRelevanceConfig& config,
+                 FeatureRelevanceResult& result) {
+  const std::size_t num_demos = n.signal.size(), num_features = result.features.size();
+  std::vector<std::pair<std::size_t, std::size_t>> demo_pairs;
+  for (std::size_t p = 0; p < num_demos; ++p) {
+    for (std::size_t q = p + 1; q < num_demos; ++q) demo_pairs.emplace_back(p, q);
+  }
+  std::vector<DtwPairView> views;
+  views.reserve(demo_pairs.size() * num_features);
+  for (const auto& [p, q] : demo_pairs) {
+    for (std::size_t f = 0; f < num_features; ++f) {
+      views.push_back({n.signal[p][f].data(), n.signal[p][f].size(), n.signal[q][f].data(),
+                       n.signal[q][f].size()});
+    }
+  }
+  DtwOptions dtw_options;
+  if (config.band_fraction >= 0) {
+    dtw_options.band = static_cast<int>(std::ceil(config.band_fraction * double(n.longest)));
+  }
+  const std::vector<DtwResult> alignments = dtw_batch(views, dtw_options, config.threads);
+  for (std::size_t k = 0; k < demo_pairs.size(); ++k) {
+    const auto [p, q] = demo_pairs[k];
+    for (std::size_t f = 0; f < num_features; ++f) {
+      const DtwResult& r = alignments[k * num_features + f];
+      const DtwPairView& v = views[k * num_features + f];
+      const auto aligned = dtw_aligned_pair(v.a, v.b, r.path);
+      FeatureRelevance& fr = result.features[f];
+      fr.correlation(p, q) = fr.correlation(q, p) =
+          pearson_correlation(aligned.first, aligned.second);
+      fr.distance(p, q) = fr.distance(q, p) =
+          std::sqrt(std::max(0.0, r.cost) / double(r.path.size()));
+    }
+  }
+}
+
+// The paper's score: mean correlation weighted by 1 - the normalized mean DTW distance.
+void score_features(FeatureRelevanceResult& result) {
+  const double n = double(result.num_demos), pairs = n * (n - 1) / 2.0;
+  double dmin = INFINITY, dmax = -INFINITY;
+  for (FeatureRelevance& fr : result.features) {
+    fr.mean_correlation = (fr.correlation.sum() - n) / (2.0 * pairs);
+    fr.mean_distance = fr.distance.sum() / (2.0 * pairs);
+    if (!fr.constant)
+      dmin = std::min(dmin, fr.mean_distance), dmax = std::max(dmax, fr.mean_distance);
+  }
+  for (FeatureRelevance& fr : result.features) {
+    if (fr.constant) {
+      fr.mean_correlation = 0.0;
+      fr.normalized_distance = 1.0;
+      fr.score = 0.0;
+      result.warnings.push_back("feature '" + fr.name +
+                                "' is constant in every demonstration: score 0, not selected");
+    } else {
+      fr.normalized_distance =
+          dmax - dmin > 1e-12 ? (fr.mean_distance - dmin) / (dmax - dmin) : 0.0;
+      fr.score = fr.mean_correlation * (1.0 - fr.normalized_distance);
+    }
+  }
+}
+
+void select_features(FeatureRelevanceResult& result, double threshold) {
+  std::vector<double> weighted, correlation_only;
+  std::vector<bool> excluded;
+  for (const FeatureRelevance& fr : result.features) {
+    weighted.push_back(fr.score);
+    correlation_only.push_back(fr.mean_correlation);
+    excluded.push_back(fr.constant);
+  }
+  for (std::size_t f : select_by_threshold(weighted, excluded, threshold)) {
+    result.features[f].selected = true;
+    result.selected.push_back(result.features[f].name);
+  }
+  for (std::size_t f : select_by_threshold(correlation_only, excluded, threshold)) {
+    result.features[f].selected_correlation_only = true;
+    result.selected_correlation_only.push_back(result.features[f].name);
+  }
+  if (result.selected.empty()) {
+    result.warnings.push_back("no feature varies in any demonstration: nothing selected");
+    return;
+  }
+  const auto best =  // the best scored feature (select_by_threshold lists the best first)
+      std::find_if(result.features.begin(), result.features.end(),
+                   [&](const FeatureRelevance& fr) { return fr.name == result.selected[0]; });
+  if (best->score <= 0) {
+    result.warnings.push_back("no feature has a positive relevance score; kept only '" +
+                              result.selected[0] + "'");
+  }
+}
+
+}  // namespace
+
 FeatureRelevanceResult compute_feature_relevance(const std::vector<FeatureMatrix>& demos,
                                                  std::vector<std::string> features,
                                                  const FeatureRelevanceConfig& config) {
@@ -69,70 +224,8 @@ FeatureRelevanceResult compute_feature_relevance(const std::vector<FeatureMatrix
   if (features.empty()) features = demos.front().names;
   if (features.empty()) throw std::invalid_argument("feature relevance: no features");
   const std::size_t num_demos = demos.size(), num_features = features.size();
-
-  // Normalized copies: signal[d][f].
-  std::vector<std::vector<std::vector<double>>> signal(num_demos);
-  std::vector<std::vector<bool>> constant_in(num_demos);
-  std::size_t longest = 0;
-  for (std::size_t d = 0; d < num_demos; ++d) {
-    const FeatureMatrix& demo = demos[d];
-    const std::string context = "demonstration " + std::to_string(d);
-    demo.validate_shape();
-    if (demo.rows() < 2) throw std::invalid_argument(context + " has fewer than 2 samples");
-    longest = std::max<std::size_t>(longest, demo.rows());
-    for (const std::string& name : features) {
-      const int col = demo.index_of(name);
-      if (col < 0) throw std::invalid_argument(context + " has no feature '" + name + "'");
-      Eigen::VectorXd x = demo.data.col(col);
-      for (Eigen::Index r = 0; r < x.size(); ++r) {
-        if (!std::isfinite(x[r])) {
-          throw std::invalid_argument(context + ": feature '" + name + "' has " +
-                                      (std::isnan(x[r]) ? "NaN" : "Inf") + " at sample " +
-                                      std::to_string(r));
-        }
-      }
-      signal[d].emplace_back(x.data(), x.data() + x.size());
-    }
-  }
-  for (std::size_t f = 0; f < num_features; ++f) {
-    double lo = INFINITY, hi = -INFINITY;
-    if (!config.normalize_per_demo) {
-      for (std::size_t d = 0; d < num_demos; ++d) {
-        const auto [mn, mx] = std::minmax_element(signal[d][f].begin(), signal[d][f].end());
-        lo = std::min(lo, *mn), hi = std::max(hi, *mx);
-      }
-    }
-    for (std::size_t d = 0; d < num_demos; ++d) {
-      std::vector<double>& x = signal[d][f];
-      const auto [mn, mx] = std::minmax_element(x.begin(), x.end());
-      const bool flat = !(*mx - *mn > 1e-12 * (1.0 + std::max(std::abs(*mx), std::abs(*mn))));
-      constant_in[d].push_back(flat);
-      const double offset = config.normalize_per_demo ? *mn : lo;
-      const double range = config.normalize_per_demo ? *mx - *mn : hi - lo;
-      const bool zero = config.normalize_per_demo ? flat : !(range > 1e-12 * (1.0 + std::abs(hi)));
-      for (double& v : x) v = zero ? 0.0 : (v - offset) / range;
-    }
-  }
-
-  // Every (pair, feature) alignment in one batch; pairs of one demonstration pair share shapes,
-  // so they fill the SIMD lanes without padding.
-  std::vector<std::pair<std::size_t, std::size_t>> demo_pairs;
-  for (std::size_t p = 0; p < num_demos; ++p) {
-    for (std::size_t q = p + 1; q < num_demos; ++q) demo_pairs.emplace_back(p, q);
-  }
-  std::vector<DtwPairView> views;
-  views.reserve(demo_pairs.size() * num_features);
-  for (const auto& [p, q] : demo_pairs) {
-    for (std::size_t f = 0; f < num_features; ++f) {
-      views.push_back(
-          {signal[p][f].data(), signal[p][f].size(), signal[q][f].data(), signal[q][f].size()});
-    }
-  }
-  DtwOptions dtw_options;
-  if (config.band_fraction >= 0) {
-    dtw_options.band = static_cast<int>(std::ceil(config.band_fraction * double(longest)));
-  }
-  const std::vector<DtwResult> alignments = dtw_batch(views, dtw_options, config.threads);
+  NormalizedSignals signals = read_signals(demos, features);
+  normalize(signals, num_features, config.normalize_per_demo);
 
   FeatureRelevanceResult result;
   result.num_demos = num_demos;
@@ -143,64 +236,12 @@ FeatureRelevanceResult compute_feature_relevance(const std::vector<FeatureMatrix
     fr.correlation = Eigen::MatrixXd::Identity(num_demos, num_demos);
     fr.distance = Eigen::MatrixXd::Zero(num_demos, num_demos);
     fr.constant = true;
-    for (std::size_t d = 0; d < num_demos; ++d) fr.constant = fr.constant && constant_in[d][f];
+    for (std::size_t d = 0; d < num_demos; ++d)
+      fr.constant = fr.constant && signals.constant_in[d][f];
   }
-  for (std::size_t k = 0; k < demo_pairs.size(); ++k) {
-    const auto [p, q] = demo_pairs[k];
-    for (std::size_t f = 0; f < num_features; ++f) {
-      const DtwResult& r = alignments[k * num_features + f];
-      const DtwPairView& v = views[k * num_features + f];
-      const auto aligned = dtw_aligned_pair(v.a, v.b, r.path);
-      const double c = pearson_correlation(aligned.first, aligned.second);
-      const double dist = std::sqrt(std::max(0.0, r.cost) / double(r.path.size()));
-      FeatureRelevance& fr = result.features[f];
-      fr.correlation(p, q) = fr.correlation(q, p) = c;
-      fr.distance(p, q) = fr.distance(q, p) = dist;
-    }
-  }
-  const double pairs = double(demo_pairs.size());
-  double dmin = INFINITY, dmax = -INFINITY;
-  for (FeatureRelevance& fr : result.features) {
-    fr.mean_correlation = (fr.correlation.sum() - double(num_demos)) / (2.0 * pairs);
-    fr.mean_distance = fr.distance.sum() / (2.0 * pairs);
-    if (!fr.constant)
-      dmin = std::min(dmin, fr.mean_distance), dmax = std::max(dmax, fr.mean_distance);
-  }
-  std::vector<double> weighted, correlation_only;
-  std::vector<bool> excluded;
-  for (FeatureRelevance& fr : result.features) {
-    if (fr.constant) {
-      fr.mean_correlation = 0.0;
-      fr.normalized_distance = 1.0;
-      fr.score = 0.0;
-      result.warnings.push_back("feature '" + fr.name +
-                                "' is constant in every demonstration: score 0, not selected");
-    } else {
-      fr.normalized_distance =
-          dmax - dmin > 1e-12 ? (fr.mean_distance - dmin) / (dmax - dmin) : 0.0;
-      fr.score = fr.mean_correlation * (1.0 - fr.normalized_distance);
-    }
-    weighted.push_back(fr.score);
-    correlation_only.push_back(fr.mean_correlation);
-    excluded.push_back(fr.constant);
-  }
-  for (std::size_t f : select_by_threshold(weighted, excluded, config.threshold)) {
-    result.features[f].selected = true;
-    result.selected.push_back(result.features[f].name);
-  }
-  for (std::size_t f : select_by_threshold(correlation_only, excluded, config.threshold)) {
-    result.features[f].selected_correlation_only = true;
-    result.selected_correlation_only.push_back(result.features[f].name);
-  }
-  if (result.selected.empty()) {
-    result.warnings.push_back("no feature varies in any demonstration: nothing selected");
-  } else if (result
-                 .features[std::find(features.begin(), features.end(), result.selected[0]) -
-                           features.begin()]
-                 .score <= 0) {
-    result.warnings.push_back("no feature has a positive relevance score; kept only '" +
-                              result.selected[0] + "'");
-  }
+  align_pairs(signals, config, result);
+  score_features(result);
+  select_features(result, config.threshold);
   return result;
 }
 

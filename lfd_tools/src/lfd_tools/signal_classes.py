@@ -1,4 +1,4 @@
-"""Classes of real-world signals for measuring the segmentation (issue 22): seeded generators of
+"""Classes of real-world signals for measuring the segmentation: seeded generators of
 synthetic demonstrations, one per kind of recording that other robots produce. Each class is a
 task: 6-8 demos that share one phase sequence, each with its own durations and poses. Motions are
 minimum-jerk, positions carry sensor noise, a wrist F/T has an offset, white noise and drift, and

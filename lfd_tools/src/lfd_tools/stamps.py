@@ -1,7 +1,7 @@
 """The timestamp policy of lfd_core/io/stamp_order.hpp for the Python readers of recorded messages
 (the judge's bag readers, lfd_tools.bags): messages are taken in the order of their stamps, never of
 their arrival; out-of-order and duplicate stamps are counted, and so are gaps, and the reader passes
-the warning on, worded as the C++ readers word it. Nothing is dropped silently (issue 23: a late
+the warning on, worded as the C++ readers word it. Nothing is dropped silently (a late
 message arriving last was taken as an object's final pose, and judged the demo by it)."""
 import bisect
 import sys
