@@ -301,6 +301,33 @@ TEST(SensoryEvents, DriftWithoutContactNeedsTheQuietExcursionFloor) {
   EXPECT_NEAR(static_cast<double>(events[1]), 1000.0, 3.0);
 }
 
+// A busy demo: four presses (1.5 s each, 6 to 14 N, noise 0.5 N) with 1.2 s lifts between them,
+// from 1.7 s to 11.6 s of a 12.6 s recording at 50 Hz. Only its first second is quiet: one block of
+// twelve. The quiet excursion must come from that block (the 10th percentile, the second quietest
+// block, held a press edge and put the floor above every press), so each press makes its onset and
+// its release.
+TEST(SensoryEvents, ABusyDemoWithOneQuietSecondKeepsItsPresses) {
+  std::mt19937 rng(3);
+  std::normal_distribution<double> g(0.0, 0.5);
+  Eigen::VectorXd force(630);
+  const std::vector<std::pair<Eigen::Index, double>> presses = {
+      {85, 9.0}, {220, 14.0}, {355, 6.0}, {490, 11.0}};
+  for (Eigen::Index t = 0; t < force.size(); ++t) {
+    force[t] = g(rng);
+    for (const auto& [on, level] : presses)
+      if (t >= on && t < on + 75) force[t] += level;
+  }
+  SensoryEventConfig joint = yaml_at_50hz();
+  joint.merge_gap = 25;  // the joint segmentation's 0.5 s: a lift is a rest of its own
+  const Events events = lfd::detect_sensory_events(force, joint);
+  ASSERT_EQ(events.size(), 2 * presses.size()) << ::testing::PrintToString(events);
+  for (std::size_t k = 0; k < presses.size(); ++k) {
+    EXPECT_NEAR(static_cast<double>(events[2 * k]), static_cast<double>(presses[k].first), 3.0);
+    EXPECT_NEAR(static_cast<double>(events[2 * k + 1]), static_cast<double>(presses[k].first + 75),
+                3.0);
+  }
+}
+
 // A contact force building up over 0.8 s (noise a tenth of its height) and fading over 0.6 s: the
 // fitted events sit where the force leaves rest and where it is back at rest, within 0.1 s.
 TEST(SensoryEvents, FittedEventsAtTheStartAndEndOfSlowRamps) {

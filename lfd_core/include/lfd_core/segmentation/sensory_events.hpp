@@ -75,9 +75,9 @@ struct SensoryEventConfig {
   double noise_floor_sigmas = 6.0;  ///< 0 = paper-literal (no noise floor)
   /// The threshold is also at least this many quiet excursions (0 = off; needs noise_block): the
   /// largest lagged difference within a block, 0 for a block whose raw signal does not move at
-  /// all, 10th percentile over the blocks. Measured on the detector's own statistic, so drift,
-  /// clipped, quantized or correlated noise needs no model (a sigma of the raw differences does
-  /// not see a drift).
+  /// all, the 1/15 quantile over the blocks (a busy demo has few quiet seconds). Measured on the
+  /// detector's own statistic, so drift, clipped, quantized or correlated noise needs no model (a
+  /// sigma of the raw differences does not see a drift).
   double noise_floor_excursions = 0.0;
   double hysteresis = 0.5;             ///< in (0, 1]; 1 = paper-literal single threshold
   std::size_t min_active_samples = 1;  ///< bursts shorter than this are ignored
