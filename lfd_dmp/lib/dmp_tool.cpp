@@ -136,6 +136,65 @@ int learn(const std::vector<std::string>& args, std::ostream& out) {
   return 0;
 }
 
+std::optional<Eigen::Quaterniond> optQuaternion(const Options& o, const std::string& key) {
+  if (!o.count(key)) return std::nullopt;
+  const Eigen::VectorXd v = toVector(o.at(key), key);
+  if (v.size() != 4) throw UsageError(key + " needs 4 numbers w,x,y,z");
+  return Eigen::Quaterniond(v[0], v[1], v[2], v[3]);
+}
+
+lfd::SegmentRolloutOptions rolloutOptions(const Options& o) {
+  lfd::SegmentRolloutOptions ro;
+  if (const auto dt = optNumber(o, "--dt")) ro.dt = *dt;
+  ro.tau = optNumber(o, "--tau");
+  ro.duration = optNumber(o, "--duration");
+  ro.goal_filter = optNumber(o, "--goal-filter").value_or(0.0);
+  if (o.count("--start")) ro.start_position = toVector(o.at("--start"), "--start");
+  if (o.count("--goal")) ro.goal_position = toVector(o.at("--goal"), "--goal");
+  ro.start_orientation = optQuaternion(o, "--start-quat");
+  ro.goal_orientation = optQuaternion(o, "--goal-quat");
+  ro.start_gripper = optNumber(o, "--start-gripper");
+  ro.goal_gripper = optNumber(o, "--goal-gripper");
+  return ro;
+}
+
+// --generalize: the segment's demos generalized to --goal; else the DMP of demo --demo (0).
+lfd::SegmentDmp dmpToRollOut(const Options& o, const SegmentSkills& seg,
+                             const lfd::SegmentRolloutOptions& ro, std::ostream& out) {
+  if (o.count("--generalize")) {
+    if (o.count("--demo")) throw UsageError("--demo and --generalize are exclusive");
+    if (!ro.goal_position) throw UsageError("--generalize needs --goal");
+    std::vector<lfd::SegmentDmp> dmps;
+    std::vector<Eigen::VectorXd> params;
+    for (const auto& d : seg.demos) {
+      dmps.push_back(d.dmp);
+      params.push_back(d.parameters);
+    }
+    const lfd::GeneralizationResult res = lfd::generalizeSegment(dmps, params, *ro.goal_position);
+    if (res.outside_demo_range) out << "warning: " << res.warning << "\n";
+    out << "generalized from " << dmps.size() << " demos (bandwidth " << res.bandwidth << ")\n";
+    return res.dmp;
+  }
+  const int demo = static_cast<int>(optNumber(o, "--demo").value_or(0));
+  if (demo < 0 || demo >= static_cast<int>(seg.demos.size())) {
+    throw UsageError("--demo " + std::to_string(demo) + " out of range (segment has " +
+                     std::to_string(seg.demos.size()) + " demos)");
+  }
+  return seg.demos[static_cast<size_t>(demo)].dmp;
+}
+
+// The library's position names, or p0, p1, ... when they do not fit the trajectory.
+std::vector<std::string> positionColumns(const SkillLibrary& lib,
+                                         const lfd::SegmentTrajectory& traj) {
+  std::vector<std::string> names = lib.position_names;
+  if (static_cast<Eigen::Index>(names.size()) != traj.positions.cols()) {
+    names.clear();
+    for (Eigen::Index d = 0; d < traj.positions.cols(); ++d)
+      names.push_back("p" + std::to_string(d));
+  }
+  return names;
+}
+
 int rollout(const std::vector<std::string>& args, std::ostream& out) {
   const Options o = parse(args,
                           {"--library", "--out", "--segment", "--demo", "--start", "--goal",
@@ -156,46 +215,8 @@ int rollout(const std::vector<std::string>& args, std::ostream& out) {
   if (seg.demos.empty())
     throw std::runtime_error("segment " + std::to_string(seg_index) + " has no demos");
 
-  lfd::SegmentRolloutOptions ro;
-  if (const auto dt = optNumber(o, "--dt")) ro.dt = *dt;
-  ro.tau = optNumber(o, "--tau");
-  ro.duration = optNumber(o, "--duration");
-  ro.goal_filter = optNumber(o, "--goal-filter").value_or(0.0);
-  if (o.count("--start")) ro.start_position = toVector(o.at("--start"), "--start");
-  if (o.count("--goal")) ro.goal_position = toVector(o.at("--goal"), "--goal");
-  auto quat = [&](const std::string& key) -> std::optional<Eigen::Quaterniond> {
-    if (!o.count(key)) return std::nullopt;
-    const Eigen::VectorXd v = toVector(o.at(key), key);
-    if (v.size() != 4) throw UsageError(key + " needs 4 numbers w,x,y,z");
-    return Eigen::Quaterniond(v[0], v[1], v[2], v[3]);
-  };
-  ro.start_orientation = quat("--start-quat");
-  ro.goal_orientation = quat("--goal-quat");
-  ro.start_gripper = optNumber(o, "--start-gripper");
-  ro.goal_gripper = optNumber(o, "--goal-gripper");
-
-  lfd::SegmentDmp dmp;
-  if (o.count("--generalize")) {
-    if (o.count("--demo")) throw UsageError("--demo and --generalize are exclusive");
-    if (!ro.goal_position) throw UsageError("--generalize needs --goal");
-    std::vector<lfd::SegmentDmp> dmps;
-    std::vector<Eigen::VectorXd> params;
-    for (const auto& d : seg.demos) {
-      dmps.push_back(d.dmp);
-      params.push_back(d.parameters);
-    }
-    const lfd::GeneralizationResult res = lfd::generalizeSegment(dmps, params, *ro.goal_position);
-    if (res.outside_demo_range) out << "warning: " << res.warning << "\n";
-    out << "generalized from " << dmps.size() << " demos (bandwidth " << res.bandwidth << ")\n";
-    dmp = res.dmp;
-  } else {
-    const int demo = static_cast<int>(optNumber(o, "--demo").value_or(0));
-    if (demo < 0 || demo >= static_cast<int>(seg.demos.size())) {
-      throw UsageError("--demo " + std::to_string(demo) + " out of range (segment has " +
-                       std::to_string(seg.demos.size()) + " demos)");
-    }
-    dmp = seg.demos[static_cast<size_t>(demo)].dmp;
-  }
+  const lfd::SegmentRolloutOptions ro = rolloutOptions(o);
+  const lfd::SegmentDmp dmp = dmpToRollOut(o, seg, ro, out);
   const double samples = ro.duration.value_or(ro.tau.value_or(dmp.tau)) / ro.dt;
   if (!(samples <= kMaxRolloutSamples)) {
     throw UsageError("the rollout would hold " + std::to_string(samples) +
@@ -207,13 +228,7 @@ int rollout(const std::vector<std::string>& args, std::ostream& out) {
   } catch (const std::invalid_argument& e) {
     throw UsageError(e.what());
   }
-  std::vector<std::string> names = lib.position_names;
-  if (static_cast<Eigen::Index>(names.size()) != traj.positions.cols()) {
-    names.clear();
-    for (Eigen::Index d = 0; d < traj.positions.cols(); ++d)
-      names.push_back("p" + std::to_string(d));
-  }
-  writeTrajectoryCsv(path, traj, names, overwrite);
+  writeTrajectoryCsv(path, traj, positionColumns(lib, traj), overwrite);
   out << "rolled out " << traj.times.size() << " steps -> " << path << "\n";
   return 0;
 }

@@ -199,6 +199,43 @@ void learnSignature(const std::vector<UsedDemo>& used, const lfd::SignatureOptio
   }
 }
 
+// Majority vote on the number of changepoints (ties: fewer segments).
+size_t majorityChangepointCount(const std::vector<std::vector<double>>& changepoint_times) {
+  std::map<size_t, size_t> votes;
+  for (const auto& cps : changepoint_times) ++votes[cps.size()];
+  size_t cp_count = votes.begin()->first;
+  for (const auto& [count, n] : votes) {
+    if (n > votes[cp_count]) cp_count = count;
+  }
+  return cp_count;
+}
+
+// The library's empty segments, named after the task's when it has as many.
+void addSegments(size_t num_segments, const LearnOptions& options, LearnOutcome* outcome) {
+  // The task's names fit only the number of segments it has: a 1-segment library of a 3-segment
+  // task is not called "approach" (the executor refuses unnamed segments with a clear error).
+  const bool named = options.segment_names.size() == num_segments;
+  if (!options.segment_names.empty() && !named) {
+    outcome->warnings.push_back("the demos give " + std::to_string(num_segments) +
+                                " segment(s) (majority of changepoint counts), the task has " +
+                                std::to_string(options.segment_names.size()) +
+                                ": segments left unnamed; the executor will refuse this library");
+  }
+  for (size_t s = 0; s < num_segments; ++s) {
+    SegmentSkills seg;
+    seg.index = static_cast<int>(s);
+    seg.name = named ? options.segment_names[s] : "segment_" + std::to_string(s);
+    outcome->library.segments.push_back(seg);
+  }
+}
+
+// The poses of a used demo at its start and at every segment boundary, with its scene.
+DemoEnds demoEnds(const UsedDemo& u) {
+  DemoEnds e{*u.rec.scene, poseAt(u.rec, 0), {}};
+  for (Eigen::Index b : u.bounds) e.bounds.push_back(poseAt(u.rec, b));
+  return e;
+}
+
 }  // namespace
 
 LearnOutcome learnSkillLibrary(const std::vector<DemoRecording>& demos,
@@ -215,25 +252,10 @@ LearnOutcome learnSkillLibrary(const std::vector<DemoRecording>& demos,
   const bool with_scenes = checkScenes(demos, &frame);
   if (!(options.smoothing_sigma >= 0.0) || !std::isfinite(options.smoothing_sigma))
     throw std::invalid_argument("learnSkillLibrary: smoothing_sigma must be a finite value >= 0");
-  // Majority vote on the number of segments (ties: fewer segments).
-  std::map<size_t, size_t> votes;
-  for (const auto& cps : changepoint_times) ++votes[cps.size()];
-  size_t cp_count = votes.begin()->first;
-  for (const auto& [count, n] : votes) {
-    if (n > votes[cp_count]) cp_count = count;
-  }
+  const size_t cp_count = majorityChangepointCount(changepoint_times);
   const size_t num_segments = cp_count + 1;
 
   LearnOutcome outcome;
-  // The task's names fit only the number of segments it has: a 1-segment library of a 3-segment
-  // task is not called "approach" (the executor refuses unnamed segments with a clear error).
-  const bool named = options.segment_names.size() == num_segments;
-  if (!options.segment_names.empty() && !named) {
-    outcome.warnings.push_back("the demos give " + std::to_string(num_segments) +
-                               " segment(s) (majority of changepoint counts), the task has " +
-                               std::to_string(options.segment_names.size()) +
-                               ": segments left unnamed; the executor will refuse this library");
-  }
   SkillLibrary& lib = outcome.library;
   lib.task = options.task;
   lib.features = options.features;
@@ -243,14 +265,9 @@ LearnOutcome learnSkillLibrary(const std::vector<DemoRecording>& demos,
   lib.position_names = {"x", "y", "z"};
   lib.generalization_parameters = "goal_position";
   lib.cartesian_frame = frame;
-  std::vector<DemoEnds> ends;
-  for (size_t s = 0; s < num_segments; ++s) {
-    SegmentSkills seg;
-    seg.index = static_cast<int>(s);
-    seg.name = named ? options.segment_names[s] : "segment_" + std::to_string(s);
-    lib.segments.push_back(seg);
-  }
+  addSegments(num_segments, options, &outcome);
 
+  std::vector<DemoEnds> ends;
   std::vector<UsedDemo> used;
   for (size_t d = 0; d < demos.size(); ++d) {
     checkRecording(demos[d]);
@@ -261,13 +278,10 @@ LearnOutcome learnSkillLibrary(const std::vector<DemoRecording>& demos,
       continue;
     }
     used.push_back({smoothed(demos[d], options.smoothing_sigma, &outcome.warnings), {}});
-    const DemoRecording& rec = used.back().rec;
-    used.back().bounds = boundaries(rec, cps);
+    used.back().bounds = boundaries(used.back().rec, cps);
     if (with_scenes) {
-      DemoEnds e{*rec.scene, poseAt(rec, 0), {}};
-      for (Eigen::Index b : used.back().bounds) e.bounds.push_back(poseAt(rec, b));
-      lib.demo_scenes[rec.id] = {e.scene, e.start};
-      ends.push_back(std::move(e));
+      ends.push_back(demoEnds(used.back()));
+      lib.demo_scenes[used.back().rec.id] = {ends.back().scene, ends.back().start};
     }
   }
   outcome.demos_used = used.size();

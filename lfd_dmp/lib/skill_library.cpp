@@ -342,9 +342,9 @@ lfd::SegmentDmp segmentDmpFromJson(const json& j, const lfd::DmpParameters& para
   return dmp;
 }
 
-SkillLibrary skillLibraryFromJson(const json& j) {
-  const std::string root = "skill library";
-  SkillLibrary lib;
+namespace {
+
+void checkFormatAndVersion(const json& j, const std::string& root) {
   const std::string format = text(member(j, "format", root), "format");
   if (format != kSkillLibraryFormat) {
     fail("format", "expected \"" + std::string(kSkillLibraryFormat) + "\", got \"" + format + "\"");
@@ -360,21 +360,68 @@ SkillLibrary skillLibraryFromJson(const json& j) {
     fail("version", "unsupported version " + std::to_string(static_cast<int>(version)) +
                         " (this build reads version " + std::to_string(kSkillLibraryVersion) + ")");
   }
+}
+
+/// `param_dims` is the parameter count of the segment's earlier demos (-1: this is the first).
+DemoSkill demoSkillFromJson(const json& j, const std::string& wd, const SkillLibrary& lib,
+                            long param_dims) {
+  DemoSkill demo;
+  demo.demo_id = text(member(j, "demo_id", wd), wd + ".demo_id");
+  demo.start_time = number(member(j, "start_time", wd), wd + ".start_time");
+  demo.end_time = number(member(j, "end_time", wd), wd + ".end_time");
+  demo.parameters = vector(member(j, "parameters", wd), wd + ".parameters", param_dims);
+  demo.dmp = segmentDmpFromJson(member(j, "dmp", wd), lib.dmp_parameters, wd + ".dmp");
+  if (demo.dmp.position &&
+      demo.dmp.position->dims() != static_cast<int>(lib.position_names.size())) {
+    fail(wd + ".dmp.position", "has " + std::to_string(demo.dmp.position->dims()) +
+                                   " dimensions but position_names has " +
+                                   std::to_string(lib.position_names.size()));
+  }
+  return demo;
+}
+
+// Every demo of a segment has the same DMP parts, so they generalize into one.
+void checkSameDmpParts(const lfd::SegmentDmp& ref, const lfd::SegmentDmp& dmp,
+                       const std::string& wd) {
+  if (ref.position.has_value() != dmp.position.has_value() ||
+      ref.orientation.has_value() != dmp.orientation.has_value() ||
+      ref.gripper.has_value() != dmp.gripper.has_value()) {
+    fail(wd + ".dmp", "has different parts (position/orientation/gripper) than demos[0]");
+  }
+}
+
+SegmentSkills segmentFromJson(const json& j, const std::string& ws, const SkillLibrary& lib) {
+  SegmentSkills seg;
+  seg.index = static_cast<int>(number(member(j, "index", ws), ws + ".index"));
+  seg.name = text(member(j, "name", ws), ws + ".name");
+  if (j.contains("goal")) seg.goal = goalFromJson(j["goal"], ws + ".goal");
+  if (j.contains("time_reference"))
+    seg.time_reference = text(j["time_reference"], ws + ".time_reference");
+  const json& demos = member(j, "demos", ws);
+  if (!demos.is_array()) fail(ws + ".demos", "expected an array");
+  long param_dims = -1;
+  for (size_t d = 0; d < demos.size(); ++d) {
+    const std::string wd = ws + ".demos[" + std::to_string(d) + "]";
+    DemoSkill demo = demoSkillFromJson(demos[d], wd, lib, param_dims);
+    param_dims = demo.parameters.size();
+    if (!seg.demos.empty()) checkSameDmpParts(seg.demos.front().dmp, demo.dmp, wd);
+    seg.demos.push_back(std::move(demo));
+  }
+  return seg;
+}
+
+}  // namespace
+
+SkillLibrary skillLibraryFromJson(const json& j) {
+  const std::string root = "skill library";
+  SkillLibrary lib;
+  checkFormatAndVersion(j, root);
   lib.version = kSkillLibraryVersion;
   lib.task = text(member(j, "task", root), "task");
-  const json& features = member(j, "features", root);
-  if (!features.is_array()) fail("features", "expected an array of strings");
-  for (size_t i = 0; i < features.size(); ++i) {
-    lib.features.push_back(text(features[i], "features[" + std::to_string(i) + "]"));
-  }
+  lib.features = texts(member(j, "features", root), "features");
   lib.generalization_parameters =
       text(member(j, "generalization_parameters", root), "generalization_parameters");
-  const json& names = member(j, "position_names", root);
-  if (!names.is_array()) fail("position_names", "expected an array of strings");
-  lib.position_names.clear();
-  for (size_t i = 0; i < names.size(); ++i) {
-    lib.position_names.push_back(text(names[i], "position_names[" + std::to_string(i) + "]"));
-  }
+  lib.position_names = texts(member(j, "position_names", root), "position_names");
   lib.dmp_parameters = dmpParametersFromJson(member(j, "dmp_parameters", root), "dmp_parameters");
   if (j.contains("smoothing_sigma")) {
     lib.smoothing_sigma = number(j["smoothing_sigma"], "smoothing_sigma");
@@ -391,42 +438,8 @@ SkillLibrary skillLibraryFromJson(const json& j) {
   const json& segments = member(j, "segments", root);
   if (!segments.is_array()) fail("segments", "expected an array");
   for (size_t s = 0; s < segments.size(); ++s) {
-    const std::string ws = "segments[" + std::to_string(s) + "]";
-    SegmentSkills seg;
-    seg.index = static_cast<int>(number(member(segments[s], "index", ws), ws + ".index"));
-    seg.name = text(member(segments[s], "name", ws), ws + ".name");
-    if (segments[s].contains("goal")) seg.goal = goalFromJson(segments[s]["goal"], ws + ".goal");
-    if (segments[s].contains("time_reference"))
-      seg.time_reference = text(segments[s]["time_reference"], ws + ".time_reference");
-    const json& demos = member(segments[s], "demos", ws);
-    if (!demos.is_array()) fail(ws + ".demos", "expected an array");
-    long param_dims = -1;
-    for (size_t d = 0; d < demos.size(); ++d) {
-      const std::string wd = ws + ".demos[" + std::to_string(d) + "]";
-      DemoSkill demo;
-      demo.demo_id = text(member(demos[d], "demo_id", wd), wd + ".demo_id");
-      demo.start_time = number(member(demos[d], "start_time", wd), wd + ".start_time");
-      demo.end_time = number(member(demos[d], "end_time", wd), wd + ".end_time");
-      demo.parameters = vector(member(demos[d], "parameters", wd), wd + ".parameters", param_dims);
-      param_dims = demo.parameters.size();
-      demo.dmp = segmentDmpFromJson(member(demos[d], "dmp", wd), lib.dmp_parameters, wd + ".dmp");
-      if (demo.dmp.position &&
-          demo.dmp.position->dims() != static_cast<int>(lib.position_names.size())) {
-        fail(wd + ".dmp.position", "has " + std::to_string(demo.dmp.position->dims()) +
-                                       " dimensions but position_names has " +
-                                       std::to_string(lib.position_names.size()));
-      }
-      if (!seg.demos.empty()) {
-        const auto& ref = seg.demos.front().dmp;
-        if (ref.position.has_value() != demo.dmp.position.has_value() ||
-            ref.orientation.has_value() != demo.dmp.orientation.has_value() ||
-            ref.gripper.has_value() != demo.dmp.gripper.has_value()) {
-          fail(wd + ".dmp", "has different parts (position/orientation/gripper) than demos[0]");
-        }
-      }
-      seg.demos.push_back(std::move(demo));
-    }
-    lib.segments.push_back(std::move(seg));
+    lib.segments.push_back(
+        segmentFromJson(segments[s], "segments[" + std::to_string(s) + "]", lib));
   }
   if (j.contains("sensory_signature")) {
     lib.sensory_signature = signatureFromJson(j["sensory_signature"], "sensory_signature");

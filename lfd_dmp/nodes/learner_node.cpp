@@ -74,61 +74,16 @@ class Learner {
       checkCounts(req);
       std::vector<std::string> bags;
       std::vector<std::vector<double>> cps;
-      if (!req.segmentations.empty()) {
-        for (size_t i = 0; i < req.segmentations.size(); ++i) {
-          const auto& s = req.segmentations[i];
-          lfd::checkRequestPath("segmentations[" + std::to_string(i) + "].source", s.source,
-                                paths_);
-          bags.push_back(s.source);
-          cps.push_back(s.changepoint_times);
-        }
-      } else {
-        if (req.changepoint_counts.size() != req.bag_paths.size()) {
-          throw std::invalid_argument("changepoint_counts needs one entry per bag");
-        }
-        size_t k = 0;
-        for (size_t i = 0; i < req.bag_paths.size(); ++i) {
-          lfd::checkRequestPath("bag_paths[" + std::to_string(i) + "]", req.bag_paths[i], paths_);
-          bags.push_back(req.bag_paths[i]);
-          std::vector<double> c;
-          for (uint32_t j = 0; j < req.changepoint_counts[i]; ++j) {
-            if (k >= req.changepoint_times.size()) {
-              throw std::invalid_argument("changepoint_times has fewer entries than the counts");
-            }
-            c.push_back(req.changepoint_times[k++]);
-          }
-          cps.push_back(c);
-        }
-        if (k != req.changepoint_times.size()) {
-          throw std::invalid_argument("changepoint_times has more entries than the counts");
-        }
-      }
+      requestedDemos(req, &bags, &cps);
       if (bags.empty()) throw std::invalid_argument("no demonstrations given");
       checkBudget(bags);
       const std::string output = lfd::checkOutputFile(req.output_path, paths_, req.overwrite, bags,
                                                       lfd_dmp::skillLibraryOutput());
-      std::vector<lfd_dmp::DemoRecording> demos;
-      for (const auto& b : bags) {
-        demos.push_back(lfd_dmp::readDemoBag(
-            b, topics_, [this](const std::string& target, const std::string& source) {
-              return liveTransform(target, source);
-            }));
-        checkDemoSize(demos.back(), b);
-        if (signature_) lfd_dmp::readDemoSensors(b, sensors_, &demos.back());
-      }
+      const std::vector<lfd_dmp::DemoRecording> demos = readDemos(bags);
       std::vector<std::string> read_warnings;  // stamps the readers put in order, per demo
       for (const auto& d : demos)
         read_warnings.insert(read_warnings.end(), d.warnings.begin(), d.warnings.end());
-      lfd_dmp::LearnOptions opt;
-      opt.task = req.task;
-      opt.features = req.selected_features;
-      opt.segment_names = req.segment_names;
-      opt.params.num_basis = req.num_basis > 0 ? req.num_basis : num_basis_;
-      opt.smoothing_sigma = smoothing_sigma_;
-      opt.time_alignment = time_alignment_;
-      opt.frames = frames_;
-      opt.signature = signature_;
-      const lfd_dmp::LearnOutcome out = lfd_dmp::learnSkillLibrary(demos, cps, opt);
+      const lfd_dmp::LearnOutcome out = lfd_dmp::learnSkillLibrary(demos, cps, learnOptions(req));
       lfd_dmp::saveSkillLibrary(out.library, output, req.overwrite);
       res.success = true;
       res.warnings = read_warnings;
@@ -149,6 +104,68 @@ class Learner {
   }
 
  private:
+  // The request's bags (paths checked) and each one's changepoint times: from its segmentations,
+  // else from bag_paths with changepoint_counts splitting changepoint_times.
+  void requestedDemos(const lfd_msgs::LearnSkills::Request& req, std::vector<std::string>* bags,
+                      std::vector<std::vector<double>>* cps) const {
+    if (!req.segmentations.empty()) {
+      for (size_t i = 0; i < req.segmentations.size(); ++i) {
+        const auto& s = req.segmentations[i];
+        lfd::checkRequestPath("segmentations[" + std::to_string(i) + "].source", s.source, paths_);
+        bags->push_back(s.source);
+        cps->push_back(s.changepoint_times);
+      }
+      return;
+    }
+    if (req.changepoint_counts.size() != req.bag_paths.size()) {
+      throw std::invalid_argument("changepoint_counts needs one entry per bag");
+    }
+    size_t k = 0;
+    for (size_t i = 0; i < req.bag_paths.size(); ++i) {
+      lfd::checkRequestPath("bag_paths[" + std::to_string(i) + "]", req.bag_paths[i], paths_);
+      bags->push_back(req.bag_paths[i]);
+      std::vector<double> c;
+      for (uint32_t j = 0; j < req.changepoint_counts[i]; ++j) {
+        if (k >= req.changepoint_times.size()) {
+          throw std::invalid_argument("changepoint_times has fewer entries than the counts");
+        }
+        c.push_back(req.changepoint_times[k++]);
+      }
+      cps->push_back(c);
+    }
+    if (k != req.changepoint_times.size()) {
+      throw std::invalid_argument("changepoint_times has more entries than the counts");
+    }
+  }
+
+  // Each bag's poses (a bag without /tf_static: live tf), size-checked, and its sensors when a
+  // signature is learned.
+  std::vector<lfd_dmp::DemoRecording> readDemos(const std::vector<std::string>& bags) {
+    std::vector<lfd_dmp::DemoRecording> demos;
+    for (const auto& b : bags) {
+      demos.push_back(lfd_dmp::readDemoBag(
+          b, topics_, [this](const std::string& target, const std::string& source) {
+            return liveTransform(target, source);
+          }));
+      checkDemoSize(demos.back(), b);
+      if (signature_) lfd_dmp::readDemoSensors(b, sensors_, &demos.back());
+    }
+    return demos;
+  }
+
+  lfd_dmp::LearnOptions learnOptions(const lfd_msgs::LearnSkills::Request& req) const {
+    lfd_dmp::LearnOptions opt;
+    opt.task = req.task;
+    opt.features = req.selected_features;
+    opt.segment_names = req.segment_names;
+    opt.params.num_basis = req.num_basis > 0 ? req.num_basis : num_basis_;
+    opt.smoothing_sigma = smoothing_sigma_;
+    opt.time_alignment = time_alignment_;
+    opt.frames = frames_;
+    opt.signature = signature_;
+    return opt;
+  }
+
   // The request's work, checked before any bag is read: its bags and their total size (each one
   // opened by the file-access layer: a regular file inside the roots).
   void checkBudget(const std::vector<std::string>& bags) const {

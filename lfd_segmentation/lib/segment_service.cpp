@@ -99,6 +99,79 @@ lfd_msgs::DemoSegmentation demo_message(const DemoFeatures& demo,
   return m;
 }
 
+// Every string within one bound before anything else: a 10 MB path is refused, not echoed. The
+// bag count is checked before the overrides are parsed.
+void check_request_size(const lfd_msgs::Segment::Request& request,
+                        const SegmentationParams& params) {
+  lfd::StringBudget strings;
+  strings.max_bytes = params.limits.max_request_string_bytes;
+  strings.key = "limits/max_request_string_bytes";
+  lfd::checkRequestStrings(request, strings);
+  if (request.bag_paths.empty()) {
+    throw std::invalid_argument("empty request: give at least one bag path");
+  }
+  if (request.bag_paths.size() > params.limits.max_bags) {
+    throw std::invalid_argument(std::to_string(request.bag_paths.size()) +
+                                " bag paths, over the limit of " +
+                                std::to_string(params.limits.max_bags) + " (limits/max_bags)");
+  }
+}
+
+// Reads the bags and selects their features unless `cache` already holds them under `key`.
+void ensure_prepared(const std::vector<DemoFiles>& files, const std::string& key,
+                     const SegmentationParams& p, const lfd::SegmentationPipelineConfig& config,
+                     const std::vector<std::string>& bag_paths, PreparedCache& cache) {
+  if (!cache.key.empty() && cache.key == key) return;
+  cache = PreparedCache{};  // the stale entry goes before anything is read
+  for (const DemoFiles& demo : files) {
+    cache.demos.push_back(read_bag_features(demo, p.topics, p.rate, p.limits));
+    cache.matrices.push_back(cache.demos.back().matrix);
+  }
+  check_demos_fit(p, cache.matrices, bag_paths);
+  cache.prepared = lfd::prepare_segmentation(cache.matrices, cache.demos[0].sensor_features, config,
+                                             cache.demos[0].state_features);
+  cache.key = key;
+}
+
+lfd_msgs::FeatureScore feature_score_message(const lfd::FeatureRelevance& f) {
+  lfd_msgs::FeatureScore s;
+  s.name = f.name;
+  s.mean_correlation = f.mean_correlation;
+  s.mean_distance = f.mean_distance;
+  s.normalized_distance = f.normalized_distance;
+  s.score = f.score;
+  s.constant = f.constant;
+  s.selected = f.selected;
+  s.selected_correlation_only = f.selected_correlation_only;
+  s.num_demos = static_cast<uint32_t>(f.correlation.rows());
+  for (Eigen::Index r = 0; r < f.correlation.rows(); ++r) {
+    for (Eigen::Index c = 0; c < f.correlation.cols(); ++c) {
+      s.correlation.push_back(f.correlation(r, c));
+    }
+  }
+  return s;
+}
+
+void fill_response(const std::vector<DemoFeatures>& demos,
+                   const lfd::SegmentationPipelineResult& result, double rate,
+                   lfd_msgs::Segment::Response& response) {
+  response.warnings.clear();
+  for (const DemoFeatures& demo : demos)  // the stamps each bag's reader put in order
+    response.warnings.insert(response.warnings.end(), demo.warnings.begin(), demo.warnings.end());
+  response.warnings.insert(response.warnings.end(), result.warnings.begin(), result.warnings.end());
+  response.selected_features = result.selected_features;
+  response.selected_weights = result.feature_weights;
+  response.sensor_features = result.sensor_features;
+  for (std::size_t d = 0; d < demos.size(); ++d) {
+    response.demos.push_back(demo_message(demos[d], result.demos[d], rate));
+  }
+  if (result.relevance_computed) {
+    for (const lfd::FeatureRelevance& f : result.relevance.features) {
+      response.features.push_back(feature_score_message(f));
+    }
+  }
+}
+
 }  // namespace
 
 void handle_segment_request(const SegmentationParams& params,
@@ -107,19 +180,7 @@ void handle_segment_request(const SegmentationParams& params,
   const auto start = std::chrono::steady_clock::now();
   response = lfd_msgs::Segment::Response();
   try {
-    // Every string within one bound before anything else: a 10 MB path is refused, not echoed.
-    lfd::StringBudget strings;
-    strings.max_bytes = params.limits.max_request_string_bytes;
-    strings.key = "limits/max_request_string_bytes";
-    lfd::checkRequestStrings(request, strings);
-    if (request.bag_paths.empty()) {
-      throw std::invalid_argument("empty request: give at least one bag path");
-    }
-    if (request.bag_paths.size() > params.limits.max_bags) {  // before parsing the overrides
-      throw std::invalid_argument(std::to_string(request.bag_paths.size()) +
-                                  " bag paths, over the limit of " +
-                                  std::to_string(params.limits.max_bags) + " (limits/max_bags)");
-    }
+    check_request_size(request, params);
     const SegmentationParams p = apply_overrides(params, request);
     lfd::PathPolicy paths = p.paths;
     paths.require_absolute = true;  // a service: the CLI takes relative paths, the node does not
@@ -131,51 +192,11 @@ void handle_segment_request(const SegmentationParams& params,
     PreparedCache local;  // without a cache
     PreparedCache& used = cache ? *cache : local;
     const lfd::SegmentationPipelineConfig config = p.pipeline_config();
-    if (used.key.empty() || used.key != key) {
-      used = PreparedCache{};  // the stale entry goes before anything is read
-      for (const DemoFiles& demo : files) {
-        used.demos.push_back(read_bag_features(demo, p.topics, p.rate, p.limits));
-        used.matrices.push_back(used.demos.back().matrix);
-      }
-      check_demos_fit(p, used.matrices, request.bag_paths);
-      used.prepared = lfd::prepare_segmentation(used.matrices, used.demos[0].sensor_features,
-                                                config, used.demos[0].state_features);
-      used.key = key;
-    }
+    ensure_prepared(files, key, p, config, request.bag_paths, used);
     check_demos_fit(p, used.matrices, request.bag_paths);  // this request's window_seconds
     const lfd::SegmentationPipelineResult result =
         lfd::segment_prepared(used.prepared, used.matrices, config);
-    response.warnings.clear();
-    for (const DemoFeatures& demo : used.demos)  // the stamps each bag's reader put in order
-      response.warnings.insert(response.warnings.end(), demo.warnings.begin(), demo.warnings.end());
-    response.warnings.insert(response.warnings.end(), result.warnings.begin(),
-                             result.warnings.end());
-    response.selected_features = result.selected_features;
-    response.selected_weights = result.feature_weights;
-    response.sensor_features = result.sensor_features;
-    for (std::size_t d = 0; d < used.demos.size(); ++d) {
-      response.demos.push_back(demo_message(used.demos[d], result.demos[d], p.rate));
-    }
-    if (result.relevance_computed) {
-      for (const lfd::FeatureRelevance& f : result.relevance.features) {
-        lfd_msgs::FeatureScore s;
-        s.name = f.name;
-        s.mean_correlation = f.mean_correlation;
-        s.mean_distance = f.mean_distance;
-        s.normalized_distance = f.normalized_distance;
-        s.score = f.score;
-        s.constant = f.constant;
-        s.selected = f.selected;
-        s.selected_correlation_only = f.selected_correlation_only;
-        s.num_demos = static_cast<uint32_t>(f.correlation.rows());
-        for (Eigen::Index r = 0; r < f.correlation.rows(); ++r) {
-          for (Eigen::Index c = 0; c < f.correlation.cols(); ++c) {
-            s.correlation.push_back(f.correlation(r, c));
-          }
-        }
-        response.features.push_back(s);
-      }
-    }
+    fill_response(used.demos, result, p.rate, response);
     response.success = true;
   } catch (const std::exception& e) {
     response = lfd_msgs::Segment::Response();

@@ -107,6 +107,19 @@ void perturbQuaternion(std::array<double, 4>* q, const std::array<double, 3>& ro
   for (int i = 0; i < 4; ++i) (*q)[i] = res[i];
 }
 
+// Makes actuator u a pure P term: force = kp * (ctrl - q). Damping, gravity and velocity
+// feed-forward are handled in computeControls() and by implicit joint damping.
+void makeProportionalActuator(mjModel* m, int u, double kp) {
+  m->actuator_dyntype[u] = mjDYN_NONE;
+  m->actuator_gaintype[u] = mjGAIN_FIXED;
+  m->actuator_biastype[u] = mjBIAS_AFFINE;
+  mju_zero(m->actuator_gainprm + mjNGAIN * u, mjNGAIN);
+  mju_zero(m->actuator_biasprm + mjNBIAS * u, mjNBIAS);
+  m->actuator_gainprm[mjNGAIN * u] = kp;
+  m->actuator_biasprm[mjNBIAS * u + 1] = -kp;
+  m->actuator_ctrllimited[u] = 0;  // targets are clamped to joint limits before ctrl
+}
+
 }  // namespace
 
 WorkcellSim::WorkcellSim(const std::string& mjcf_path, const WorkcellConfig& config, LogSink log)
@@ -138,21 +151,7 @@ WorkcellSim::WorkcellSim(const std::string& mjcf_path, const WorkcellConfig& con
   }
   configureActuators();
 
-  base_body_ =
-      config_.base_body.empty() ? -1 : mj_name2id(m_, mjOBJ_BODY, config_.base_body.c_str());
-  if (base_body_ < 0) {
-    // Fall back to the robot's root: the first child of the world that is not a free object.
-    for (int b = 1; b < m_->nbody && base_body_ < 0; ++b) {
-      if (m_->body_parentid[b] == 0 && m_->body_jntnum[b] > 0 &&
-          m_->jnt_type[m_->body_jntadr[b]] != mjJNT_FREE) {
-        base_body_ = b;
-      }
-    }
-    if (base_body_ < 0) base_body_ = 0;
-    if (!config_.base_body.empty())
-      this->log(LogLevel::kWarn, "no body '" + config_.base_body + "'; using body '" +
-                                     mj_id2name(m_, mjOBJ_BODY, base_body_) + "' as the base");
-  }
+  findBaseBody();
   // A joint belongs to the robot when its body hangs from the same world child as base_link;
   // any other (the drawer's slide) is a scene object's.
   for (int j : joint_ids_)
@@ -180,6 +179,31 @@ WorkcellSim::WorkcellSim(const std::string& mjcf_path, const WorkcellConfig& con
 
   setNoise(config_.noise, config_.noise_seed);
 
+  recordInitialScene();
+  reset({}, true);
+}
+
+void WorkcellSim::findBaseBody() {
+  base_body_ =
+      config_.base_body.empty() ? -1 : mj_name2id(m_, mjOBJ_BODY, config_.base_body.c_str());
+  if (base_body_ < 0) {
+    // Fall back to the robot's root: the first child of the world that is not a free object.
+    for (int b = 1; b < m_->nbody && base_body_ < 0; ++b) {
+      if (m_->body_parentid[b] == 0 && m_->body_jntnum[b] > 0 &&
+          m_->jnt_type[m_->body_jntadr[b]] != mjJNT_FREE) {
+        base_body_ = b;
+      }
+    }
+    if (base_body_ < 0) base_body_ = 0;
+    if (!config_.base_body.empty())
+      log(LogLevel::kWarn, "no body '" + config_.base_body + "'; using body '" +
+                               mj_id2name(m_, mjOBJ_BODY, base_body_) + "' as the base");
+  }
+}
+
+// The model's object poses (free joints in qpos0, fixed objects as mocap bodies): what reset and
+// divergence recovery put back.
+void WorkcellSim::recordInitialScene() {
   initial_qpos_.assign(m_->qpos0, m_->qpos0 + m_->nq);
   scene_qpos_ = initial_qpos_;
   scene_mocap_.assign(7 * m_->nmocap, 0.0);
@@ -189,7 +213,6 @@ WorkcellSim::WorkcellSim(const std::string& mjcf_path, const WorkcellConfig& con
     std::copy(m_->body_pos + 3 * b, m_->body_pos + 3 * b + 3, scene_mocap_.begin() + 7 * id);
     std::copy(m_->body_quat + 4 * b, m_->body_quat + 4 * b + 4, scene_mocap_.begin() + 7 * id + 3);
   }
-  reset({}, true);
 }
 
 // The robot file describes this model: a name it gives that the model lacks is a robot file for
@@ -232,62 +255,8 @@ void WorkcellSim::configureActuators() {
       log(LogLevel::kWarn, "actuator of " + a.name + " has gear != 1; forcing 1");
       m_->actuator_gear[6 * u] = 1.0;
     }
-
-    // Proportional gain: config, else the MJCF position actuator's, else the default.
-    const bool is_position_actuator = m_->actuator_gaintype[u] == mjGAIN_FIXED &&
-                                      m_->actuator_biastype[u] == mjBIAS_AFFINE &&
-                                      m_->actuator_biasprm[mjNBIAS * u + 1] < 0.0;
-    auto kp_it = config_.kp.find(a.name);
-    a.kp = kp_it != config_.kp.end() ? kp_it->second
-           : is_position_actuator    ? m_->actuator_gainprm[mjNGAIN * u]
-                                     : config_.default_kp;
-    if (!(a.kp > 0.0)) throw std::invalid_argument("joint " + a.name + " has a non-positive kp");
-    // Make the actuator a pure P term: force = kp * (ctrl - q). Damping, gravity and velocity
-    // feed-forward are handled in computeControls() and by implicit joint damping.
-    m_->actuator_dyntype[u] = mjDYN_NONE;
-    m_->actuator_gaintype[u] = mjGAIN_FIXED;
-    m_->actuator_biastype[u] = mjBIAS_AFFINE;
-    mju_zero(m_->actuator_gainprm + mjNGAIN * u, mjNGAIN);
-    mju_zero(m_->actuator_biasprm + mjNBIAS * u, mjNBIAS);
-    m_->actuator_gainprm[mjNGAIN * u] = a.kp;
-    m_->actuator_biasprm[mjNBIAS * u + 1] = -a.kp;
-    m_->actuator_ctrllimited[u] = 0;  // targets are clamped to joint limits before ctrl
-
-    // Damping: raise joint damping to the requested value (implicit in MuJoCo's integrators).
-    const double inertia =
-        m_->dof_invweight0[a.dof_adr] > 0 ? 1.0 / m_->dof_invweight0[a.dof_adr] : 1.0;
-    auto kd_it = config_.kd.find(a.name);
-    const double kd = kd_it != config_.kd.end()
-                          ? kd_it->second
-                          : config_.damping_ratio * 2.0 * std::sqrt(a.kp * inertia);
-    m_->dof_damping[a.dof_adr] = std::max(m_->dof_damping[a.dof_adr], kd);
-    a.kd = m_->dof_damping[a.dof_adr];
-
-    if (m_->jnt_limited[joint]) {
-      a.limit.position_limited = true;
-      a.limit.lower = m_->jnt_range[2 * joint];
-      a.limit.upper = m_->jnt_range[2 * joint + 1];
-    }
-    auto v_it = config_.velocity_limits.find(a.name);
-    a.velocity_from_config = v_it != config_.velocity_limits.end();
-    a.limit.velocity = a.velocity_from_config ? v_it->second : config_.default_velocity_limit;
-    auto e_it = config_.effort_limits.find(a.name);
-    a.effort_from_config = e_it != config_.effort_limits.end();
-    if (a.effort_from_config) {
-      a.limit.effort = e_it->second;
-    } else if (m_->actuator_forcelimited[u]) {
-      a.limit.effort = std::max(std::abs(m_->actuator_forcerange[2 * u]),
-                                std::abs(m_->actuator_forcerange[2 * u + 1]));
-    } else {
-      a.limit.effort = config_.default_effort_limit;
-    }
-    if (!(a.limit.velocity > 0.0) || !(a.limit.effort > 0.0)) {
-      throw std::invalid_argument("joint " + a.name + " needs positive velocity/effort limits");
-    }
-    a.effort_cap = a.limit.effort;
-    m_->actuator_forcelimited[u] = 1;
-    m_->actuator_forcerange[2 * u] = -a.effort_cap;
-    m_->actuator_forcerange[2 * u + 1] = a.effort_cap;
+    configureGains(a);
+    configureLimits(a);
 
     actuated_index_[a.name] = static_cast<int>(actuated_.size());
     actuated_names_.push_back(a.name);
@@ -296,6 +265,62 @@ void WorkcellSim::configureActuators() {
   for (const auto& [name, value] : config_.kp) {
     if (!actuated_index_.count(name)) log(LogLevel::kWarn, "kp for unknown joint '" + name + "'");
   }
+}
+
+// Proportional gain: config, else the MJCF position actuator's, else the default; the damping
+// reaches config's kd or damping_ratio (raised only: the model's own damping stays a floor).
+void WorkcellSim::configureGains(Actuated& a) {
+  const int u = a.actuator;
+  const bool is_position_actuator = m_->actuator_gaintype[u] == mjGAIN_FIXED &&
+                                    m_->actuator_biastype[u] == mjBIAS_AFFINE &&
+                                    m_->actuator_biasprm[mjNBIAS * u + 1] < 0.0;
+  auto kp_it = config_.kp.find(a.name);
+  a.kp = kp_it != config_.kp.end() ? kp_it->second
+         : is_position_actuator    ? m_->actuator_gainprm[mjNGAIN * u]
+                                   : config_.default_kp;
+  if (!(a.kp > 0.0)) throw std::invalid_argument("joint " + a.name + " has a non-positive kp");
+  makeProportionalActuator(m_, u, a.kp);
+
+  // Damping: raise joint damping to the requested value (implicit in MuJoCo's integrators).
+  const double inertia =
+      m_->dof_invweight0[a.dof_adr] > 0 ? 1.0 / m_->dof_invweight0[a.dof_adr] : 1.0;
+  auto kd_it = config_.kd.find(a.name);
+  const double kd = kd_it != config_.kd.end()
+                        ? kd_it->second
+                        : config_.damping_ratio * 2.0 * std::sqrt(a.kp * inertia);
+  m_->dof_damping[a.dof_adr] = std::max(m_->dof_damping[a.dof_adr], kd);
+  a.kd = m_->dof_damping[a.dof_adr];
+}
+
+// Position limits from the model; velocity and effort limits from config, else the model's force
+// range (effort), else the defaults. The actuator's force range becomes the effort cap.
+void WorkcellSim::configureLimits(Actuated& a) {
+  const int u = a.actuator, joint = a.joint;
+  if (m_->jnt_limited[joint]) {
+    a.limit.position_limited = true;
+    a.limit.lower = m_->jnt_range[2 * joint];
+    a.limit.upper = m_->jnt_range[2 * joint + 1];
+  }
+  auto v_it = config_.velocity_limits.find(a.name);
+  a.velocity_from_config = v_it != config_.velocity_limits.end();
+  a.limit.velocity = a.velocity_from_config ? v_it->second : config_.default_velocity_limit;
+  auto e_it = config_.effort_limits.find(a.name);
+  a.effort_from_config = e_it != config_.effort_limits.end();
+  if (a.effort_from_config) {
+    a.limit.effort = e_it->second;
+  } else if (m_->actuator_forcelimited[u]) {
+    a.limit.effort = std::max(std::abs(m_->actuator_forcerange[2 * u]),
+                              std::abs(m_->actuator_forcerange[2 * u + 1]));
+  } else {
+    a.limit.effort = config_.default_effort_limit;
+  }
+  if (!(a.limit.velocity > 0.0) || !(a.limit.effort > 0.0)) {
+    throw std::invalid_argument("joint " + a.name + " needs positive velocity/effort limits");
+  }
+  a.effort_cap = a.limit.effort;
+  m_->actuator_forcelimited[u] = 1;
+  m_->actuator_forcerange[2 * u] = -a.effort_cap;
+  m_->actuator_forcerange[2 * u + 1] = a.effort_cap;
 }
 
 void WorkcellSim::applyUrdfLimits(const std::string& urdf_xml) {

@@ -265,34 +265,8 @@ class BridgeNode {
           "(robot, tf and object poses are all published)");
     }
 
-    // Names are relative (the node's namespace, remappable), except the master-wide /clock, which
-    // every sim-time node reads by that name, and the tf tree /tf.
-    clock_pub_ = nh.advertise<rosgraph_msgs::Clock>("/clock", 10);
-    joint_state_pub_ = nh.advertise<sensor_msgs::JointState>("joint_states", kSensorQueue);
-    object_joint_pub_ = nh.advertise<sensor_msgs::JointState>("objects/joint_states", kSensorQueue);
-    gripper_state_pub_ = nh.advertise<sensor_msgs::JointState>("gripper/state", kSensorQueue);
-    sensor_pubs_ = lfd_sim_bridge::makeSensorPublishers(nh, sensors, kSensorQueue);
-    ee_pose_pub_ = nh.advertise<geometry_msgs::PoseStamped>("ee_pose", kSensorQueue);
-    ee_twist_pub_ = nh.advertise<geometry_msgs::TwistStamped>("ee_twist", kSensorQueue);
-    tf_pub_ = nh.advertise<tf2_msgs::TFMessage>("/tf", 100);
-    sim_->readState(&state_);
-    for (const std::string& name : state_.object_names) {
-      object_pubs_.push_back(
-          nh.advertise<geometry_msgs::PoseStamped>("objects/" + name + "/pose", kSensorQueue));
-    }
-    static_tf_.sendTransform(
-        toTransform(sim_->basePoseInWorld(), ros::Time(0), world_frame_, base_frame_));
-
-    ros::TransportHints hints = ros::TransportHints().tcpNoDelay();
-    joint_command_sub_ =
-        nh.subscribe("joint_command", 10, &BridgeNode::onJointCommand, this, hints);
-    trajectory_sub_ = nh.subscribe("joint_trajectory", 10, &BridgeNode::onTrajectory, this, hints);
-    gripper_sub_ = nh.subscribe("gripper/command", 10, &BridgeNode::onGripper, this, hints);
-    reset_srv_ = nh.advertiseService("bridge/reset", &BridgeNode::onReset, this);
-    scene_srv_ = nh.advertiseService("bridge/set_scene", &BridgeNode::onSetScene, this);
-    pause_srv_ = nh.advertiseService("bridge/pause", &BridgeNode::onPause, this);
-    step_srv_ = nh.advertiseService("bridge/step", &BridgeNode::onStep, this);
-    fault_srv_ = nh.advertiseService("bridge/inject_fault", &BridgeNode::onInjectFault, this);
+    advertiseTopics(nh, sensors);
+    serveCommands(nh);
 
     ROS_INFO(
         "bridge: %zu actuated joints, dt %.4f s, /clock every %ld steps, sensors every %ld "
@@ -330,6 +304,41 @@ class BridgeNode {
   }
 
  private:
+  // The state, sensor and object topics, /clock, /tf and the base's static transform.
+  void advertiseTopics(ros::NodeHandle& nh, const std::vector<lfd_sim::SensorBinding>& sensors) {
+    // Names are relative (the node's namespace, remappable), except the master-wide /clock, which
+    // every sim-time node reads by that name, and the tf tree /tf.
+    clock_pub_ = nh.advertise<rosgraph_msgs::Clock>("/clock", 10);
+    joint_state_pub_ = nh.advertise<sensor_msgs::JointState>("joint_states", kSensorQueue);
+    object_joint_pub_ = nh.advertise<sensor_msgs::JointState>("objects/joint_states", kSensorQueue);
+    gripper_state_pub_ = nh.advertise<sensor_msgs::JointState>("gripper/state", kSensorQueue);
+    sensor_pubs_ = lfd_sim_bridge::makeSensorPublishers(nh, sensors, kSensorQueue);
+    ee_pose_pub_ = nh.advertise<geometry_msgs::PoseStamped>("ee_pose", kSensorQueue);
+    ee_twist_pub_ = nh.advertise<geometry_msgs::TwistStamped>("ee_twist", kSensorQueue);
+    tf_pub_ = nh.advertise<tf2_msgs::TFMessage>("/tf", 100);
+    sim_->readState(&state_);
+    for (const std::string& name : state_.object_names) {
+      object_pubs_.push_back(
+          nh.advertise<geometry_msgs::PoseStamped>("objects/" + name + "/pose", kSensorQueue));
+    }
+    static_tf_.sendTransform(
+        toTransform(sim_->basePoseInWorld(), ros::Time(0), world_frame_, base_frame_));
+  }
+
+  // The command topics (joints, trajectories, gripper) and the bridge/ services.
+  void serveCommands(ros::NodeHandle& nh) {
+    ros::TransportHints hints = ros::TransportHints().tcpNoDelay();
+    joint_command_sub_ =
+        nh.subscribe("joint_command", 10, &BridgeNode::onJointCommand, this, hints);
+    trajectory_sub_ = nh.subscribe("joint_trajectory", 10, &BridgeNode::onTrajectory, this, hints);
+    gripper_sub_ = nh.subscribe("gripper/command", 10, &BridgeNode::onGripper, this, hints);
+    reset_srv_ = nh.advertiseService("bridge/reset", &BridgeNode::onReset, this);
+    scene_srv_ = nh.advertiseService("bridge/set_scene", &BridgeNode::onSetScene, this);
+    pause_srv_ = nh.advertiseService("bridge/pause", &BridgeNode::onPause, this);
+    step_srv_ = nh.advertiseService("bridge/step", &BridgeNode::onStep, this);
+    fault_srv_ = nh.advertiseService("bridge/inject_fault", &BridgeNode::onInjectFault, this);
+  }
+
   static void rosLogSink(lfd_sim::LogLevel level, const std::string& text) {
     switch (level) {
       case lfd_sim::LogLevel::kInfo:

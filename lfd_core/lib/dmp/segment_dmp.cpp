@@ -5,14 +5,11 @@
 #include <string>
 
 namespace lfd {
+namespace {
 
-SegmentDmp SegmentDmp::learn(const SegmentDemo& demo, const DmpParameters& params) {
-  params.validate();
-  validateDemoTimes(demo.times, "SegmentDmp::learn");
+// The demo has at least one part, and every part it has is one sample per time (finite).
+void checkDemoParts(const SegmentDemo& demo, bool has_pos, bool has_ori, bool has_grip) {
   const Eigen::Index m = demo.times.size();
-  const bool has_pos = demo.positions.cols() > 0;
-  const bool has_ori = demo.quaternions.cols() > 0;
-  const bool has_grip = demo.gripper.size() > 0;
   if (!has_pos && !has_ori && !has_grip) {
     throw std::invalid_argument(
         "SegmentDmp::learn: the demo has no position, orientation or gripper");
@@ -33,6 +30,46 @@ SegmentDmp SegmentDmp::learn(const SegmentDemo& demo, const DmpParameters& param
     check_rows(demo.gripper.size(), "gripper");
     requireFinite(demo.gripper, "SegmentDmp::learn gripper");
   }
+}
+
+// A rollout option's vector (same size as the learned one, finite), else the learned one.
+Eigen::VectorXd givenOrLearned(const std::optional<Eigen::VectorXd>& given,
+                               const Eigen::VectorXd& learned, const char* name) {
+  if (!given) return learned;
+  if (given->size() != learned.size()) {
+    throw std::invalid_argument(std::string("SegmentDmpRunner: ") + name + " has " +
+                                std::to_string(given->size()) + " dims, the DMP has " +
+                                std::to_string(learned.size()));
+  }
+  requireFinite(*given, name);
+  return *given;
+}
+
+Eigen::Quaterniond checkedNormalized(const Eigen::Quaterniond& q, const char* name) {
+  if (!q.coeffs().allFinite() || q.norm() < 1e-6) {
+    throw std::invalid_argument(std::string("SegmentDmpRunner: ") + name +
+                                " must be a finite non-zero quaternion");
+  }
+  return q.normalized();
+}
+
+double checkedFinite(double v, const char* name) {
+  if (!std::isfinite(v)) {
+    throw std::invalid_argument(std::string("SegmentDmpRunner: ") + name + " is not finite");
+  }
+  return v;
+}
+
+}  // namespace
+
+SegmentDmp SegmentDmp::learn(const SegmentDemo& demo, const DmpParameters& params) {
+  params.validate();
+  validateDemoTimes(demo.times, "SegmentDmp::learn");
+  const Eigen::Index m = demo.times.size();
+  const bool has_pos = demo.positions.cols() > 0;
+  const bool has_ori = demo.quaternions.cols() > 0;
+  const bool has_grip = demo.gripper.size() > 0;
+  checkDemoParts(demo, has_pos, has_ori, has_grip);
 
   const double tau = demo.times[m - 1] - demo.times[0];
   const CanonicalSystem canonical(params.alpha_x);
@@ -203,62 +240,47 @@ SegmentDmpRunner::SegmentDmpRunner(const SegmentDmp& dmp, const SegmentRolloutOp
   }
   act_.resize(static_cast<size_t>(basis_->maxActive()) + 1);
 
-  auto vec_or = [](const std::optional<Eigen::VectorXd>& given, const Eigen::VectorXd& learned,
-                   const char* name) -> Eigen::VectorXd {
-    if (!given) return learned;
-    if (given->size() != learned.size()) {
-      throw std::invalid_argument(std::string("SegmentDmpRunner: ") + name + " has " +
-                                  std::to_string(given->size()) + " dims, the DMP has " +
-                                  std::to_string(learned.size()));
-    }
-    requireFinite(*given, name);
-    return *given;
-  };
-  auto unit = [](const Eigen::Quaterniond& q, const char* name) {
-    if (!q.coeffs().allFinite() || q.norm() < 1e-6) {
-      throw std::invalid_argument(std::string("SegmentDmpRunner: ") + name +
-                                  " must be a finite non-zero quaternion");
-    }
-    return q.normalized();
-  };
-  auto finite = [](double v, const char* name) {
-    if (!std::isfinite(v)) {
-      throw std::invalid_argument(std::string("SegmentDmpRunner: ") + name + " is not finite");
-    }
-    return v;
-  };
-  if (dmp.position) {
-    start_pos_ = vec_or(o.start_position, dmp.position->start(), "start_position");
-    goal_pos_ = vec_or(o.goal_position, dmp.position->goal(), "goal_position");
-    target_goal_pos_ = goal_pos_;
-    y_ = start_pos_;
-    // Default start velocities are the demo's, time-scaled with tau (v = tau * dy/dt invariant).
-    const double scale = dmp.tau / tau_;
-    v_ = tau_ * vec_or(o.start_velocity, Eigen::VectorXd(dmp.position->startVelocity() * scale),
-                       "start_velocity");
-    f_pos_.resize(dmp.position->dims());
-  }
-  if (dmp.orientation) {
-    start_ori_ = unit(o.start_orientation.value_or(dmp.orientation->start()), "start_orientation");
-    goal_ori_ = unit(o.goal_orientation.value_or(dmp.orientation->goal()), "goal_orientation");
-    target_goal_ori_ = goal_ori_;
-    orient_.q = start_ori_;
-    const Eigen::Vector3d w0 = o.start_angular_velocity.value_or(
-        Eigen::Vector3d(dmp.orientation->startAngularVelocity() * (dmp.tau / tau_)));
-    requireFinite(w0, "start_angular_velocity");
-    orient_.eta = tau_ * w0;
-  }
-  if (dmp.gripper) {
-    grip_start_ = finite(o.start_gripper.value_or(dmp.gripper->start()[0]), "start_gripper");
-    grip_goal_ = finite(o.goal_gripper.value_or(dmp.gripper->goal()[0]), "goal_gripper");
-    grip_target_goal_ = grip_goal_;
-    grip_y_ = grip_start_;
-    grip_v_ = dmp.tau * dmp.gripper->startVelocity()[0];
-  }
+  if (dmp.position) setUpPosition(o);
+  if (dmp.orientation) setUpOrientation(o);
+  if (dmp.gripper) setUpGripper(o);
   x_end_ = std::exp(-dmp.params.alpha_x);
   if (dmp.position) u0_.resize(dmp.position->dims());
   x_ = 1.0;
   evaluateForcing(x_);
+}
+
+void SegmentDmpRunner::setUpPosition(const SegmentRolloutOptions& o) {
+  start_pos_ = givenOrLearned(o.start_position, dmp_.position->start(), "start_position");
+  goal_pos_ = givenOrLearned(o.goal_position, dmp_.position->goal(), "goal_position");
+  target_goal_pos_ = goal_pos_;
+  y_ = start_pos_;
+  // Default start velocities are the demo's, time-scaled with tau (v = tau * dy/dt invariant).
+  const double scale = dmp_.tau / tau_;
+  v_ = tau_ * givenOrLearned(o.start_velocity,
+                             Eigen::VectorXd(dmp_.position->startVelocity() * scale),
+                             "start_velocity");
+  f_pos_.resize(dmp_.position->dims());
+}
+
+void SegmentDmpRunner::setUpOrientation(const SegmentRolloutOptions& o) {
+  start_ori_ = checkedNormalized(o.start_orientation.value_or(dmp_.orientation->start()),
+                                 "start_orientation");
+  goal_ori_ =
+      checkedNormalized(o.goal_orientation.value_or(dmp_.orientation->goal()), "goal_orientation");
+  target_goal_ori_ = goal_ori_;
+  orient_.q = start_ori_;
+  const Eigen::Vector3d w0 = o.start_angular_velocity.value_or(
+      Eigen::Vector3d(dmp_.orientation->startAngularVelocity() * (dmp_.tau / tau_)));
+  requireFinite(w0, "start_angular_velocity");
+  orient_.eta = tau_ * w0;
+}
+
+void SegmentDmpRunner::setUpGripper(const SegmentRolloutOptions& o) {
+  grip_start_ = checkedFinite(o.start_gripper.value_or(dmp_.gripper->start()[0]), "start_gripper");
+  grip_goal_ = checkedFinite(o.goal_gripper.value_or(dmp_.gripper->goal()[0]), "goal_gripper");
+  grip_target_goal_ = grip_goal_;
+  grip_y_ = grip_start_;
+  grip_v_ = dmp_.tau * dmp_.gripper->startVelocity()[0];
 }
 
 void SegmentDmpRunner::setGoal(const SegmentGoal& goal) {

@@ -89,8 +89,8 @@ void InverseKinematics::secondaryTask(const Eigen::VectorXd& q) {
   }
 }
 
-bool InverseKinematics::solve(const Eigen::Isometry3d& target,
-                              const Eigen::Ref<const Eigen::VectorXd>& seed, IkResult& result) {
+void InverseKinematics::checkSolveInputs(const Eigen::Isometry3d& target,
+                                         const Eigen::Ref<const Eigen::VectorXd>& seed) const {
   const int n = chain_.dof();
   if (seed.size() != n)
     throw std::invalid_argument("InverseKinematics: seed has " + std::to_string(seed.size()) +
@@ -98,6 +98,66 @@ bool InverseKinematics::solve(const Eigen::Isometry3d& target,
   if (!seed.allFinite()) throw std::invalid_argument("InverseKinematics: seed is not finite");
   if (!target.matrix().allFinite())
     throw std::invalid_argument("InverseKinematics: target pose is not finite");
+}
+
+void InverseKinematics::setNullSpaceTask(const IkResult& progress) {
+  // Null-space motion moves the tip at second order; close to the goal it would keep the error
+  // from shrinking below the tolerance, so the last iterations polish with the primary task only.
+  const bool polishing =
+      progress.position_error < options_.polish_factor * options_.position_tolerance &&
+      progress.orientation_error < options_.polish_factor * options_.orientation_tolerance;
+  if (polishing) {
+    z_.setZero();
+  } else {
+    secondaryTask(q_);
+    z_.array() /= inv_sqrt_cost_.array();  // so that the unscaled null-space step is z
+  }
+}
+
+void InverseKinematics::dampedStep(const Vector6d& ew, int unweighted_axes, double eps2,
+                                   double lambda_max2) {
+  const int n = chain_.dof();
+  const Matrix6d a = jac_w_ * jac_w_.transpose();
+  eigen_.compute(a);
+  const Vector6d& s = eigen_.eigenvalues();  // ascending; the first ones belong to free axes
+  const double sigma_min2 = std::max(0.0, s[unweighted_axes]);
+  double lambda2 = options_.error_damping * ew.squaredNorm() + 1e-10;
+  if (sigma_min2 < eps2) lambda2 += (1.0 - sigma_min2 / eps2) * lambda_max2;
+  const Matrix6d& v = eigen_.eigenvectors();
+  const Vector6d inv_diag = (s.array().max(0.0) + lambda2).inverse();
+  const Matrix6d a_inv = v * inv_diag.asDiagonal() * v.transpose();
+  for (int i = 0; i < n; ++i)
+    if (frozen_[i]) z_[i] = 0.0;
+  // Primary task plus the damped null-space projection of the secondary task.
+  const Vector6d jz = jac_w_ * z_;
+  dq_.noalias() = jac_w_.transpose() * (a_inv * (ew - jz));
+  dq_ += z_;
+  dq_.array() *= inv_sqrt_cost_.array();  // back to joint units
+  const double biggest = dq_.cwiseAbs().maxCoeff();
+  if (biggest > options_.max_step) dq_ *= options_.max_step / biggest;
+}
+
+bool InverseKinematics::freezeJointsPushedPastLimits() {
+  const int n = chain_.dof();
+  const Eigen::VectorXd& lo = chain_.lowerLimits();
+  const Eigen::VectorXd& hi = chain_.upperLimits();
+  bool newly_frozen = false;
+  for (int i = 0; i < n; ++i) {
+    if (frozen_[i]) continue;
+    const double next = q_[i] + dq_[i];
+    if ((next < lo[i] && q_[i] <= lo[i] + 1e-9) || (next > hi[i] && q_[i] >= hi[i] - 1e-9)) {
+      frozen_[i] = true;  // already at the limit and pushed further: let the others work
+      jac_w_.col(i).setZero();
+      newly_frozen = true;
+    }
+  }
+  return newly_frozen;
+}
+
+bool InverseKinematics::solve(const Eigen::Isometry3d& target,
+                              const Eigen::Ref<const Eigen::VectorXd>& seed, IkResult& result) {
+  checkSolveInputs(target, seed);
+  const int n = chain_.dof();
   result.failure.clear();
   const Vector6d& w = options_.weights;
   const Vector6d sqrt_w = w.cwiseSqrt();
@@ -106,8 +166,6 @@ bool InverseKinematics::solve(const Eigen::Isometry3d& target,
   for (int k = 0; k < 6; ++k) unweighted_axes += w[k] > 0 ? 0 : 1;
   const double eps2 = options_.singular_threshold * options_.singular_threshold;
   const double lambda_max2 = options_.max_damping * options_.max_damping;
-  const Eigen::VectorXd& lo = chain_.lowerLimits();
-  const Eigen::VectorXd& hi = chain_.upperLimits();
 
   q_ = seed;
   chain_.clampToLimits(q_);
@@ -130,49 +188,12 @@ bool InverseKinematics::solve(const Eigen::Isometry3d& target,
     const Vector6d ew = e.cwiseProduct(sqrt_w);
     // Weighted task rows and cost-scaled joint columns: the step is solved for dq' = C^1/2 dq.
     jac_w_ = sqrt_w.asDiagonal() * jac_ * inv_sqrt_cost_.asDiagonal();
-    // Null-space motion moves the tip at second order; close to the goal it would keep the error
-    // from shrinking below the tolerance, so the last iterations polish with the primary task only.
-    const bool polishing =
-        result.position_error < options_.polish_factor * options_.position_tolerance &&
-        result.orientation_error < options_.polish_factor * options_.orientation_tolerance;
-    if (polishing) {
-      z_.setZero();
-    } else {
-      secondaryTask(q_);
-      z_.array() /= inv_sqrt_cost_.array();  // so that the unscaled null-space step is z
-    }
+    setNullSpaceTask(result);
     frozen_.setConstant(false);
     // Up to three passes: joints whose step would cross a limit are frozen and the step redone.
     for (int pass = 0; pass < 3; ++pass) {
-      const Matrix6d a = jac_w_ * jac_w_.transpose();
-      eigen_.compute(a);
-      const Vector6d& s = eigen_.eigenvalues();  // ascending; the first ones belong to free axes
-      const double sigma_min2 = std::max(0.0, s[unweighted_axes]);
-      double lambda2 = options_.error_damping * ew.squaredNorm() + 1e-10;
-      if (sigma_min2 < eps2) lambda2 += (1.0 - sigma_min2 / eps2) * lambda_max2;
-      const Matrix6d& v = eigen_.eigenvectors();
-      const Vector6d inv_diag = (s.array().max(0.0) + lambda2).inverse();
-      const Matrix6d a_inv = v * inv_diag.asDiagonal() * v.transpose();
-      for (int i = 0; i < n; ++i)
-        if (frozen_[i]) z_[i] = 0.0;
-      // Primary task plus the damped null-space projection of the secondary task.
-      const Vector6d jz = jac_w_ * z_;
-      dq_.noalias() = jac_w_.transpose() * (a_inv * (ew - jz));
-      dq_ += z_;
-      dq_.array() *= inv_sqrt_cost_.array();  // back to joint units
-      const double biggest = dq_.cwiseAbs().maxCoeff();
-      if (biggest > options_.max_step) dq_ *= options_.max_step / biggest;
-      bool newly_frozen = false;
-      for (int i = 0; i < n; ++i) {
-        if (frozen_[i]) continue;
-        const double next = q_[i] + dq_[i];
-        if ((next < lo[i] && q_[i] <= lo[i] + 1e-9) || (next > hi[i] && q_[i] >= hi[i] - 1e-9)) {
-          frozen_[i] = true;  // already at the limit and pushed further: let the others work
-          jac_w_.col(i).setZero();
-          newly_frozen = true;
-        }
-      }
-      if (!newly_frozen) break;
+      dampedStep(ew, unweighted_axes, eps2, lambda_max2);
+      if (!freezeJointsPushedPastLimits()) break;
     }
     for (int i = 0; i < n; ++i)
       if (frozen_[i]) dq_[i] = 0.0;

@@ -252,16 +252,10 @@ void sweep_rows(const SweepArgs& args) {
   }
 }
 
-template <bool kPaths, bool kBand>
-void run_group(const DtwPairView* const* lanes, int used, int band, Workspace& ws, double* costs,
-               WarpingPath* paths) {
-  std::size_t rows = 0, cols = 0;
-  for (int k = 0; k < used; ++k) {
-    rows = std::max(rows, lanes[k]->n);
-    cols = std::max(cols, lanes[k]->m);
-  }
-  const std::size_t padded_rows = (rows + kStripe - 1) / kStripe * kStripe;
-  // Interleave: a[i][k] = lane k's a[i]; padding stays 0 (never reaches a lane's end cell).
+// Interleaves a group's pairs into the lanes: a[i] lane k = pair k's a[i]; padding stays 0 (it
+// never reaches a lane's end cell).
+void interleave(const DtwPairView* const* lanes, int used, std::size_t padded_rows,
+                std::size_t cols, Workspace& ws) {
   ws.a.assign(padded_rows, Lanes{splat(0.f)});
   ws.b.assign(cols, Lanes{splat(0.f)});
   ws.prev.assign(cols, Lanes{splat(INFINITY)});
@@ -272,6 +266,47 @@ void run_group(const DtwPairView* const* lanes, int used, int band, Workspace& w
     for (std::size_t j = 0; j < p.m; ++j) ws.b[j].v[k] = static_cast<float>(p.b[j]);
     ws.end_column[p.m - 1] = 1;
   }
+}
+
+// Lane k's warping path (n x m cells), traced back through the sweep's step bits.
+void lane_path(const std::uint8_t* steps, std::size_t cols, long n, long m, int k,
+               WarpingPath& path) {
+  path.clear();
+  path.reserve(static_cast<std::size_t>(n + m));
+  long i = n - 1, j = m - 1;
+  const unsigned bit = 1u << k;
+  while (i > 0 || j > 0) {
+    path.emplace_back(static_cast<int>(i), static_cast<int>(j));
+    if (i == 0) {
+      --j;
+    } else if (j == 0) {
+      --i;
+    } else {
+      const std::uint8_t* s = steps + (std::size_t(i) * cols + std::size_t(j)) * 2;
+      if (s[1] & bit) {
+        --j;
+      } else if (s[0] & bit) {
+        --i;
+      } else {
+        --i;
+        --j;
+      }
+    }
+  }
+  path.emplace_back(0, 0);
+  std::reverse(path.begin(), path.end());
+}
+
+template <bool kPaths, bool kBand>
+void run_group(const DtwPairView* const* lanes, int used, int band, Workspace& ws, double* costs,
+               WarpingPath* paths) {
+  std::size_t rows = 0, cols = 0;
+  for (int k = 0; k < used; ++k) {
+    rows = std::max(rows, lanes[k]->n);
+    cols = std::max(cols, lanes[k]->m);
+  }
+  const std::size_t padded_rows = (rows + kStripe - 1) / kStripe * kStripe;
+  interleave(lanes, used, padded_rows, cols, ws);
   if (kPaths) {
     const std::size_t bytes = padded_rows * cols * 2;
     if (bytes > kMaxDirectionBytes) {
@@ -305,32 +340,7 @@ void run_group(const DtwPairView* const* lanes, int used, int band, Workspace& w
 
   if (kPaths) {
     for (int k = 0; k < used; ++k) {
-      const long n = long(lanes[k]->n), m = long(lanes[k]->m);
-      WarpingPath& path = paths[k];
-      path.clear();
-      path.reserve(static_cast<std::size_t>(n + m));
-      long i = n - 1, j = m - 1;
-      const unsigned bit = 1u << k;
-      while (i > 0 || j > 0) {
-        path.emplace_back(static_cast<int>(i), static_cast<int>(j));
-        if (i == 0) {
-          --j;
-        } else if (j == 0) {
-          --i;
-        } else {
-          const std::uint8_t* s = ws.steps.data() + (std::size_t(i) * cols + std::size_t(j)) * 2;
-          if (s[1] & bit) {
-            --j;
-          } else if (s[0] & bit) {
-            --i;
-          } else {
-            --i;
-            --j;
-          }
-        }
-      }
-      path.emplace_back(0, 0);
-      std::reverse(path.begin(), path.end());
+      lane_path(ws.steps.data(), cols, long(lanes[k]->n), long(lanes[k]->m), k, paths[k]);
     }
   }
 }

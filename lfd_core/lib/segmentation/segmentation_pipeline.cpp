@@ -122,15 +122,10 @@ double sample_rate_of(const FeatureMatrix& demo) {
   return 1.0 / step;
 }
 
-PreparedSegmentation prepare_segmentation(const std::vector<FeatureMatrix>& demos,
-                                          const std::vector<std::string>& sensor_features,
-                                          const SegmentationPipelineConfig& config,
-                                          const std::vector<std::string>& state_features) {
-  if (demos.empty()) throw std::invalid_argument("no demonstrations to segment");
-  PreparedSegmentation prepared;
-  SegmentationPipelineResult& result = prepared.base;
+namespace {
 
-  // ---- input checks: shape, same features, roles, finite samples, lengths
+// Every demonstration is a well-formed matrix with at least 2 samples.
+void check_demo_shapes(const std::vector<FeatureMatrix>& demos) {
   for (std::size_t d = 0; d < demos.size(); ++d) {
     try {
       demos[d].validate_shape();
@@ -142,8 +137,13 @@ PreparedSegmentation prepare_segmentation(const std::vector<FeatureMatrix>& demo
                                   " samples; at least 2 are needed");
     }
   }
-  check_same_features(demos);
-  const FeatureMatrix& first = demos[0];
+}
+
+// The named roles exist; without named state features, every feature that is not a sensor is one.
+void assign_feature_roles(const FeatureMatrix& first,
+                          const std::vector<std::string>& sensor_features,
+                          const std::vector<std::string>& state_features,
+                          SegmentationPipelineResult* result) {
   for (const std::string& s : sensor_features) {
     if (first.index_of(s) < 0) {
       throw std::invalid_argument("sensor feature '" + s + "' is not in the demonstrations");
@@ -152,7 +152,7 @@ PreparedSegmentation prepare_segmentation(const std::vector<FeatureMatrix>& demo
   if (state_features.empty()) {
     for (const std::string& name : first.names) {
       if (std::find(sensor_features.begin(), sensor_features.end(), name) == sensor_features.end())
-        result.state_features.push_back(name);
+        result->state_features.push_back(name);
     }
   } else {
     for (const std::string& s : state_features) {
@@ -160,28 +160,26 @@ PreparedSegmentation prepare_segmentation(const std::vector<FeatureMatrix>& demo
         throw std::invalid_argument("state feature '" + s + "' is not in the demonstrations");
       }
     }
-    result.state_features = state_features;
+    result->state_features = state_features;
   }
-  result.sensor_features = sensor_features;
-  if (result.state_features.empty()) {
+  result->sensor_features = sensor_features;
+  if (result->state_features.empty()) {
     throw std::invalid_argument("no state feature to segment (every feature is a sensor)");
   }
-  std::vector<std::string> used = result.state_features;
-  used.insert(used.end(), sensor_features.begin(), sensor_features.end());
-  for (std::size_t d = 0; d < demos.size(); ++d) check_finite(demos[d].select(used), demo_label(d));
+}
 
-  demo_settings(demos, config);  // checks every demo's clock and length
-
-  // ---- constant state features carry no information
+// Constant state features carry no information: they are dropped with a warning.
+std::vector<std::string> informative_state_features(const std::vector<FeatureMatrix>& demos,
+                                                    SegmentationPipelineResult* result) {
   std::vector<std::string> informative;
-  for (const std::string& name : result.state_features) {
+  for (const std::string& name : result->state_features) {
     bool constant_everywhere = true;
     for (const FeatureMatrix& demo : demos) {
       constant_everywhere = constant_everywhere && is_constant(demo, demo.require(name));
     }
     if (constant_everywhere) {
-      result.warnings.push_back("state feature '" + name +
-                                "' is constant in every demonstration and is ignored");
+      result->warnings.push_back("state feature '" + name +
+                                 "' is constant in every demonstration and is ignored");
     } else {
       informative.push_back(name);
     }
@@ -189,31 +187,62 @@ PreparedSegmentation prepare_segmentation(const std::vector<FeatureMatrix>& demo
   if (informative.empty()) {
     throw std::invalid_argument("every state feature is constant: nothing to segment");
   }
+  return informative;
+}
 
-  // ---- II-B feature relevance (needs >= 2 demonstrations)
-  const auto relevance_start = std::chrono::steady_clock::now();
+// II-B feature relevance picks and weighs the features; it needs >= 2 demonstrations, so a single
+// one uses every informative feature with equal weights.
+void select_weighted_features(const std::vector<FeatureMatrix>& demos,
+                              const std::vector<std::string>& informative,
+                              const SegmentationPipelineConfig& config,
+                              SegmentationPipelineResult* result) {
   if (demos.size() >= 2) {
     FeatureRelevanceConfig relevance_config = config.relevance;
     relevance_config.threads = config.threads;
-    result.relevance = compute_feature_relevance(demos, informative, relevance_config);
-    result.relevance_computed = true;
-    for (const std::string& w : result.relevance.warnings) result.warnings.push_back(w);
-    result.selected_features = result.relevance.selected;
-    for (double score : result.relevance.selected_scores()) {
+    result->relevance = compute_feature_relevance(demos, informative, relevance_config);
+    result->relevance_computed = true;
+    for (const std::string& w : result->relevance.warnings) result->warnings.push_back(w);
+    result->selected_features = result->relevance.selected;
+    for (double score : result->relevance.selected_scores()) {
       // Weights must be positive; a non-positive best score (warned above) keeps weight 1.
-      result.feature_weights.push_back(score > 0 ? score : 1.0);
+      result->feature_weights.push_back(score > 0 ? score : 1.0);
     }
-    if (result.selected_features.empty()) {
+    if (result->selected_features.empty()) {
       throw std::invalid_argument("feature relevance selected no feature");
     }
   } else {
-    result.warnings.push_back(
+    result->warnings.push_back(
         "a single demonstration: feature relevance needs at least 2, so every non-constant "
         "state feature is used with equal weights");
-    result.selected_features = informative;
-    result.feature_weights.assign(informative.size(), 1.0);
+    result->selected_features = informative;
+    result->feature_weights.assign(informative.size(), 1.0);
   }
+}
 
+}  // namespace
+
+PreparedSegmentation prepare_segmentation(const std::vector<FeatureMatrix>& demos,
+                                          const std::vector<std::string>& sensor_features,
+                                          const SegmentationPipelineConfig& config,
+                                          const std::vector<std::string>& state_features) {
+  if (demos.empty()) throw std::invalid_argument("no demonstrations to segment");
+  PreparedSegmentation prepared;
+  SegmentationPipelineResult& result = prepared.base;
+
+  // ---- input checks: shape, same features, roles, finite samples, lengths
+  check_demo_shapes(demos);
+  check_same_features(demos);
+  assign_feature_roles(demos[0], sensor_features, state_features, &result);
+  std::vector<std::string> used = result.state_features;
+  used.insert(used.end(), sensor_features.begin(), sensor_features.end());
+  for (std::size_t d = 0; d < demos.size(); ++d) check_finite(demos[d].select(used), demo_label(d));
+
+  demo_settings(demos, config);  // checks every demo's clock and length
+
+  const std::vector<std::string> informative = informative_state_features(demos, &result);
+
+  const auto relevance_start = std::chrono::steady_clock::now();
+  select_weighted_features(demos, informative, config, &result);
   result.relevance_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - relevance_start).count();
   return prepared;

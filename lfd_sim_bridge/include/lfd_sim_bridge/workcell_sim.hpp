@@ -223,6 +223,10 @@ class WorkcellSim {
                                  const std::vector<int>& index) const;
   struct Actuated;
   void configureActuators();
+  void configureGains(Actuated& a);   // kp and kd of a's joint
+  void configureLimits(Actuated& a);  // a's position, velocity and effort limits
+  void findBaseBody();                // base_body_: config's, else the robot's root body
+  void recordInitialScene();
   void computeControls();
   bool diverged(std::string* why) const;
   std::array<int, 4> badNumberWarnings() const;

@@ -103,6 +103,10 @@ class SegmentDmpRunner {
 
  private:
   void evaluateForcing(double x);  // fills f_pos_, f_ori_, f_grip_ at phase x
+  // Each part's start, goal and state: the options' values (checked), else the learned ones.
+  void setUpPosition(const SegmentRolloutOptions& o);
+  void setUpOrientation(const SegmentRolloutOptions& o);
+  void setUpGripper(const SegmentRolloutOptions& o);
 
   const SegmentDmp& dmp_;
   const GaussianBasis* basis_ = nullptr;

@@ -79,7 +79,17 @@ class InverseKinematics {
                                                const Eigen::Isometry3d& current);
 
  private:
+  void checkSolveInputs(const Eigen::Isometry3d& target,
+                        const Eigen::Ref<const Eigen::VectorXd>& seed) const;
+  // z_ = the secondary (posture and limit) task, or zero while polishing close to the goal.
+  void setNullSpaceTask(const IkResult& progress);
   void secondaryTask(const Eigen::VectorXd& q);
+  // One damped least-squares step into dq_ (joint units, at most max_step) for the weighted task
+  // error `ew` with the joints in frozen_ held still.
+  void dampedStep(const Eigen::Matrix<double, 6, 1>& ew, int unweighted_axes, double eps2,
+                  double lambda_max2);
+  // Freezes the joints already at a limit that dq_ pushes further; true if one was.
+  bool freezeJointsPushedPastLimits();
 
   KinematicChain chain_;  // own copy: the solver never dangles
   IkOptions options_;
