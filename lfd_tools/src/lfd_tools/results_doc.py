@@ -110,16 +110,27 @@ def update_file(path, sections):
 
 # ---- the sources ---------------------------------------------------------------------------------
 
-def origin(doc, when=None, what=""):
-    """The line that opens a generated section: what made it, at which commit, on which date."""
+def commit_of(doc):
+    """The checkout's commit, "-dirty" when a tracked file other than `doc` has changes (the
+    sections written before are no change of the code), or "unknown" outside a git checkout."""
+    git = lambda *a: subprocess.run(["git", "-C", os.path.dirname(os.path.abspath(doc))] + list(a),
+                                    capture_output=True, text=True)
     try:
-        commit = subprocess.run(["git", "-C", os.path.dirname(os.path.abspath(doc)), "describe",
-                                 "--always", "--dirty", "--abbrev=7"], capture_output=True,
-                                text=True, check=True).stdout.strip()
-    except (OSError, subprocess.CalledProcessError):
-        commit = "unknown"
+        head, top = git("rev-parse", "--short=7", "HEAD"), git("rev-parse", "--show-toplevel")
+        if head.returncode or top.returncode:
+            return "unknown"
+        doc_in_repo = os.path.relpath(os.path.realpath(doc), os.path.realpath(top.stdout.strip()))
+        dirty = git("diff", "--quiet", "HEAD", "--", ":/", ":(top,exclude)" + doc_in_repo)
+    except OSError:
+        return "unknown"
+    return head.stdout.strip() + ("-dirty" if dirty.returncode else "")
+
+
+def origin(doc, when=None, what=""):
+    """The line that opens a generated section: what made it, on which date, at which commit."""
     day = (when or datetime.datetime.now()).strftime("%Y-%m-%d")
-    return "*Generated from %s, %s; checkout at commit %s.*" % (what or "its JSON", day, commit)
+    return ("*Generated from %s, %s; checkout at commit %s.*"
+            % (what or "its JSON", day, commit_of(doc)))
 
 
 STAGE_TIMES = ("datasets_s", "segment_s", "learn_s", "reproduce_s", "figures_s")  # run order
