@@ -22,7 +22,10 @@ motion"), for the faults with a moment (not sensors_frozen, which is wrong only 
 should have changed).
 
   bench_faults.py --library-dir DIR [--mode sim] [--tasks grasp,drawer] [--goals N]
-                  [--attach] [--out result.json]
+                  [--attach] [--out result.json] [--update-docs]
+
+--update-docs: after the run, rewrite docs/results.md's section bench-faults from its summary
+(lfd_tools.results_doc).
 """
 import json
 import os
@@ -31,7 +34,7 @@ import statistics
 import sys
 import time
 
-from lfd_tools import bags, lockstep, master, report, reproduction, tasks
+from lfd_tools import bags, lockstep, master, report, reproduction, results_doc, tasks
 
 FROZEN_AT_S = 0.3
 # faults of the monitoring itself: always counted
@@ -159,7 +162,11 @@ def summarize(runs):
 def main():
     ap = reproduction.goal_bench_parser(__doc__, goals=5)
     ap.add_argument("--out", default=None)
+    ap.add_argument("--update-docs", action="store_true",
+                    help="rewrite docs/results.md's section bench-faults from the result")
     args = ap.parse_args()
+    if args.update_docs:
+        results_doc.check("faults")  # before the run, not after its 20 minutes
     lib_dir = os.path.abspath(args.library_dir)
     names = reproduction.selected_tasks(args.tasks)
     results = {"runs": []}
@@ -201,6 +208,8 @@ def main():
                             time.time() - started, (r["alarm"] or r["error"])[:90]), flush=True)
             results["summary"] = summarize(results["runs"])
             print(json.dumps(results["summary"], indent=1))
+    if args.update_docs:
+        results_doc.report_update("faults", results)
     return 0
 
 

@@ -12,6 +12,10 @@ Where each failed run failed (the dataset's readme): neg_1 misses the hole (inse
 misses the grasp (pickup_leg), neg_3 misses the hole and bumps the table (insert_leg).
 
   bench_pr2_signature.py [--data ../shared/data/pr2_ikea] [--cli PATH] [--out result.json]
+                         [--update-docs]
+
+--update-docs: rewrite docs/results.md's section bench-pr2-signature from the result
+(lfd_tools.results_doc; run with devel/setup.bash sourced).
 """
 import argparse
 import itertools
@@ -19,6 +23,8 @@ import json
 import os
 import subprocess
 import sys
+
+from lfd_tools import results_doc
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.normpath(os.path.join(HERE, "..", ".."))
@@ -62,7 +68,14 @@ def main():
     ap.add_argument("--with-object", action="store_true",
                     help="monitor the leg marker's position too (the AR world model, a camera)")
     ap.add_argument("--out")
+    ap.add_argument("--update-docs", action="store_true",
+                    help="rewrite docs/results.md's section bench-pr2-signature from the result")
     a = ap.parse_args()
+    if a.update_docs:
+        try:
+            results_doc.check("pr2-signature")
+        except RuntimeError as exc:
+            ap.error(str(exc))
     labels = json.load(open(os.path.join(a.data, "labels.json")))
     if a.with_object:
         a.channels = ",".join(SENSORS + OBJECT)
@@ -85,9 +98,7 @@ def main():
             ok += neg_score > max(pos_scores)
             rows.append({"train": train, "run": neg, "segment": FAILED_SEGMENT[neg],
                          "score": neg_score, "positive_max": max(pos_scores), "worst": worst})
-            print("%-14s %-8s %-12s %8.2f %8.2f  %s t=%.1f s expected %.3g measured %.3g" % (
-                "+".join(train), neg, FAILED_SEGMENT[neg], neg_score, max(pos_scores),
-                worst["channel"], worst["time"], worst["expected"], worst["measured"]))
+            print("%-14s %-8s %-12s %8s %8s  %s" % results_doc.pr2_case_cells(rows[-1]))
         for p in held:
             rows.append({"train": train, "run": p,
                          "alarms": [max(seg["scores"]) > 1 for seg in by_run[p]["segments"]],
@@ -101,8 +112,11 @@ def main():
                         w["channel"], w["time"], w["phase"], w["expected"], w["measured"]))
     print("failed runs above every held-out successful run on their failed segment: %d of %d"
           % (ok, total))
+    result = {"rows": rows, "separated": ok, "cases": total}
     if a.out:
-        json.dump({"rows": rows, "separated": ok, "cases": total}, open(a.out, "w"), indent=1)
+        json.dump(result, open(a.out, "w"), indent=1)
+    if a.update_docs:
+        results_doc.report_update("pr2-signature", result)
 
 
 if __name__ == "__main__":

@@ -3,12 +3,15 @@
 each stage's wall time, the wall time per demonstration (datasets stage / demos recorded) and per
 reproduced goal (reproduce stage / goals), from the run's report.json.
 
-  bench_pipeline.py [--out DIR] [--keep] [--runs N] -- [pipeline.py options, e.g. --datasets ...]
+  bench_pipeline.py [--out DIR] [--keep] [--runs N] [--json FILE] [--update-docs]
+                    -- [pipeline.py options, e.g. --datasets ...]
 
 Run it after `./lfd build` with devel/setup.bash sourced. Without --out a temporary folder is used
 and removed (--keep keeps it). The stage times include each stage's ROS start-up; the per-demo and
 per-goal figures are stage time divided by work done, so start-up cost shows as a higher figure on
-small runs. Prints one table per run, then the median of every figure when --runs > 1.
+small runs. Prints one table per run, then the median of every figure when --runs > 1. --json
+writes every figure ({"runs", "median", "pipeline_args"}); --update-docs rewrites docs/results.md's
+section bench-pipeline from them (lfd_tools.results_doc).
 """
 import argparse
 import json
@@ -19,6 +22,8 @@ import subprocess
 import sys
 import tempfile
 import time
+
+from lfd_tools import results_doc
 
 ROOT = os.path.abspath(os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", ".."))
 PIPELINE = os.path.join(ROOT, "lfd_launch", "scripts", "pipeline.py")
@@ -42,9 +47,7 @@ def figures_of(report, wall):
 
 def show(figures):
     for key, value in figures.items():
-        text = "-" if value is None else ("%d" % value if key in ("demos", "goals")
-                                          else "%.1f" % value)
-        print("  %-14s %s" % (key, text))
+        print("  %-14s %s" % (key, results_doc.pipeline_figure_text(key, value)))
 
 
 def one_run(out, pipeline_args):
@@ -66,8 +69,16 @@ def main():
     ap.add_argument("--out", default=None)
     ap.add_argument("--keep", action="store_true")
     ap.add_argument("--runs", type=int, default=1)
+    ap.add_argument("--json", default=None, help="write every figure to this file")
+    ap.add_argument("--update-docs", action="store_true",
+                    help="rewrite docs/results.md's section bench-pipeline from the figures")
     ap.add_argument("pipeline_args", nargs="*")
     args = ap.parse_args()
+    if args.update_docs:
+        try:
+            results_doc.check("bench-pipeline")
+        except RuntimeError as exc:
+            ap.error(str(exc))
     runs = []
     for i in range(args.runs):
         out = args.out or tempfile.mkdtemp(prefix="lfd_bench_pipeline_")
@@ -81,10 +92,18 @@ def main():
         runs.append(figures)
         if not args.out and not args.keep:
             shutil.rmtree(out, ignore_errors=True)
+    median = None
     if len(runs) > 1:
+        median = {k: (statistics.median([r[k] for r in runs if r[k] is not None])
+                      if any(r[k] is not None for r in runs) else None) for k in runs[0]}
         print("median of %d runs:" % len(runs))
-        show({k: (statistics.median([r[k] for r in runs if r[k] is not None])
-                  if any(r[k] is not None for r in runs) else None) for k in runs[0]})
+        show(median)
+    result = {"runs": runs, "median": median, "pipeline_args": args.pipeline_args}
+    if args.json:
+        with open(args.json, "w") as f:
+            json.dump(result, f, indent=1)
+    if args.update_docs:
+        results_doc.report_update("bench-pipeline", result)
 
 
 if __name__ == "__main__":

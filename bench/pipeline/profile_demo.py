@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """Where the wall time of recording demonstrations goes, between the simulated steps.
 
-  profile_demo.py [--dataset sim_wipe] [--demos 2] [--out DIR] [--json FILE]
+  profile_demo.py [--dataset sim_wipe] [--demos 2] [--out DIR] [--json FILE] [--update-docs]
 
 Records `--demos` demonstrations of one dataset with generate_datasets.py (one launch: bridge,
 recorder, demonstrator, robot_state_publisher, as the datasets stage runs them) and breaks the wall
@@ -16,7 +16,8 @@ What a demo's step round trips cost beyond the bridge's own work is the lockstep
 service's sockets and the demonstrator's wake-up). Time outside the demos is process start-up,
 the graph coming up, and judging the bags.
 
-Run after `./lfd build` with devel/setup.bash sourced; needs no running master.
+Run after `./lfd build` with devel/setup.bash sourced; needs no running master. --update-docs
+rewrites docs/results.md's section profile-demo from the figures (lfd_tools.results_doc).
 """
 import argparse
 import glob
@@ -31,6 +32,7 @@ import time
 
 import yaml
 
+from lfd_tools import results_doc
 from lfd_tools.processes import CpuSampler
 
 ROOT = os.path.abspath(os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", ".."))
@@ -84,7 +86,14 @@ def main():
     parser.add_argument("--demos", type=int, default=2)
     parser.add_argument("--out", help="keep the run here (default: a temporary folder, removed)")
     parser.add_argument("--json", help="also write the figures to this file")
+    parser.add_argument("--update-docs", action="store_true",
+                        help="rewrite docs/results.md's section profile-demo from the figures")
     args = parser.parse_args()
+    if args.update_docs:
+        try:
+            results_doc.check("profile-demo")
+        except RuntimeError as exc:
+            parser.error(str(exc))
     out = args.out or tempfile.mkdtemp(prefix="lfd_profile_demo_")
     start = time.time()
     proc = subprocess.Popen(["/usr/bin/python3", GENERATE, "--out", out, "--datasets", args.dataset,
@@ -106,7 +115,7 @@ def main():
     parts = summed(d.get("wall_parts", {}) for d in demos)
     counts = summed(d.get("wall_counts", {}) for d in demos)
     bridge_parts = summed(bridge)
-    step_kinds = ("step_calls", "contact_step_calls")  # free chunks; short ones waiting for contact
+    step_kinds = results_doc.DEMO_STEP_KINDS
     handshake = sum(parts.get(k, 0.0) for k in step_kinds) - sum(bridge_parts.values())
     result = {
         "dataset": args.dataset, "demos": len(demos), "sim_s": sim_s, "wall_s": wall,
@@ -123,25 +132,14 @@ def main():
         "cpu_s": {name: {"user": round(u, 2), "system": round(s, 2)}
                   for name, (u, s) in sampler.by_name().items()},
     }
-    print("%d demos of %s: %.1f s of sim time in %.1f s wall (%.1fx real time overall, "
-          "%.1fx within the demos)"
-          % (len(demos), args.dataset, sim_s, wall, sim_s / wall, sim_s / max(demo_wall, 1e-9)))
+    print(results_doc.demo_profile_summary(result))
     for key in ("graph_up_s", "before_first_demo_s", "after_last_demo_s"):
         if result[key] is not None:
             print("  %-34s %6.2f s" % (key, result[key]))
     calls = int(sum(counts.get(k, 0) for k in step_kinds))
     print("  within the demos (%.2f s; %.2f ms per step round trip beyond the bridge's work):"
           % (demo_wall, 1000.0 * handshake / max(calls, 1)))
-    rows = [("bridge: physics", bridge_parts.get("physics", 0.0)),
-            ("bridge: publishing", bridge_parts.get("publishing", 0.0)),
-            ("%d step round trips beyond the bridge's work" % calls, handshake)]
-    rows += [("demonstrator: %s (%d)" % (k, counts.get(k, 0)), v) for k, v in sorted(parts.items())
-             if k not in step_kinds]
-    rows += [("  of which: all of %s (%d)" % (k, counts.get(k, 0)), parts.get(k, 0.0))
-             for k in step_kinds]
-    rows.append(("demonstrator: the rest (its own code, callbacks)",
-                 result["demonstrator_other_s"]))
-    for name, seconds in rows:
+    for name, seconds in results_doc.demo_profile_rows(result):
         print("    %-48s %6.2f s  %5.1f%%"
               % (name, seconds, 100.0 * seconds / max(demo_wall, 1e-9)))
     print("  CPU by process (user + system):")
@@ -151,6 +149,8 @@ def main():
     if args.json:
         with open(args.json, "w") as f:
             json.dump(result, f, indent=1)
+    if args.update_docs:
+        results_doc.report_update("profile-demo", result)
     if not args.out:
         shutil.rmtree(out, ignore_errors=True)
 

@@ -2,7 +2,7 @@
 """Where the wall time of reproducing goals goes, between the simulated steps.
 
   profile_reproduction.py --library-dir DIR [--mode sim] [--tasks grasp,wipe] [--goals 2]
-                          [--attach] [--json FILE]
+                          [--attach] [--json FILE] [--update-docs]
 
 Reproduces the first `--goals` unseen goals of each task in lockstep, as the reproduce stage does
 (reproduce.launch: bridge, executor, robot_state_publisher; lfd_tools.reproduction), and breaks
@@ -16,19 +16,17 @@ each goal's wall time down by what the lockstep client was doing (lfd_tools.lock
   judge_waits   waiting for the last sensor messages before judging; judging: the task's rules
 Settling before and after the motion is stepped too (step_calls outside `motion`). Also prints the
 CPU time of every process of the graph (from /proc). Run after `./lfd build` with
-devel/setup.bash sourced, on a skill library the learn stage wrote.
+devel/setup.bash sourced, on a skill library the learn stage wrote. --update-docs rewrites
+docs/results.md's section profile-reproduction from the figures (lfd_tools.results_doc).
 """
-import collections
 import json
 import os
 import sys
 import time
 
-from lfd_tools import master, reproduction, report, tasks
+from lfd_tools import master, reproduction, report, results_doc, tasks
 from lfd_tools.lockstep import Cell
 from lfd_tools.processes import CpuSampler
-
-ORDER = ("scene_calls", "planning", "motion", "judge_waits", "judging")
 
 
 def profile_goals(cell, lib_dir, mode, names, goals):
@@ -57,22 +55,10 @@ def profile_goals(cell, lib_dir, mode, names, goals):
 
 
 def show(rows, cpu):
-    wall, sim = sum(r["wall_s"] for r in rows), sum(r["sim_s"] for r in rows)
-    parts, calls = collections.Counter(), collections.Counter()
-    for r in rows:
-        parts.update(r["parts"])
-        calls.update(r["calls"])
-    print("%d goals: %.1f s of sim time in %.1f s wall (%.1fx real time)"
-          % (len(rows), sim, wall, sim / max(wall, 1e-9)))
-    for name in ORDER:
-        print("  %-44s %6.2f s  %5.1f%%"
-              % ("%s (%d)" % (name, calls[name]), parts[name], 100 * parts[name] / wall))
-    print("  %-44s %6.2f s"
-          % ("of which /bridge/step round trips (%d)" % calls["step_calls"], parts["step_calls"]))
-    print("  %-44s %6.2f s" % ("of motion: its step round trips", parts["motion_step_calls"]))
-    print("  %-44s %6.2f s" % ("of motion: the rest (client loop, action traffic)",
-                               parts["motion"] - parts["motion_step_calls"]))
-    print("  %-44s %6.2f s" % ("outside every measured part", wall - sum(parts[n] for n in ORDER)))
+    summary, parts = results_doc.reproduction_profile(rows)
+    print(summary)
+    for name, seconds, share in parts:
+        print("  %-44s %6.2f s" % (name, seconds) + ("" if share is None else "  %5.1f%%" % share))
     print("CPU by process (user + system) over the whole run:")
     for name, (user, system) in cpu.items():
         if user + system >= 0.05:
@@ -82,7 +68,11 @@ def show(rows, cpu):
 def main():
     ap = reproduction.goal_bench_parser(__doc__, goals=2)
     ap.add_argument("--json", default=None)
+    ap.add_argument("--update-docs", action="store_true",
+                    help="rewrite docs/results.md's section profile-reproduction from the figures")
     args = ap.parse_args()
+    if args.update_docs:
+        results_doc.check("profile-reproduction")
     lib_dir = os.path.abspath(args.library_dir)
     names = reproduction.selected_tasks(args.tasks)
     sampler = CpuSampler(os.getpid())
@@ -97,6 +87,8 @@ def main():
     if args.json:
         with open(args.json, "w") as f:
             json.dump({"goals": rows, "cpu_s": cpu}, f, indent=1)
+    if args.update_docs:
+        results_doc.report_update("profile-reproduction", {"goals": rows, "cpu_s": cpu})
     return 0
 
 

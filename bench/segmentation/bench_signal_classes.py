@@ -15,10 +15,12 @@ truth with the project's scorer (lfd_tools.segmentation_scoring / lfd_tools.judg
 
   bench_signal_classes.py [--seeds 0,1,2] [--classes a,b] [--cli PATH] [--config YAML]
                           [--procedure NAME] [--out result.json] [--min-success X] [--keep DIR]
+                          [--update-docs]
 
 Run with devel/setup.bash sourced (lfd_tools). A failed CLI run scores its demos with no
 changepoint and prints its error. --min-success X (0-1): exit 1 when any class's rate at 0.5 s
-is below X (for CI).
+is below X (for CI). --update-docs: rewrite docs/results.md's section bench-signal-classes from
+the result (lfd_tools.results_doc).
 """
 import argparse
 import json
@@ -30,7 +32,7 @@ import tempfile
 import time
 
 import numpy as np
-from lfd_tools import judge, segmentation_scoring, signal_classes
+from lfd_tools import judge, results_doc, segmentation_scoring, signal_classes
 
 ROOT = os.path.abspath(os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", ".."))
 DEFAULT_CLI = os.path.join(ROOT, "devel", "lib", "lfd_segmentation", "segment")
@@ -123,21 +125,14 @@ def score_class(args, name, work):
     return out
 
 
-HEADER = "%-22s %5s %-14s %6s %-14s %6s %6s %6s %7s %7s %5s %9s %7s" % (
-    "class", "demos", "ok@0.5", "rate", "ok@1.0", "rate", "cover", "f1@0.5", "err_med", "err_p95",
-    "none", "cps/truth", "time_s")
+COLUMNS = "%-22s %5s %-14s %6s %-14s %6s %6s %6s %7s %7s %5s %9s %7s"
+HEADER = COLUMNS % results_doc.SIGNAL_CLASS_HEADER
 
 
 def row(name, r):
-    a, b = r["at"]["0.5"], r["at"]["1.0"]
-    per_seed = lambda tol: ",".join(str(s["correct"][tol]) for s in r["seeds"])
-    line = "%-22s %5d %-14s %6.2f %-14s %6.2f %6.3f %6.3f %7.2f %7.2f %5d %4.1f/%-4.1f %7.1f" % (
-        name, a["demos"], per_seed("0.5"), a["success_rate"], per_seed("1.0"), b["success_rate"],
-        a["covering"], a["f1"], a["time_error_median_s"], a["time_error_p95_s"],
-        a["transitions_without_changepoint"], r["changepoints_per_demo"], r["boundaries_per_demo"],
-        sum(s["seconds"] for s in r["seeds"]))
     errors = ["seed %d: %s" % (s["seed"], s["error"]) for s in r["seeds"] if s["error"]]
-    return line + "".join("\n    error: " + e for e in errors)
+    return (COLUMNS % results_doc.signal_class_cells(name, r)
+            + "".join("\n    error: " + e for e in errors))
 
 
 def parse_args():
@@ -155,6 +150,9 @@ def parse_args():
     ap.add_argument("--min-success", type=float, default=None,
                     help="exit 1 when a class's success rate at 0.5 s is below this (0-1)")
     ap.add_argument("--keep", default="", help="generate into this folder and keep it")
+    ap.add_argument("--update-docs", action="store_true",
+                    help="rewrite docs/results.md's section bench-signal-classes from the result "
+                         "(only when asked: CI runs this bench on one seed)")
     args = ap.parse_args()
     args.seeds = [int(s) for s in args.seeds.split(",") if s]
     names = [c for c in args.classes.split(",") if c] or list(signal_classes.CLASSES)
@@ -164,6 +162,11 @@ def parse_args():
                  % (", ".join(unknown), ", ".join(signal_classes.CLASSES)))
     if not os.access(args.cli, os.X_OK):
         ap.error("no `segment` CLI at %s (./lfd build, or --cli)" % args.cli)
+    if args.update_docs:
+        try:
+            results_doc.check("signal-classes")
+        except RuntimeError as exc:
+            ap.error(str(exc))
     return args, names
 
 
@@ -181,11 +184,13 @@ def main():
     finally:
         if not args.keep:
             shutil.rmtree(work, ignore_errors=True)
+    result = {"cli": args.cli, "config": args.config, "procedure": args.procedure,
+              "seeds": args.seeds, "tolerances_s": list(TOLERANCES), "classes": results}
     if args.out:
         with open(args.out, "w") as f:
-            json.dump({"cli": args.cli, "config": args.config, "procedure": args.procedure,
-                       "seeds": args.seeds, "tolerances_s": list(TOLERANCES),
-                       "classes": results}, f, indent=1)
+            json.dump(result, f, indent=1)
+    if args.update_docs:
+        results_doc.report_update("signal-classes", result)
     below = [n for n, r in results.items() if args.min_success is not None
              and r["at"]["0.5"]["success_rate"] < args.min_success]
     if below:

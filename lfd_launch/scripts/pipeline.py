@@ -57,6 +57,9 @@ keeps results newer than their library for the same goals; `--force` redoes lear
 keeping everything recorded so far (reproduction results include the goals done).
 Reduced runs (CI): `--demos N` records N configurations per dataset (spread over the task's list;
 later stages use the bags present), `--goals N` reproduces N unseen goals per task (spread).
+`--update-docs`: after a run without problems, the generated pipeline sections of docs/results.md
+are rewritten from the report (lfd_tools.results_doc). Only when asked: a run writes into its --out
+folder, never into the checkout, so CI, fresh roots and reduced runs leave the measured figures be.
 """
 import argparse
 import contextlib
@@ -67,7 +70,7 @@ import subprocess
 import sys
 import time
 
-from lfd_tools import config, judge, report as records, tasks
+from lfd_tools import config, report as records, report_tables as tables, results_doc, tasks
 from lfd_tools.jobs import run_parallel, run_tool, split, workers
 from lfd_tools.master import background_launch, private_master
 from lfd_tools.processes import TAG_VAR, kill_tagged
@@ -381,99 +384,26 @@ def write_report(out, report):
     if "robot" in report:
         lines += ["Robot: %s (package %s_description)" % (report["robot"], report["robot"]), ""]
     if "datasets" in report:
-        lines += ["## Datasets", "", "| dataset | demos |", "| --- | --- |"]
-        lines += ["| %s | %d |" % (n, d["demos"]) for n, d in sorted(report["datasets"].items())]
-        lines.append("")
+        lines += ["## Datasets", ""] + tables.datasets_table(report) + [""]
     if "segmentation" in report:
-        methods = sorted({m for e in report["segmentation"].values() for m in e["methods"]})
-        lines += ["## Segmentation success rate", "",
-                  ("| dataset | " + " | ".join(methods)
-                   + " | selected features (%s) |" % records.PAPER_METHOD),
-                  "| --- " * (len(methods) + 2) + "|"]
-        for name, e in sorted(report["segmentation"].items()):
-            cells = ["%.0f%%" % (100 * e["methods"][m]) if e["methods"].get(m) is not None
-                     else "error"
-                     for m in methods]
-            lines.append("| %s | %s | %s |"
-                         % (name, " | ".join(cells), ", ".join(e["selected_features"])))
-        tol = next(iter(report["segmentation"].values()))["tolerance_s"]
-        lines += ["", "A changepoint counts when it lies within %.2f s of its ground-truth "
-                      "transition." % tol, ""]
+        lines += ["## Segmentation success rate", ""] + tables.segmentation_table(report) + [""]
     if report.get("learning"):
-        lines += ["## Learning (skill libraries from the validated changepoints)", "",
-                  "| dataset | segments (task's) | demos used | changepoints per demo "
-                  "| warnings / error |",
-                  "| --- | --- | --- | --- | --- |"]
-        for name, e in sorted(report["learning"].items()):
-            notes = e.get("error") or ("%d warning(s)" % len(e["warnings"])
-                                       if e.get("warnings") else "")
-            lines.append("| %s | %s (%s) | %s | %s | %s |" % (
-                name, e.get("segments"), e.get("expected_segments"), e.get("demos_used"),
-                " ".join(str(c) for c in e.get("changepoint_counts", [])), notes))
-        lines += ["", "Segment goals learned from the demos' scenes: the frame in which each "
-                  "segment's end varies least, and that spread (RMS across the demos).", "",
-                  "| dataset | segment | position frame (spread) | orientation frame (spread) "
-                  "| generalized along |",
-                  "| --- | --- | --- | --- | --- |"]
-        for name, e in sorted(report["learning"].items()):
-            for g in e.get("segment_goals", []):
-                if g.get("position_frame") is None:
-                    continue
-                lines.append("| %s | %s | %s (%.1f mm) | %s (%.3f rad) | %s |" % (
-                    name, g["segment"], g["position_frame"], 1e3 * g["position_spread_m"],
-                    g["orientation_frame"], g["orientation_spread_rad"],
-                    g.get("motion_frame") or "-"))
-        lines.append("")
+        lines += (["## Learning (skill libraries from the validated changepoints)", ""]
+                  + tables.learning_table(report) + [""] + tables.segment_goals_table(report)
+                  + [""])
     for key, title in (("reproduction", "sim"), ("reproduction_teleop", "teleop")):
         if not report.get(key):
             continue
-        lines += ["## Reproduction toward unseen goals (%s)" % title, "",
-                  "| task | success | time ratio | mean object error | mean TCP error "
-                  "| monitor alarms | note |",
-                  "| --- | --- | --- | --- | --- | --- | --- |"]
-        mm = lambda v: "-" if v is None else "%.1f mm" % (v * 1e3)
-        for task, e in sorted(report[key].items()):
-            goals = e.get("goals", [])
-            lines.append("| %s | %s | %s | %s | %s | %s | %s |" % (
-                task, ("%d/%d" % (sum(g["success"] for g in goals), len(goals))
-                       if goals else "-"),
-                ("-" if e.get("execution_time_ratio") is None
-                 else "%.2f" % e["execution_time_ratio"]),
-                mm(e.get("mean_object_position_error_m")), mm(e.get("mean_tcp_position_error_m")),
-                records.monitor_summary(goals), (e.get("error") or "").replace("|", "/")))
-        lines += ["", "Success (the task files): " + "; ".join(
-            judge.describe_criteria(t, tasks.success_criterion(t)) for t in sorted(report[key]))
-            + ". Time ratio: executed / mean demonstrated duration.", ""]
-        for task, e in sorted(report[key].items()):
-            if not e.get("goals"):
-                continue
-            lines += ["%s, per goal%s:" % (task, records.ridges_note(e["goals"])), "",
-                      "| goal | result | object error | yaw error | TCP error | time ratio "
-                      "| planning | wall | anomaly score |",
-                      "| --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
-            sec = lambda v: "-" if v is None else "%.2f s" % v
-            for g in e["goals"]:
-                lines.append("| %d | %s | %s | %s | %s | %s | %s | %s | %s |" % (
-                    g["id"], "ok" if g["success"] else "FAILED", mm(g["object_position_error_m"]),
-                    ("-" if g["object_yaw_error_rad"] is None
-                     else "%.3f rad" % g["object_yaw_error_rad"]),
-                    mm(g["tcp_position_error_m"]),
-                    "-" if g["time_ratio"] is None else "%.3f" % g["time_ratio"],
-                    sec(g.get("planning_time_s")), sec(g.get("wall_time_s")),
-                    "%.2f" % g["max_anomaly_score"] if g.get("monitored") else "-"))
-            lines.append("")
+        lines += (["## Reproduction toward unseen goals (%s)" % title, ""]
+                  + tables.reproduction_table(report, key) + [""] + tables.goal_tables(report, key))
     if report.get("figures"):
-        lines += ["## Figures", ""]
-        for name, paths in sorted(report["figures"].items()):
-            lines += ["### %s" % name, ""] + ["![%s](%s)" % (os.path.basename(p), p)
-                                              for p in paths] + [""]
+        lines += ["## Figures", ""] + tables.figure_list(report)
     report["problems"] = problems(report) + report.get("figure_problems", [])
     if report["problems"]:
         lines += ["## Problems", ""] + ["- " + p for p in report["problems"]] + [""]
     with open(os.path.join(out, "report.json"), "w") as f:
         json.dump(report, f, indent=1, sort_keys=True)
-    lines += ["## Timings", ""] + ["- %s: %.1f s" % (k, v)
-                                   for k, v in sorted(report["timings"].items())]
+    lines += ["## Timings", ""] + tables.timings_list(report)
     with open(os.path.join(out, "report.md"), "w") as f:
         f.write("\n".join(lines) + "\n")
     return "\n".join(lines)
@@ -505,6 +435,10 @@ def main():
                          "every stage's launch files and tools use it" % config.DEFAULT_ROBOT)
     ap.add_argument("--jobs", type=int, default=0,
                     help="independent simulations / figure jobs at once (0 = one per core)")
+    ap.add_argument("--update-docs", action="store_true",
+                    help="after a run without problems, rewrite the generated pipeline sections "
+                         "of docs/results.md from its report (never by default: a CI, fresh-root "
+                         "or reduced run must not change the checkout's measured figures)")
     # roslaunch (lfd_launch/pipeline.launch) appends __name:= / __log:= remappings: not ours.
     args = ap.parse_args([a for a in sys.argv[1:] if not a.startswith("__")])
     # SIGTERM (kill, CI timeouts) and a SIGINT ignored by a non-interactive parent shell stop the
@@ -539,6 +473,12 @@ def main():
         say("error: unknown stage(s) %s; known: %s" % (",".join(unknown), ",".join(STAGES)))
         return 2
     stages = [s for s in STAGES if s in stages]  # always in data-flow order
+    if args.update_docs:
+        try:  # before the work: a file without the sections is said now, not after the run
+            results_doc.check("pipeline")
+        except RuntimeError as exc:
+            say("error: --update-docs: %s" % exc)
+            return 2
 
     report_path = os.path.join(out, "report.json")
     report = {}
@@ -593,6 +533,15 @@ def main():
     for p in report["problems"]:
         say("problem: " + p)
     say("report: %s and %s" % (report_path, os.path.join(out, "report.md")))
+    if args.update_docs:
+        if status or report["problems"]:
+            say("docs/results.md not updated: the run had problems")
+        else:
+            try:
+                results_doc.report_update("pipeline", report)
+            except (OSError, RuntimeError) as exc:  # the run is done and reported; the doc is not
+                say("error: docs/results.md not updated: %s" % exc)
+                status = 1
     return status
 
 

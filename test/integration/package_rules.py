@@ -13,7 +13,7 @@ import rostest
 
 ROOT = os.path.abspath(os.path.join(os.path.dirname(os.path.realpath(__file__)), "..", ".."))
 ALGORITHMS = ("lfd_segmentation", "lfd_dmp")
-ROBOTS = ("_description",)  # a robot package's name ends so (README, "Adding a robot")
+ROBOTS = ("_description",)  # a robot package's name ends so (DESIGN.md, "Adding a robot")
 
 
 def manifests():

@@ -37,7 +37,7 @@ def robot_dir(name=None):
         return rospkg.RosPack().get_path(package)
     except rospkg.ResourceNotFound:
         raise RuntimeError("robot %r: no package %s (a robot is a <robot>_description package with "
-                           "config/robot.yaml; see README, Adding a robot)"
+                           "config/robot.yaml; see DESIGN.md, Adding a robot)"
                            % (name or robot_name(), package))
 
 
