@@ -41,7 +41,7 @@ void BM_ClaspProfile(benchmark::State& state) {
   lfd::ClaspConfig config;
   config.window_size = kWindow;
   for (auto _ : state) {
-    lfd::ClaspProfile p = lfd::compute_clasp_profile(x, config);
+    lfd::ClaspProfile p = lfd::computeClaspProfile(x, config);
     benchmark::DoNotOptimize(p.profile.data());
   }
   const double m = static_cast<double>(n - kWindow + 1);
@@ -60,7 +60,7 @@ void BM_SelfJoinKnn(benchmark::State& state) {
   const auto n = static_cast<std::size_t>(state.range(0));
   const Eigen::VectorXd x = regimes(n);
   for (auto _ : state) {
-    lfd::KnnResult knn = lfd::self_join_knn(x, kWindow, 3, kWindow / 2);
+    lfd::KnnResult knn = lfd::selfJoinKnn(x, kWindow, 3, kWindow / 2);
     benchmark::DoNotOptimize(knn.indices.data());
   }
 }
@@ -68,9 +68,9 @@ BENCHMARK(BM_SelfJoinKnn)->Arg(20000)->Unit(benchmark::kMillisecond);
 
 void BM_ScoreProfileOnly(benchmark::State& state) {
   const auto n = static_cast<std::size_t>(state.range(0));
-  const lfd::KnnResult knn = lfd::self_join_knn(regimes(n), kWindow, 3, kWindow / 2);
+  const lfd::KnnResult knn = lfd::selfJoinKnn(regimes(n), kWindow, 3, kWindow / 2);
   for (auto _ : state) {
-    Eigen::VectorXd p = lfd::classification_score_profile(knn, 5 * kWindow);
+    Eigen::VectorXd p = lfd::classificationScoreProfile(knn, 5 * kWindow);
     benchmark::DoNotOptimize(p.data());
   }
 }
@@ -82,7 +82,7 @@ void BM_ClaspSegmentation(benchmark::State& state) {
   const Eigen::VectorXd x = regimes(n);
   std::size_t found = 0;
   for (auto _ : state) {
-    lfd::ClaspSegmentation s = lfd::clasp_segment(x, lfd::ClaspConfig{});
+    lfd::ClaspSegmentation s = lfd::claspSegment(x, lfd::ClaspConfig{});
     found = s.changepoints.size();
     benchmark::DoNotOptimize(s.first_profile.data());
   }
@@ -98,7 +98,7 @@ void BM_MultivariateSegmentation(benchmark::State& state) {
   const std::vector<double> weights{1.0, 0.9, 0.8, 0.5, 0.3, 0.2};
   lfd::MultivariateSegmentationConfig config;
   for (auto _ : state) {
-    lfd::MultivariateSegmentation s = lfd::segment_multivariate(features, weights, config);
+    lfd::MultivariateSegmentation s = lfd::segmentMultivariate(features, weights, config);
     benchmark::DoNotOptimize(s.changepoints.data());
   }
 }

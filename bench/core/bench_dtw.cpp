@@ -21,8 +21,8 @@ struct Workload {
   double cells = 0;
 };
 
-const Workload& relevance_workload() {
-  static const Workload w = [] {
+const Workload& relevanceWorkload() {
+  static const Workload kW = [] {
     Workload w;
     std::mt19937 rng(42);
     std::normal_distribution<double> noise(0.0, 0.02);
@@ -52,44 +52,44 @@ const Workload& relevance_workload() {
     }
     return w;
   }();
-  return w;
+  return kW;
 }
 
-void set_rate(benchmark::State& state, double cells_per_iteration) {
+void setRate(benchmark::State& state, double cells_per_iteration) {
   state.counters["Gcells/s"] = benchmark::Counter(cells_per_iteration * 1e-9 * state.iterations(),
                                                   benchmark::Counter::kIsRate);
 }
 
 void BM_ScalarPairCost(benchmark::State& state) {
-  const auto& p = relevance_workload().pairs.front();
-  for (auto _ : state) benchmark::DoNotOptimize(lfd::dtw_cost(p.a, p.n, p.b, p.m));
-  set_rate(state, double(p.n) * p.m);
+  const auto& p = relevanceWorkload().pairs.front();
+  for (auto _ : state) benchmark::DoNotOptimize(lfd::dtwCost(p.a, p.n, p.b, p.m));
+  setRate(state, double(p.n) * p.m);
 }
 
 void BM_ScalarPairPath(benchmark::State& state) {
-  const auto& p = relevance_workload().pairs.front();
+  const auto& p = relevanceWorkload().pairs.front();
   for (auto _ : state) benchmark::DoNotOptimize(lfd::dtw(p.a, p.n, p.b, p.m).cost);
-  set_rate(state, double(p.n) * p.m);
+  setRate(state, double(p.n) * p.m);
 }
 
 void BM_BatchCostRelevance(benchmark::State& state) {
-  const Workload& w = relevance_workload();
-  for (auto _ : state) benchmark::DoNotOptimize(lfd::dtw_cost_batch(w.pairs, {}, state.range(0)));
-  set_rate(state, w.cells);
+  const Workload& w = relevanceWorkload();
+  for (auto _ : state) benchmark::DoNotOptimize(lfd::dtwCostBatch(w.pairs, {}, state.range(0)));
+  setRate(state, w.cells);
 }
 
 void BM_BatchPathsRelevance(benchmark::State& state) {
-  const Workload& w = relevance_workload();
-  for (auto _ : state) benchmark::DoNotOptimize(lfd::dtw_batch(w.pairs, {}, state.range(0)));
-  set_rate(state, w.cells);
+  const Workload& w = relevanceWorkload();
+  for (auto _ : state) benchmark::DoNotOptimize(lfd::dtwBatch(w.pairs, {}, state.range(0)));
+  setRate(state, w.cells);
 }
 
 void BM_BatchPathsRelevanceBand(benchmark::State& state) {
-  const Workload& w = relevance_workload();
+  const Workload& w = relevanceWorkload();
   for (auto _ : state) {
-    benchmark::DoNotOptimize(lfd::dtw_batch(w.pairs, {int(state.range(1))}, state.range(0)));
+    benchmark::DoNotOptimize(lfd::dtwBatch(w.pairs, {int(state.range(1))}, state.range(0)));
   }
-  set_rate(state, w.cells);  // full-matrix cells, for comparison with the unbanded run
+  setRate(state, w.cells);  // full-matrix cells, for comparison with the unbanded run
 }
 
 }  // namespace

@@ -111,9 +111,9 @@ void ikColdReach(benchmark::State& state, const Robot& robot) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  static const std::vector<Robot> robots = {loadRobot(LFD_ROBOT_DIR),
-                                            loadRobot(LFD_ARM7_ROBOT_DIR)};
-  for (const Robot& robot : robots) {
+  static const std::vector<Robot> kRobots = {loadRobot(LFD_ROBOT_DIR),
+                                             loadRobot(LFD_ARM7_ROBOT_DIR)};
+  for (const Robot& robot : kRobots) {
     const std::string tag = robot.name + " (" + std::to_string(robot.chain.dof()) + " DoF)";
     const auto add = [&robot, &tag](const std::string& what,
                                     void (*run)(benchmark::State&, const Robot&)) {

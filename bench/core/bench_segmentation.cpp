@@ -49,7 +49,7 @@ std::vector<std::string> sensors() {
 }
 
 // The YAML's event settings (seconds are converted per demo).
-lfd::SegmentationPipelineConfig yaml_config() {
+lfd::SegmentationPipelineConfig yamlConfig() {
   lfd::SegmentationPipelineConfig c;
   c.seconds = lfd::TimeParameters{};
   c.events.noise_floor_sigmas = 0.0;
@@ -64,37 +64,35 @@ lfd::SegmentationPipelineConfig yaml_config() {
 
 void BM_Pipeline(benchmark::State& state) {
   const auto d = demos();
-  const auto config = yaml_config();
-  for (auto _ : state)
-    benchmark::DoNotOptimize(lfd::run_segmentation_pipeline(d, sensors(), config));
+  const auto config = yamlConfig();
+  for (auto _ : state) benchmark::DoNotOptimize(lfd::runSegmentationPipeline(d, sensors(), config));
 }
 BENCHMARK(BM_Pipeline)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 void BM_PrepareOnly(benchmark::State& state) {
   const auto d = demos();
-  const auto config = yaml_config();
-  for (auto _ : state) benchmark::DoNotOptimize(lfd::prepare_segmentation(d, sensors(), config));
+  const auto config = yamlConfig();
+  for (auto _ : state) benchmark::DoNotOptimize(lfd::prepareSegmentation(d, sensors(), config));
 }
 BENCHMARK(BM_PrepareOnly)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 // II-C alone, per combination: what each further method costs once the selection is shared.
 void BM_SegmentPrepared(benchmark::State& state) {
   const auto d = demos();
-  auto config = yaml_config();
-  const lfd::PreparedSegmentation prepared = lfd::prepare_segmentation(d, sensors(), config);
+  auto config = yamlConfig();
+  const lfd::PreparedSegmentation prepared = lfd::prepareSegmentation(d, sensors(), config);
   config.segmentation.combination = static_cast<lfd::ProfileCombination>(state.range(0));
-  for (auto _ : state) benchmark::DoNotOptimize(lfd::segment_prepared(prepared, d, config));
-  state.SetLabel(lfd::to_string(config.segmentation.combination));
+  for (auto _ : state) benchmark::DoNotOptimize(lfd::segmentPrepared(prepared, d, config));
+  state.SetLabel(lfd::toString(config.segmentation.combination));
 }
 BENCHMARK(BM_SegmentPrepared)->DenseRange(0, 5)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 void BM_SensorEventsFitted(benchmark::State& state) {
   const auto d = demos();
-  const auto config = lfd::in_samples(yaml_config(), 50.0);
+  const auto config = lfd::inSamples(yamlConfig(), 50.0);
   const Eigen::MatrixXd s = d[0].select(sensors()).data;
   const std::vector<std::size_t> groups(kSensors, 0);
-  for (auto _ : state)
-    benchmark::DoNotOptimize(lfd::detect_sensor_events(s, config.events, groups));
+  for (auto _ : state) benchmark::DoNotOptimize(lfd::detectSensorEvents(s, config.events, groups));
 }
 BENCHMARK(BM_SensorEventsFitted)->Unit(benchmark::kMicrosecond);
 

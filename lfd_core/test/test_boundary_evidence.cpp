@@ -14,7 +14,7 @@ namespace {
 constexpr double kRate = 50.0;
 
 // Minimum-jerk position profile from 0 to 1 (tau in [0, 1]).
-double min_jerk(double tau) {
+double minJerk(double tau) {
   tau = std::clamp(tau, 0.0, 1.0);
   return tau * tau * tau * (10.0 - 15.0 * tau + 6.0 * tau * tau);
 }
@@ -32,7 +32,7 @@ struct Motion {
   std::vector<double> starts;  // start time of each piece
 };
 
-Motion make_motion(const std::vector<Piece>& pieces) {
+Motion makeMotion(const std::vector<Piece>& pieces) {
   Motion m;
   double total = 0.0;
   for (const Piece& p : pieces) {
@@ -46,18 +46,17 @@ Motion make_motion(const std::vector<Piece>& pieces) {
     m.time.push_back(t);
     double x = 0.0;
     for (std::size_t k = 0; k < pieces.size(); ++k)
-      if (pieces[k].way != 0.0)
-        x += pieces[k].way * min_jerk((t - m.starts[k]) / pieces[k].seconds);
+      if (pieces[k].way != 0.0) x += pieces[k].way * minJerk((t - m.starts[k]) / pieces[k].seconds);
     m.states(i, 0) = x;
   }
   return m;
 }
 
-Eigen::VectorXd speed_of(const Motion& m) {
-  return lfd::state_speed(m.states, m.time, lfd::PauseConfig{}.smoothing);
+Eigen::VectorXd speedOf(const Motion& m) {
+  return lfd::stateSpeed(m.states, m.time, lfd::PauseConfig{}.smoothing);
 }
 
-std::size_t sample_at(double t) {
+std::size_t sampleAt(double t) {
   return static_cast<std::size_t>(std::lround(t * kRate));
 }
 
@@ -68,35 +67,35 @@ std::vector<lfd::Pause> interior(const std::vector<lfd::Pause>& pauses, std::siz
   return out;
 }
 
-// ---- state_speed
+// ---- stateSpeed
 
 TEST(StateSpeed, IsNearZeroAtRestAndPeaksMidMove) {
   // 1 s rest, a 2 s min-jerk move of 1, 1 s rest: peak speed 1.875 / 2 at t = 2 s.
-  const Motion m = make_motion({{1.0, 0.0}, {2.0, 1.0}, {1.0, 0.0}});
-  const Eigen::VectorXd speed = speed_of(m);
+  const Motion m = makeMotion({{1.0, 0.0}, {2.0, 1.0}, {1.0, 0.0}});
+  const Eigen::VectorXd speed = speedOf(m);
   ASSERT_EQ(speed.size(), m.states.rows());
   Eigen::Index peak = 0;
   const double top = speed.maxCoeff(&peak);
   EXPECT_NEAR(m.time[static_cast<std::size_t>(peak)], 2.0, 0.05);
   EXPECT_NEAR(top, 1.875 / 2.0, 0.05 * 1.875 / 2.0);
-  EXPECT_LT(speed[static_cast<Eigen::Index>(sample_at(0.5))], 1e-3 * top);
-  EXPECT_LT(speed[static_cast<Eigen::Index>(sample_at(3.5))], 1e-3 * top);
+  EXPECT_LT(speed[static_cast<Eigen::Index>(sampleAt(0.5))], 1e-3 * top);
+  EXPECT_LT(speed[static_cast<Eigen::Index>(sampleAt(3.5))], 1e-3 * top);
   EXPECT_GE(speed.minCoeff(), 0.0);
 }
 
 TEST(StateSpeed, ThrowsWhenTimestampsAndSamplesDiffer) {
-  const Motion m = make_motion({{1.0, 1.0}});
+  const Motion m = makeMotion({{1.0, 1.0}});
   std::vector<double> short_clock(m.time.begin(), m.time.end() - 1);
-  EXPECT_THROW(lfd::state_speed(m.states, short_clock, 0.1), std::invalid_argument);
+  EXPECT_THROW(lfd::stateSpeed(m.states, short_clock, 0.1), std::invalid_argument);
 }
 
-// ---- find_pauses
+// ---- findPauses
 
 TEST(FindPauses, ReportsTheRestBetweenTwoMovesEndingWhereMotionResumes) {
   // rest 1 s, move 2 s, rest 2 s, move 2 s, rest 1 s: the second move starts at 5 s.
-  const Motion m = make_motion({{1.0, 0.0}, {2.0, 1.0}, {2.0, 0.0}, {2.0, -1.0}, {1.0, 0.0}});
+  const Motion m = makeMotion({{1.0, 0.0}, {2.0, 1.0}, {2.0, 0.0}, {2.0, -1.0}, {1.0, 0.0}});
   const std::size_t n = m.time.size();
-  const auto pauses = lfd::find_pauses(speed_of(m), m.time, lfd::PauseConfig{});
+  const auto pauses = lfd::findPauses(speedOf(m), m.time, lfd::PauseConfig{});
   const auto inside = interior(pauses, n);
   ASSERT_EQ(inside.size(), 1u);
   const double begin = m.time[inside[0].begin], end = m.time[inside[0].end];
@@ -106,9 +105,9 @@ TEST(FindPauses, ReportsTheRestBetweenTwoMovesEndingWhereMotionResumes) {
 }
 
 TEST(FindPauses, ReportsTheFirstAndLastRestsAtTheDemosEnds) {
-  const Motion m = make_motion({{1.0, 0.0}, {2.0, 1.0}, {2.0, 0.0}, {2.0, -1.0}, {1.0, 0.0}});
+  const Motion m = makeMotion({{1.0, 0.0}, {2.0, 1.0}, {2.0, 0.0}, {2.0, -1.0}, {1.0, 0.0}});
   const std::size_t n = m.time.size();
-  const auto pauses = lfd::find_pauses(speed_of(m), m.time, lfd::PauseConfig{});
+  const auto pauses = lfd::findPauses(speedOf(m), m.time, lfd::PauseConfig{});
   ASSERT_EQ(pauses.size(), 3u);
   EXPECT_EQ(pauses.front().begin, 0u);
   EXPECT_NEAR(m.time[pauses.front().end], 1.0, 0.15);
@@ -118,40 +117,40 @@ TEST(FindPauses, ReportsTheFirstAndLastRestsAtTheDemosEnds) {
 
 // Two 1 s moves of 1 with `dip` s of rest between them, the second going on (`way` 1) or back
 // (`way` -1), between 1 s rests.
-Motion two_moves(double dip, double way) {
-  return make_motion({{1.0, 0.0}, {1.0, 1.0}, {dip, 0.0}, {1.0, way}, {1.0, 0.0}});
+Motion twoMoves(double dip, double way) {
+  return makeMotion({{1.0, 0.0}, {1.0, 1.0}, {dip, 0.0}, {1.0, way}, {1.0, 0.0}});
 }
 
 TEST(FindPauses, AShortDipBetweenTwoMovesIsNoPause) {
   // A reversal with 0.1 s of rest, and a move that goes on after 0.2 s of rest: both shorter
   // than min_pause (0.25 s).
-  for (const Motion& m : {two_moves(0.1, -1.0), two_moves(0.2, 1.0)}) {
-    const auto pauses = lfd::find_pauses(speed_of(m), m.time, lfd::PauseConfig{});
+  for (const Motion& m : {twoMoves(0.1, -1.0), twoMoves(0.2, 1.0)}) {
+    const auto pauses = lfd::findPauses(speedOf(m), m.time, lfd::PauseConfig{});
     EXPECT_TRUE(interior(pauses, m.time.size()).empty());
     EXPECT_EQ(pauses.size(), 2u) << "only the first and the last rest";
   }
 }
 
-// ---- motion_onset_evidence
+// ---- motionOnsetEvidence
 
 // Weight of the one onset after an interior pause of `pause` seconds between two moves.
-std::vector<lfd::BoundaryEvidence> onsets_after_pause(double pause, double weight,
-                                                      std::vector<double>* time = nullptr) {
-  const Motion m = make_motion({{1.0, 0.0}, {2.0, 1.0}, {pause, 0.0}, {2.0, -1.0}, {1.0, 0.0}});
-  const Eigen::VectorXd speed = speed_of(m);
+std::vector<lfd::BoundaryEvidence> onsetsAfterPause(double pause, double weight,
+                                                    std::vector<double>* time = nullptr) {
+  const Motion m = makeMotion({{1.0, 0.0}, {2.0, 1.0}, {pause, 0.0}, {2.0, -1.0}, {1.0, 0.0}});
+  const Eigen::VectorXd speed = speedOf(m);
   const lfd::PauseConfig config;
-  const auto pauses = lfd::find_pauses(speed, m.time, config);
+  const auto pauses = lfd::findPauses(speed, m.time, config);
   if (time) *time = m.time;
-  return lfd::motion_onset_evidence(speed, m.time, pauses, config, weight);
+  return lfd::motionOnsetEvidence(speed, m.time, pauses, config, weight);
 }
 
 TEST(MotionOnsetEvidence, ALongerPauseWeighsMore) {
   std::vector<double> time;
-  const auto long_pause = onsets_after_pause(3.0, 0.8, &time);
+  const auto long_pause = onsetsAfterPause(3.0, 0.8, &time);
   ASSERT_EQ(long_pause.size(), 1u);
   EXPECT_EQ(long_pause[0].kind, lfd::EvidenceKind::kMotionOnset);
   EXPECT_NEAR(time[long_pause[0].index], 6.0, 0.15) << "where the second move starts";
-  const auto short_pause = onsets_after_pause(0.5, 0.8);
+  const auto short_pause = onsetsAfterPause(0.5, 0.8);
   ASSERT_EQ(short_pause.size(), 1u);
   EXPECT_GT(long_pause[0].weight, short_pause[0].weight);
   EXPECT_GT(short_pause[0].weight, 0.0);
@@ -162,46 +161,46 @@ TEST(MotionOnsetEvidence, ALongerPauseWeighsMore) {
 
 TEST(MotionOnsetEvidence, TheDemosFirstMotionIsNoEvidence) {
   // One move between the two end rests: the motion starts from the first rest only.
-  const Motion m = make_motion({{1.5, 0.0}, {2.0, 1.0}, {1.5, 0.0}});
-  const Eigen::VectorXd speed = speed_of(m);
+  const Motion m = makeMotion({{1.5, 0.0}, {2.0, 1.0}, {1.5, 0.0}});
+  const Eigen::VectorXd speed = speedOf(m);
   const lfd::PauseConfig config;
-  const auto pauses = lfd::find_pauses(speed, m.time, config);
+  const auto pauses = lfd::findPauses(speed, m.time, config);
   ASSERT_EQ(pauses.size(), 2u);
-  EXPECT_TRUE(lfd::motion_onset_evidence(speed, m.time, pauses, config, 0.8).empty());
+  EXPECT_TRUE(lfd::motionOnsetEvidence(speed, m.time, pauses, config, 0.8).empty());
 }
 
-// ---- motion_stop_evidence
+// ---- motionStopEvidence
 
 // The one stop of `m`, at the slowest sample between the two moves' peaks (1.5 s and, with a
 // dip of `dip` s, 2.5 + dip s).
-void expect_one_stop_at_the_speed_minimum(const Motion& m, double dip) {
-  const Eigen::VectorXd speed = speed_of(m);
-  const auto stops = lfd::motion_stop_evidence(speed, m.time, lfd::PauseConfig{}, 0.3);
+void expectOneStopAtTheSpeedMinimum(const Motion& m, double dip) {
+  const Eigen::VectorXd speed = speedOf(m);
+  const auto stops = lfd::motionStopEvidence(speed, m.time, lfd::PauseConfig{}, 0.3);
   ASSERT_EQ(stops.size(), 1u);
   EXPECT_EQ(stops[0].kind, lfd::EvidenceKind::kMotionStop);
   EXPECT_DOUBLE_EQ(stops[0].weight, 0.3);
-  const Eigen::Index from = static_cast<Eigen::Index>(sample_at(1.5));
+  const Eigen::Index from = static_cast<Eigen::Index>(sampleAt(1.5));
   Eigen::Index slowest = 0;
-  speed.segment(from, static_cast<Eigen::Index>(sample_at(2.5 + dip)) - from).minCoeff(&slowest);
+  speed.segment(from, static_cast<Eigen::Index>(sampleAt(2.5 + dip)) - from).minCoeff(&slowest);
   EXPECT_EQ(stops[0].index, static_cast<std::size_t>(from + slowest));
   EXPECT_NEAR(m.time[stops[0].index], 2.0 + 0.5 * dip, 0.1);
 }
 
 TEST(MotionStopEvidence, AReversalIsOnePieceAtTheSpeedMinimum) {
-  expect_one_stop_at_the_speed_minimum(two_moves(0.0, -1.0), 0.0);
-  expect_one_stop_at_the_speed_minimum(two_moves(0.1, -1.0), 0.1);
+  expectOneStopAtTheSpeedMinimum(twoMoves(0.0, -1.0), 0.0);
+  expectOneStopAtTheSpeedMinimum(twoMoves(0.1, -1.0), 0.1);
 }
 
 TEST(MotionStopEvidence, AnInstantOfRestBetweenTwoMovesIsOnePieceAtTheSpeedMinimum) {
-  expect_one_stop_at_the_speed_minimum(two_moves(0.2, 1.0), 0.2);
+  expectOneStopAtTheSpeedMinimum(twoMoves(0.2, 1.0), 0.2);
 }
 
 TEST(MotionStopEvidence, APauseIsNoStop) {
-  const Motion m = two_moves(2.0, 1.0);
-  EXPECT_TRUE(lfd::motion_stop_evidence(speed_of(m), m.time, lfd::PauseConfig{}, 0.3).empty());
+  const Motion m = twoMoves(2.0, 1.0);
+  EXPECT_TRUE(lfd::motionStopEvidence(speedOf(m), m.time, lfd::PauseConfig{}, 0.3).empty());
 }
 
-// ---- gather_into_pauses
+// ---- gatherIntoPauses
 
 TEST(GatherIntoPauses, EvidenceInsideAnInteriorPauseMovesToItsEnd) {
   const std::vector<lfd::Pause> pauses = {{0, 50}, {200, 300}, {400, 450}};
@@ -212,7 +211,7 @@ TEST(GatherIntoPauses, EvidenceInsideAnInteriorPauseMovesToItsEnd) {
       {200, 0.6, lfd::EvidenceKind::kSensorLevel},  // at the pause's first sample
       {420, 0.9, lfd::EvidenceKind::kContact},      // in the last rest
   };
-  lfd::gather_into_pauses(pauses, 450, 0, &evidence);
+  lfd::gatherIntoPauses(pauses, 450, 0, &evidence);
   EXPECT_EQ(evidence[0].index, 20u) << "the first rest keeps its evidence";
   EXPECT_EQ(evidence[1].index, 100u);
   EXPECT_EQ(evidence[2].index, 300u);
@@ -230,12 +229,12 @@ TEST(GatherIntoPauses, EvidenceAsTheHandStopsStaysWhereItIs) {
       {208, 0.9, lfd::EvidenceKind::kContact},
       {230, 0.9, lfd::EvidenceKind::kContact},
   };
-  lfd::gather_into_pauses(pauses, 450, 10, &evidence);
+  lfd::gatherIntoPauses(pauses, 450, 10, &evidence);
   EXPECT_EQ(evidence[0].index, 208u);
   EXPECT_EQ(evidence[1].index, 300u);
 }
 
-// ---- sensory_evidence
+// ---- sensoryEvidence
 
 lfd::SensoryEvent event(std::size_t index, bool rest_edge) {
   lfd::SensoryEvent e;
@@ -251,7 +250,7 @@ TEST(SensoryEvidence, ARestEdgeIsContactWithTheContactWeight) {
   lfd::EvidenceWeights weights;
   weights.contact = 0.77;
   weights.sensor_level = 0.55;
-  const auto out = lfd::sensory_evidence(events, weights, 25);
+  const auto out = lfd::sensoryEvidence(events, weights, 25);
   ASSERT_EQ(out.size(), 1u);
   EXPECT_EQ(out[0].index, 100u);
   EXPECT_EQ(out[0].kind, lfd::EvidenceKind::kContact);
@@ -264,7 +263,7 @@ TEST(SensoryEvidence, ALevelEventNearARestEdgeJoinsItAndAFarOneStaysPut) {
   lfd::EvidenceWeights weights;
   weights.contact = 0.77;
   weights.sensor_level = 0.55;
-  auto out = lfd::sensory_evidence(events, weights, 25);
+  auto out = lfd::sensoryEvidence(events, weights, 25);
   ASSERT_EQ(out.size(), 4u);
   std::sort(out.begin(), out.end(),
             [](const lfd::BoundaryEvidence& a, const lfd::BoundaryEvidence& b) {
@@ -293,7 +292,7 @@ TEST(SensoryEvidence, ALevelEventNearARestEdgeJoinsItAndAFarOneStaysPut) {
 TEST(SensoryEvidence, ALevelEventJustBeyondTheFoldStaysPut) {
   lfd::SensorEvents events;
   events.details = {event(100, true), event(126, false)};
-  const auto out = lfd::sensory_evidence(events, lfd::EvidenceWeights{}, 25);
+  const auto out = lfd::sensoryEvidence(events, lfd::EvidenceWeights{}, 25);
   ASSERT_EQ(out.size(), 2u);
   for (const auto& e : out)
     if (e.kind == lfd::EvidenceKind::kSensorLevel) {

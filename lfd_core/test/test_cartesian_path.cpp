@@ -73,7 +73,7 @@ TEST(RobotSetup, RepositoryFileDescribesTheWaistAndRightArm) {
 }
 
 TEST(RobotSetup, BadFilesAreClearErrors) {
-  const auto expectError = [](const std::string& text, const std::string& needle) {
+  const auto expect_error = [](const std::string& text, const std::string& needle) {
     const std::string path = writeTemp(text);
     try {
       lfd::loadRobotSetup(path);
@@ -83,32 +83,32 @@ TEST(RobotSetup, BadFilesAreClearErrors) {
     }
     std::remove(path.c_str());
   };
-  expectError("gripper: {joint: G}\n", "ik");
-  expectError("ik: {base_link: a}\n", "tip_link");
-  expectError("ik: {tip_link: t, joint_costs: {J: -1}}\n", "joint_costs.J");
-  expectError("ik: {tip_link: t, tolerance: {position: 0}}\n", "tolerance.position");
-  expectError("ik: {tip_link: t}\ngripper: {joint: G, open_opening: 0.0, close_opening: 0.05}\n",
-              "open_opening");
-  expectError("ik: [1, 2\n", "cannot be read");
-  expectError("ik: {tip_link: t}\ngripper: {close_effort: 5}\n", "gripper.joint");
-  expectError("ik: {tip_link: t}\ngripper: {joint: G, opening_scale: 0}\n",
-              "gripper.opening_scale");
-  expectError("ik: {tip_link: t}\ninitial_posture: {J: .nan}\n", "initial_posture.J");
-  expectError("ik: {tip_link: t}\ninitial_posture: [1]\n", "initial_posture must map");
+  expect_error("gripper: {joint: G}\n", "ik");
+  expect_error("ik: {base_link: a}\n", "tip_link");
+  expect_error("ik: {tip_link: t, joint_costs: {J: -1}}\n", "joint_costs.J");
+  expect_error("ik: {tip_link: t, tolerance: {position: 0}}\n", "tolerance.position");
+  expect_error("ik: {tip_link: t}\ngripper: {joint: G, open_opening: 0.0, close_opening: 0.05}\n",
+               "open_opening");
+  expect_error("ik: [1, 2\n", "cannot be read");
+  expect_error("ik: {tip_link: t}\ngripper: {close_effort: 5}\n", "gripper.joint");
+  expect_error("ik: {tip_link: t}\ngripper: {joint: G, opening_scale: 0}\n",
+               "gripper.opening_scale");
+  expect_error("ik: {tip_link: t}\ninitial_posture: {J: .nan}\n", "initial_posture.J");
+  expect_error("ik: {tip_link: t}\ninitial_posture: [1]\n", "initial_posture must map");
   const std::string ik = "ik: {tip_link: t}\n";
-  expectError(ik + "sensors: {a: 1}\n", "sensors must be a list");
-  expectError(ik + "sensors: [{topic: /f, type: T, fields: {force: s}}]\n", "sensors[0].frame");
-  expectError(ik + "sensors: [{topic: /f, type: T, frame: f, fields: {}}]\n", "sensors[0].fields");
-  expectError(ik + "sensors: [{topic: /f, type: T, frame: f, fields: {values: []}}]\n",
-              "sensors[0].fields.values");
-  expectError(ik + "sensors: [{topic: /f, type: T, frame: f, rate: 3, fields: {a: s}}]\n",
-              "unknown key 'rate'");
-  expectError(ik + "sensors: [{topic: /f, type: T, frame: f, fields: {a: s}},\n"
-                   "          {topic: /f, type: U, frame: g, fields: {b: t}}]\n",
-              "topic /f appears twice");
-  expectError(ik + "sensors: [{topic: /f, type: T, frame: f, fields: {a: s}},\n"
-                   "          {topic: /g, type: U, frame: g, fields: {b: [t, s]}}]\n",
-              "sensor 's' is read twice (/f and /g)");
+  expect_error(ik + "sensors: {a: 1}\n", "sensors must be a list");
+  expect_error(ik + "sensors: [{topic: /f, type: T, fields: {force: s}}]\n", "sensors[0].frame");
+  expect_error(ik + "sensors: [{topic: /f, type: T, frame: f, fields: {}}]\n", "sensors[0].fields");
+  expect_error(ik + "sensors: [{topic: /f, type: T, frame: f, fields: {values: []}}]\n",
+               "sensors[0].fields.values");
+  expect_error(ik + "sensors: [{topic: /f, type: T, frame: f, rate: 3, fields: {a: s}}]\n",
+               "unknown key 'rate'");
+  expect_error(ik + "sensors: [{topic: /f, type: T, frame: f, fields: {a: s}},\n"
+                    "          {topic: /f, type: U, frame: g, fields: {b: t}}]\n",
+               "topic /f appears twice");
+  expect_error(ik + "sensors: [{topic: /f, type: T, frame: f, fields: {a: s}},\n"
+                    "          {topic: /g, type: U, frame: g, fields: {b: [t, s]}}]\n",
+               "sensor 's' is read twice (/f and /g)");
   EXPECT_THROW(lfd::loadRobotSetup("/nonexistent/robot.yaml"), std::runtime_error);
 }
 

@@ -51,7 +51,7 @@ Eigen::VectorXd piecewise(const std::vector<Regime>& regimes, unsigned seed) {
   return x;
 }
 
-Eigen::VectorXd random_walk(std::size_t n, unsigned seed) {
+Eigen::VectorXd randomWalk(std::size_t n, unsigned seed) {
   std::mt19937 rng(seed);
   std::normal_distribution<double> gauss(0.0, 1.0);
   Eigen::VectorXd x(static_cast<Eigen::Index>(n));
@@ -60,7 +60,7 @@ Eigen::VectorXd random_walk(std::size_t n, unsigned seed) {
   return x;
 }
 
-void expect_same_knn(const lfd::KnnResult& fast, const lfd::KnnResult& ref, bool check_indices) {
+void expectSameKnn(const lfd::KnnResult& fast, const lfd::KnnResult& ref, bool check_indices) {
   ASSERT_EQ(fast.num_subsequences, ref.num_subsequences);
   ASSERT_EQ(fast.k, ref.k);
   for (std::size_t i = 0; i < fast.indices.size(); ++i) {
@@ -73,13 +73,13 @@ void expect_same_knn(const lfd::KnnResult& fast, const lfd::KnnResult& ref, bool
 
 TEST(ClaspKnn, MatchesBruteForceOnRandomWalks) {
   for (unsigned seed = 1; seed <= 4; ++seed) {
-    const Eigen::VectorXd x = random_walk(300 + 37 * seed, seed);
+    const Eigen::VectorXd x = randomWalk(300 + 37 * seed, seed);
     for (std::size_t w : {5, 16, 31}) {
       const std::size_t excl = w / 2;
       for (auto dist : {ClaspDistance::kZNormalizedEuclidean, ClaspDistance::kEuclidean}) {
-        const auto fast = lfd::self_join_knn(x, w, 3, excl, dist);
-        const auto ref = lfd::brute_force_knn(x, w, 3, excl, dist);
-        expect_same_knn(fast, ref, true);
+        const auto fast = lfd::selfJoinKnn(x, w, 3, excl, dist);
+        const auto ref = lfd::bruteForceKnn(x, w, 3, excl, dist);
+        expectSameKnn(fast, ref, true);
       }
     }
   }
@@ -87,9 +87,9 @@ TEST(ClaspKnn, MatchesBruteForceOnRandomWalks) {
 
 TEST(ClaspKnn, BruteForceAgreesWithDirectZNormDistance) {
   // Independent check of the similarity algebra: recompute the reported distance from scratch.
-  const Eigen::VectorXd x = random_walk(200, 9);
+  const Eigen::VectorXd x = randomWalk(200, 9);
   const std::size_t w = 12;
-  const auto knn = lfd::self_join_knn(x, w, 3, w / 2);
+  const auto knn = lfd::selfJoinKnn(x, w, 3, w / 2);
   const auto znorm = [&](std::size_t i) {
     Eigen::VectorXd s = x.segment(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(w));
     const double mu = s.mean();
@@ -108,12 +108,12 @@ TEST(ClaspKnn, FlatStretchesAndTies) {
   // are all identical and tie to the smallest index (claspy's rule).
   Eigen::VectorXd x = Eigen::VectorXd::Zero(400);
   x.tail(200).setConstant(1.0);
-  const auto euclid = lfd::self_join_knn(x, 10, 3, 5, ClaspDistance::kEuclidean);
+  const auto euclid = lfd::selfJoinKnn(x, 10, 3, 5, ClaspDistance::kEuclidean);
   for (std::size_t i = 0; i < 190; ++i)
     for (std::size_t r = 0; r < 3; ++r) EXPECT_LT(euclid.neighbour(i, r), 191) << i;
   for (std::size_t i = 200; i < euclid.num_subsequences; ++i)
     for (std::size_t r = 0; r < 3; ++r) EXPECT_GE(euclid.neighbour(i, r), 200) << i;
-  const auto znorm = lfd::self_join_knn(x, 10, 3, 5);
+  const auto znorm = lfd::selfJoinKnn(x, 10, 3, 5);
   EXPECT_EQ(znorm.neighbour(300, 0), 0);
   EXPECT_EQ(znorm.neighbour(300, 2), 2);
   EXPECT_EQ(znorm.neighbour(0, 0), 6);  // first index beyond the exclusion zone
@@ -121,15 +121,15 @@ TEST(ClaspKnn, FlatStretchesAndTies) {
 }
 
 TEST(ClaspKnn, RejectsBadInput) {
-  Eigen::VectorXd x = random_walk(50, 1);
-  EXPECT_THROW(lfd::self_join_knn(x, 1, 3, 0), std::invalid_argument);
-  EXPECT_THROW(lfd::self_join_knn(x, 60, 3, 0), std::invalid_argument);
+  Eigen::VectorXd x = randomWalk(50, 1);
+  EXPECT_THROW(lfd::selfJoinKnn(x, 1, 3, 0), std::invalid_argument);
+  EXPECT_THROW(lfd::selfJoinKnn(x, 60, 3, 0), std::invalid_argument);
   x[10] = std::nan("");
-  EXPECT_THROW(lfd::self_join_knn(x, 5, 3, 2), std::invalid_argument);
+  EXPECT_THROW(lfd::selfJoinKnn(x, 5, 3, 2), std::invalid_argument);
 }
 
 // Direct O(m k) per split reference for the incremental profile.
-double direct_score(const lfd::KnnResult& knn, std::size_t s, ClaspScore score) {
+double directScore(const lfd::KnnResult& knn, std::size_t s, ClaspScore score) {
   const std::size_t m = knn.num_subsequences, k = knn.k, w = knn.window;
   double tp = 0, tn = 0, fp = 0, fn = 0;
   for (std::size_t i = 0; i < m; ++i) {
@@ -150,44 +150,44 @@ double direct_score(const lfd::KnnResult& knn, std::size_t s, ClaspScore score) 
 TEST(ClaspProfile, IncrementalEqualsDirect) {
   const Eigen::VectorXd x =
       piecewise({{Shape::kSine, 20, 0.1, 250}, {Shape::kSquare, 35, 0.1, 250}}, 3);
-  const auto knn = lfd::self_join_knn(x, 15, 3, 7);
+  const auto knn = lfd::selfJoinKnn(x, 15, 3, 7);
   for (auto score : {ClaspScore::kRocAuc, ClaspScore::kMacroF1}) {
-    const Eigen::VectorXd p = lfd::classification_score_profile(knn, 40, score);
+    const Eigen::VectorXd p = lfd::classificationScoreProfile(knn, 40, score);
     ASSERT_EQ(p.size(), x.size());
     EXPECT_TRUE(std::isnan(p[39]));
     EXPECT_TRUE(std::isnan(p[x.size() - 39]));
     for (std::size_t s = 40; s <= static_cast<std::size_t>(x.size()) - 40; ++s)
-      EXPECT_NEAR(p[static_cast<Eigen::Index>(s)], direct_score(knn, s, score), 1e-12) << s;
+      EXPECT_NEAR(p[static_cast<Eigen::Index>(s)], directScore(knn, s, score), 1e-12) << s;
   }
 }
 
 TEST(ClaspWindow, SelectsWindowOnTheOrderOfThePeriod) {
   const Eigen::VectorXd x = piecewise({{Shape::kSine, 50, 0.05, 2000}}, 5);
-  const std::size_t fft = lfd::dominant_fourier_window_size(x, 10);
+  const std::size_t fft = lfd::dominantFourierWindowSize(x, 10);
   EXPECT_NEAR(static_cast<double>(fft), 50.0, 2.0);
-  const std::size_t acf = lfd::autocorrelation_window_size(x, 10);
+  const std::size_t acf = lfd::autocorrelationWindowSize(x, 10);
   EXPECT_NEAR(static_cast<double>(acf), 50.0, 2.0);
-  const std::size_t suss = lfd::suss_window_size(x, 10);
+  const std::size_t suss = lfd::sussWindowSize(x, 10);
   EXPECT_GE(suss, 10u);
   EXPECT_LE(suss, 100u);
-  EXPECT_EQ(lfd::select_window_size(x, lfd::WindowSelection::kDominantFourier, 10), fft / 2);
+  EXPECT_EQ(lfd::selectWindowSize(x, lfd::WindowSelection::kDominantFourier, 10), fft / 2);
 }
 
 struct PlantedCase {
   std::vector<Regime> regimes;
 };
 
-std::vector<std::size_t> truth_of(const std::vector<Regime>& regimes) {
+std::vector<std::size_t> truthOf(const std::vector<Regime>& regimes) {
   std::vector<std::size_t> cps;
   std::size_t t = 0;
   for (std::size_t i = 0; i + 1 < regimes.size(); ++i) cps.push_back(t += regimes[i].length);
   return cps;
 }
 
-void expect_planted(const std::vector<Regime>& regimes, unsigned seed) {
+void expectPlanted(const std::vector<Regime>& regimes, unsigned seed) {
   const Eigen::VectorXd x = piecewise(regimes, seed);
-  const auto seg = lfd::clasp_segment(x, ClaspConfig{});
-  const auto truth = truth_of(regimes);
+  const auto seg = lfd::claspSegment(x, ClaspConfig{});
+  const auto truth = truthOf(regimes);
   ASSERT_EQ(seg.changepoints.size(), truth.size()) << "window " << seg.window_size;
   for (std::size_t i = 0; i < truth.size(); ++i) {
     EXPECT_NEAR(static_cast<double>(seg.changepoints[i]), static_cast<double>(truth[i]),
@@ -198,21 +198,21 @@ void expect_planted(const std::vector<Regime>& regimes, unsigned seed) {
 }
 
 TEST(ClaspSegment, FindsOnePlantedChangepoint) {
-  expect_planted({{Shape::kSine, 30, 0.1, 1200}, {Shape::kSine, 60, 0.1, 800}}, 11);
+  expectPlanted({{Shape::kSine, 30, 0.1, 1200}, {Shape::kSine, 60, 0.1, 800}}, 11);
 }
 
 TEST(ClaspSegment, FindsTwoPlantedChangepoints) {
-  expect_planted(
+  expectPlanted(
       {{Shape::kSine, 40, 0.1, 900}, {Shape::kSquare, 40, 0.1, 700}, {Shape::kSaw, 25, 0.1, 900}},
       12);
 }
 
 TEST(ClaspSegment, FindsThreePlantedChangepoints) {
-  expect_planted({{Shape::kSine, 40, 0.05, 800},
-                  {Shape::kSquare, 60, 0.05, 800},
-                  {Shape::kSine, 20, 0.05, 800},
-                  {Shape::kSaw, 30, 0.05, 800}},
-                 13);
+  expectPlanted({{Shape::kSine, 40, 0.05, 800},
+                 {Shape::kSquare, 60, 0.05, 800},
+                 {Shape::kSine, 20, 0.05, 800},
+                 {Shape::kSaw, 30, 0.05, 800}},
+                13);
 }
 
 // A change of noise level alone is found, but k-NN cannot place it sharply (noisy windows find
@@ -220,7 +220,7 @@ TEST(ClaspSegment, FindsThreePlantedChangepoints) {
 TEST(ClaspSegment, FindsANoiseLevelChange) {
   const std::vector<Regime> regimes = {{Shape::kSine, 20, 0.05, 1200},
                                        {Shape::kSine, 20, 0.6, 1200}};
-  const auto seg = lfd::clasp_segment(piecewise(regimes, 13), ClaspConfig{});
+  const auto seg = lfd::claspSegment(piecewise(regimes, 13), ClaspConfig{});
   ASSERT_EQ(seg.changepoints.size(), 1u);
   EXPECT_NEAR(static_cast<double>(seg.changepoints[0]), 1200.0, 10.0 * seg.window_size);
 }
@@ -228,24 +228,24 @@ TEST(ClaspSegment, FindsANoiseLevelChange) {
 TEST(ClaspSegment, StationarySeriesHasNoChangepoint) {
   for (unsigned seed : {21u, 22u, 23u}) {
     const Eigen::VectorXd x = piecewise({{Shape::kSine, 40, 0.2, 3000}}, seed);
-    const auto seg = lfd::clasp_segment(x, ClaspConfig{});
+    const auto seg = lfd::claspSegment(x, ClaspConfig{});
     EXPECT_TRUE(seg.changepoints.empty()) << "seed " << seed << " cp " << seg.changepoints.front();
   }
   std::mt19937 rng(5);
   std::normal_distribution<double> gauss(0.0, 1.0);
   Eigen::VectorXd noise(3000);
   for (Eigen::Index i = 0; i < noise.size(); ++i) noise[i] = gauss(rng);
-  EXPECT_TRUE(lfd::clasp_segment(noise, ClaspConfig{}).changepoints.empty());
+  EXPECT_TRUE(lfd::claspSegment(noise, ClaspConfig{}).changepoints.empty());
 }
 
 TEST(ClaspSegment, FixedCountReturnsThatManyChangepoints) {
   const Eigen::VectorXd x =
       piecewise({{Shape::kSine, 30, 0.1, 1000}, {Shape::kSquare, 60, 0.1, 1000}}, 4);
-  const auto seg = lfd::clasp_segment(x, ClaspConfig{}, 1);
+  const auto seg = lfd::claspSegment(x, ClaspConfig{}, 1);
   ASSERT_EQ(seg.changepoints.size(), 1u);
   EXPECT_NEAR(static_cast<double>(seg.changepoints[0]), 1000.0,
               static_cast<double>(seg.window_size));
-  EXPECT_TRUE(lfd::clasp_segment(x, ClaspConfig{}, 0).changepoints.empty());
+  EXPECT_TRUE(lfd::claspSegment(x, ClaspConfig{}, 0).changepoints.empty());
 }
 
 // A perfectly separable change scores (almost) 1 wherever it lies: the straddling subsequences
@@ -257,7 +257,7 @@ TEST(ClaspProfile, CleanChangeIsNotPulledTowardsEitherEnd) {
         piecewise({{Shape::kSine, 25, 0.02, first}, {Shape::kSquare, 50, 0.02, 2000 - first}}, 31);
     ClaspConfig config;
     config.window_size = 25;
-    const lfd::ClaspProfile p = lfd::compute_clasp_profile(x, config);
+    const lfd::ClaspProfile p = lfd::computeClaspProfile(x, config);
     Eigen::Index best = -1;
     for (Eigen::Index i = 0; i < p.profile.size(); ++i)
       if (!std::isnan(p.profile[i]) && (best < 0 || p.profile[i] > p.profile[best])) best = i;
@@ -277,32 +277,31 @@ TEST(ClaspProfile, TieJitterPutsThePeakOnTheStepOfAHeldSignal) {
   config.window_size = 20;
   config.distance = ClaspDistance::kEuclidean;
   config.tie_jitter = 0.01;
-  const lfd::ClaspProfile p = lfd::compute_clasp_profile(x, config);
+  const lfd::ClaspProfile p = lfd::computeClaspProfile(x, config);
   Eigen::Index best = -1;
   for (Eigen::Index i = 0; i < n; ++i)
     if (!std::isnan(p.profile[i]) && (best < 0 || p.profile[i] > p.profile[best])) best = i;
   EXPECT_NEAR(static_cast<double>(best), static_cast<double>(step), 20.0);
   EXPECT_LT(p.profile[700], p.profile[best] - 0.05);  // deep inside the held stretch
   config.tie_jitter = -1.0;
-  EXPECT_THROW(lfd::compute_clasp_profile(x, config), std::invalid_argument);
+  EXPECT_THROW(lfd::computeClaspProfile(x, config), std::invalid_argument);
 }
 
 TEST(ClaspSignificance, SeparatesRealFromRandomSplit) {
   const Eigen::VectorXd x =
       piecewise({{Shape::kSine, 30, 0.1, 1000}, {Shape::kSquare, 60, 0.1, 1000}}, 6);
-  const auto knn = lfd::self_join_knn(x, 20, 3, 10);
-  EXPECT_LT(lfd::split_log10_p_value(knn, 1000), -50.0);
-  EXPECT_GT(lfd::split_log10_p_value(knn, 500), lfd::split_log10_p_value(knn, 1000));
-  EXPECT_EQ(lfd::split_log10_p_value(knn, 0), 0.0);
+  const auto knn = lfd::selfJoinKnn(x, 20, 3, 10);
+  EXPECT_LT(lfd::splitLog10PValue(knn, 1000), -50.0);
+  EXPECT_GT(lfd::splitLog10PValue(knn, 500), lfd::splitLog10PValue(knn, 1000));
+  EXPECT_EQ(lfd::splitLog10PValue(knn, 0), 0.0);
 }
 
 TEST(ClaspConfigParsing, RoundTrips) {
-  for (auto s : {"suss", "fft", "acf"})
-    EXPECT_EQ(lfd::to_string(lfd::parse_window_selection(s)), s);
-  for (auto s : {"roc_auc", "f1"}) EXPECT_EQ(lfd::to_string(lfd::parse_clasp_score(s)), s);
+  for (auto s : {"suss", "fft", "acf"}) EXPECT_EQ(lfd::toString(lfd::parseWindowSelection(s)), s);
+  for (auto s : {"roc_auc", "f1"}) EXPECT_EQ(lfd::toString(lfd::parseClaspScore(s)), s);
   for (auto s : {"euclidean", "znorm_euclidean"})
-    EXPECT_EQ(lfd::to_string(lfd::parse_clasp_distance(s)), s);
-  EXPECT_THROW(lfd::parse_clasp_score("accuracy"), std::invalid_argument);
+    EXPECT_EQ(lfd::toString(lfd::parseClaspDistance(s)), s);
+  EXPECT_THROW(lfd::parseClaspScore("accuracy"), std::invalid_argument);
 }
 
 }  // namespace

@@ -22,7 +22,7 @@ Eigen::MatrixXd sampled(int rows) {
   return m;
 }
 
-// ---- on_uniform_grid
+// ---- onUniformGrid
 
 TEST(OnUniformGrid, InterpolatesLinearlyBetweenSamples) {
   const std::vector<double> time = {0.0, 0.5, 1.0, 2.0, 2.35};
@@ -32,7 +32,7 @@ TEST(OnUniformGrid, InterpolatesLinearlyBetweenSamples) {
       0.0, 20.0,          //
       4.0, 20.0,          //
       5.0, 30.0;
-  const Eigen::MatrixXd grid = lfd::on_uniform_grid(features, time, 0.3);
+  const Eigen::MatrixXd grid = lfd::onUniformGrid(features, time, 0.3);
   ASSERT_EQ(grid.rows(), 8);  // floor(2.35 / 0.3) + 1
   ASSERT_EQ(grid.cols(), 2);
   const std::vector<double> first = {0.0, 0.6, 0.8, 0.2, 0.8, 2.0, 3.2, 4.0 + 0.1 / 0.35};
@@ -47,7 +47,7 @@ TEST(OnUniformGrid, StartsAtTheFirstTimestamp) {
   const std::vector<double> time = {10.0, 10.4, 11.0};
   Eigen::MatrixXd features(3, 1);
   features << 1.0, 2.0, 3.0;
-  const Eigen::MatrixXd grid = lfd::on_uniform_grid(features, time, 0.5);
+  const Eigen::MatrixXd grid = lfd::onUniformGrid(features, time, 0.5);
   ASSERT_EQ(grid.rows(), 3);
   EXPECT_NEAR(grid(0, 0), 1.0, 1e-12);
   EXPECT_NEAR(grid(1, 0), 2.0 + 0.1 / 0.6, 1e-9);
@@ -57,17 +57,17 @@ TEST(OnUniformGrid, StartsAtTheFirstTimestamp) {
 TEST(OnUniformGrid, ThrowsOnABadStepOrAMissingTimestamp) {
   const std::vector<double> time = {0.0, 1.0, 2.0};
   const Eigen::MatrixXd features = Eigen::MatrixXd::Ones(3, 1);
-  EXPECT_THROW(lfd::on_uniform_grid(features, time, 0.0), std::invalid_argument);
-  EXPECT_THROW(lfd::on_uniform_grid(features, time, -0.1), std::invalid_argument);
-  EXPECT_THROW(lfd::on_uniform_grid(features, {0.0, 1.0}, 0.1), std::invalid_argument);
+  EXPECT_THROW(lfd::onUniformGrid(features, time, 0.0), std::invalid_argument);
+  EXPECT_THROW(lfd::onUniformGrid(features, time, -0.1), std::invalid_argument);
+  EXPECT_THROW(lfd::onUniformGrid(features, {0.0, 1.0}, 0.1), std::invalid_argument);
 }
 
-// ---- multivariate_dtw_map
+// ---- multivariateDtwMap
 
 TEST(MultivariateDtwMap, MapsEachRowNearItsStretchedPosition) {
   const Eigen::MatrixXd a = sampled(60);
   const Eigen::MatrixXd b = sampled(90);  // the same motion, 1.5 times slower
-  const std::vector<double> map = lfd::multivariate_dtw_map(a, b);
+  const std::vector<double> map = lfd::multivariateDtwMap(a, b);
   ASSERT_EQ(map.size(), 60u);
   for (std::size_t i = 0; i < map.size(); ++i)
     EXPECT_NEAR(map[i], static_cast<double>(i) * 89.0 / 59.0, 2.0) << "row " << i;
@@ -77,18 +77,18 @@ TEST(MultivariateDtwMap, MapsEachRowNearItsStretchedPosition) {
 
 TEST(MultivariateDtwMap, MapsIdenticalSeriesOnTheDiagonal) {
   const Eigen::MatrixXd a = sampled(40);
-  const std::vector<double> map = lfd::multivariate_dtw_map(a, a);
+  const std::vector<double> map = lfd::multivariateDtwMap(a, a);
   ASSERT_EQ(map.size(), 40u);
   for (std::size_t i = 0; i < map.size(); ++i) EXPECT_DOUBLE_EQ(map[i], static_cast<double>(i));
-  EXPECT_NEAR(lfd::multivariate_dtw_cost(a, a), 0.0, 1e-12);
+  EXPECT_NEAR(lfd::multivariateDtwCost(a, a), 0.0, 1e-12);
 }
 
 TEST(MultivariateDtwMap, ThrowsOnDifferentFeatureCounts) {
-  EXPECT_THROW(lfd::multivariate_dtw_map(sampled(10), Eigen::MatrixXd::Zero(10, 3)),
+  EXPECT_THROW(lfd::multivariateDtwMap(sampled(10), Eigen::MatrixXd::Zero(10, 3)),
                std::invalid_argument);
 }
 
-// ---- anchored_dtw_map
+// ---- anchoredDtwMap
 
 bool monotone(const std::vector<double>& map) {
   for (std::size_t i = 1; i < map.size(); ++i)
@@ -100,7 +100,7 @@ TEST(AnchoredDtwMap, HoldsTheAnchorsExactlyAndIsMonotone) {
   const Eigen::MatrixXd a = sampled(60);
   const Eigen::MatrixXd b = sampled(90);
   // Free DTW puts row 20 near 30 and row 40 near 60; the anchors say 38 and 70.
-  const std::vector<double> map = lfd::anchored_dtw_map(a, b, {20, 40}, {38, 70});
+  const std::vector<double> map = lfd::anchoredDtwMap(a, b, {20, 40}, {38, 70});
   ASSERT_EQ(map.size(), 60u);
   EXPECT_TRUE(monotone(map));
   EXPECT_DOUBLE_EQ(map[20], 38.0);
@@ -114,25 +114,23 @@ TEST(AnchoredDtwMap, HoldsTheAnchorsExactlyAndIsMonotone) {
 
 TEST(AnchoredDtwMap, WithoutAnchorsEqualsTheFreeMap) {
   const Eigen::MatrixXd a = sampled(50), b = sampled(70);
-  EXPECT_EQ(lfd::anchored_dtw_map(a, b, {}, {}), lfd::multivariate_dtw_map(a, b));
+  EXPECT_EQ(lfd::anchoredDtwMap(a, b, {}, {}), lfd::multivariateDtwMap(a, b));
 }
 
 TEST(AnchoredDtwMap, SkipsAnchorsOutOfOrderOrOutside) {
   const Eigen::MatrixXd a = sampled(60), b = sampled(90);
-  const std::vector<double> one = lfd::anchored_dtw_map(a, b, {20}, {38});
+  const std::vector<double> one = lfd::anchoredDtwMap(a, b, {20}, {38});
   // (10, 50) goes back in a; (30, 20) goes back in b; (70, 80) lies outside a.
-  const std::vector<double> skipped =
-      lfd::anchored_dtw_map(a, b, {20, 10, 30, 70}, {38, 50, 20, 80});
+  const std::vector<double> skipped = lfd::anchoredDtwMap(a, b, {20, 10, 30, 70}, {38, 50, 20, 80});
   EXPECT_EQ(skipped, one);
   EXPECT_TRUE(monotone(skipped));
 }
 
 TEST(AnchoredDtwMap, ThrowsWhenTheAnchorListsDifferInLength) {
-  EXPECT_THROW(lfd::anchored_dtw_map(sampled(20), sampled(30), {5, 10}, {7}),
-               std::invalid_argument);
+  EXPECT_THROW(lfd::anchoredDtwMap(sampled(20), sampled(30), {5, 10}, {7}), std::invalid_argument);
 }
 
-// ---- align_to_medoid
+// ---- alignToMedoid
 
 TEST(AlignToMedoid, TheOutlierIsNotTheMedoid) {
   Eigen::MatrixXd outlier(60, 2);
@@ -142,7 +140,7 @@ TEST(AlignToMedoid, TheOutlierIsNotTheMedoid) {
   }
   // The outlier first: taking the first demo would pick it.
   const std::vector<Eigen::MatrixXd> demos = {outlier, sampled(50), sampled(60), sampled(75)};
-  const lfd::DemoAlignment alignment = lfd::align_to_medoid(demos, 1);
+  const lfd::DemoAlignment alignment = lfd::alignToMedoid(demos, 1);
   EXPECT_NE(alignment.reference, 0u);
   ASSERT_EQ(alignment.to_reference.size(), demos.size());
   ASSERT_EQ(alignment.from_reference.size(), demos.size());
@@ -161,23 +159,22 @@ TEST(AlignToMedoid, TheOutlierIsNotTheMedoid) {
 }
 
 TEST(AlignToMedoid, ThrowsOnNoDemoOrDifferentFeatureCounts) {
-  EXPECT_THROW(lfd::align_to_medoid({}, 1), std::invalid_argument);
-  EXPECT_THROW(lfd::align_to_medoid({sampled(10), Eigen::MatrixXd::Zero(10, 3)}, 1),
+  EXPECT_THROW(lfd::alignToMedoid({}, 1), std::invalid_argument);
+  EXPECT_THROW(lfd::alignToMedoid({sampled(10), Eigen::MatrixXd::Zero(10, 3)}, 1),
                std::invalid_argument);
-  EXPECT_THROW(lfd::align_to_medoid({sampled(10), Eigen::MatrixXd(0, 2)}, 1),
-               std::invalid_argument);
+  EXPECT_THROW(lfd::alignToMedoid({sampled(10), Eigen::MatrixXd(0, 2)}, 1), std::invalid_argument);
 }
 
-// ---- map_row
+// ---- mapRow
 
 TEST(MapRow, InterpolatesBetweenRowsAndClampsAtTheEnds) {
   const std::vector<double> map = {0.0, 2.0, 6.0};
-  EXPECT_DOUBLE_EQ(lfd::map_row(map, 0.5), 1.0);
-  EXPECT_DOUBLE_EQ(lfd::map_row(map, 1.25), 3.0);
-  EXPECT_DOUBLE_EQ(lfd::map_row(map, 1.0), 2.0);
-  EXPECT_DOUBLE_EQ(lfd::map_row(map, -1.0), 0.0);
-  EXPECT_DOUBLE_EQ(lfd::map_row(map, 2.0), 6.0);
-  EXPECT_DOUBLE_EQ(lfd::map_row(map, 7.5), 6.0);
+  EXPECT_DOUBLE_EQ(lfd::mapRow(map, 0.5), 1.0);
+  EXPECT_DOUBLE_EQ(lfd::mapRow(map, 1.25), 3.0);
+  EXPECT_DOUBLE_EQ(lfd::mapRow(map, 1.0), 2.0);
+  EXPECT_DOUBLE_EQ(lfd::mapRow(map, -1.0), 0.0);
+  EXPECT_DOUBLE_EQ(lfd::mapRow(map, 2.0), 6.0);
+  EXPECT_DOUBLE_EQ(lfd::mapRow(map, 7.5), 6.0);
 }
 
 }  // namespace

@@ -10,7 +10,7 @@ namespace {
 // Nine synthetic grasp-like demonstrations at different speeds. "gripper" (open -> closed at 40 %
 // of the task) and "speed" (one bump per phase) have the same shape in every demo; the others are
 // noise, a random walk, a ramp whose direction depends on the demo, and a constant.
-std::vector<lfd::FeatureMatrix> make_demos(unsigned seed, int count = 9) {
+std::vector<lfd::FeatureMatrix> makeDemos(unsigned seed, int count = 9) {
   std::mt19937 rng(seed);
   std::normal_distribution<double> noise(0.0, 1.0);
   std::uniform_real_distribution<double> uniform(-1.0, 1.0);
@@ -42,7 +42,7 @@ std::vector<lfd::FeatureMatrix> make_demos(unsigned seed, int count = 9) {
 
 TEST(FeatureRelevance, PlantedConsistentFeaturesWinAndNoiseIsNotSelected) {
   for (unsigned seed : {1u, 2u, 3u}) {
-    const auto result = lfd::compute_feature_relevance(make_demos(seed));
+    const auto result = lfd::computeFeatureRelevance(makeDemos(seed));
     ASSERT_FALSE(result.selected.empty());
     const std::string best = result.selected.front();
     EXPECT_TRUE(best == "gripper" || best == "speed") << "seed " << seed << " best " << best;
@@ -66,8 +66,8 @@ TEST(FeatureRelevance, PlantedConsistentFeaturesWinAndNoiseIsNotSelected) {
 }
 
 TEST(FeatureRelevance, MatricesAreSymmetricWithUnitDiagonalAndScoresFollowTheFormula) {
-  const auto demos = make_demos(5, 4);
-  const auto result = lfd::compute_feature_relevance(demos);
+  const auto demos = makeDemos(5, 4);
+  const auto result = lfd::computeFeatureRelevance(demos);
   ASSERT_EQ(result.features.size(), demos[0].names.size());
   double dmin = INFINITY, dmax = -INFINITY;
   for (const auto& f : result.features) {
@@ -91,7 +91,7 @@ TEST(FeatureRelevance, MatricesAreSymmetricWithUnitDiagonalAndScoresFollowTheFor
 }
 
 TEST(FeatureRelevance, ConstantFeatureIsFlaggedWithoutNaN) {
-  const auto result = lfd::compute_feature_relevance(make_demos(4, 3));
+  const auto result = lfd::computeFeatureRelevance(makeDemos(4, 3));
   const auto& c = result.feature("constant");
   EXPECT_TRUE(c.constant);
   EXPECT_EQ(c.score, 0.0);
@@ -102,7 +102,7 @@ TEST(FeatureRelevance, ConstantFeatureIsFlaggedWithoutNaN) {
 }
 
 TEST(FeatureRelevance, CorrelationOnlyVariantIsKeptSeparately) {
-  const auto result = lfd::compute_feature_relevance(make_demos(6));
+  const auto result = lfd::computeFeatureRelevance(makeDemos(6));
   ASSERT_FALSE(result.selected_correlation_only.empty());
   for (const auto& f : result.features) {
     EXPECT_EQ(
@@ -113,36 +113,35 @@ TEST(FeatureRelevance, CorrelationOnlyVariantIsKeptSeparately) {
 }
 
 TEST(FeatureRelevance, BadInputGivesClearErrors) {
-  auto demos = make_demos(7, 3);
-  EXPECT_THROW(lfd::compute_feature_relevance({demos[0]}), std::invalid_argument);
-  EXPECT_THROW(lfd::compute_feature_relevance({}), std::invalid_argument);
-  EXPECT_THROW(lfd::compute_feature_relevance(demos, {"missing"}), std::invalid_argument);
+  auto demos = makeDemos(7, 3);
+  EXPECT_THROW(lfd::computeFeatureRelevance({demos[0]}), std::invalid_argument);
+  EXPECT_THROW(lfd::computeFeatureRelevance({}), std::invalid_argument);
+  EXPECT_THROW(lfd::computeFeatureRelevance(demos, {"missing"}), std::invalid_argument);
   auto nan_demos = demos;
   nan_demos[1].data(10, 1) = std::nan("");
   try {
-    lfd::compute_feature_relevance(nan_demos);
+    lfd::computeFeatureRelevance(nan_demos);
     FAIL() << "NaN accepted";
   } catch (const std::invalid_argument& e) {
     EXPECT_NE(std::string(e.what()).find("gripper"), std::string::npos) << e.what();
   }
   lfd::FeatureRelevanceConfig bad_threshold;
   bad_threshold.threshold = 1.5;
-  EXPECT_THROW(lfd::compute_feature_relevance(demos, {}, bad_threshold), std::invalid_argument);
+  EXPECT_THROW(lfd::computeFeatureRelevance(demos, {}, bad_threshold), std::invalid_argument);
 }
 
 TEST(FeatureRelevance, SelectionThresholdKeepsFeaturesNearTheBest) {
   const std::vector<double> scores{0.5, 0.95, 1.0, 0.89, 0.91};
-  const auto picked = lfd::select_by_threshold(scores, {}, 0.9);
+  const auto picked = lfd::selectByThreshold(scores, {}, 0.9);
   EXPECT_EQ(picked, (std::vector<std::size_t>{2, 1, 4}));
-  EXPECT_EQ(lfd::select_by_threshold({-0.2, -0.1}, {}, 0.9), (std::vector<std::size_t>{1}));
-  EXPECT_EQ(lfd::select_by_threshold({1.0, 0.95}, {true, false}, 0.9),
-            (std::vector<std::size_t>{1}));
+  EXPECT_EQ(lfd::selectByThreshold({-0.2, -0.1}, {}, 0.9), (std::vector<std::size_t>{1}));
+  EXPECT_EQ(lfd::selectByThreshold({1.0, 0.95}, {true, false}, 0.9), (std::vector<std::size_t>{1}));
 }
 
 TEST(FeatureRelevance, PearsonOfConstantIsZero) {
-  EXPECT_EQ(lfd::pearson_correlation({1, 1, 1}, {1, 2, 3}), 0.0);
-  EXPECT_NEAR(lfd::pearson_correlation({1, 2, 3}, {2, 4, 6}), 1.0, 1e-12);
-  EXPECT_NEAR(lfd::pearson_correlation({1, 2, 3}, {3, 2, 1}), -1.0, 1e-12);
+  EXPECT_EQ(lfd::pearsonCorrelation({1, 1, 1}, {1, 2, 3}), 0.0);
+  EXPECT_NEAR(lfd::pearsonCorrelation({1, 2, 3}, {2, 4, 6}), 1.0, 1e-12);
+  EXPECT_NEAR(lfd::pearsonCorrelation({1, 2, 3}, {3, 2, 1}), -1.0, 1e-12);
 }
 
 }  // namespace

@@ -1,4 +1,4 @@
-// The joint segmentation (joint_segmentation.hpp) through run_segmentation_pipeline with the
+// The joint segmentation (joint_segmentation.hpp) through runSegmentationPipeline with the
 // procedure kJoint, on small synthetic demos at 50 Hz whose phase durations are drawn from a fixed
 // seed: a reach -> press -> retract task with a touch sensor, and pose-only tasks of moves and
 // pauses.
@@ -16,14 +16,14 @@ namespace {
 
 constexpr double kRate = 50.0;
 
-double min_jerk(double tau) {
+double minJerk(double tau) {
   tau = std::clamp(tau, 0.0, 1.0);
   return tau * tau * tau * (10.0 - 15.0 * tau + 6.0 * tau * tau);
 }
 
 // Seconds, the shipped event settings (config/segmentation.yaml: fitted placement, so that a
 // sensor leaving or regaining rest is a rest edge, i.e. contact evidence), the joint procedure.
-lfd::SegmentationPipelineConfig joint_config() {
+lfd::SegmentationPipelineConfig jointConfig() {
   lfd::SegmentationPipelineConfig config;
   config.seconds = lfd::TimeParameters{};
   config.procedure = lfd::SegmentationProcedure::kJoint;
@@ -49,8 +49,8 @@ struct Demo {
 
 // Samples the legs at 50 Hz with pose noise; `touch` (if not null) gives the sensor at time t.
 template <typename Touch>
-lfd::FeatureMatrix sample_legs(const Eigen::Vector3d& start, const std::vector<Leg>& legs,
-                               std::mt19937* rng, const Touch& touch, bool with_touch) {
+lfd::FeatureMatrix sampleLegs(const Eigen::Vector3d& start, const std::vector<Leg>& legs,
+                              std::mt19937* rng, const Touch& touch, bool with_touch) {
   std::normal_distribution<double> noise(0.0, 1.0);
   double total = 0.0;
   for (const Leg& l : legs) total += l.seconds;
@@ -65,7 +65,7 @@ lfd::FeatureMatrix sample_legs(const Eigen::Vector3d& start, const std::vector<L
     Eigen::Vector3d p = start, from = start;
     double t0 = 0.0;
     for (const Leg& l : legs) {
-      if (t >= t0) p = from + (l.to - from) * min_jerk((t - t0) / l.seconds);
+      if (t >= t0) p = from + (l.to - from) * minJerk((t - t0) / l.seconds);
       from = l.to;
       t0 += l.seconds;
     }
@@ -79,7 +79,7 @@ lfd::FeatureMatrix sample_legs(const Eigen::Vector3d& start, const std::vector<L
 // touch sensor rises to ~5 with noise), retract (the hand leaves: release). Truth: the contact
 // onset and the release. With `slide` (m) the hand does not hold still while in contact but
 // slides that far along y (a wipe), from the instant of contact to the release.
-std::vector<Demo> reach_press_retract(int count, unsigned seed, double slide = 0.0) {
+std::vector<Demo> reachPressRetract(int count, unsigned seed, double slide = 0.0) {
   std::mt19937 rng(seed);
   std::uniform_real_distribution<double> unit(0.0, 1.0);
   std::vector<Demo> demos;
@@ -99,7 +99,7 @@ std::vector<Demo> reach_press_retract(int count, unsigned seed, double slide = 0
     };
     Demo demo;
     const Eigen::Vector3d slid = button + Eigen::Vector3d(0.0, slide, 0.0);
-    demo.matrix = sample_legs(
+    demo.matrix = sampleLegs(
         home, {{rest, home}, {reach, button}, {press, slid}, {retract, home}, {last, home}}, &rng,
         touch, true);
     demo.truth = {onset, release};
@@ -111,7 +111,7 @@ std::vector<Demo> reach_press_retract(int count, unsigned seed, double slide = 0
 // Pose only: move -> 2 s pause -> move -> 2 s pause -> move, each move hesitating 0.3 s halfway.
 // Truth: where motion resumes after each long pause. `lacking` (>= 0) names a demo without the
 // middle move (and its pause): move -> 2 s pause -> move home.
-std::vector<Demo> moves_and_pauses(int count, unsigned seed, int lacking = -1) {
+std::vector<Demo> movesAndPauses(int count, unsigned seed, int lacking = -1) {
   std::mt19937 rng(seed);
   std::uniform_real_distribution<double> unit(0.0, 1.0);
   std::vector<Demo> demos;
@@ -148,7 +148,7 @@ std::vector<Demo> moves_and_pauses(int count, unsigned seed, int lacking = -1) {
     }
     legs.push_back({last, home});
     Demo demo;
-    demo.matrix = sample_legs(
+    demo.matrix = sampleLegs(
         home, legs, &rng, [](double, double) { return 0.0; }, false);
     demo.truth = truth;
     demos.push_back(std::move(demo));
@@ -168,15 +168,15 @@ std::string listed(const std::vector<double>& v) {
   return "[" + out + "]";
 }
 
-std::string all_warnings(const lfd::SegmentationPipelineResult& r) {
+std::string allWarnings(const lfd::SegmentationPipelineResult& r) {
   std::string out;
   for (const std::string& w : r.warnings) out += "\n  " + w;
   return out;
 }
 
 // The warnings naming demonstration d that contain `needle`.
-std::size_t warnings_about(const lfd::SegmentationPipelineResult& r, std::size_t d,
-                           const std::string& needle) {
+std::size_t warningsAbout(const lfd::SegmentationPipelineResult& r, std::size_t d,
+                          const std::string& needle) {
   const std::string name = "demonstration " + std::to_string(d) + ":";
   return static_cast<std::size_t>(
       std::count_if(r.warnings.begin(), r.warnings.end(), [&](const std::string& w) {
@@ -185,12 +185,12 @@ std::size_t warnings_about(const lfd::SegmentationPipelineResult& r, std::size_t
 }
 
 // Each changepoint time of demo d within `tolerance` of its true boundary, as many as the truth.
-void expect_boundaries(const lfd::SegmentationPipelineResult& result, const Demo& demo,
-                       std::size_t d, double tolerance) {
+void expectBoundaries(const lfd::SegmentationPipelineResult& result, const Demo& demo,
+                      std::size_t d, double tolerance) {
   const auto& r = result.demos[d];
   ASSERT_EQ(r.changepoint_times.size(), demo.truth.size())
       << "demo " << d << ": got " << listed(r.changepoint_times) << ", truth " << listed(demo.truth)
-      << all_warnings(result);
+      << allWarnings(result);
   for (std::size_t k = 0; k < demo.truth.size(); ++k)
     EXPECT_NEAR(r.changepoint_times[k], demo.truth[k], tolerance)
         << "demo " << d << " boundary " << k << ": got " << listed(r.changepoint_times)
@@ -198,28 +198,27 @@ void expect_boundaries(const lfd::SegmentationPipelineResult& result, const Demo
 }
 
 TEST(JointSegmentation, FindsTheContactOnsetAndReleaseOfEveryDemo) {
-  const auto demos = reach_press_retract(6, 11);
-  const auto result = lfd::run_segmentation_pipeline(matrices(demos), {"touch"}, joint_config());
+  const auto demos = reachPressRetract(6, 11);
+  const auto result = lfd::runSegmentationPipeline(matrices(demos), {"touch"}, jointConfig());
   ASSERT_EQ(result.demos.size(), demos.size());
   for (std::size_t d = 0; d < demos.size(); ++d) {
-    expect_boundaries(result, demos[d], d, 0.2);
+    expectBoundaries(result, demos[d], d, 0.2);
     EXPECT_EQ(result.demos[d].changepoint_evidence.size(), result.demos[d].changepoints.size());
-    EXPECT_EQ(warnings_about(result, d, "lack"), 0u) << all_warnings(result);
+    EXPECT_EQ(warningsAbout(result, d, "lack"), 0u) << allWarnings(result);
   }
 }
 
 // Kills demo `dead`'s touch sensor and segments: every other demo finds its boundaries, and the
 // dead one places each boundary on its own motion near the truth or reports it as lacking.
-lfd::SegmentationPipelineResult segment_with_a_dead_sensor(std::vector<Demo> demos,
-                                                           std::size_t dead) {
+lfd::SegmentationPipelineResult segmentWithADeadSensor(std::vector<Demo> demos, std::size_t dead) {
   demos[dead].matrix.data.col(3).setConstant(0.0);
-  const auto result = lfd::run_segmentation_pipeline(matrices(demos), {"touch"}, joint_config());
+  const auto result = lfd::runSegmentationPipeline(matrices(demos), {"touch"}, jointConfig());
   for (std::size_t d = 0; d < demos.size(); ++d)
-    if (d != dead) expect_boundaries(result, demos[d], d, 0.2);
+    if (d != dead) expectBoundaries(result, demos[d], d, 0.2);
   const auto& r = result.demos[dead];
-  EXPECT_EQ(r.changepoints.size() + warnings_about(result, dead, "lack"), 2u)
+  EXPECT_EQ(r.changepoints.size() + warningsAbout(result, dead, "lack"), 2u)
       << "each of the 2 boundaries is placed or reported: got " << listed(r.changepoint_times)
-      << all_warnings(result);
+      << allWarnings(result);
   for (double t : r.changepoint_times) {
     const auto& truth = demos[dead].truth;
     const double off = std::min(std::abs(t - truth[0]), std::abs(t - truth[1]));
@@ -232,17 +231,17 @@ lfd::SegmentationPipelineResult segment_with_a_dead_sensor(std::vector<Demo> dem
 // and ClaSP evidence, and that a boundary it shows no evidence of is reported as lacking, never
 // forced. So every agreed boundary is either placed near the truth or named in a warning.
 TEST(JointSegmentation, ADemoWithADeadSensorIsSegmentedFromItsMotionOrWarned) {
-  const auto result = segment_with_a_dead_sensor(reach_press_retract(6, 11), 2);
-  EXPECT_EQ(warnings_about(result, 2, "sensor 'touch' is constant"), 1u) << all_warnings(result);
+  const auto result = segmentWithADeadSensor(reachPressRetract(6, 11), 2);
+  EXPECT_EQ(warningsAbout(result, 2, "sensor 'touch' is constant"), 1u) << allWarnings(result);
 }
 
 // The same task with the hand sliding 25 cm along the surface while in contact (a wipe): the
 // contact is no pause of the hand, so nothing folds the onset into the release.
 TEST(JointSegmentation, FindsTheContactOnsetAndReleaseOfAWipe) {
-  const auto demos = reach_press_retract(6, 11, 0.25);
-  const auto result = lfd::run_segmentation_pipeline(matrices(demos), {"touch"}, joint_config());
+  const auto demos = reachPressRetract(6, 11, 0.25);
+  const auto result = lfd::runSegmentationPipeline(matrices(demos), {"touch"}, jointConfig());
   ASSERT_EQ(result.demos.size(), demos.size());
-  for (std::size_t d = 0; d < demos.size(); ++d) expect_boundaries(result, demos[d], d, 0.2);
+  for (std::size_t d = 0; d < demos.size(); ++d) expectBoundaries(result, demos[d], d, 0.2);
 }
 
 TEST(JointSegmentation, AWipeWithADeadSensorIsSegmentedFromItsMotionOrWarned) {
@@ -250,41 +249,41 @@ TEST(JointSegmentation, AWipeWithADeadSensorIsSegmentedFromItsMotionOrWarned) {
   // the slide starting after a 0.3 s stop (weight 0.22, below min_piece_weight 0.3), so its
   // onset goes to a ClaSP changepoint mid-slide, 1.9 s off (left open).
   GTEST_SKIP() << "the dead demo's onset has no evidence as sure as min_piece_weight";
-  segment_with_a_dead_sensor(reach_press_retract(6, 11, 0.25), 2);
+  segmentWithADeadSensor(reachPressRetract(6, 11, 0.25), 2);
 }
 
 // Pose only: the long pauses end where a new skill starts; a 0.3 s hesitation inside a move is
 // no boundary.
 TEST(JointSegmentation, BoundariesAreWhereMotionResumesAfterTheLongPauses) {
-  const auto demos = moves_and_pauses(6, 5);
-  const auto result = lfd::run_segmentation_pipeline(matrices(demos), {}, joint_config());
+  const auto demos = movesAndPauses(6, 5);
+  const auto result = lfd::runSegmentationPipeline(matrices(demos), {}, jointConfig());
   ASSERT_EQ(result.demos.size(), demos.size());
-  for (std::size_t d = 0; d < demos.size(); ++d) expect_boundaries(result, demos[d], d, 0.3);
+  for (std::size_t d = 0; d < demos.size(); ++d) expectBoundaries(result, demos[d], d, 0.3);
 }
 
 // One demo skips the middle move: it is reported as lacking that boundary, not given one.
 TEST(JointSegmentation, ADemoLackingAPhaseIsReportedNotForced) {
   const std::size_t odd = 3;
-  const auto demos = moves_and_pauses(6, 5, static_cast<int>(odd));
-  const auto result = lfd::run_segmentation_pipeline(matrices(demos), {}, joint_config());
+  const auto demos = movesAndPauses(6, 5, static_cast<int>(odd));
+  const auto result = lfd::runSegmentationPipeline(matrices(demos), {}, jointConfig());
   ASSERT_EQ(result.demos.size(), demos.size());
   for (std::size_t d = 0; d < demos.size(); ++d)
-    if (d != odd) expect_boundaries(result, demos[d], d, 0.3);
+    if (d != odd) expectBoundaries(result, demos[d], d, 0.3);
   const auto& r = result.demos[odd];
-  EXPECT_LT(r.changepoints.size(), 2u) << listed(r.changepoint_times) << all_warnings(result);
-  EXPECT_GE(warnings_about(result, odd, "lack"), 1u) << all_warnings(result);
+  EXPECT_LT(r.changepoints.size(), 2u) << listed(r.changepoint_times) << allWarnings(result);
+  EXPECT_GE(warningsAbout(result, odd, "lack"), 1u) << allWarnings(result);
   // What it has is its one pause's end.
-  ASSERT_EQ(r.changepoint_times.size(), 1u) << all_warnings(result);
+  ASSERT_EQ(r.changepoint_times.size(), 1u) << allWarnings(result);
   EXPECT_NEAR(r.changepoint_times[0], demos[odd].truth[0], 0.3);
 }
 
 TEST(JointSegmentation, NeedsAClock) {
-  const auto demos = matrices(reach_press_retract(3, 11));
-  auto config = joint_config();
+  const auto demos = matrices(reachPressRetract(3, 11));
+  auto config = jointConfig();
   config.seconds.reset();
-  EXPECT_THROW(lfd::run_segmentation_pipeline(demos, {"touch"}, config), std::invalid_argument);
+  EXPECT_THROW(lfd::runSegmentationPipeline(demos, {"touch"}, config), std::invalid_argument);
   try {
-    lfd::run_segmentation_pipeline(demos, {"touch"}, config);
+    lfd::runSegmentationPipeline(demos, {"touch"}, config);
   } catch (const std::invalid_argument& e) {
     EXPECT_NE(std::string(e.what()).find("seconds"), std::string::npos) << e.what();
   }

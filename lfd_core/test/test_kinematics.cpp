@@ -16,7 +16,7 @@ namespace {
 const std::string kRobotUrdf = std::string(LFD_ROBOT_DIR) + "/models/jvrc1_like.urdf";
 
 // base -> (fixed, rotated) -> revolute z -> prismatic x -> fixed tip.
-const char* kSmallUrdf = R"(<?xml version="1.0"?>
+const char* const kSmallUrdf = R"(<?xml version="1.0"?>
 <robot name="small">
   <link name="base"/><link name="a"/><link name="b"/><link name="c"/><link name="tip"/>
   <joint name="mount" type="fixed"><parent link="base"/><child link="a"/>

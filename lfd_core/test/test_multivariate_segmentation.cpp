@@ -25,51 +25,51 @@ Eigen::VectorXd vec(std::initializer_list<double> v) {
 TEST(CombineProfiles, AllFourMethodsExact) {
   const std::vector<Eigen::VectorXd> p{vec({0.5, 0.9, kNaN}), vec({0.8, 0.4, 0.7})};
   const std::vector<double> w{3.0, 1.0};
-  const auto avg = lfd::combine_profiles(p, w, ProfileCombination::kAverage);
+  const auto avg = lfd::combineProfiles(p, w, ProfileCombination::kAverage);
   EXPECT_DOUBLE_EQ(avg[0], 0.65);
   EXPECT_DOUBLE_EQ(avg[1], 0.65);
   EXPECT_TRUE(std::isnan(avg[2]));  // undefined in one feature -> undefined
-  const auto prod = lfd::combine_profiles(p, w, ProfileCombination::kProduct);
+  const auto prod = lfd::combineProfiles(p, w, ProfileCombination::kProduct);
   EXPECT_NEAR(prod[0], std::sqrt(0.5 * 0.8), 1e-12);
   EXPECT_NEAR(prod[1], std::sqrt(0.9 * 0.4), 1e-12);
-  const auto wavg = lfd::combine_profiles(p, w, ProfileCombination::kWeightedAverage);
+  const auto wavg = lfd::combineProfiles(p, w, ProfileCombination::kWeightedAverage);
   EXPECT_NEAR(wavg[0], (3 * 0.5 + 0.8) / 4, 1e-12);
-  const auto wprod = lfd::combine_profiles(p, w, ProfileCombination::kWeightedProduct);
+  const auto wprod = lfd::combineProfiles(p, w, ProfileCombination::kWeightedProduct);
   EXPECT_NEAR(wprod[0], std::pow(0.5, 0.75) * std::pow(0.8, 0.25), 1e-12);
   EXPECT_NEAR(wprod[1], std::pow(0.9, 0.75) * std::pow(0.4, 0.25), 1e-12);
   // Unweighted methods ignore the weights; a zero weight removes a feature from weighted ones.
-  EXPECT_DOUBLE_EQ(lfd::combine_profiles(p, {1.0, 0.0}, ProfileCombination::kWeightedProduct)[1],
+  EXPECT_DOUBLE_EQ(lfd::combineProfiles(p, {1.0, 0.0}, ProfileCombination::kWeightedProduct)[1],
                    0.9);
 }
 
 TEST(CombineProfiles, ProductStaysFiniteWithManyFeaturesAndZeros) {
   std::vector<Eigen::VectorXd> p(200, vec({1e-3, 0.0}));
-  const auto prod = lfd::combine_profiles(p, {}, ProfileCombination::kProduct);
+  const auto prod = lfd::combineProfiles(p, {}, ProfileCombination::kProduct);
   EXPECT_NEAR(prod[0], 1e-3, 1e-12);  // a raw product would underflow to 0
   EXPECT_GT(prod[1], 0.0);            // zeros are clamped, not -inf in log space
 }
 
 TEST(CombineProfiles, RejectsBadInput) {
   const std::vector<Eigen::VectorXd> p{vec({0.5, 0.6}), vec({0.5})};
-  EXPECT_THROW(lfd::combine_profiles(p, {}, ProfileCombination::kAverage), std::invalid_argument);
+  EXPECT_THROW(lfd::combineProfiles(p, {}, ProfileCombination::kAverage), std::invalid_argument);
   const std::vector<Eigen::VectorXd> q{vec({0.5}), vec({0.5})};
-  EXPECT_THROW(lfd::combine_profiles(q, {1.0}, ProfileCombination::kWeightedAverage),
+  EXPECT_THROW(lfd::combineProfiles(q, {1.0}, ProfileCombination::kWeightedAverage),
                std::invalid_argument);
-  EXPECT_THROW(lfd::combine_profiles(q, {1.0, -1.0}, ProfileCombination::kWeightedAverage),
+  EXPECT_THROW(lfd::combineProfiles(q, {1.0, -1.0}, ProfileCombination::kWeightedAverage),
                std::invalid_argument);
-  EXPECT_THROW(lfd::combine_profiles(q, {0.0, 0.0}, ProfileCombination::kWeightedProduct),
+  EXPECT_THROW(lfd::combineProfiles(q, {0.0, 0.0}, ProfileCombination::kWeightedProduct),
                std::invalid_argument);
-  EXPECT_THROW(lfd::combine_profiles({}, {}, ProfileCombination::kAverage), std::invalid_argument);
+  EXPECT_THROW(lfd::combineProfiles({}, {}, ProfileCombination::kAverage), std::invalid_argument);
 }
 
 TEST(CombineProfiles, ParsesNames) {
   for (auto name : {"average", "product", "weighted_average", "weighted_product"})
-    EXPECT_EQ(lfd::to_string(lfd::parse_profile_combination(name)), name);
-  EXPECT_THROW(lfd::parse_profile_combination("median"), std::invalid_argument);
+    EXPECT_EQ(lfd::toString(lfd::parseProfileCombination(name)), name);
+  EXPECT_THROW(lfd::parseProfileCombination("median"), std::invalid_argument);
 }
 
 TEST(KaiserWindow, ShapeAndKnownValues) {
-  const auto k = lfd::kaiser_window(101, 2.0);
+  const auto k = lfd::kaiserWindow(101, 2.0);
   EXPECT_NEAR(k[50], 1.0, 1e-12);
   EXPECT_NEAR(k[0], 1.0 / 2.2795853023360673, 1e-9);  // 1 / I0(2)
   EXPECT_NEAR(k[100], k[0], 1e-12);
@@ -78,14 +78,14 @@ TEST(KaiserWindow, ShapeAndKnownValues) {
     EXPECT_NEAR(k[i], k[100 - i], 1e-12);
   }
   // Stronger fades: the ends are 1 / I0(beta) (I0 values of scipy.special.i0).
-  EXPECT_NEAR(lfd::kaiser_window(11, 5.0)[0] * 27.239871823604442, 1.0, 1e-13);
-  EXPECT_NEAR(lfd::kaiser_window(11, 10.0)[10] * 2815.716628466254, 1.0, 1e-13);
-  EXPECT_TRUE(lfd::kaiser_window(10, 0.0).isOnes());
-  EXPECT_THROW(lfd::kaiser_window(10, -1.0), std::invalid_argument);
+  EXPECT_NEAR(lfd::kaiserWindow(11, 5.0)[0] * 27.239871823604442, 1.0, 1e-13);
+  EXPECT_NEAR(lfd::kaiserWindow(11, 10.0)[10] * 2815.716628466254, 1.0, 1e-13);
+  EXPECT_TRUE(lfd::kaiserWindow(10, 0.0).isOnes());
+  EXPECT_THROW(lfd::kaiserWindow(10, -1.0), std::invalid_argument);
 }
 
 // Feature with a real changepoint at `cp`: a sine that turns into a square wave.
-Eigen::VectorXd shape_change(std::size_t n, std::size_t cp, std::mt19937& rng) {
+Eigen::VectorXd shapeChange(std::size_t n, std::size_t cp, std::mt19937& rng) {
   std::normal_distribution<double> g(0.0, 0.05);
   Eigen::VectorXd x(static_cast<Eigen::Index>(n));
   for (std::size_t t = 0; t < n; ++t) {
@@ -96,7 +96,7 @@ Eigen::VectorXd shape_change(std::size_t n, std::size_t cp, std::mt19937& rng) {
 }
 
 // Feature with a changepoint in level and speed: slow drift, then a faster oscillation.
-Eigen::VectorXd level_change(std::size_t n, std::size_t cp, std::mt19937& rng) {
+Eigen::VectorXd levelChange(std::size_t n, std::size_t cp, std::mt19937& rng) {
   std::normal_distribution<double> g(0.0, 0.05);
   Eigen::VectorXd x(static_cast<Eigen::Index>(n));
   for (std::size_t t = 0; t < n; ++t) {
@@ -121,12 +121,12 @@ TEST(MultivariateSegmentation, WeightedProductIgnoresLowWeightNoiseFeatures) {
   for (unsigned seed = 1; seed <= 3; ++seed) {
     std::mt19937 rng(seed);
     Eigen::MatrixXd f(n, 4);
-    f.col(0) = shape_change(n, cp, rng);
+    f.col(0) = shapeChange(n, cp, rng);
     f.col(1) = noise(n, rng);
     f.col(2) = noise(n, rng);
     f.col(3) = noise(n, rng);
     lfd::MultivariateSegmentationConfig config;  // weighted product, significance test
-    const auto seg = lfd::segment_multivariate(f, {1.0, 0.05, 0.05, 0.05}, config);
+    const auto seg = lfd::segmentMultivariate(f, {1.0, 0.05, 0.05, 0.05}, config);
     ASSERT_EQ(seg.changepoints.size(), 1u) << "seed " << seed;
     correct += std::abs(static_cast<double>(seg.changepoints[0]) - cp) <= seg.window_sizes[0];
   }
@@ -137,20 +137,20 @@ TEST(MultivariateSegmentation, EveryCombinationFindsASharedChangepoint) {
   const std::size_t n = 2000, cp = 800;
   std::mt19937 rng(7);
   Eigen::MatrixXd f(n, 3);
-  f.col(0) = shape_change(n, cp, rng);
-  f.col(1) = level_change(n, cp, rng);
+  f.col(0) = shapeChange(n, cp, rng);
+  f.col(1) = levelChange(n, cp, rng);
   f.col(2) = noise(n, rng);
   const std::vector<double> weights{1.0, 0.8, 0.1};
   for (auto method : {ProfileCombination::kAverage, ProfileCombination::kProduct,
                       ProfileCombination::kWeightedAverage, ProfileCombination::kWeightedProduct}) {
     lfd::MultivariateSegmentationConfig config;
     config.combination = method;
-    const auto seg = lfd::segment_multivariate(f, weights, config);
-    ASSERT_FALSE(seg.changepoints.empty()) << lfd::to_string(method);
+    const auto seg = lfd::segmentMultivariate(f, weights, config);
+    ASSERT_FALSE(seg.changepoints.empty()) << lfd::toString(method);
     ASSERT_FALSE(seg.candidates.empty());
     EXPECT_TRUE(seg.candidates.front().accepted);
     EXPECT_NEAR(static_cast<double>(seg.candidates.front().index), static_cast<double>(cp), 40.0)
-        << lfd::to_string(method);
+        << lfd::toString(method);
   }
 }
 
@@ -158,13 +158,13 @@ TEST(MultivariateSegmentation, FirstProfilesArePenalizedByTheKaiserWindow) {
   const std::size_t n = 1500;
   std::mt19937 rng(3);
   Eigen::MatrixXd f(n, 2);
-  f.col(0) = shape_change(n, 700, rng);
-  f.col(1) = level_change(n, 700, rng);
+  f.col(0) = shapeChange(n, 700, rng);
+  f.col(1) = levelChange(n, 700, rng);
   lfd::MultivariateSegmentationConfig config;
   config.kaiser_beta = 3.0;
-  const auto seg = lfd::segment_multivariate(f, {1.0, 1.0}, config);
+  const auto seg = lfd::segmentMultivariate(f, {1.0, 1.0}, config);
   ASSERT_EQ(seg.first_profile.size(), static_cast<Eigen::Index>(n));
-  const Eigen::VectorXd kaiser = lfd::kaiser_window(n, 3.0);
+  const Eigen::VectorXd kaiser = lfd::kaiserWindow(n, 3.0);
   const std::size_t min_s = seg.min_segment_length;
   for (std::size_t t = 0; t < n; ++t) {
     const auto i = static_cast<Eigen::Index>(t);
@@ -182,12 +182,12 @@ TEST(MultivariateSegmentation, MinSegmentLengthIsEnforced) {
   const std::size_t n = 2000;
   std::mt19937 rng(5);
   Eigen::MatrixXd f(n, 2);
-  f.col(0) = shape_change(n, 1000, rng);
+  f.col(0) = shapeChange(n, 1000, rng);
   f.col(1) = noise(n, rng);
   lfd::MultivariateSegmentationConfig config;
   config.num_changepoints = 6;  // force more splits than the data holds
   config.min_segment_length = 300;
-  const auto seg = lfd::segment_multivariate(f, {1.0, 1.0}, config);
+  const auto seg = lfd::segmentMultivariate(f, {1.0, 1.0}, config);
   ASSERT_FALSE(seg.changepoints.empty());
   EXPECT_LE(seg.changepoints.size(), 6u);
   std::size_t previous = 0;
@@ -197,30 +197,30 @@ TEST(MultivariateSegmentation, MinSegmentLengthIsEnforced) {
   }
   EXPECT_GE(n - previous, 300u);
   config.min_segment_length = 1000;  // no split leaves two segments of >= 1000 + 1
-  EXPECT_TRUE(lfd::segment_multivariate(f, {1.0, 1.0}, config).changepoints.empty());
+  EXPECT_TRUE(lfd::segmentMultivariate(f, {1.0, 1.0}, config).changepoints.empty());
 }
 
 // Two features, each with its own changepoint: a level change at 600, a shape change at 1300.
-Eigen::MatrixXd changes_at_600_and_1300() {
+Eigen::MatrixXd changesAt600And1300() {
   const std::size_t n = 2000;
   std::mt19937 rng(4);
   Eigen::MatrixXd f(n, 2);
-  f.col(0) = shape_change(n, 1300, rng);
-  f.col(1) = level_change(n, 600, rng);
+  f.col(0) = shapeChange(n, 1300, rng);
+  f.col(1) = levelChange(n, 600, rng);
   return f;
 }
 
 TEST(MultivariateSegmentation, CandidateZonesRestrictTheArgmax) {
-  const Eigen::MatrixXd f = changes_at_600_and_1300();
+  const Eigen::MatrixXd f = changesAt600And1300();
   lfd::MultivariateSegmentationConfig config;
   config.num_changepoints = 1;
-  const auto free = lfd::segment_multivariate(f, {1.0, 1.0}, config);
+  const auto free = lfd::segmentMultivariate(f, {1.0, 1.0}, config);
   ASSERT_EQ(free.changepoints.size(), 1u);
   // Only allow the zone around the other changepoint: the argmax must come from inside it.
   const bool first_at_600 = std::abs(static_cast<double>(free.changepoints[0]) - 600.0) < 100.0;
   const lfd::Interval zone = first_at_600 ? lfd::Interval{1200, 1400} : lfd::Interval{500, 700};
   config.candidate_zones = {zone};
-  const auto zoned = lfd::segment_multivariate(f, {1.0, 1.0}, config);
+  const auto zoned = lfd::segmentMultivariate(f, {1.0, 1.0}, config);
   ASSERT_EQ(zoned.changepoints.size(), 1u);
   EXPECT_TRUE(zone.contains(zoned.changepoints[0])) << zoned.changepoints[0];
   Eigen::Index best = static_cast<Eigen::Index>(zone.begin);
@@ -233,7 +233,7 @@ TEST(MultivariateSegmentation, CandidateZonesRestrictTheArgmax) {
 // A zone marks one sensory interaction: however many changepoints are asked for, a zone holds at
 // most one, and a zone-less demonstration (callback returning nothing) gets none.
 TEST(MultivariateSegmentation, EachZoneHoldsAtMostOneChangepoint) {
-  const Eigen::MatrixXd f = changes_at_600_and_1300();
+  const Eigen::MatrixXd f = changesAt600And1300();
   lfd::MultivariateSegmentationConfig config;
   config.num_changepoints = 4;
   config.min_segment_length = 100;
@@ -243,14 +243,14 @@ TEST(MultivariateSegmentation, EachZoneHoldsAtMostOneChangepoint) {
     seen_min_s = min_s;
     return zones;
   };
-  const auto seg = lfd::segment_multivariate(f, {1.0, 1.0}, config);
+  const auto seg = lfd::segmentMultivariate(f, {1.0, 1.0}, config);
   EXPECT_EQ(seen_min_s, 100u);
   ASSERT_EQ(seg.changepoints.size(), 2u);
   EXPECT_TRUE(zones[0].contains(seg.changepoints[0])) << seg.changepoints[0];
   EXPECT_TRUE(zones[1].contains(seg.changepoints[1])) << seg.changepoints[1];
 
   config.candidate_zones_for = [](std::size_t) { return std::vector<lfd::Interval>{}; };
-  const auto none = lfd::segment_multivariate(f, {1.0, 1.0}, config);
+  const auto none = lfd::segmentMultivariate(f, {1.0, 1.0}, config);
   EXPECT_TRUE(none.changepoints.empty());
   EXPECT_FALSE(std::isnan(none.first_profile[1000]));  // profiles are still reported
 }
@@ -270,13 +270,13 @@ TEST(MultivariateSegmentation, ZoneThresholdAcceptsWeakerInZoneEvidence) {
   config.window_sizes = {20};
   config.min_segment_length = 60;
   config.candidate_zones = {{250, 350}};
-  EXPECT_TRUE(lfd::segment_multivariate(f, {1.0}, config).changepoints.empty());
+  EXPECT_TRUE(lfd::segmentMultivariate(f, {1.0}, config).changepoints.empty());
   config.zone_p_value_threshold = 1e-5;
-  const auto seg = lfd::segment_multivariate(f, {1.0}, config);
+  const auto seg = lfd::segmentMultivariate(f, {1.0}, config);
   ASSERT_EQ(seg.changepoints.size(), 1u);
   EXPECT_NEAR(static_cast<double>(seg.changepoints[0]), cp, 25.0);
   config.zone_p_value_threshold = 1.0;
-  EXPECT_THROW(lfd::segment_multivariate(f, {1.0}, config), std::invalid_argument);
+  EXPECT_THROW(lfd::segmentMultivariate(f, {1.0}, config), std::invalid_argument);
 }
 
 // The whole series' in-zone argmax is a weak change in the middle (where the Kaiser window does not
@@ -297,7 +297,7 @@ TEST(MultivariateSegmentation, AnInsignificantZoneDoesNotCloseTheOthers) {
   config.candidate_zones = {{weak - 50, weak + 50}, {strong - 50, strong + 50}};
   config.kaiser_beta = 6.0;  // a strong fade: the end's change ranks below the middle's
   config.zone_p_value_threshold = 1e-40;  // the middle's split (1e-25) is not enough
-  const auto seg = lfd::segment_multivariate(f, {1.0}, config);
+  const auto seg = lfd::segmentMultivariate(f, {1.0}, config);
   ASSERT_GE(seg.candidates.size(), 2u);
   EXPECT_TRUE(config.candidate_zones[0].contains(seg.candidates[0].index));
   EXPECT_FALSE(seg.candidates[0].accepted);
@@ -310,12 +310,12 @@ TEST(MultivariateSegmentation, AnInsignificantZoneDoesNotCloseTheOthers) {
 // With anchors ClaSP still decides which zones hold a changepoint, but each one sits on its
 // zone's event nearest to the argmax, and a zone ClaSP leaves empty stays empty.
 TEST(MultivariateSegmentation, AnchorsPlaceChangepointsOnTheZoneEvents) {
-  const Eigen::MatrixXd f = changes_at_600_and_1300();
+  const Eigen::MatrixXd f = changesAt600And1300();
   lfd::MultivariateSegmentationConfig config;
   config.min_segment_length = 100;
   const std::vector<lfd::Interval> zones{{450, 760}, {1150, 1450}, {1700, 1800}};
   config.candidate_zones = zones;
-  const auto plain = lfd::segment_multivariate(f, {1.0, 1.0}, config);
+  const auto plain = lfd::segmentMultivariate(f, {1.0, 1.0}, config);
   ASSERT_EQ(plain.changepoints.size(), 2u);
   EXPECT_EQ(plain.changepoints[1], zones[1].begin);  // pinned to the edge, 150 before the change
   for (const lfd::SplitCandidate& c : plain.candidates) EXPECT_FALSE(c.anchored);
@@ -323,7 +323,7 @@ TEST(MultivariateSegmentation, AnchorsPlaceChangepointsOnTheZoneEvents) {
   // Events 80 samples after each change, one more farther inside the first zone, and one in the
   // zone where nothing changes.
   config.zone_anchors = {680, 740, 1380, 1750};
-  const auto seg = lfd::segment_multivariate(f, {1.0, 1.0}, config);
+  const auto seg = lfd::segmentMultivariate(f, {1.0, 1.0}, config);
   ASSERT_EQ(seg.changepoints.size(), 2u);
   EXPECT_EQ(seg.changepoints[0], 680u);  // nearer to the argmax than 740
   EXPECT_EQ(seg.changepoints[1], 1380u);
@@ -340,16 +340,16 @@ TEST(MultivariateSegmentation, AnchorsPlaceChangepointsOnTheZoneEvents) {
 // A zone's preferred anchors (rest edges: contact made or lost) are taken before a nearer
 // event of the same zone (a force ramp reaching its plateau).
 TEST(MultivariateSegmentation, PreferredAnchorsComeFirstInTheirZone) {
-  const Eigen::MatrixXd f = changes_at_600_and_1300();
+  const Eigen::MatrixXd f = changesAt600And1300();
   lfd::MultivariateSegmentationConfig config;
   config.min_segment_length = 100;
   config.candidate_zones = {{450, 760}, {1150, 1450}};
   config.zone_anchors = {680, 740, 1380};
-  const auto nearest = lfd::segment_multivariate(f, {1.0, 1.0}, config);
+  const auto nearest = lfd::segmentMultivariate(f, {1.0, 1.0}, config);
   ASSERT_EQ(nearest.changepoints.size(), 2u);
   EXPECT_EQ(nearest.changepoints[0], 680u);
   config.preferred_anchors = {false, true, false};
-  const auto preferred = lfd::segment_multivariate(f, {1.0, 1.0}, config);
+  const auto preferred = lfd::segmentMultivariate(f, {1.0, 1.0}, config);
   ASSERT_EQ(preferred.changepoints.size(), 2u);
   EXPECT_EQ(preferred.changepoints[0], 740u);
   EXPECT_EQ(preferred.changepoints[1], 1380u);
@@ -359,14 +359,14 @@ TEST(MultivariateSegmentation, PreferredAnchorsComeFirstInTheirZone) {
 // push: contact and release). With anchors each changepoint sits on its own event of that zone;
 // without anchors the zone holds one.
 TEST(MultivariateSegmentation, AMergedZoneHoldsOneAnchoredChangepointPerEvent) {
-  const Eigen::MatrixXd f = changes_at_600_and_1300();
+  const Eigen::MatrixXd f = changesAt600And1300();
   lfd::MultivariateSegmentationConfig config;
   config.min_segment_length = 100;
   config.candidate_zones = {{450, 1450}};
-  const auto one = lfd::segment_multivariate(f, {1.0, 1.0}, config);
+  const auto one = lfd::segmentMultivariate(f, {1.0, 1.0}, config);
   EXPECT_EQ(one.changepoints.size(), 1u);
   config.zone_anchors = {610, 1290};
-  const auto two = lfd::segment_multivariate(f, {1.0, 1.0}, config);
+  const auto two = lfd::segmentMultivariate(f, {1.0, 1.0}, config);
   EXPECT_EQ(two.changepoints, (std::vector<std::size_t>{610, 1290}));
 }
 
@@ -384,26 +384,26 @@ TEST(MultivariateSegmentation, ARestEdgeZoneNeedsLessClaspEvidence) {
   config.candidate_zones = {{250, 350}};
   config.zone_anchors = {cp};
   config.zone_p_value_threshold = 1e-5;
-  const auto strict = lfd::segment_multivariate(f, {}, config);
+  const auto strict = lfd::segmentMultivariate(f, {}, config);
   ASSERT_FALSE(strict.candidates.empty());
   const double log_p = strict.candidates[0].log10_p_value;
   ASSERT_GT(log_p, -5.0) << "the change must be weak for this test";
   ASSERT_LT(log_p, -1.0) << "but not absent";
   EXPECT_TRUE(strict.changepoints.empty());
   config.rest_edge_p_value_threshold = 0.1;
-  EXPECT_TRUE(lfd::segment_multivariate(f, {}, config).changepoints.empty()) << "not preferred";
+  EXPECT_TRUE(lfd::segmentMultivariate(f, {}, config).changepoints.empty()) << "not preferred";
   config.preferred_anchors = {true};
-  EXPECT_EQ(lfd::segment_multivariate(f, {}, config).changepoints,
+  EXPECT_EQ(lfd::segmentMultivariate(f, {}, config).changepoints,
             (std::vector<std::size_t>{static_cast<std::size_t>(cp)}));
 }
 
 // Without zones a longer demo needs more evidence: significance_per_sample raises the threshold
 // with the length, never lowers it below p_value_threshold.
 TEST(MultivariateSegmentation, ALongDemoNeedsMoreEvidenceWithoutZones) {
-  const Eigen::MatrixXd f = changes_at_600_and_1300();
+  const Eigen::MatrixXd f = changesAt600And1300();
   lfd::MultivariateSegmentationConfig config;
   config.min_segment_length = 100;
-  const auto plain = lfd::segment_multivariate(f, {1.0, 1.0}, config);
+  const auto plain = lfd::segmentMultivariate(f, {1.0, 1.0}, config);
   ASSERT_GE(plain.changepoints.size(), 2u);
   double strongest = 0.0;
   for (const lfd::SplitCandidate& c : plain.candidates)
@@ -411,9 +411,9 @@ TEST(MultivariateSegmentation, ALongDemoNeedsMoreEvidenceWithoutZones) {
   // A rate whose threshold over these 2000 samples lies beyond the strongest split's evidence
   // leaves no changepoint; a rate below p_value_threshold changes nothing.
   config.significance_per_sample = -strongest / 2000.0 * 1.01;
-  EXPECT_TRUE(lfd::segment_multivariate(f, {1.0, 1.0}, config).changepoints.empty());
+  EXPECT_TRUE(lfd::segmentMultivariate(f, {1.0, 1.0}, config).changepoints.empty());
   config.significance_per_sample = 1e-6;
-  EXPECT_EQ(lfd::segment_multivariate(f, {1.0, 1.0}, config).changepoints, plain.changepoints);
+  EXPECT_EQ(lfd::segmentMultivariate(f, {1.0, 1.0}, config).changepoints, plain.changepoints);
 }
 
 TEST(MultivariateSegmentation, StationaryFeaturesGiveNoChangepoint) {
@@ -424,7 +424,7 @@ TEST(MultivariateSegmentation, StationaryFeaturesGiveNoChangepoint) {
     f(static_cast<Eigen::Index>(t), 0) = std::sin(2.0 * M_PI * static_cast<double>(t) / 50.0);
   f.col(0) += 0.1 * noise(n, rng);
   f.col(1) = noise(n, rng);
-  const auto seg = lfd::segment_multivariate(f, {1.0, 0.5}, lfd::MultivariateSegmentationConfig{});
+  const auto seg = lfd::segmentMultivariate(f, {1.0, 0.5}, lfd::MultivariateSegmentationConfig{});
   EXPECT_TRUE(seg.changepoints.empty());
   ASSERT_EQ(seg.candidates.size(), 1u);
   EXPECT_FALSE(seg.candidates[0].accepted);
@@ -435,20 +435,20 @@ TEST(MultivariateSegmentation, ConstantColumnIsIgnoredAndBadInputRejected) {
   const std::size_t n = 1500;
   std::mt19937 rng(2);
   Eigen::MatrixXd f(n, 2);
-  f.col(0) = shape_change(n, 600, rng);
+  f.col(0) = shapeChange(n, 600, rng);
   f.col(1).setConstant(3.0);
-  const auto seg = lfd::segment_multivariate(f, {1.0, 1.0}, lfd::MultivariateSegmentationConfig{});
+  const auto seg = lfd::segmentMultivariate(f, {1.0, 1.0}, lfd::MultivariateSegmentationConfig{});
   ASSERT_EQ(seg.changepoints.size(), 1u);
   EXPECT_NEAR(static_cast<double>(seg.changepoints[0]), 600.0, 40.0);
   EXPECT_EQ(seg.window_sizes[1], 0u);
   EXPECT_TRUE(seg.first_feature_profiles[1].isZero());
 
   lfd::MultivariateSegmentationConfig config;
-  EXPECT_THROW(lfd::segment_multivariate(f, {1.0}, config), std::invalid_argument);
-  EXPECT_THROW(lfd::segment_multivariate(f, {1.0, -0.1}, config), std::invalid_argument);
-  EXPECT_THROW(lfd::segment_multivariate(Eigen::MatrixXd(n, 0), {}, config), std::invalid_argument);
+  EXPECT_THROW(lfd::segmentMultivariate(f, {1.0}, config), std::invalid_argument);
+  EXPECT_THROW(lfd::segmentMultivariate(f, {1.0, -0.1}, config), std::invalid_argument);
+  EXPECT_THROW(lfd::segmentMultivariate(Eigen::MatrixXd(n, 0), {}, config), std::invalid_argument);
   f(10, 0) = std::nan("");
-  EXPECT_THROW(lfd::segment_multivariate(f, {1.0, 1.0}, config), std::invalid_argument);
+  EXPECT_THROW(lfd::segmentMultivariate(f, {1.0, 1.0}, config), std::invalid_argument);
 }
 
 }  // namespace
@@ -464,9 +464,8 @@ TEST(DistanceAverage, OneChannelGivesTheUnivariateNeighbours) {
   for (Eigen::Index i = 0; i < x.size(); ++i) x[i] = std::sin(0.2 * i) + 0.3 * g(rng);
   for (auto distance :
        {lfd::ClaspDistance::kEuclidean, lfd::ClaspDistance::kZNormalizedEuclidean}) {
-    const lfd::KnnResult uni = lfd::brute_force_knn(x, 20, 3, 10, distance);
-    const lfd::KnnResult avg =
-        lfd::distance_average_knn(Eigen::MatrixXd(x), {}, 20, 3, 10, distance);
+    const lfd::KnnResult uni = lfd::bruteForceKnn(x, 20, 3, 10, distance);
+    const lfd::KnnResult avg = lfd::distanceAverageKnn(Eigen::MatrixXd(x), {}, 20, 3, 10, distance);
     ASSERT_EQ(avg.num_subsequences, uni.num_subsequences);
     std::size_t same = 0;
     for (std::size_t i = 0; i < uni.indices.size(); ++i) same += uni.indices[i] == avg.indices[i];
@@ -493,14 +492,14 @@ TEST(DistanceAverage, ScaleFreeAndWeighted) {
   for (auto c :
        {ProfileCombination::kDistanceAverage, ProfileCombination::kWeightedDistanceAverage}) {
     config.combination = c;
-    const auto r = lfd::segment_multivariate(
+    const auto r = lfd::segmentMultivariate(
         x, {1.0, c == ProfileCombination::kDistanceAverage ? 1.0 : 0.1}, config);
     ASSERT_EQ(r.changepoints.size(), 1u);
     EXPECT_NEAR(static_cast<double>(r.changepoints[0]), static_cast<double>(change), 25.0);
   }
-  EXPECT_EQ(lfd::parse_profile_combination("weighted_distance_average"),
+  EXPECT_EQ(lfd::parseProfileCombination("weighted_distance_average"),
             ProfileCombination::kWeightedDistanceAverage);
-  EXPECT_EQ(lfd::to_string(ProfileCombination::kDistanceAverage), "distance_average");
+  EXPECT_EQ(lfd::toString(ProfileCombination::kDistanceAverage), "distance_average");
 }
 
 }  // namespace

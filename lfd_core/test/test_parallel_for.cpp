@@ -16,24 +16,24 @@ namespace {
 TEST(ParallelFor, RunsEveryIndexOnce) {
   for (int threads : {1, 3, 0, -2}) {
     std::vector<std::atomic<int>> runs(1000);
-    lfd::parallel_for(runs.size(), threads, [&](std::size_t i) { ++runs[i]; });
+    lfd::parallelFor(runs.size(), threads, [&](std::size_t i) { ++runs[i]; });
     for (std::size_t i = 0; i < runs.size(); ++i) ASSERT_EQ(runs[i], 1) << i << ", " << threads;
   }
   int calls = 0;
-  lfd::parallel_for(0, 4, [&](std::size_t) { ++calls; });
+  lfd::parallelFor(0, 4, [&](std::size_t) { ++calls; });
   EXPECT_EQ(calls, 0);
 }
 
 TEST(ParallelFor, OneThreadRunsOnTheCaller) {
   std::set<std::thread::id> ids;
-  lfd::parallel_for(20, 1, [&](std::size_t) { ids.insert(std::this_thread::get_id()); });
+  lfd::parallelFor(20, 1, [&](std::size_t) { ids.insert(std::this_thread::get_id()); });
   EXPECT_EQ(ids, std::set<std::thread::id>{std::this_thread::get_id()});
 }
 
 TEST(ParallelFor, UsesUpToTheGivenThreads) {
   std::mutex m;
   std::set<std::thread::id> ids;
-  lfd::parallel_for(64, 3, [&](std::size_t) {
+  lfd::parallelFor(64, 3, [&](std::size_t) {
     std::this_thread::sleep_for(std::chrono::milliseconds(1));  // give every worker a job
     std::lock_guard<std::mutex> lock(m);
     ids.insert(std::this_thread::get_id());
@@ -50,7 +50,7 @@ TEST(ParallelFor, RethrowsTheFirstFailureAfterAllJobsFinished) {
   std::atomic<int> running{0}, finished{0};
   std::vector<std::atomic<bool>> done(kJobs);
   try {
-    lfd::parallel_for(kJobs, 4, [&](std::size_t i) {
+    lfd::parallelFor(kJobs, 4, [&](std::size_t i) {
       ++running;
       if (i == 7 || i == 3) {
         --running;
@@ -71,17 +71,17 @@ TEST(ParallelFor, RethrowsTheFirstFailureAfterAllJobsFinished) {
 }
 
 TEST(ParallelFor, ExceptionsOfAnyTypeAndOnOneThread) {
-  EXPECT_THROW(lfd::parallel_for(5, 1,
-                                 [](std::size_t i) {
-                                   if (i == 4) throw 42;
-                                 }),
+  EXPECT_THROW(lfd::parallelFor(5, 1,
+                                [](std::size_t i) {
+                                  if (i == 4) throw 42;
+                                }),
                int);
   int ran = 0;
-  EXPECT_THROW(lfd::parallel_for(5, 1,
-                                 [&](std::size_t i) {
-                                   ++ran;
-                                   if (i == 0) throw std::logic_error("first");
-                                 }),
+  EXPECT_THROW(lfd::parallelFor(5, 1,
+                                [&](std::size_t i) {
+                                  ++ran;
+                                  if (i == 0) throw std::logic_error("first");
+                                }),
                std::logic_error);
   EXPECT_EQ(ran, 5);  // the failure stops no other job
 }
@@ -95,7 +95,7 @@ TEST(ParallelFor, ScratchIsPerWorker) {
   std::mutex m;
   std::set<const Scratch*> seen;
   std::atomic<int> total{0}, shared{0};
-  lfd::parallel_for_with_scratch<Scratch>(200, 3, [&](std::size_t, Scratch& s) {
+  lfd::parallelForWithScratch<Scratch>(200, 3, [&](std::size_t, Scratch& s) {
     if (s.busy.exchange(true)) ++shared;
     ++s.jobs;
     ++total;
@@ -114,7 +114,7 @@ TEST(ParallelFor, ScratchIsPerWorker) {
 
 TEST(ParallelFor, ScratchKeepsItsStateAcrossJobs) {
   std::vector<std::size_t> sizes;
-  lfd::parallel_for_with_scratch<std::vector<int>>(4, 1, [&](std::size_t i, std::vector<int>& s) {
+  lfd::parallelForWithScratch<std::vector<int>>(4, 1, [&](std::size_t i, std::vector<int>& s) {
     s.push_back(static_cast<int>(i));
     sizes.push_back(s.size());
   });

@@ -26,7 +26,7 @@ std::vector<double> ramp(std::size_t n, std::size_t start, std::size_t end, doub
 TEST(RampFit, StepIsARampOfOneSample) {
   std::vector<double> y(100, 0.0);
   std::fill(y.begin() + 40, y.end(), 2.0);
-  const lfd::RampFit f = lfd::fit_ramp(y, 0, y.size());
+  const lfd::RampFit f = lfd::fitRamp(y, 0, y.size());
   EXPECT_EQ(f.start, 40u);
   EXPECT_EQ(f.end, 40u);
   EXPECT_NEAR(f.before, 0.0, 1e-12);
@@ -35,7 +35,7 @@ TEST(RampFit, StepIsARampOfOneSample) {
 
 TEST(RampFit, CleanRampStartAndEndExactlyWithinAWindow) {
   const std::vector<double> y = ramp(300, 120, 180, 1.0, -3.0);  // a falling ramp, absolute indices
-  const lfd::RampFit f = lfd::fit_ramp(y, 100, 220);
+  const lfd::RampFit f = lfd::fitRamp(y, 100, 220);
   EXPECT_EQ(f.start, 120u);
   EXPECT_EQ(f.end, 180u);
   EXPECT_NEAR(f.before, 1.0, 1e-9);
@@ -50,7 +50,7 @@ TEST(RampFit, NoisyRampWithinAFewSamples) {
   for (int trial = 0; trial < 20; ++trial) {
     std::vector<double> y = ramp(200, 80, 130, 0.0, 3.0);
     for (double& v : y) v += noise(rng);
-    const lfd::RampFit f = lfd::fit_ramp(y, 40, 170);
+    const lfd::RampFit f = lfd::fitRamp(y, 40, 170);
     EXPECT_NEAR(static_cast<double>(f.start), 80.0, 5.0) << trial;
     EXPECT_NEAR(static_cast<double>(f.end), 130.0, 5.0) << trial;
   }
@@ -58,12 +58,12 @@ TEST(RampFit, NoisyRampWithinAFewSamples) {
 
 TEST(RampFit, ConstantWindowAndBadWindows) {
   const std::vector<double> flat(10, 4.0);
-  const lfd::RampFit f = lfd::fit_ramp(flat, 2, 8);
+  const lfd::RampFit f = lfd::fitRamp(flat, 2, 8);
   EXPECT_EQ(f.before, 4.0);
   EXPECT_EQ(f.after, 4.0);
-  EXPECT_THROW(lfd::fit_ramp(flat, 5, 6), std::invalid_argument);
-  EXPECT_THROW(lfd::fit_ramp(flat, 9, 20), std::invalid_argument);  // clipped to 1 sample
-  EXPECT_THROW(lfd::fit_ramp({}, 0, 5), std::invalid_argument);
+  EXPECT_THROW(lfd::fitRamp(flat, 5, 6), std::invalid_argument);
+  EXPECT_THROW(lfd::fitRamp(flat, 9, 20), std::invalid_argument);  // clipped to 1 sample
+  EXPECT_THROW(lfd::fitRamp({}, 0, 5), std::invalid_argument);
 }
 
 }  // namespace

@@ -19,7 +19,7 @@ using lfd::rosmsg::UnknownField;
 // A made-up type that uses every construct: comments, constants (a string constant keeps its
 // '#'), Header, builtins and aliases, fixed and variable arrays, strings, time and duration,
 // nested types with and without their package.
-const char* kSampleDefinition = R"(# A sample for the reader tests
+const char* const kSampleDefinition = R"(# A sample for the reader tests
 Header header
 int32 MODE_A=1     # a constant is part of the type, not of the bytes
 string NOTE=keep # this
@@ -55,7 +55,7 @@ Point position
 int16[] counts
 )";
 
-MessageSchema sample_schema() {
+MessageSchema sampleSchema() {
   return MessageSchema::parse("test_pkg/Sample", kSampleDefinition);
 }
 
@@ -65,7 +65,7 @@ struct Item {
   std::vector<std::int16_t> counts;
 };
 
-Bytes sample_bytes(std::uint32_t stamp_sec = 100, std::vector<Item> items = {}) {
+Bytes sampleBytes(std::uint32_t stamp_sec = 100, std::vector<Item> items = {}) {
   if (items.empty()) items = {{"leg", 1, 2, 3, {7, -8}}, {"top", 4, 5, 6, {}}};
   Bytes b;
   b.put<std::uint32_t>(42).put<std::uint32_t>(stamp_sec).put<std::uint32_t>(500000000).str("base");
@@ -93,26 +93,26 @@ Bytes sample_bytes(std::uint32_t stamp_sec = 100, std::vector<Item> items = {}) 
 }
 
 TEST(RosMessageSchema, ParsesEveryConstruct) {
-  const MessageSchema s = sample_schema();
+  const MessageSchema s = sampleSchema();
   const auto& root = s.root();
   EXPECT_EQ(root.name, "test_pkg/Sample");
   ASSERT_EQ(root.fields.size(), 16u);  // constants are not fields
   EXPECT_EQ(root.constants, (std::vector<std::string>{"MODE_A=1", "NOTE=keep # this"}));
-  const auto& header = root.fields[root.field_index("header")];
+  const auto& header = root.fields[root.fieldIndex("header")];
   EXPECT_EQ(header.type_name, "std_msgs/Header");
   EXPECT_EQ(s.type(header.message).name, "std_msgs/Header");
-  const auto& p = root.fields[root.field_index("p")];
+  const auto& p = root.fields[root.fieldIndex("p")];
   EXPECT_EQ(p.type_name, "test_pkg/Point");  // resolved in the user's package
   EXPECT_EQ(s.type(p.message).fixed_size, 24u);
-  const auto& items = root.fields[root.field_index("items")];
+  const auto& items = root.fields[root.fieldIndex("items")];
   EXPECT_EQ(items.array_length, lfd::rosmsg::kVariableLength);
   EXPECT_EQ(s.type(items.message).fields[1].type_name, "test_pkg/Point");
   EXPECT_FALSE(s.type(items.message).fixed_size.has_value());
-  EXPECT_EQ(root.fields[root.field_index("fixed")].array_length, 3);
-  EXPECT_EQ(root.fields[root.field_index("small")].kind, Kind::kInt8);    // byte
-  EXPECT_EQ(root.fields[root.field_index("letter")].kind, Kind::kUint8);  // char
-  EXPECT_EQ(root.fields[root.field_index("t")].kind, Kind::kTime);
-  EXPECT_EQ(root.fields[root.field_index("d")].kind, Kind::kDuration);
+  EXPECT_EQ(root.fields[root.fieldIndex("fixed")].array_length, 3);
+  EXPECT_EQ(root.fields[root.fieldIndex("small")].kind, Kind::kInt8);    // byte
+  EXPECT_EQ(root.fields[root.fieldIndex("letter")].kind, Kind::kUint8);  // char
+  EXPECT_EQ(root.fields[root.fieldIndex("t")].kind, Kind::kTime);
+  EXPECT_EQ(root.fields[root.fieldIndex("d")].kind, Kind::kDuration);
   EXPECT_FALSE(root.fixed_size.has_value());
 }
 
@@ -139,8 +139,8 @@ TEST(RosMessageSchema, BadDefinitionsAreErrors) {
 }
 
 TEST(RosMessageReader, ReadsNestedArraysStringsTimeByPath) {
-  const MessageSchema s = sample_schema();
-  const Bytes b = sample_bytes();
+  const MessageSchema s = sampleSchema();
+  const Bytes b = sampleBytes();
   const std::vector<std::string> paths{"mode",
                                        "flag",
                                        "ratio",
@@ -168,30 +168,29 @@ TEST(RosMessageReader, ReadsNestedArraysStringsTimeByPath) {
     EXPECT_TRUE(reader.present(k)) << paths[k];
     EXPECT_DOUBLE_EQ(reader.value(k), expected[k]) << paths[k];
   }
-  EXPECT_DOUBLE_EQ(reader.header_stamp(), 100.5);
+  EXPECT_DOUBLE_EQ(reader.headerStamp(), 100.5);
 }
 
 TEST(RosMessageReader, ElementsAMessageDoesNotCarryAreAbsent) {
-  const MessageSchema s = sample_schema();
+  const MessageSchema s = sampleSchema();
   FieldReader reader(s,
                      {"values/5", "values/zz", "items/2/position/x", "items/1/counts/0", "mode"});
-  const Bytes b = sample_bytes();
+  const Bytes b = sampleBytes();
   reader.read(b.data.data(), b.data.size());
   for (std::size_t k = 0; k < 4; ++k) EXPECT_FALSE(reader.present(k)) << k;
   EXPECT_TRUE(reader.present(4));
   // The same reader on a message with three items sees the third.
-  const Bytes more =
-      sample_bytes(0, {{"a", 0, 0, 0, {1}}, {"b", 0, 0, 0, {2}}, {"c", 9, 0, 0, {}}});
+  const Bytes more = sampleBytes(0, {{"a", 0, 0, 0, {1}}, {"b", 0, 0, 0, {2}}, {"c", 9, 0, 0, {}}});
   reader.read(more.data.data(), more.data.size());
   EXPECT_TRUE(reader.present(2));
   EXPECT_DOUBLE_EQ(reader.value(2), 9.0);
   EXPECT_TRUE(reader.present(3));
-  EXPECT_DOUBLE_EQ(reader.header_stamp(), 0.5);  // 0 s + 0.5 s
+  EXPECT_DOUBLE_EQ(reader.headerStamp(), 0.5);  // 0 s + 0.5 s
 }
 
 TEST(RosMessageReader, TruncatedExtendedOrCorruptBytesAreErrors) {
-  const MessageSchema s = sample_schema();
-  const Bytes b = sample_bytes();
+  const MessageSchema s = sampleSchema();
+  const Bytes b = sampleBytes();
   FieldReader reader(s, {"big", "items/1/position/z"});
   // Every truncation, read through a buffer of exactly that size (so a sanitizer would catch
   // any read past it).
@@ -217,9 +216,9 @@ TEST(RosMessageReader, TruncatedExtendedOrCorruptBytesAreErrors) {
   EXPECT_DOUBLE_EQ(reader.value(1), 6.0);
 }
 
-std::string unknown_message(const MessageSchema& s, const Bytes& b, const std::string& path) {
+std::string unknownMessage(const MessageSchema& s, const Bytes& b, const std::string& path) {
   try {
-    lfd::rosmsg::expand_fields(s, b.data.data(), b.data.size(), {path});
+    lfd::rosmsg::expandFields(s, b.data.data(), b.data.size(), {path});
   } catch (const UnknownField& e) {
     return e.what();
   }
@@ -227,9 +226,9 @@ std::string unknown_message(const MessageSchema& s, const Bytes& b, const std::s
 }
 
 TEST(RosMessageReader, UnknownPathsListTheFields) {
-  const MessageSchema s = sample_schema();
-  const Bytes b = sample_bytes();
-  const std::string e = unknown_message(s, b, "items/0/position/w");
+  const MessageSchema s = sampleSchema();
+  const Bytes b = sampleBytes();
+  const std::string e = unknownMessage(s, b, "items/0/position/w");
   EXPECT_NE(e.find("no field 'items/0/position/w'"), std::string::npos) << e;
   EXPECT_NE(e.find("has no field 'w' (it has x, y, z, norm)"), std::string::npos) << e;
   for (const char* listed : {"\n  header/stamp\n", "\n  values/<0..2> or <name: a, bb, c>\n",
@@ -238,30 +237,29 @@ TEST(RosMessageReader, UnknownPathsListTheFields) {
     EXPECT_NE(e.find(listed), std::string::npos) << listed << " not in " << e;
   }
   EXPECT_EQ(e.find("label"), std::string::npos) << "strings are not numbers: " << e;
-  EXPECT_NE(unknown_message(s, b, "label").find("is a string"), std::string::npos);
-  EXPECT_NE(unknown_message(s, b, "values").find("add an index, a name or *"), std::string::npos);
-  EXPECT_NE(unknown_message(s, b, "p").find("with fields x, y, z"), std::string::npos);
-  EXPECT_NE(unknown_message(s, b, "fixed/3").find("has 3 elements"), std::string::npos);
+  EXPECT_NE(unknownMessage(s, b, "label").find("is a string"), std::string::npos);
+  EXPECT_NE(unknownMessage(s, b, "values").find("add an index, a name or *"), std::string::npos);
+  EXPECT_NE(unknownMessage(s, b, "p").find("with fields x, y, z"), std::string::npos);
+  EXPECT_NE(unknownMessage(s, b, "fixed/3").find("has 3 elements"), std::string::npos);
   // Names index variable arrays only: a fixed array's elements mean their position.
-  EXPECT_NE(unknown_message(s, b, "fixed/a").find("float64[3]: index it with a number"),
+  EXPECT_NE(unknownMessage(s, b, "fixed/a").find("float64[3]: index it with a number"),
             std::string::npos);
   const MessageSchema plain = MessageSchema::parse("p/T", "float64[] a\n");
   Bytes two;
   two.put<std::uint32_t>(2).put(1.0).put(2.0);
-  EXPECT_NE(unknown_message(plain, two, "a/x").find("without a string[]"), std::string::npos);
-  EXPECT_NE(unknown_message(s, b, "items/leg/id").find("index it with a number"),
-            std::string::npos);
-  EXPECT_NE(unknown_message(s, b, "mode/x").find("has no fields"), std::string::npos);
+  EXPECT_NE(unknownMessage(plain, two, "a/x").find("without a string[]"), std::string::npos);
+  EXPECT_NE(unknownMessage(s, b, "items/leg/id").find("index it with a number"), std::string::npos);
+  EXPECT_NE(unknownMessage(s, b, "mode/x").find("has no fields"), std::string::npos);
   EXPECT_THROW(FieldReader(s, {"p/w"}), UnknownField);
   EXPECT_THROW(FieldReader(s, {"values/*"}), UnknownField);
   EXPECT_THROW(FieldReader(s, {"a//b"}), UnknownField);
 }
 
 TEST(RosMessageReader, WildcardsExpandOverTheSample) {
-  const MessageSchema s = sample_schema();
-  const Bytes b = sample_bytes();
+  const MessageSchema s = sampleSchema();
+  const Bytes b = sampleBytes();
   auto expand = [&](const std::string& p) {
-    return lfd::rosmsg::expand_fields(s, b.data.data(), b.data.size(), {p});
+    return lfd::rosmsg::expandFields(s, b.data.data(), b.data.size(), {p});
   };
   EXPECT_EQ(expand("values/*"), (std::vector<std::string>{"values/a", "values/bb", "values/c"}));
   EXPECT_EQ(expand("fixed/*"), (std::vector<std::string>{"fixed/0", "fixed/1", "fixed/2"}));
@@ -270,8 +268,8 @@ TEST(RosMessageReader, WildcardsExpandOverTheSample) {
   EXPECT_EQ(expand("items/*/counts/*"),
             (std::vector<std::string>{"items/0/counts/0", "items/0/counts/1"}));
   EXPECT_EQ(expand("/p/x"), (std::vector<std::string>{"p/x"}));
-  EXPECT_EQ(lfd::rosmsg::array_length(s, b.data.data(), b.data.size(), "items"), 2u);
-  EXPECT_EQ(lfd::rosmsg::string_values(s, b.data.data(), b.data.size(), "items/1/id"),
+  EXPECT_EQ(lfd::rosmsg::arrayLength(s, b.data.data(), b.data.size(), "items"), 2u);
+  EXPECT_EQ(lfd::rosmsg::stringValues(s, b.data.data(), b.data.size(), "items/1/id"),
             (std::vector<std::string>{"top"}));
 }
 
@@ -294,7 +292,7 @@ TEST(RosMessageReader, NamesIndexArraysFromTheNearestKeyArray) {
   EXPECT_DOUBLE_EQ(r.value(0), -0.5);
   EXPECT_DOUBLE_EQ(r.value(1), 1.0);
   EXPECT_FALSE(r.present(2));
-  EXPECT_DOUBLE_EQ(r.header_stamp(), 0.0);  // zero stamp: the caller uses the receive time
+  EXPECT_DOUBLE_EQ(r.headerStamp(), 0.0);  // zero stamp: the caller uses the receive time
 
   const MessageSchema state =
       MessageSchema::parse("ctrl/State",
@@ -308,7 +306,7 @@ TEST(RosMessageReader, NamesIndexArraysFromTheNearestKeyArray) {
   s.read(c.data.data(), c.data.size());
   EXPECT_DOUBLE_EQ(s.value(0), 2.0);
   EXPECT_DOUBLE_EQ(s.value(1), -0.1);
-  EXPECT_EQ(lfd::rosmsg::expand_fields(state, c.data.data(), c.data.size(), {"error/positions/*"}),
+  EXPECT_EQ(lfd::rosmsg::expandFields(state, c.data.data(), c.data.size(), {"error/positions/*"}),
             (std::vector<std::string>{"error/positions/j0", "error/positions/j1"}));
 }
 
@@ -319,9 +317,9 @@ namespace {
 // Arrays of messages whose order is not fixed (a world model's objects, /tf's transforms): an
 // element chosen by the value of one of its fields.
 TEST(RosMessageReader, ElementsSelectedByAFieldValue) {
-  const MessageSchema s = sample_schema();
+  const MessageSchema s = sampleSchema();
   const Bytes b =
-      sample_bytes(1, {{"leg", 1, 2, 3, {7}}, {"top", 4, 5, 6, {8, 9}}, {"top", 7, 0, 0, {}}});
+      sampleBytes(1, {{"leg", 1, 2, 3, {7}}, {"top", 4, 5, 6, {8, 9}}, {"top", 7, 0, 0, {}}});
   FieldReader r(s, {"items/id=top/position/x", "items/id=top/counts/1", "items/id=leg/position/z",
                     "items/id=nope/position/x", "items/1/position/y", "header/seq"});
   r.read(b.data.data(), b.data.size());
@@ -332,7 +330,7 @@ TEST(RosMessageReader, ElementsSelectedByAFieldValue) {
   EXPECT_DOUBLE_EQ(r.value(4), 5.0);  // indices and selectors together
   EXPECT_DOUBLE_EQ(r.value(5), 42.0);
   // Reordered elements: the selector follows the element, the index does not.
-  const Bytes swapped = sample_bytes(1, {{"top", 4, 5, 6, {8, 9}}, {"leg", 1, 2, 3, {7}}});
+  const Bytes swapped = sampleBytes(1, {{"top", 4, 5, 6, {8, 9}}, {"leg", 1, 2, 3, {7}}});
   r.read(swapped.data.data(), swapped.data.size());
   EXPECT_DOUBLE_EQ(r.value(0), 4.0);
   EXPECT_DOUBLE_EQ(r.value(2), 3.0);

@@ -11,7 +11,7 @@ namespace {
 
 using Indices = std::vector<std::size_t>;
 
-lfd::FeatureMatrix demo_matrix() {
+lfd::FeatureMatrix demoMatrix() {
   lfd::FeatureMatrix m;
   m.names = {"x"};
   m.data = Eigen::MatrixXd::Zero(1000, 1);
@@ -57,8 +57,8 @@ TEST(SegmentationConsensus, APluralityPrunesTheDemosWithMore) {
              demo({}),
              demo({{100, -28}, {300, -38}, {500, -33}, {700, -20}}),
              demo({{100, -25}, {300, -6}, {500, -32}})};
-  const std::vector<lfd::FeatureMatrix> demos(6, demo_matrix());
-  lfd::agree_on_changepoint_count(demos, true, 0.0, &r);
+  const std::vector<lfd::FeatureMatrix> demos(6, demoMatrix());
+  lfd::agreeOnChangepointCount(demos, true, 0.0, &r);
   EXPECT_EQ(r.demos[4].changepoints, (Indices{300, 500}));
   EXPECT_EQ(r.demos[4].pruned, (Indices{100, 700}));
   EXPECT_EQ(r.demos[5].changepoints, (Indices{100, 500}));
@@ -77,12 +77,12 @@ TEST(SegmentationConsensus, ATieOrTooFewVotesIsNoAgreement) {
              demo({{100, -30}, {300, -20}}),
              demo({{100, -30}, {300, -20}}),
              demo({{100, -30}, {300, -20}})};
-  const std::vector<lfd::FeatureMatrix> demos(6, demo_matrix());
-  lfd::agree_on_changepoint_count(demos, true, 0.0, &r);
+  const std::vector<lfd::FeatureMatrix> demos(6, demoMatrix());
+  lfd::agreeOnChangepointCount(demos, true, 0.0, &r);
   EXPECT_TRUE(r.warnings.empty());
   r.demos.resize(4);
   r.demos[2] = demo({{100, -30}, {300, -20}, {500, -10}});
-  lfd::agree_on_changepoint_count(std::vector<lfd::FeatureMatrix>(4, demo_matrix()), true, 0.0, &r);
+  lfd::agreeOnChangepointCount(std::vector<lfd::FeatureMatrix>(4, demoMatrix()), true, 0.0, &r);
   EXPECT_TRUE(r.warnings.empty());  // counts 1, 1, 3, 2: two votes at most
 }
 
@@ -95,15 +95,15 @@ TEST(SegmentationConsensus, ADemoShortOfTheAgreedCountTakesItsBestInZoneCandidat
              demo({{100, -30}, {300, -20}}), demo({{100, -30}}, {{300, -3}, {700, -1}}),
              demo({}, {{300, -3}})};
   r.demos[4].events.clear();
-  const std::vector<lfd::FeatureMatrix> demos(5, demo_matrix());
-  lfd::agree_on_changepoint_count(demos, true, 1e-2, &r);
+  const std::vector<lfd::FeatureMatrix> demos(5, demoMatrix());
+  lfd::agreeOnChangepointCount(demos, true, 1e-2, &r);
   EXPECT_EQ(r.demos[3].changepoints, (Indices{100, 300}));
   EXPECT_EQ(r.demos[3].added, (Indices{300}));
   EXPECT_NEAR(r.demos[3].added_times[0], 3.0, 1e-12);
   EXPECT_TRUE(r.demos[4].changepoints.empty());
   // Without validation (no zones) nothing is added.
   r.demos[3] = demo({{100, -30}}, {{300, -3}});
-  lfd::agree_on_changepoint_count(demos, false, 1e-2, &r);
+  lfd::agreeOnChangepointCount(demos, false, 1e-2, &r);
   EXPECT_EQ(r.demos[3].changepoints, (Indices{100}));
 }
 

@@ -11,7 +11,7 @@
 namespace {
 
 // Two-phase demonstrations: the gripper closes at 40 %, the touch sensor steps up with it.
-std::vector<lfd::FeatureMatrix> make_demos(int count) {
+std::vector<lfd::FeatureMatrix> makeDemos(int count) {
   std::mt19937 rng(3);
   std::normal_distribution<double> noise(0.0, 1.0);
   std::vector<lfd::FeatureMatrix> demos;
@@ -33,34 +33,34 @@ std::vector<lfd::FeatureMatrix> make_demos(int count) {
 }
 
 TEST(SegmentationMethod, RegistryReturnsEveryMethodByName) {
-  const std::vector<std::string> names = lfd::segmentation_method_names();
+  const std::vector<std::string> names = lfd::segmentationMethodNames();
   EXPECT_EQ(names, (std::vector<std::string>{"zone_search", "paper", "joint"}));
   for (const std::string& name : names) {
-    const auto method = lfd::make_segmentation_method(name);
+    const auto method = lfd::makeSegmentationMethod(name);
     ASSERT_NE(method, nullptr);
     EXPECT_EQ(method->name(), name);
   }
 }
 
 TEST(SegmentationMethod, ProceduresMapOntoRegisteredNames) {
-  for (const std::string& name : lfd::segmentation_method_names())
-    EXPECT_EQ(lfd::to_string(lfd::parse_segmentation_procedure(name)), name);
+  for (const std::string& name : lfd::segmentationMethodNames())
+    EXPECT_EQ(lfd::toString(lfd::parseSegmentationProcedure(name)), name);
 }
 
 TEST(SegmentationMethod, UnknownNameListsTheKnownOnes) {
   try {
-    lfd::make_segmentation_method("zone-search");
+    lfd::makeSegmentationMethod("zone-search");
     FAIL() << "an unknown name must throw";
   } catch (const std::invalid_argument& e) {
     const std::string message = e.what();
     EXPECT_NE(message.find("'zone-search'"), std::string::npos) << message;
-    for (const std::string& name : lfd::segmentation_method_names())
+    for (const std::string& name : lfd::segmentationMethodNames())
       EXPECT_NE(message.find(name), std::string::npos) << message;
   }
 }
 
-void expect_same(const lfd::SegmentationPipelineResult& a,
-                 const lfd::SegmentationPipelineResult& b) {
+void expectSame(const lfd::SegmentationPipelineResult& a,
+                const lfd::SegmentationPipelineResult& b) {
   ASSERT_EQ(a.demos.size(), b.demos.size());
   for (std::size_t d = 0; d < a.demos.size(); ++d) {
     EXPECT_EQ(a.demos[d].changepoints, b.demos[d].changepoints) << "demo " << d;
@@ -76,17 +76,16 @@ void expect_same(const lfd::SegmentationPipelineResult& a,
 }
 
 TEST(SegmentationMethod, SegmentPreparedRunsTheNamedMethod) {
-  const auto demos = make_demos(4);
+  const auto demos = makeDemos(4);
   lfd::SegmentationPipelineConfig config;
   config.seconds = lfd::TimeParameters{};
   config.procedure = lfd::SegmentationProcedure::kZoneSearch;
-  const lfd::PreparedSegmentation prepared = lfd::prepare_segmentation(demos, {"touch"}, config);
-  const auto through_pipeline = lfd::segment_prepared(prepared, demos, config);
+  const lfd::PreparedSegmentation prepared = lfd::prepareSegmentation(demos, {"touch"}, config);
+  const auto through_pipeline = lfd::segmentPrepared(prepared, demos, config);
   const auto direct = lfd::ZoneSearchSegmentation().segment(prepared, demos, config);
-  const auto by_name =
-      lfd::make_segmentation_method("zone_search")->segment(prepared, demos, config);
-  expect_same(through_pipeline, direct);
-  expect_same(through_pipeline, by_name);
+  const auto by_name = lfd::makeSegmentationMethod("zone_search")->segment(prepared, demos, config);
+  expectSame(through_pipeline, direct);
+  expectSame(through_pipeline, by_name);
   // The synthetic grasp is found, so the comparison is not between two empty results.
   for (const auto& demo : direct.demos) EXPECT_FALSE(demo.changepoints.empty());
 }

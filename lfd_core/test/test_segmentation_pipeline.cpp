@@ -17,7 +17,7 @@ struct SyntheticDemo {
   std::size_t grasp = 0;
 };
 
-std::vector<SyntheticDemo> make_demos(int count, unsigned seed = 1) {
+std::vector<SyntheticDemo> makeDemos(int count, unsigned seed = 1) {
   std::mt19937 rng(seed);
   std::normal_distribution<double> noise(0.0, 1.0);
   std::vector<SyntheticDemo> demos;
@@ -52,8 +52,8 @@ std::vector<lfd::FeatureMatrix> matrices(const std::vector<SyntheticDemo>& demos
 }
 
 TEST(SegmentationPipeline, FindsTheGraspChangepointInEveryDemo) {
-  const auto demos = make_demos(4);
-  const auto result = lfd::run_segmentation_pipeline(matrices(demos), {"touch"});
+  const auto demos = makeDemos(4);
+  const auto result = lfd::runSegmentationPipeline(matrices(demos), {"touch"});
   ASSERT_TRUE(result.relevance_computed);
   ASSERT_FALSE(result.selected_features.empty());
   EXPECT_EQ(std::find(result.selected_features.begin(), result.selected_features.end(), "noise"),
@@ -78,7 +78,7 @@ TEST(SegmentationPipeline, FindsTheGraspChangepointInEveryDemo) {
 // one changepoint, so that demo keeps its most significant one and reports the other as pruned;
 // the other demos are untouched.
 TEST(SegmentationPipeline, ConsensusDropsTheExtraChangepointOfOneDemo) {
-  auto demos = make_demos(4);
+  auto demos = makeDemos(4);
   lfd::FeatureMatrix& odd = demos[2].matrix;
   const Eigen::Index slip = static_cast<Eigen::Index>(0.75 * static_cast<double>(odd.rows()));
   odd.data.col(0).tail(odd.rows() - slip).array() += 0.06;
@@ -88,7 +88,7 @@ TEST(SegmentationPipeline, ConsensusDropsTheExtraChangepointOfOneDemo) {
 
   lfd::SegmentationPipelineConfig config;
   config.consensus_count = false;
-  const auto plain = lfd::run_segmentation_pipeline(matrices(demos), {"touch"}, config);
+  const auto plain = lfd::runSegmentationPipeline(matrices(demos), {"touch"}, config);
   const auto& two = plain.demos[2];
   ASSERT_EQ(two.changepoints.size(), 2u);  // the slip is a changepoint on its own
   EXPECT_NEAR(double(two.changepoints[1]), double(slip), 0.1 * odd.rows());
@@ -99,7 +99,7 @@ TEST(SegmentationPipeline, ConsensusDropsTheExtraChangepointOfOneDemo) {
       log_p.at(two.changepoints[0]) < log_p.at(two.changepoints[1]) ? 0 : 1;
 
   config.consensus_count = true;
-  const auto result = lfd::run_segmentation_pipeline(matrices(demos), {"touch"}, config);
+  const auto result = lfd::runSegmentationPipeline(matrices(demos), {"touch"}, config);
   for (std::size_t d = 0; d < demos.size(); ++d) {
     if (d == 2) continue;
     EXPECT_EQ(result.demos[d].changepoints, plain.demos[d].changepoints) << "demo " << d;
@@ -110,7 +110,7 @@ TEST(SegmentationPipeline, ConsensusDropsTheExtraChangepointOfOneDemo) {
   ASSERT_EQ(one.pruned.size(), 1u);
   EXPECT_EQ(one.changepoints[0], two.changepoints[stronger]);
   EXPECT_EQ(one.pruned[0], two.changepoints[1 - stronger]);
-  EXPECT_NEAR(one.pruned_times[0], odd.time_at(one.pruned[0]), 1e-12);
+  EXPECT_NEAR(one.pruned_times[0], odd.timeAt(one.pruned[0]), 1e-12);
   EXPECT_NE(std::find_if(result.warnings.begin(), result.warnings.end(),
                          [](const std::string& w) {
                            return w.find("demonstration 2: 2 changepoints where 3 of the 4") !=
@@ -120,8 +120,8 @@ TEST(SegmentationPipeline, ConsensusDropsTheExtraChangepointOfOneDemo) {
 }
 
 TEST(SegmentationPipeline, SingleDemoFallsBackWithAWarning) {
-  const auto demos = make_demos(1);
-  const auto result = lfd::run_segmentation_pipeline(matrices(demos), {"touch"});
+  const auto demos = makeDemos(1);
+  const auto result = lfd::runSegmentationPipeline(matrices(demos), {"touch"});
   EXPECT_FALSE(result.relevance_computed);
   EXPECT_EQ(result.selected_features, (std::vector<std::string>{"gripper", "speed", "noise"}));
   bool warned = false;
@@ -131,7 +131,7 @@ TEST(SegmentationPipeline, SingleDemoFallsBackWithAWarning) {
 }
 
 TEST(SegmentationPipeline, ConstantFeatureIsIgnoredWithAWarning) {
-  const auto result = lfd::run_segmentation_pipeline(matrices(make_demos(2)), {"touch"});
+  const auto result = lfd::runSegmentationPipeline(matrices(makeDemos(2)), {"touch"});
   bool warned = false;
   for (const auto& w : result.warnings)
     warned = warned || w.find("'constant'") != std::string::npos;
@@ -139,11 +139,11 @@ TEST(SegmentationPipeline, ConstantFeatureIsIgnoredWithAWarning) {
   EXPECT_THROW(result.relevance.feature("constant"), std::invalid_argument);
 }
 
-void expect_error(const std::vector<lfd::FeatureMatrix>& demos, const std::string& needle,
-                  const lfd::SegmentationPipelineConfig& config = {},
-                  const std::vector<std::string>& sensors = {"touch"}) {
+void expectError(const std::vector<lfd::FeatureMatrix>& demos, const std::string& needle,
+                 const lfd::SegmentationPipelineConfig& config = {},
+                 const std::vector<std::string>& sensors = {"touch"}) {
   try {
-    lfd::run_segmentation_pipeline(demos, sensors, config);
+    lfd::runSegmentationPipeline(demos, sensors, config);
     FAIL() << "expected an error mentioning '" << needle << "'";
   } catch (const std::invalid_argument& e) {
     EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
@@ -151,42 +151,42 @@ void expect_error(const std::vector<lfd::FeatureMatrix>& demos, const std::strin
 }
 
 TEST(SegmentationPipeline, BadInputGivesClearErrors) {
-  const auto good = matrices(make_demos(3));
-  expect_error({}, "no demonstrations");
+  const auto good = matrices(makeDemos(3));
+  expectError({}, "no demonstrations");
 
   auto renamed = good;
   renamed[2].names[1] = "velocity";
-  expect_error(renamed, "features differ");
+  expectError(renamed, "features differ");
 
   auto with_nan = good;
   with_nan[1].data(7, 0) = std::nan("");
-  expect_error(with_nan, "demonstration 1: feature 'gripper' has NaN");
+  expectError(with_nan, "demonstration 1: feature 'gripper' has NaN");
 
   auto with_inf = good;
   with_inf[0].data(3, 4) = INFINITY;
-  expect_error(with_inf, "feature 'touch' has Inf");
+  expectError(with_inf, "feature 'touch' has Inf");
 
   lfd::SegmentationPipelineConfig long_min_s;
   long_min_s.segmentation.min_segment_length = 300;
-  expect_error(good, "2 * min_s", long_min_s);
+  expectError(good, "2 * min_s", long_min_s);
 
-  expect_error(good, "sensor feature 'missing'", {}, {"missing"});
-  expect_error(good, "every feature is a sensor", {},
-               {"gripper", "speed", "noise", "constant", "touch"});
+  expectError(good, "sensor feature 'missing'", {}, {"missing"});
+  expectError(good, "every feature is a sensor", {},
+              {"gripper", "speed", "noise", "constant", "touch"});
 
   auto all_constant = good;
   for (auto& m : all_constant) m.data.leftCols(3).setConstant(1.0);
-  expect_error(all_constant, "constant");
+  expectError(all_constant, "constant");
 
   auto empty = good;
   empty[0].data.resize(0, 5);
   empty[0].time.clear();
-  expect_error(empty, "demonstration 0");
+  expectError(empty, "demonstration 0");
 }
 
 // The same grasp, recorded at any rate: a continuous-time demo (gripper closing over 0.2 s at
 // `grasp_s`, one speed bump per phase, touch stepping up at the grasp) sampled at `rate` Hz.
-lfd::FeatureMatrix sampled_demo(double rate, double duration, double grasp_s, unsigned seed) {
+lfd::FeatureMatrix sampledDemo(double rate, double duration, double grasp_s, unsigned seed) {
   std::mt19937 rng(seed);
   std::normal_distribution<double> noise(0.0, 1.0);
   lfd::FeatureMatrix m;
@@ -218,8 +218,8 @@ TEST(SegmentationPipeline, SameChangepointsAtAnyRate) {
   for (double rate : {25.0, 50.0, 100.0, 200.0}) {
     std::vector<lfd::FeatureMatrix> demos;
     for (std::size_t d = 0; d < grasps.size(); ++d)
-      demos.push_back(sampled_demo(rate, 8.0, grasps[d], static_cast<unsigned>(7 + d)));
-    const auto result = lfd::run_segmentation_pipeline(demos, {"touch"}, config);
+      demos.push_back(sampledDemo(rate, 8.0, grasps[d], static_cast<unsigned>(7 + d)));
+    const auto result = lfd::runSegmentationPipeline(demos, {"touch"}, config);
     for (std::size_t d = 0; d < grasps.size(); ++d) {
       EXPECT_NEAR(result.demos[d].sample_rate, rate, 1e-6);
       EXPECT_EQ(result.demos[d].min_segment_length, static_cast<std::size_t>(std::lround(rate)));
@@ -238,18 +238,18 @@ TEST(SegmentationPipeline, SameChangepointsAtAnyRate) {
 }
 
 TEST(SegmentationPipeline, SecondsNeedAClock) {
-  auto demos = matrices(make_demos(3));
+  auto demos = matrices(makeDemos(3));
   demos[1].time.clear();
   lfd::SegmentationPipelineConfig config;
   config.seconds = lfd::TimeParameters{};
-  expect_error(demos, "demonstration 1: no clock", config);
+  expectError(demos, "demonstration 1: no clock", config);
 }
 
 // A dead (constant) sensor: a warning naming it, no zone, no changepoint, no crash.
 TEST(SegmentationPipeline, DeadSensorWarnsAndGivesNoZone) {
-  auto demos = matrices(make_demos(3));
+  auto demos = matrices(makeDemos(3));
   demos[1].data.col(4).setConstant(0.0);
-  const auto result = lfd::run_segmentation_pipeline(demos, {"touch"});
+  const auto result = lfd::runSegmentationPipeline(demos, {"touch"});
   EXPECT_TRUE(result.demos[1].zones.empty());
   EXPECT_TRUE(result.demos[1].changepoints.empty());
   EXPECT_NE(std::find_if(result.warnings.begin(), result.warnings.end(),
@@ -264,14 +264,14 @@ TEST(SegmentationPipeline, DeadSensorWarnsAndGivesNoZone) {
 // The feature selection does not depend on the combination: preparing once and segmenting with
 // each method gives what a full run per method gives.
 TEST(SegmentationPipeline, OneFeatureSelectionServesEveryCombination) {
-  const auto demos = matrices(make_demos(4));
-  const lfd::PreparedSegmentation prepared = lfd::prepare_segmentation(demos, {"touch"});
+  const auto demos = matrices(makeDemos(4));
+  const lfd::PreparedSegmentation prepared = lfd::prepareSegmentation(demos, {"touch"});
   EXPECT_TRUE(prepared.base.demos.empty());
   for (const char* name : {"average", "weighted_product", "distance_average"}) {
     lfd::SegmentationPipelineConfig config;
-    config.segmentation.combination = lfd::parse_profile_combination(name);
-    const auto shared = lfd::segment_prepared(prepared, demos, config);
-    const auto full = lfd::run_segmentation_pipeline(demos, {"touch"}, config);
+    config.segmentation.combination = lfd::parseProfileCombination(name);
+    const auto shared = lfd::segmentPrepared(prepared, demos, config);
+    const auto full = lfd::runSegmentationPipeline(demos, {"touch"}, config);
     EXPECT_EQ(shared.selected_features, full.selected_features) << name;
     ASSERT_EQ(shared.demos.size(), full.demos.size());
     for (std::size_t d = 0; d < demos.size(); ++d)
@@ -282,12 +282,12 @@ TEST(SegmentationPipeline, OneFeatureSelectionServesEveryCombination) {
 // The paper's procedure: paper_candidates candidates anywhere, none anchored, then the zone
 // filter: the accepted ones are the candidates inside a zone, the rejected ones the others.
 TEST(SegmentationPipeline, PaperProcedureFiltersCandidatesFoundAnywhere) {
-  const auto demos = matrices(make_demos(4));
+  const auto demos = matrices(makeDemos(4));
   lfd::SegmentationPipelineConfig config;
   config.procedure = lfd::SegmentationProcedure::kPaper;
   config.paper_candidates = 3;
   config.segmentation.min_segment_length = 30;
-  const auto result = lfd::run_segmentation_pipeline(demos, {"touch"}, config);
+  const auto result = lfd::runSegmentationPipeline(demos, {"touch"}, config);
   for (const lfd::DemoSegmentationResult& d : result.demos) {
     EXPECT_EQ(d.clasp.changepoints.size(), 3u);
     EXPECT_EQ(d.changepoints.size() + d.rejected.size(), 3u);
@@ -299,17 +299,17 @@ TEST(SegmentationPipeline, PaperProcedureFiltersCandidatesFoundAnywhere) {
       EXPECT_TRUE(std::none_of(d.zones.begin(), d.zones.end(),
                                [&](const lfd::Interval& z) { return z.contains(cp); }));
   }
-  EXPECT_EQ(lfd::parse_segmentation_procedure("paper"), lfd::SegmentationProcedure::kPaper);
-  EXPECT_THROW(lfd::parse_segmentation_procedure("papers"), std::invalid_argument);
+  EXPECT_EQ(lfd::parseSegmentationProcedure("paper"), lfd::SegmentationProcedure::kPaper);
+  EXPECT_THROW(lfd::parseSegmentationProcedure("papers"), std::invalid_argument);
 }
 
 // Consensus counts only the demos with evidence: three demos whose sensor is dead (no event, so
 // no changepoint) must not out-vote the one demo whose changepoint has its own sensory event.
 TEST(SegmentationPipeline, DemosWithoutEventsDoNotVote) {
-  auto synthetic = make_demos(5);
+  auto synthetic = makeDemos(5);
   auto demos = matrices(synthetic);
   for (std::size_t d : {1u, 2u, 3u}) demos[d].data.col(4).setConstant(0.0);
-  const auto result = lfd::run_segmentation_pipeline(demos, {"touch"});
+  const auto result = lfd::runSegmentationPipeline(demos, {"touch"});
   for (std::size_t d : {0u, 4u}) {
     ASSERT_EQ(result.demos[d].changepoints.size(), 1u) << "demo " << d;
     EXPECT_TRUE(result.demos[d].pruned.empty()) << "demo " << d;

@@ -16,7 +16,7 @@ using lfd::SensoryEventConfig;
 using Events = std::vector<std::size_t>;
 using Zones = std::vector<Interval>;
 
-SensoryEventConfig paper_literal() {
+SensoryEventConfig paperLiteral() {
   SensoryEventConfig c;
   c.median_window = 1;
   c.noise_floor_sigmas = 0.0;
@@ -24,7 +24,7 @@ SensoryEventConfig paper_literal() {
   return c;
 }
 
-Eigen::VectorXd from_diffs(const std::vector<double>& diffs) {
+Eigen::VectorXd fromDiffs(const std::vector<double>& diffs) {
   Eigen::VectorXd x(static_cast<Eigen::Index>(diffs.size() + 1));
   x[0] = 0.0;
   for (std::size_t i = 0; i < diffs.size(); ++i)
@@ -35,38 +35,38 @@ Eigen::VectorXd from_diffs(const std::vector<double>& diffs) {
 TEST(SensoryEvents, StepGivesOnAndOffEventForBothSigns) {
   Eigen::VectorXd up = Eigen::VectorXd::Zero(200);
   up.tail(100).setConstant(1.0);
-  EXPECT_EQ(lfd::detect_sensory_events(up, paper_literal()), (Events{100, 101}));
-  EXPECT_EQ(lfd::detect_sensory_events(up), (Events{100, 101}));  // defaults keep clean steps
-  const Eigen::VectorXd down = -up;                               // high -> low
-  EXPECT_EQ(lfd::detect_sensory_events(down, paper_literal()), (Events{100, 101}));
+  EXPECT_EQ(lfd::detectSensoryEvents(up, paperLiteral()), (Events{100, 101}));
+  EXPECT_EQ(lfd::detectSensoryEvents(up), (Events{100, 101}));  // defaults keep clean steps
+  const Eigen::VectorXd down = -up;                             // high -> low
+  EXPECT_EQ(lfd::detectSensoryEvents(down, paperLiteral()), (Events{100, 101}));
 }
 
 TEST(SensoryEvents, PulseGivesBeginningAndEndOfBothEdges) {
   Eigen::VectorXd x = Eigen::VectorXd::Zero(100);
   x.segment(50, 10).setConstant(2.0);
-  EXPECT_EQ(lfd::detect_sensory_events(x, paper_literal()), (Events{50, 51, 60, 61}));
+  EXPECT_EQ(lfd::detectSensoryEvents(x, paperLiteral()), (Events{50, 51, 60, 61}));
 }
 
 TEST(SensoryEvents, ThresholdIsARatioOfTheLargestDifference) {
   // |diff| at t = 1..7: 0.1 0.5 1.0 0.3 0.15 0.0 0.0 -> threshold 0.4.
-  const Eigen::VectorXd x = from_diffs({0.1, 0.5, 1.0, 0.3, 0.15, 0.0, 0.0});
-  EXPECT_EQ(lfd::detect_sensory_events(x, paper_literal()), (Events{2, 4}));
-  SensoryEventConfig hyst = paper_literal();
+  const Eigen::VectorXd x = fromDiffs({0.1, 0.5, 1.0, 0.3, 0.15, 0.0, 0.0});
+  EXPECT_EQ(lfd::detectSensoryEvents(x, paperLiteral()), (Events{2, 4}));
+  SensoryEventConfig hyst = paperLiteral();
   hyst.hysteresis = 0.5;  // stays active until |diff| <= 0.2
-  EXPECT_EQ(lfd::detect_sensory_events(x, hyst), (Events{2, 5}));
-  SensoryEventConfig high = paper_literal();
+  EXPECT_EQ(lfd::detectSensoryEvents(x, hyst), (Events{2, 5}));
+  SensoryEventConfig high = paperLiteral();
   high.threshold_ratio = 0.9;
-  EXPECT_EQ(lfd::detect_sensory_events(x, high), (Events{3, 4}));
+  EXPECT_EQ(lfd::detectSensoryEvents(x, high), (Events{3, 4}));
 }
 
 TEST(SensoryEvents, ActivityRunningToTheEndHasNoOffEvent) {
-  const Eigen::VectorXd x = from_diffs({0.0, 0.0, 1.0, 1.0, 1.0});
-  EXPECT_EQ(lfd::detect_sensory_events(x, paper_literal()), (Events{3}));
+  const Eigen::VectorXd x = fromDiffs({0.0, 0.0, 1.0, 1.0, 1.0});
+  EXPECT_EQ(lfd::detectSensoryEvents(x, paperLiteral()), (Events{3}));
 }
 
 TEST(SensoryEvents, ConstantOrTinySignalsHaveNoEvents) {
-  EXPECT_TRUE(lfd::detect_sensory_events(Eigen::VectorXd::Constant(50, 4.0)).empty());
-  EXPECT_TRUE(lfd::detect_sensory_events(Eigen::VectorXd::Zero(1)).empty());
+  EXPECT_TRUE(lfd::detectSensoryEvents(Eigen::VectorXd::Constant(50, 4.0)).empty());
+  EXPECT_TRUE(lfd::detectSensoryEvents(Eigen::VectorXd::Zero(1)).empty());
 }
 
 TEST(SensoryEvents, NoiseFloorAndMedianKeepNoiseFromFloodingEvents) {
@@ -80,31 +80,31 @@ TEST(SensoryEvents, NoiseFloorAndMedianKeepNoiseFromFloodingEvents) {
   }
   spiky[400] = 5.0;  // one-sample glitch, larger than the real step
   // Paper-literal: 0.4 x max of pure noise is crossed everywhere.
-  EXPECT_GT(lfd::detect_sensory_events(pure, paper_literal()).size(), 20u);
-  EXPECT_TRUE(lfd::detect_sensory_events(pure).empty());
-  const Events on_step = lfd::detect_sensory_events(step);
+  EXPECT_GT(lfd::detectSensoryEvents(pure, paperLiteral()).size(), 20u);
+  EXPECT_TRUE(lfd::detectSensoryEvents(pure).empty());
+  const Events on_step = lfd::detectSensoryEvents(step);
   ASSERT_FALSE(on_step.empty());
   for (std::size_t e : on_step) EXPECT_NEAR(static_cast<double>(e), 1000.0, 4.0);
   // The glitch dominates the literal rule (the real step is below 0.4 x 5) ...
-  const Events literal = lfd::detect_sensory_events(spiky, paper_literal());
+  const Events literal = lfd::detectSensoryEvents(spiky, paperLiteral());
   ASSERT_FALSE(literal.empty());
   EXPECT_EQ(literal.front(), 400u);
   // ... while the median filter removes it and finds the step.
-  const Events robust = lfd::detect_sensory_events(spiky);
+  const Events robust = lfd::detectSensoryEvents(spiky);
   ASSERT_FALSE(robust.empty());
   for (std::size_t e : robust) EXPECT_NEAR(static_cast<double>(e), 1500.0, 3.0);
 }
 
 TEST(SensoryEvents, MinActiveSamplesAndMergeGap) {
   // Two bursts (t = 3 and t = 6..7) separated by two quiet samples.
-  const Eigen::VectorXd x = from_diffs({0, 0, 1.0, 0, 0, 1.0, 1.0, 0, 0, 0});
-  EXPECT_EQ(lfd::detect_sensory_events(x, paper_literal()), (Events{3, 4, 6, 8}));
-  SensoryEventConfig merged = paper_literal();
+  const Eigen::VectorXd x = fromDiffs({0, 0, 1.0, 0, 0, 1.0, 1.0, 0, 0, 0});
+  EXPECT_EQ(lfd::detectSensoryEvents(x, paperLiteral()), (Events{3, 4, 6, 8}));
+  SensoryEventConfig merged = paperLiteral();
   merged.merge_gap = 2;
-  EXPECT_EQ(lfd::detect_sensory_events(x, merged), (Events{3, 8}));
-  SensoryEventConfig longer = paper_literal();
+  EXPECT_EQ(lfd::detectSensoryEvents(x, merged), (Events{3, 8}));
+  SensoryEventConfig longer = paperLiteral();
   longer.min_active_samples = 2;
-  EXPECT_EQ(lfd::detect_sensory_events(x, longer), (Events{6, 8}));
+  EXPECT_EQ(lfd::detectSensoryEvents(x, longer), (Events{6, 8}));
 }
 
 // A contact seen by a chattering sensor: quiet, then 0..3 noise-like chatter for 150 samples with
@@ -119,12 +119,12 @@ TEST(SensoryEvents, LaggedLevelDifferenceSeesContactNotSpikesOrChatter) {
   SensoryEventConfig paper;  // lag 1: the spike and every chatter edge are events
   paper.median_window = 1;
   paper.noise_floor_sigmas = 0.0;
-  EXPECT_GT(lfd::detect_sensory_events(x, paper).size(), 6u);
+  EXPECT_GT(lfd::detectSensoryEvents(x, paper).size(), 6u);
   SensoryEventConfig level;
   level.median_window = 13;
   level.difference_lag = 13;
   level.merge_gap = 50;
-  const Events events = lfd::detect_sensory_events(x, level);
+  const Events events = lfd::detectSensoryEvents(x, level);
   ASSERT_EQ(events.size(), 2u) << ::testing::PrintToString(events);
   // Within a lag and a half: the median needs half its window of chatter before its level rises.
   EXPECT_NEAR(static_cast<double>(events[0]), 150.0, 20.0);
@@ -133,7 +133,7 @@ TEST(SensoryEvents, LaggedLevelDifferenceSeesContactNotSpikesOrChatter) {
 
 // Hand-made sensor signals at 50 Hz with the settings of config/segmentation.yaml (0.26 s median,
 // 0.5 s lag, 1 s merge gap, 5.5 sigma noise floor from 1 s blocks).
-SensoryEventConfig config_at_50hz(lfd::EventThreshold threshold) {
+SensoryEventConfig configAt50hz(lfd::EventThreshold threshold) {
   SensoryEventConfig c;
   c.threshold = threshold;
   c.median_window = 13;
@@ -159,14 +159,14 @@ TEST(SensoryEvents, OnsetAfterALongOscillatingContact) {
     if (s >= 1.0 && s < 19.0) x[t] += 4.0 + 1.5 * std::sin(2 * M_PI * 1.3 * s) + chatter(rng);
     if (t >= 1050) x[t] += 1.0;
   }
-  SensoryEventConfig local = config_at_50hz(lfd::EventThreshold::kNoise);
-  const Events events = lfd::detect_sensory_events(x, local);
+  SensoryEventConfig local = configAt50hz(lfd::EventThreshold::kNoise);
+  const Events events = lfd::detectSensoryEvents(x, local);
   ASSERT_FALSE(events.empty());
   EXPECT_NEAR(static_cast<double>(events.back()), 1050.0, 3.0) << ::testing::PrintToString(events);
   EXPECT_NEAR(static_cast<double>(events.front()), 50.0, 3.0) << ::testing::PrintToString(events);
   SensoryEventConfig global = local;
   global.noise_block = 0;
-  const Events missed = lfd::detect_sensory_events(x, global);
+  const Events missed = lfd::detectSensoryEvents(x, global);
   EXPECT_TRUE(missed.empty() || missed.back() < 1000) << ::testing::PrintToString(missed);
 }
 
@@ -179,7 +179,7 @@ TEST(SensoryEvents, SlowForceRampGivesItsStartAndEnd) {
   for (Eigen::Index t = 0; t < x.size(); ++t)
     x[t] = 5.0 * std::clamp((t - 200.0) / 100.0, 0.0, 1.0) + g(rng);
   for (auto mode : {lfd::EventThreshold::kRatioOfMax, lfd::EventThreshold::kNoise}) {
-    const Events events = lfd::detect_sensory_events(x, config_at_50hz(mode));
+    const Events events = lfd::detectSensoryEvents(x, configAt50hz(mode));
     ASSERT_EQ(events.size(), 2u) << ::testing::PrintToString(events);
     EXPECT_NEAR(static_cast<double>(events[0]), 200.0, 7.5);  // 0.15 s
     EXPECT_NEAR(static_cast<double>(events[1]), 300.0, 7.5);
@@ -195,7 +195,7 @@ TEST(SensoryEvents, StaleSensorValueIsNotTakenAsTheNoise) {
   Eigen::VectorXd x(1000);
   for (Eigen::Index t = 0; t < x.size(); ++t)
     x[t] = t < 300 ? (t >= 150 ? 2.0 : 0.0) + g(rng) : x[299];
-  const Events events = lfd::detect_sensory_events(x, config_at_50hz(lfd::EventThreshold::kNoise));
+  const Events events = lfd::detectSensoryEvents(x, configAt50hz(lfd::EventThreshold::kNoise));
   ASSERT_EQ(events.size(), 1u) << ::testing::PrintToString(events);
   EXPECT_NEAR(static_cast<double>(events[0]), 150.0, 3.0);
 }
@@ -203,42 +203,41 @@ TEST(SensoryEvents, StaleSensorValueIsNotTakenAsTheNoise) {
 TEST(SensoryEvents, DeadSensorHasNoEvents) {
   for (auto mode : {lfd::EventThreshold::kRatioOfMax, lfd::EventThreshold::kNoise})
     EXPECT_TRUE(
-        lfd::detect_sensory_events(Eigen::VectorXd::Constant(500, 3.3), config_at_50hz(mode))
-            .empty());
-  EXPECT_EQ(lfd::parse_event_threshold("noise"), lfd::EventThreshold::kNoise);
-  EXPECT_THROW(lfd::parse_event_threshold("max"), std::invalid_argument);
+        lfd::detectSensoryEvents(Eigen::VectorXd::Constant(500, 3.3), configAt50hz(mode)).empty());
+  EXPECT_EQ(lfd::parseEventThreshold("noise"), lfd::EventThreshold::kNoise);
+  EXPECT_THROW(lfd::parseEventThreshold("max"), std::invalid_argument);
 }
 
 TEST(SensoryEvents, RejectsBadConfigAndInput) {
   {
     SensoryEventConfig c;
     c.difference_lag = 0;
-    EXPECT_THROW(lfd::detect_sensory_events(Eigen::VectorXd::Zero(10), c), std::invalid_argument);
+    EXPECT_THROW(lfd::detectSensoryEvents(Eigen::VectorXd::Zero(10), c), std::invalid_argument);
   }
   SensoryEventConfig c;
   c.threshold_ratio = 0.0;
-  EXPECT_THROW(lfd::detect_sensory_events(Eigen::VectorXd::Zero(5), c), std::invalid_argument);
+  EXPECT_THROW(lfd::detectSensoryEvents(Eigen::VectorXd::Zero(5), c), std::invalid_argument);
   c = SensoryEventConfig{};
   c.hysteresis = 1.5;
-  EXPECT_THROW(lfd::detect_sensory_events(Eigen::VectorXd::Zero(5), c), std::invalid_argument);
+  EXPECT_THROW(lfd::detectSensoryEvents(Eigen::VectorXd::Zero(5), c), std::invalid_argument);
   Eigen::VectorXd x = Eigen::VectorXd::Zero(5);
   x[2] = std::nan("");
-  EXPECT_THROW(lfd::detect_sensory_events(x), std::invalid_argument);
+  EXPECT_THROW(lfd::detectSensoryEvents(x), std::invalid_argument);
 }
 
 TEST(ConfidenceZones, EquationOneWithClippingAndMerging) {
-  EXPECT_EQ(lfd::confidence_zones({10, 50}, 20, 100), (Zones{{0, 20}, {40, 60}}));
-  EXPECT_EQ(lfd::confidence_zones({3}, 20, 100), (Zones{{0, 13}}));       // clipped at 0
-  EXPECT_EQ(lfd::confidence_zones({95}, 20, 100), (Zones{{85, 100}}));    // clipped at len(T)
-  EXPECT_EQ(lfd::confidence_zones({25, 10}, 20, 100), (Zones{{0, 35}}));  // overlap merges
-  EXPECT_EQ(lfd::confidence_zones({10, 31}, 20, 100), (Zones{{0, 41}}));  // touching merges
-  EXPECT_EQ(lfd::confidence_zones({10, 32}, 20, 100), (Zones{{0, 20}, {22, 42}}));
-  EXPECT_EQ(lfd::confidence_zones({50}, 21, 100), (Zones{{40, 60}}));  // min_s / 2 = 10
-  EXPECT_TRUE(lfd::confidence_zones({}, 20, 100).empty());
+  EXPECT_EQ(lfd::confidenceZones({10, 50}, 20, 100), (Zones{{0, 20}, {40, 60}}));
+  EXPECT_EQ(lfd::confidenceZones({3}, 20, 100), (Zones{{0, 13}}));       // clipped at 0
+  EXPECT_EQ(lfd::confidenceZones({95}, 20, 100), (Zones{{85, 100}}));    // clipped at len(T)
+  EXPECT_EQ(lfd::confidenceZones({25, 10}, 20, 100), (Zones{{0, 35}}));  // overlap merges
+  EXPECT_EQ(lfd::confidenceZones({10, 31}, 20, 100), (Zones{{0, 41}}));  // touching merges
+  EXPECT_EQ(lfd::confidenceZones({10, 32}, 20, 100), (Zones{{0, 20}, {22, 42}}));
+  EXPECT_EQ(lfd::confidenceZones({50}, 21, 100), (Zones{{40, 60}}));  // min_s / 2 = 10
+  EXPECT_TRUE(lfd::confidenceZones({}, 20, 100).empty());
 }
 
 TEST(ConfidenceZones, ValidationAcceptsInsideAndRejectsOutside) {
-  const auto v = lfd::validate_with_zones({70, 5, 30, 55, 60, 39}, {{0, 20}, {40, 60}});
+  const auto v = lfd::validateWithZones({70, 5, 30, 55, 60, 39}, {{0, 20}, {40, 60}});
   EXPECT_EQ(v.accepted, (Events{5, 55, 60}));  // zone bounds are inclusive
   EXPECT_EQ(v.rejected, (Events{30, 39, 70}));
 }
@@ -247,7 +246,7 @@ TEST(ConfidenceZones, FullValidationOverSeveralSensors) {
   Eigen::MatrixXd sensors = Eigen::MatrixXd::Zero(300, 2);
   sensors.block(100, 0, 200, 1).setConstant(1.0);  // touch from t = 100 on
   sensors.block(250, 1, 50, 1).setConstant(-3.0);  // force drop at t = 250
-  const auto v = lfd::validate_changepoints({90, 160, 240, 280}, sensors, 40);
+  const auto v = lfd::validateChangepoints({90, 160, 240, 280}, sensors, 40);
   EXPECT_EQ(v.events_per_sensor[0], (Events{100, 101}));
   EXPECT_EQ(v.events_per_sensor[1], (Events{250, 251}));
   EXPECT_EQ(v.events, (Events{100, 101, 250, 251}));
@@ -255,7 +254,7 @@ TEST(ConfidenceZones, FullValidationOverSeveralSensors) {
   EXPECT_EQ(v.accepted, (Events{90, 240}));
   EXPECT_EQ(v.rejected, (Events{160, 280}));
   // No sensor at all: nothing can be confirmed.
-  const auto none = lfd::validate_changepoints({90}, Eigen::MatrixXd(300, 0), 40);
+  const auto none = lfd::validateChangepoints({90}, Eigen::MatrixXd(300, 0), 40);
   EXPECT_TRUE(none.zones.empty());
   EXPECT_EQ(none.rejected, (Events{90}));
 }
@@ -265,8 +264,8 @@ TEST(ConfidenceZones, FullValidationOverSeveralSensors) {
 namespace {
 
 // The settings of config/segmentation.yaml at 50 Hz: quiet-excursion floor, fitted placement.
-SensoryEventConfig yaml_at_50hz() {
-  SensoryEventConfig c = config_at_50hz(lfd::EventThreshold::kRatioOfMax);
+SensoryEventConfig yamlAt50hz() {
+  SensoryEventConfig c = configAt50hz(lfd::EventThreshold::kRatioOfMax);
   c.noise_floor_sigmas = 0.0;
   c.noise_floor_excursions = 5.0;
   c.placement = lfd::EventPlacement::kFit;
@@ -287,15 +286,15 @@ TEST(SensoryEvents, DriftWithoutContactNeedsTheQuietExcursionFloor) {
     drift += 0.03 * g(rng);
     x[t] = drift + 0.05 * g(rng);
   }
-  SensoryEventConfig sigma = yaml_at_50hz();
+  SensoryEventConfig sigma = yamlAt50hz();
   sigma.noise_floor_excursions = 0.0;
   sigma.noise_floor_sigmas = 5.5;
-  EXPECT_GE(lfd::detect_sensory_events(x, sigma).size(), 2u);
-  EXPECT_TRUE(lfd::detect_sensory_events(x, yaml_at_50hz()).empty());
+  EXPECT_GE(lfd::detectSensoryEvents(x, sigma).size(), 2u);
+  EXPECT_TRUE(lfd::detectSensoryEvents(x, yamlAt50hz()).empty());
   // A real contact on top of the same drift still makes its events.
   Eigen::VectorXd touched = x;
   touched.segment(700, 300).array() += 6.0;
-  const Events events = lfd::detect_sensory_events(touched, yaml_at_50hz());
+  const Events events = lfd::detectSensoryEvents(touched, yamlAt50hz());
   ASSERT_EQ(events.size(), 2u) << ::testing::PrintToString(events);
   EXPECT_NEAR(static_cast<double>(events[0]), 700.0, 3.0);
   EXPECT_NEAR(static_cast<double>(events[1]), 1000.0, 3.0);
@@ -317,9 +316,9 @@ TEST(SensoryEvents, ABusyDemoWithOneQuietSecondKeepsItsPresses) {
     for (const auto& [on, level] : presses)
       if (t >= on && t < on + 75) force[t] += level;
   }
-  SensoryEventConfig joint = yaml_at_50hz();
+  SensoryEventConfig joint = yamlAt50hz();
   joint.merge_gap = 25;  // the joint segmentation's 0.5 s: a lift is a rest of its own
-  const Events events = lfd::detect_sensory_events(force, joint);
+  const Events events = lfd::detectSensoryEvents(force, joint);
   ASSERT_EQ(events.size(), 2 * presses.size()) << ::testing::PrintToString(events);
   for (std::size_t k = 0; k < presses.size(); ++k) {
     EXPECT_NEAR(static_cast<double>(events[2 * k]), static_cast<double>(presses[k].first), 3.0);
@@ -339,7 +338,7 @@ TEST(SensoryEvents, FittedEventsAtTheStartAndEndOfSlowRamps) {
     const double down = std::clamp((t - 500.0) / 30.0, 0.0, 1.0);
     x[t] = 3.0 * (up - down) + g(rng);
   }
-  const auto events = lfd::detect_sensory_event_details(x, yaml_at_50hz());
+  const auto events = lfd::detectSensoryEventDetails(x, yamlAt50hz());
   std::vector<std::size_t> rest_edges;
   for (const lfd::SensoryEvent& e : events)
     if (e.rest_edge) rest_edges.push_back(e.index);
@@ -361,13 +360,13 @@ TEST(SensoryEvents, OnePadLettingGoWhileTheOtherHoldsIsNoRestEdge) {
       if (d.rest_edge) out.push_back(d.index);
     return out;
   };
-  const lfd::SensorEvents one = lfd::detect_sensor_events(pads, yaml_at_50hz(), {0, 0});
+  const lfd::SensorEvents one = lfd::detectSensorEvents(pads, yamlAt50hz(), {0, 0});
   EXPECT_EQ(rest_edges(one), (Events{200, 500}));
   EXPECT_EQ(one.zone_events, (Events{200, 500}));
   EXPECT_EQ(one.all.size(), 4u);
-  const lfd::SensorEvents two = lfd::detect_sensor_events(pads, yaml_at_50hz(), {0, 1});
+  const lfd::SensorEvents two = lfd::detectSensorEvents(pads, yamlAt50hz(), {0, 1});
   EXPECT_EQ(rest_edges(two), (Events{200, 325, 350, 500}));
-  EXPECT_THROW(lfd::detect_sensor_events(pads, yaml_at_50hz(), {0}), std::invalid_argument);
+  EXPECT_THROW(lfd::detectSensorEvents(pads, yamlAt50hz(), {0}), std::invalid_argument);
 }
 
 // A wrist F/T pressing and wiping, at 50 Hz: the press force (10 N) from 2 s, the friction (4 N)
@@ -381,9 +380,9 @@ TEST(SensoryEvents, TheSensorLeavesRestWithItsFirstChannelAndRegainsItWithItsLas
   for (Eigen::Index t = 100; t < 430; ++t)
     wrench(t, 0) = 10.0 * std::min(1.0, (430.0 - static_cast<double>(t)) / 30.0);
   wrench.block(110, 1, 300, 1).setConstant(4.0);
-  const lfd::SensorEvents e = lfd::detect_sensor_events(wrench, yaml_at_50hz(), {0, 0});
+  const lfd::SensorEvents e = lfd::detectSensorEvents(wrench, yamlAt50hz(), {0, 0});
   EXPECT_EQ(e.zone_events, (Events{100, 430})) << ::testing::PrintToString(e.all);
-  const lfd::SensorEvents apart = lfd::detect_sensor_events(wrench, yaml_at_50hz(), {0, 1});
+  const lfd::SensorEvents apart = lfd::detectSensorEvents(wrench, yamlAt50hz(), {0, 1});
   EXPECT_EQ(apart.zone_events, (Events{100, 110, 410, 430}));
 }
 
@@ -402,7 +401,7 @@ TEST(SensoryEvents, AChannelWithinItsNoiseDoesNotKeepTheSensorFromRest) {
     wrench(t, 0) = (pressed ? 10.0 : 0.0) + 0.3 * g(rng);
     wrench(t, 1) = (pressed ? 0.06 : 0.0) + drift + 0.02 * g(rng);
   }
-  const lfd::SensorEvents e = lfd::detect_sensor_events(wrench, yaml_at_50hz(), {0, 0});
+  const lfd::SensorEvents e = lfd::detectSensorEvents(wrench, yamlAt50hz(), {0, 0});
   ASSERT_GE(e.zone_events.size(), 2u) << ::testing::PrintToString(e.all);
   EXPECT_NEAR(static_cast<double>(e.zone_events.front()), 100.0, 3.0);
   for (std::size_t i = 1; i < e.zone_events.size(); ++i)  // the force's, maybe the torque's too
@@ -417,7 +416,7 @@ TEST(SensoryEvents, AShortPauseOfTheWholeSensorIsNoRestEdge) {
     Eigen::MatrixXd pads = Eigen::MatrixXd::Zero(700, 2);
     pads.block(100, 0, 100, 1).setConstant(2.0);
     pads.block(200 + pause, 1, 70, 1).setConstant(2.0);
-    const lfd::SensorEvents e = lfd::detect_sensor_events(pads, yaml_at_50hz(), {0, 0});
+    const lfd::SensorEvents e = lfd::detectSensorEvents(pads, yamlAt50hz(), {0, 0});
     const Events inner{200, static_cast<std::size_t>(200 + pause)};
     const bool inner_are_rest_edges =
         std::includes(e.zone_events.begin(), e.zone_events.end(), inner.begin(), inner.end());
@@ -434,12 +433,12 @@ TEST(SensoryEvents, ZonesComeFromRestEdgesOrFromEveryEventOfASensorWithout) {
   Eigen::MatrixXd gripper = Eigen::MatrixXd::Zero(600, 1);
   gripper.block(100, 0, 500, 1).setConstant(5.0);
   gripper.block(300, 0, 100, 1).setConstant(8.0);
-  const lfd::SensorEvents held = lfd::detect_sensor_events(gripper, yaml_at_50hz());
+  const lfd::SensorEvents held = lfd::detectSensorEvents(gripper, yamlAt50hz());
   EXPECT_EQ(held.all, (Events{100, 300, 400}));
   EXPECT_EQ(held.zone_events, (Events{100}));
   Eigen::MatrixXd busy = gripper;
   for (Eigen::Index t = 0; t < 100; ++t) busy(t, 0) = 0.05 * static_cast<double>(t);
-  const lfd::SensorEvents without = lfd::detect_sensor_events(busy, yaml_at_50hz());
+  const lfd::SensorEvents without = lfd::detectSensorEvents(busy, yamlAt50hz());
   EXPECT_EQ(without.all, (Events{1, 100, 300, 400}));  // the ramp's start and end, the pulse
   for (const lfd::SensoryEvent& d : without.details) EXPECT_FALSE(d.rest_edge) << d.index;
   EXPECT_EQ(without.zone_events, without.all);
@@ -454,11 +453,11 @@ TEST(SensoryEvents, ZonesComeFromRestEdgesOrFromEveryEventOfASensorWithout) {
 TEST(SensoryEvents, WeakFirstAndLastContactUnderNoiseByTheRestEdgeCusum) {
   const auto rest_edges = [](const Eigen::VectorXd& x, const SensoryEventConfig& config) {
     std::vector<double> out;
-    for (const lfd::SensoryEvent& e : lfd::detect_sensory_event_details(x, config))
+    for (const lfd::SensoryEvent& e : lfd::detectSensoryEventDetails(x, config))
       if (e.rest_edge) out.push_back(static_cast<double>(e.index));
     return out;
   };
-  SensoryEventConfig cusum = yaml_at_50hz();
+  SensoryEventConfig cusum = yamlAt50hz();
   cusum.rest_edge_sigmas = 1.0;
   int fit_late = 0;
   for (unsigned seed = 0; seed < 50; ++seed) {
@@ -476,7 +475,7 @@ TEST(SensoryEvents, WeakFirstAndLastContactUnderNoiseByTheRestEdgeCusum) {
     ASSERT_EQ(found.size(), 2u) << seed << ": " << ::testing::PrintToString(found);
     EXPECT_NEAR(found[0], 150.0, 10.0) << seed;  // the touch
     EXPECT_NEAR(found[1], 380.0, 10.0) << seed;  // the hand leaves
-    const std::vector<double> fitted = rest_edges(x, yaml_at_50hz());
+    const std::vector<double> fitted = rest_edges(x, yamlAt50hz());
     fit_late += fitted.size() == 2 && fitted[0] > 170.0 && fitted[1] < 360.0;
   }
   EXPECT_GE(fit_late, 45);  // the fit alone places both at the strong change

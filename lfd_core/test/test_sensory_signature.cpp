@@ -17,7 +17,7 @@ struct Press {
   double lose_contact_at = -1.0;  ///< s from the start: the force falls to 0 (a slip)
 };
 
-lfd::SegmentedRecording press_run(const Press& p, unsigned seed) {
+lfd::SegmentedRecording pressRun(const Press& p, unsigned seed) {
   std::mt19937 rng(seed);
   std::normal_distribution<double> noise(0.0, 0.2);
   const double total = p.approach + p.press + p.retract;
@@ -53,11 +53,11 @@ Press varied(unsigned seed) {
 
 lfd::SensorySignature learned(std::size_t demos) {
   std::vector<lfd::SegmentedRecording> d;
-  for (unsigned k = 0; k < demos; ++k) d.push_back(press_run(varied(k), 1000 + k));
-  return lfd::learn_signature(d, {"force_z", "gripper"});
+  for (unsigned k = 0; k < demos; ++k) d.push_back(pressRun(varied(k), 1000 + k));
+  return lfd::learnSignature(d, {"force_z", "gripper"});
 }
 
-double worst_score(const std::vector<std::vector<double>>& scores) {
+double worstScore(const std::vector<std::vector<double>>& scores) {
   double worst = 0.0;
   for (const auto& s : scores)
     for (double v : s) worst = std::max(worst, v);
@@ -67,8 +67,8 @@ double worst_score(const std::vector<std::vector<double>>& scores) {
 TEST(SensorySignature, NominalRunsRaiseNoAlarm) {
   const lfd::SensorySignature sig = learned(5);
   for (unsigned k = 0; k < 40; ++k) {
-    const auto scores = lfd::score_recording(sig, press_run(varied(50 + k), 5000 + k));
-    EXPECT_LT(worst_score(scores), 1.0) << "nominal run " << k;
+    const auto scores = lfd::scoreRecording(sig, pressRun(varied(50 + k), 5000 + k));
+    EXPECT_LT(worstScore(scores), 1.0) << "nominal run " << k;
   }
 }
 
@@ -78,20 +78,20 @@ TEST(SensorySignature, NominalRunsRaiseNoAlarm) {
 TEST(SensorySignature, AnEventLateByLessThanTheTimeSlackAtABoundaryIsNoAlarm) {
   std::vector<lfd::SegmentedRecording> demos;
   for (unsigned k = 0; k < 5; ++k) {
-    demos.push_back(press_run(varied(k), 1000 + k));
+    demos.push_back(pressRun(varied(k), 1000 + k));
     for (double& b : demos.back().boundaries) b += 0.3;  // after the ramp: at full force / rest
   }
-  const lfd::SensorySignature sig = lfd::learn_signature(demos, {"force_z", "gripper"});
+  const lfd::SensorySignature sig = lfd::learnSignature(demos, {"force_z", "gripper"});
   ASSERT_GE(sig.options.time_slack, 0.45);
   for (unsigned k = 0; k < 10; ++k) {
-    lfd::SegmentedRecording run = press_run(varied(60 + k), 6000 + k);
+    lfd::SegmentedRecording run = pressRun(varied(60 + k), 6000 + k);
     for (double& b : run.boundaries) b += 0.3 - 0.4;  // the plan's boundary, 0.4 s early
-    EXPECT_LT(worst_score(lfd::score_recording(sig, run)), 1.0) << "run " << k;
+    EXPECT_LT(worstScore(lfd::scoreRecording(sig, run)), 1.0) << "run " << k;
     Press missed = varied(60 + k);
     missed.level = 0.0;
-    lfd::SegmentedRecording no_force = press_run(missed, 6000 + k);
+    lfd::SegmentedRecording no_force = pressRun(missed, 6000 + k);
     for (double& b : no_force.boundaries) b += 0.3 - 0.4;
-    EXPECT_GT(lfd::score_recording(sig, no_force)[1][0], 1.0) << "run " << k;
+    EXPECT_GT(lfd::scoreRecording(sig, no_force)[1][0], 1.0) << "run " << k;
   }
 }
 
@@ -100,7 +100,7 @@ TEST(SensorySignature, APressWithoutForceIsFlaggedInThePressSegment) {
   Press p = varied(77);
   p.level = 0.0;  // the tool missed the button
   std::vector<lfd::Deviation> worst;
-  const auto scores = lfd::score_recording(sig, press_run(p, 77), &worst);
+  const auto scores = lfd::scoreRecording(sig, pressRun(p, 77), &worst);
   EXPECT_GT(scores[1][0], 1.0);
   EXPECT_LT(scores[0][0], 1.0);
   ASSERT_EQ(worst.size(), 3u);
@@ -115,11 +115,11 @@ TEST(SensorySignature, TheLiveMonitorRaisesASlipWithinAFifthOfASecond) {
   const lfd::SensorySignature sig = learned(5);
   Press p = varied(91);
   p.lose_contact_at = p.approach + 1.5;
-  const lfd::SegmentedRecording run = press_run(p, 91);
+  const lfd::SegmentedRecording run = pressRun(p, 91);
   lfd::SignatureMonitor monitor(sig);
   double alarm = -1.0;
   for (Eigen::Index i = 0; i < run.features.rows() && alarm < 0; ++i) {
-    const double t = run.features.time_at(i) - run.features.time_at(0);
+    const double t = run.features.timeAt(i) - run.features.timeAt(0);
     std::size_t s = 0;
     while (s < run.boundaries.size() && t > run.boundaries[s]) ++s;
     const double start = s ? run.boundaries[s - 1] : 0.0;
@@ -140,10 +140,10 @@ TEST(SensorySignature, TheLiveMonitorRaisesASlipWithinAFifthOfASecond) {
 
 TEST(SensorySignature, AGripperThatClosesOnNothingIsFlagged) {
   const lfd::SensorySignature sig = learned(4);
-  lfd::SegmentedRecording run = press_run(varied(33), 33);
+  lfd::SegmentedRecording run = pressRun(varied(33), 33);
   for (Eigen::Index i = 0; i < run.features.rows(); ++i)
     if (run.features.data(i, 1) < 0.05) run.features.data(i, 1) = 0.0;  // closed fully: empty
-  const auto scores = lfd::score_recording(sig, run);
+  const auto scores = lfd::scoreRecording(sig, run);
   EXPECT_GT(scores[1][1], 1.0);
 }
 
@@ -152,12 +152,12 @@ TEST(SensorySignature, TheRecordingRateDoesNotMatter) {
   for (unsigned k = 0; k < 4; ++k) {
     Press p = varied(k);
     p.rate = 50.0;
-    demos.push_back(press_run(p, 200 + k));
+    demos.push_back(pressRun(p, 200 + k));
   }
-  const auto sig = lfd::learn_signature(demos, {"force_z", "gripper"});
+  const auto sig = lfd::learnSignature(demos, {"force_z", "gripper"});
   Press fast = varied(21);
   fast.rate = 400.0;
-  EXPECT_LT(worst_score(lfd::score_recording(sig, press_run(fast, 21))), 1.0);
+  EXPECT_LT(worstScore(lfd::scoreRecording(sig, pressRun(fast, 21))), 1.0);
 }
 
 TEST(SensorySignature, ThresholdsAreStatisticsOfTheDemonstrations) {
@@ -174,22 +174,22 @@ TEST(SensorySignature, ThresholdsAreStatisticsOfTheDemonstrations) {
 }
 
 TEST(SensorySignature, BadDemonstrationsAreRefusedWithTheReason) {
-  const auto one = press_run(varied(1), 1);
+  const auto one = pressRun(varied(1), 1);
   auto expect_refused = [](const std::vector<lfd::SegmentedRecording>& demos,
                            const std::vector<std::string>& channels, const std::string& words) {
     try {
-      lfd::learn_signature(demos, channels);
+      lfd::learnSignature(demos, channels);
       ADD_FAILURE() << "accepted; expected an error with '" << words << "'";
     } catch (const std::invalid_argument& e) {
       EXPECT_NE(std::string(e.what()).find(words), std::string::npos) << e.what();
     }
   };
   expect_refused({one}, {"force_z"}, "at least 2");
-  auto fewer = press_run(varied(2), 2);
+  auto fewer = pressRun(varied(2), 2);
   fewer.boundaries.pop_back();
   expect_refused({one, fewer}, {"force_z"}, "boundaries");
   expect_refused({one, one}, {"torque_x"}, "torque_x");
-  auto backwards = press_run(varied(3), 3);
+  auto backwards = pressRun(varied(3), 3);
   std::swap(backwards.boundaries[0], backwards.boundaries[1]);
   expect_refused({one, backwards}, {"force_z"}, "increase");
 }

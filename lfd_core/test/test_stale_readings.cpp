@@ -12,7 +12,7 @@
 namespace {
 
 // A noisy 3-channel wrench of `rows` samples; rows [from, to) repeat the reading at `from`.
-Eigen::MatrixXd noisy_wrench(Eigen::Index rows, Eigen::Index from, Eigen::Index to, unsigned seed) {
+Eigen::MatrixXd noisyWrench(Eigen::Index rows, Eigen::Index from, Eigen::Index to, unsigned seed) {
   std::mt19937 rng(seed);
   std::normal_distribution<double> noise(0.0, 0.5);
   Eigen::MatrixXd m(rows, 3);
@@ -23,7 +23,7 @@ Eigen::MatrixXd noisy_wrench(Eigen::Index rows, Eigen::Index from, Eigen::Index 
 }
 
 // A noise-free touch pad: exactly 0 at rest, a smooth press in the middle.
-Eigen::MatrixXd touch_pad(Eigen::Index rows) {
+Eigen::MatrixXd touchPad(Eigen::Index rows) {
   Eigen::MatrixXd m = Eigen::MatrixXd::Zero(rows, 1);
   for (Eigen::Index r = rows / 3; r < 2 * rows / 3; ++r)
     m(r, 0) = 5.0 + std::sin(0.1 * static_cast<double>(r));
@@ -31,26 +31,26 @@ Eigen::MatrixXd touch_pad(Eigen::Index rows) {
 }
 
 TEST(RepeatedReadings, FindsTheRepeatedStretchExactly) {
-  const auto runs = lfd::repeated_readings(noisy_wrench(500, 0, 180, 1), 50);
+  const auto runs = lfd::repeatedReadings(noisyWrench(500, 0, 180, 1), 50);
   ASSERT_EQ(runs.size(), 1u);
   EXPECT_EQ(runs[0].begin, 0u);
   EXPECT_EQ(runs[0].end, 180u);
 }
 
 TEST(RepeatedReadings, OneChannelRepeatingIsNotTheSensorRepeating) {
-  Eigen::MatrixXd m = noisy_wrench(500, 0, 0, 2);
+  Eigen::MatrixXd m = noisyWrench(500, 0, 0, 2);
   m.col(1).segment(100, 200).setConstant(3.0);  // a saturated or clipped axis
-  EXPECT_TRUE(lfd::repeated_readings(m, 50).empty());
+  EXPECT_TRUE(lfd::repeatedReadings(m, 50).empty());
 }
 
 TEST(RepeatedReadings, ShorterRepeatsAreChance) {
-  EXPECT_TRUE(lfd::repeated_readings(noisy_wrench(500, 200, 240, 3), 50).empty());
+  EXPECT_TRUE(lfd::repeatedReadings(noisyWrench(500, 200, 240, 3), 50).empty());
 }
 
 TEST(StaleReadings, ANoisySensorsCachedReadingIsStale) {
-  const std::vector<Eigen::MatrixXd> demos = {
-      noisy_wrench(500, 0, 200, 4), noisy_wrench(450, 0, 0, 5), noisy_wrench(480, 0, 0, 6)};
-  const auto stale = lfd::stale_readings(demos, {50, 50, 50});
+  const std::vector<Eigen::MatrixXd> demos = {noisyWrench(500, 0, 200, 4),
+                                              noisyWrench(450, 0, 0, 5), noisyWrench(480, 0, 0, 6)};
+  const auto stale = lfd::staleReadings(demos, {50, 50, 50});
   ASSERT_EQ(stale.size(), 3u);
   ASSERT_EQ(stale[0].size(), 1u);
   EXPECT_EQ(stale[0][0].end, 200u);
@@ -61,23 +61,23 @@ TEST(StaleReadings, ANoisySensorsCachedReadingIsStale) {
 TEST(StaleReadings, ADeadDemoDoesNotOutvoteTheNoise) {
   const Eigen::MatrixXd dead = Eigen::MatrixXd::Constant(400, 3, 0.3);
   const std::vector<Eigen::MatrixXd> demos = {
-      noisy_wrench(500, 0, 200, 7), dead,
-      noisy_wrench(500, 0, 150, 8), noisy_wrench(450, 0, 0, 9),
-      noisy_wrench(480, 0, 0, 10),  noisy_wrench(470, 0, 0, 11)};
-  const auto stale = lfd::stale_readings(demos, {50, 50, 50, 50, 50, 50});
+      noisyWrench(500, 0, 200, 7), dead,
+      noisyWrench(500, 0, 150, 8), noisyWrench(450, 0, 0, 9),
+      noisyWrench(480, 0, 0, 10),  noisyWrench(470, 0, 0, 11)};
+  const auto stale = lfd::staleReadings(demos, {50, 50, 50, 50, 50, 50});
   EXPECT_EQ(stale[0].size(), 1u);
   EXPECT_EQ(stale[2].size(), 1u);
   EXPECT_EQ(stale[1].size(), 1u);  // the whole demo: the caller reports it as dead
 }
 
 TEST(StaleReadings, ANoiseFreeSensorsRestIsNotStale) {
-  const std::vector<Eigen::MatrixXd> demos = {touch_pad(300), touch_pad(320), touch_pad(310)};
-  for (const auto& spans : lfd::stale_readings(demos, {20, 20, 20})) EXPECT_TRUE(spans.empty());
+  const std::vector<Eigen::MatrixXd> demos = {touchPad(300), touchPad(320), touchPad(310)};
+  for (const auto& spans : lfd::staleReadings(demos, {20, 20, 20})) EXPECT_TRUE(spans.empty());
 }
 
 TEST(StaleReadings, BadArgumentsAreErrors) {
-  EXPECT_THROW(lfd::repeated_readings(touch_pad(10), 1), std::invalid_argument);
-  EXPECT_THROW(lfd::stale_readings({touch_pad(10)}, {5, 5}), std::invalid_argument);
+  EXPECT_THROW(lfd::repeatedReadings(touchPad(10), 1), std::invalid_argument);
+  EXPECT_THROW(lfd::staleReadings({touchPad(10)}, {5, 5}), std::invalid_argument);
 }
 
 }  // namespace

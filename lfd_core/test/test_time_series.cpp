@@ -31,7 +31,7 @@ double sigma(const Eigen::VectorXd& x) {
 
 // The clock of these tests: a 50 Hz stream from 0 s. A 200 Hz stream from -1.2 ms has no sample
 // on a period's edge (k / 50 s +- 10 ms).
-lfd::Stream clock_stream(double seconds) {
+lfd::Stream clockStream(double seconds) {
   return sampled(50.0, seconds, 0.0, 1e9, 0);
 }
 constexpr double kOffGrid = -0.0012;
@@ -40,7 +40,7 @@ constexpr double kOffGrid = -0.0012;
 // so the noise drops to half (a point reading keeps all of it and drops three samples in four).
 TEST(Resample, AStreamFasterThanTheClockIsAveragedOverEachPeriod) {
   const lfd::Stream s = sampled(200.0, 20.0, 1.0, 1e9, 3, lfd::Interpolation::kLinear, kOffGrid);
-  const lfd::FeatureMatrix m = lfd::resample({clock_stream(19.9), s}, 50.0);
+  const lfd::FeatureMatrix m = lfd::resample({clockStream(19.9), s}, 50.0);
   ASSERT_EQ(m.rows(), 996);
   EXPECT_NEAR(sigma(m.data.col(1)), 0.5, 0.05);
   // Row 1 (20 ms) averages the samples within 10..30 ms: 13.8, 18.8, 23.8 and 28.8 ms.
@@ -51,7 +51,7 @@ TEST(Resample, AStreamFasterThanTheClockIsAveragedOverEachPeriod) {
 // noise-free stream at or below the clock's rate is interpolated exactly as before.
 TEST(Resample, AveragingKeepsStepsInPlaceAndSlowerStreamsAreInterpolated) {
   const lfd::FeatureMatrix fast = lfd::resample(
-      {clock_stream(3.9), sampled(200.0, 4.0, 0.0, 2.0, 1, lfd::Interpolation::kLinear, kOffGrid)},
+      {clockStream(3.9), sampled(200.0, 4.0, 0.0, 2.0, 1, lfd::Interpolation::kLinear, kOffGrid)},
       50.0);
   EXPECT_DOUBLE_EQ(fast.data(99, 1), 0.0);   // 1.98 s: 1.9738 .. 1.9888 s
   EXPECT_DOUBLE_EQ(fast.data(100, 1), 0.5);  // 2.00 s: two samples before the step, two after

@@ -5,8 +5,7 @@
 namespace lfd_dmp {
 
 MonitoredSensors loadMonitoredSensors(const std::string& params_file) {
-  const lfd_segmentation::SegmentationParams params =
-      lfd_segmentation::load_params_file(params_file);
+  const lfd_segmentation::SegmentationParams params = lfd_segmentation::loadParamsFile(params_file);
   MonitoredSensors out;
   for (const auto& t : params.topics)
     if (t.monitor) out.topics.push_back(t);
@@ -19,7 +18,7 @@ void readDemoSensors(const std::string& bag, const MonitoredSensors& sensors, De
   if (sensors.topics.empty()) return;
   try {
     lfd_segmentation::DemoFeatures f =
-        lfd_segmentation::read_bag_features(bag, sensors.topics, sensors.rate, sensors.limits);
+        lfd_segmentation::readBagFeatures(bag, sensors.topics, sensors.rate, sensors.limits);
     demo->sensor_sources.clear();
     for (const std::string& name : f.matrix.names) {
       std::string source;

@@ -92,7 +92,7 @@ void SensorChannels::onMessage(Source* s, const topic_tools::ShapeShifter::Const
       problem_ = s->topic + ": " + e.what();
       return;
     }
-    const double header = s->reader->header_stamp();
+    const double header = s->reader->headerStamp();
     stamp = header > 0 ? ros::Time(header) : ros::Time::now();
     s->last = stamp;
     if (s->count++ == 0) s->first = stamp;

@@ -39,7 +39,7 @@ lfd::SignatureOptions optionsFromJson(const json& j, const std::string& w) {
   o.threshold_margin = number(member(j, "threshold_margin", w), w + ".threshold_margin");
   o.min_threshold = number(member(j, "min_threshold", w), w + ".min_threshold");
   try {
-    lfd::check_signature_options(o);  // the learner's own rule, one place
+    lfd::checkSignatureOptions(o);  // the learner's own rule, one place
   } catch (const std::invalid_argument& e) {
     fail(w, e.what());
   }

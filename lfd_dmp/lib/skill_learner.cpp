@@ -181,7 +181,7 @@ void learnSignature(const std::vector<UsedDemo>& used, const lfd::SignatureOptio
     lfd::SegmentedRecording r;
     r.features = rec.sensors;
     for (std::size_t k = 1; k + 1 < u.bounds.size(); ++k)  // the inner bounds: the changepoints
-      r.boundaries.push_back(rec.times[u.bounds[k]] - rec.sensors.time_at(0));
+      r.boundaries.push_back(rec.times[u.bounds[k]] - rec.sensors.timeAt(0));
     recordings.push_back(std::move(r));
   }
   if (recordings.size() < 2) {
@@ -190,7 +190,7 @@ void learnSignature(const std::vector<UsedDemo>& used, const lfd::SignatureOptio
     return;
   }
   try {
-    lfd::SensorySignature sig = lfd::learn_signature(recordings, first->sensors.names, options);
+    lfd::SensorySignature sig = lfd::learnSignature(recordings, first->sensors.names, options);
     sig.sources = first->sensor_sources;
     if (!sig.sources.empty() && sig.sources.size() != sig.channels.size()) sig.sources.clear();
     out->library.sensory_signature = std::move(sig);

@@ -259,7 +259,7 @@ class Learner {
     pnh.param("signature/threshold_margin", o.threshold_margin, o.threshold_margin);
     pnh.param("signature/min_threshold", o.min_threshold, o.min_threshold);
     try {
-      lfd::check_signature_options(o);
+      lfd::checkSignatureOptions(o);
       sensors_ = lfd_dmp::loadMonitoredSensors(file);
     } catch (const std::exception& e) {
       ROS_WARN("learner: ~signature: %s: no sensory signatures", e.what());

@@ -26,7 +26,7 @@ namespace {
 
 namespace rosmsg = lfd::rosmsg;
 
-std::string feature_name(const std::string& topic, const std::string& field) {
+std::string featureName(const std::string& topic, const std::string& field) {
   return topic + (topic.empty() || topic.back() == '/' ? "" : "/") + field;
 }
 
@@ -42,16 +42,16 @@ struct BufferStream {
 };
 
 // The serialized bytes of one message, as they were recorded.
-void message_bytes(const rosbag::MessageInstance& m, std::vector<std::uint8_t>& buffer) {
+void messageBytes(const rosbag::MessageInstance& m, std::vector<std::uint8_t>& buffer) {
   buffer.clear();
   BufferStream stream{&buffer};
   m.write(stream);
 }
 
-std::string field_list(const rosmsg::MessageSchema& schema,
-                       const std::vector<std::uint8_t>& sample) {
+std::string fieldList(const rosmsg::MessageSchema& schema,
+                      const std::vector<std::uint8_t>& sample) {
   std::string out;
-  for (const std::string& f : rosmsg::list_numeric_fields(schema, sample.data(), sample.size()))
+  for (const std::string& f : rosmsg::listNumericFields(schema, sample.data(), sample.size()))
     out += "\n  " + f;
   return out;
 }
@@ -84,9 +84,9 @@ class TopicReader {
 
   // One message of the topic, `bytes` its serialized form.
   void read(const rosbag::MessageInstance& m, const std::vector<std::uint8_t>& bytes) {
-    rosmsg::FieldReader& reader = reader_for(m, bytes);
+    rosmsg::FieldReader& reader = readerFor(m, bytes);
     reader.read(bytes.data(), bytes.size());
-    const double stamp = reader.header_stamp();
+    const double stamp = reader.headerStamp();
     // A zero stamp means "not stamped" (e.g. the PR2 world model): the receive time is the clock.
     const double t = stamp != 0.0 ? stamp : m.getTime().toSec();
     for (std::size_t k = 0; k < streams_.size(); ++k) {
@@ -97,20 +97,20 @@ class TopicReader {
   }
 
   // The streams, once every part is read; a feature no message carried is an error.
-  std::vector<lfd::Stream> take_streams() {
+  std::vector<lfd::Stream> takeStreams() {
     for (std::size_t k = 0; k < streams_.size(); ++k) {
       if (streams_[k].values.empty()) {
         throw std::invalid_argument(
             "topic " + cfg_.topic + " has no data for field '" + fields_[k] +
-            "'; numeric fields of its first message:" + field_list(*schema_, sample_));
+            "'; numeric fields of its first message:" + fieldList(*schema_, sample_));
       }
     }
     return std::move(streams_);
   }
 
  private:
-  rosmsg::FieldReader& reader_for(const rosbag::MessageInstance& m,
-                                  const std::vector<std::uint8_t>& bytes) {
+  rosmsg::FieldReader& readerFor(const rosbag::MessageInstance& m,
+                                 const std::vector<std::uint8_t>& bytes) {
     // getMD5Sum() refers to the connection's record: its address identifies the connection.
     if (&m.getMD5Sum() == last_connection_) return *last_reader_;
     const std::string key = m.getDataType() + " " + m.getMD5Sum();
@@ -123,7 +123,7 @@ class TopicReader {
         throw std::invalid_argument("topic " + cfg_.topic + ": the bag's definition of " +
                                     m.getDataType() + " cannot be parsed: " + e.what());
       }
-      if (!schema_) first_message(schema, bytes);
+      if (!schema_) firstMessage(schema, bytes);
       try {
         it = readers_.emplace(key, rosmsg::FieldReader(schema, fields_)).first;
       } catch (const rosmsg::UnknownField& e) {
@@ -136,11 +136,11 @@ class TopicReader {
     return it->second;
   }
 
-  void first_message(const rosmsg::MessageSchema& schema, const std::vector<std::uint8_t>& bytes) {
+  void firstMessage(const rosmsg::MessageSchema& schema, const std::vector<std::uint8_t>& bytes) {
     schema_ = std::make_unique<rosmsg::MessageSchema>(schema);
     sample_ = bytes;
     try {
-      fields_ = rosmsg::expand_fields(schema, sample_.data(), sample_.size(), cfg_.fields);
+      fields_ = rosmsg::expandFields(schema, sample_.data(), sample_.size(), cfg_.fields);
     } catch (const rosmsg::UnknownField& e) {
       throw std::invalid_argument("topic " + cfg_.topic + " (" + schema.root().name +
                                   "): " + e.what());
@@ -148,7 +148,7 @@ class TopicReader {
     count_->add(fields_.size(), cfg_.topic);
     for (const std::string& field : fields_) {
       lfd::Stream s;
-      s.name = feature_name(cfg_.topic, field);
+      s.name = featureName(cfg_.topic, field);
       s.interpolation = cfg_.interpolation;
       streams_.push_back(std::move(s));
     }
@@ -167,7 +167,7 @@ class TopicReader {
 
 // Opens the bag through the file-access layer's descriptor: rosbag reads the file that was checked,
 // never what the path names by then (a link swapped to a FIFO hung open()).
-void open_bag(rosbag::Bag& bag, const lfd::InputFile& file, const std::string& name) {
+void openBag(rosbag::Bag& bag, const lfd::InputFile& file, const std::string& name) {
   try {
     bag.open(file.readPath(), rosbag::bagmode::Read);
   } catch (const std::exception& e) {
@@ -175,7 +175,7 @@ void open_bag(rosbag::Bag& bag, const lfd::InputFile& file, const std::string& n
   }
 }
 
-lfd::InputFile open_part(const std::string& path, const lfd::PathPolicy& policy = {}) {
+lfd::InputFile openPart(const std::string& path, const lfd::PathPolicy& policy = {}) {
   try {
     return lfd::openInputFile(path, policy);
   } catch (const std::exception& e) {
@@ -185,8 +185,8 @@ lfd::InputFile open_part(const std::string& path, const lfd::PathPolicy& policy 
 
 // One message of a topic into its reader; bytes that do not fit the declared type (a lying
 // connection header, a truncated message: rosbag's "Buffer Overrun") are named in full.
-void read_message(const rosbag::MessageInstance& m, const std::vector<std::uint8_t>& bytes,
-                  std::size_t index, const std::string& name, TopicReader& reader) {
+void readMessage(const rosbag::MessageInstance& m, const std::vector<std::uint8_t>& bytes,
+                 std::size_t index, const std::string& name, TopicReader& reader) {
   try {
     reader.read(m, bytes);
   } catch (const rosmsg::MessageError& e) {
@@ -195,7 +195,7 @@ void read_message(const rosbag::MessageInstance& m, const std::vector<std::uint8
   }
 }
 
-std::string topics_in(rosbag::Bag& bag) {
+std::string topicsIn(rosbag::Bag& bag) {
   std::string available;
   rosbag::View all(bag);
   for (const rosbag::ConnectionInfo* c : all.getConnections()) {
@@ -207,15 +207,15 @@ std::string topics_in(rosbag::Bag& bag) {
 // Reads every configured topic of one bag file into the readers, a view per topic as the typed
 // reader did (measured: one view over all topics saved no CPU, its connection merge costs as much
 // as rereading the cached chunks).
-void read_part(const lfd::InputFile& file, const std::string& path,
-               const std::vector<TopicConfig>& topics, std::vector<TopicReader>& readers) {
+void readPart(const lfd::InputFile& file, const std::string& path,
+              const std::vector<TopicConfig>& topics, std::vector<TopicReader>& readers) {
   rosbag::Bag bag;
-  open_bag(bag, file, path);
+  openBag(bag, file, path);
   try {
     for (const TopicConfig& cfg : topics) {
       if (rosbag::View(bag, rosbag::TopicQuery(cfg.topic)).size() == 0) {
         throw std::invalid_argument("no messages on topic " + cfg.topic +
-                                    " (topics in the bag:" + topics_in(bag) + ")");
+                                    " (topics in the bag:" + topicsIn(bag) + ")");
       }
     }
     std::vector<std::uint8_t> bytes;
@@ -223,8 +223,8 @@ void read_part(const lfd::InputFile& file, const std::string& path,
       std::size_t index = 0;
       for (const rosbag::MessageInstance& m :
            rosbag::View(bag, rosbag::TopicQuery(topics[k].topic))) {
-        message_bytes(m, bytes);
-        read_message(m, bytes, index++, path, readers[k]);
+        messageBytes(m, bytes);
+        readMessage(m, bytes, index++, path, readers[k]);
       }
     }
   } catch (const std::invalid_argument& e) {
@@ -239,7 +239,7 @@ void read_part(const lfd::InputFile& file, const std::string& path,
 
 // Messages are stored in receive order; the shared timestamp policy puts each stream in stamp
 // order (duplicates kept: resampling averages them) and reports what it found.
-lfd::StampReport order_by_stamp(lfd::Stream& s) {
+lfd::StampReport orderByStamp(lfd::Stream& s) {
   lfd::StampReport report;
   const std::vector<std::size_t> order =
       lfd::orderByStamp(s.time, lfd::DuplicateStamps::kKeepAll, &report);
@@ -253,11 +253,11 @@ lfd::StampReport order_by_stamp(lfd::Stream& s) {
 }
 
 // Orders a topic's streams; one warning per topic (its fields share the messages' stamps).
-void order_topic(const std::string& topic, std::vector<lfd::Stream>& streams,
-                 std::vector<std::string>* warnings) {
+void orderTopic(const std::string& topic, std::vector<lfd::Stream>& streams,
+                std::vector<std::string>* warnings) {
   std::string warning;
   for (lfd::Stream& s : streams) {
-    const std::string w = lfd::stampWarning(topic, order_by_stamp(s));
+    const std::string w = lfd::stampWarning(topic, orderByStamp(s));
     if (warning.empty()) warning = w;
   }
   if (warnings && !warning.empty()) warnings->push_back(warning);
@@ -265,7 +265,7 @@ void order_topic(const std::string& topic, std::vector<lfd::Stream>& streams,
 
 }  // namespace
 
-std::vector<std::string> demo_parts(const std::string& path) {
+std::vector<std::string> demoParts(const std::string& path) {
   if (path.find(',') == std::string::npos || std::filesystem::exists(path)) return {path};
   std::vector<std::string> parts;
   std::stringstream in(path);
@@ -277,8 +277,8 @@ std::vector<std::string> demo_parts(const std::string& path) {
   return parts;
 }
 
-void check_request_budget(const std::vector<std::string>& entries, const RequestLimits& limits,
-                          const lfd::PathPolicy& paths, const std::string& kind) {
+void checkRequestBudget(const std::vector<std::string>& entries, const RequestLimits& limits,
+                        const lfd::PathPolicy& paths, const std::string& kind) {
   if (entries.size() > limits.max_bags) {
     throw std::invalid_argument(std::to_string(entries.size()) + " " + kind +
                                 " paths, over the limit of " + std::to_string(limits.max_bags) +
@@ -286,7 +286,7 @@ void check_request_budget(const std::vector<std::string>& entries, const Request
   }
   std::vector<std::string> files;
   for (const std::string& entry : entries) {
-    for (std::string& part : demo_parts(entry)) files.push_back(std::move(part));
+    for (std::string& part : demoParts(entry)) files.push_back(std::move(part));
   }
   lfd::InputBudget budget;
   budget.what = kind + " files";
@@ -304,27 +304,27 @@ void check_request_budget(const std::vector<std::string>& entries, const Request
   }
 }
 
-DemoFiles open_demo_files(const std::string& path, const lfd::PathPolicy& policy) {
+DemoFiles openDemoFiles(const std::string& path, const lfd::PathPolicy& policy) {
   DemoFiles files;
   files.path = path;
-  files.names = demo_parts(path);
-  for (const std::string& name : files.names) files.parts.push_back(open_part(name, policy));
+  files.names = demoParts(path);
+  for (const std::string& name : files.names) files.parts.push_back(openPart(name, policy));
   return files;
 }
 
-std::vector<lfd::Stream> read_bag_streams(const std::string& path,
-                                          const std::vector<TopicConfig>& topics,
-                                          std::vector<FeatureRole>* roles,
-                                          std::vector<std::string>* warnings,
-                                          std::size_t max_features) {
-  return read_bag_streams(open_demo_files(path), topics, roles, warnings, max_features);
+std::vector<lfd::Stream> readBagStreams(const std::string& path,
+                                        const std::vector<TopicConfig>& topics,
+                                        std::vector<FeatureRole>* roles,
+                                        std::vector<std::string>* warnings,
+                                        std::size_t max_features) {
+  return readBagStreams(openDemoFiles(path), topics, roles, warnings, max_features);
 }
 
-std::vector<lfd::Stream> read_bag_streams(const DemoFiles& files,
-                                          const std::vector<TopicConfig>& topics,
-                                          std::vector<FeatureRole>* roles,
-                                          std::vector<std::string>* warnings,
-                                          std::size_t max_features) {
+std::vector<lfd::Stream> readBagStreams(const DemoFiles& files,
+                                        const std::vector<TopicConfig>& topics,
+                                        std::vector<FeatureRole>* roles,
+                                        std::vector<std::string>* warnings,
+                                        std::size_t max_features) {
   const std::string& path = files.path;
   if (topics.empty()) throw std::invalid_argument("no topics configured for the features");
   for (const TopicConfig& cfg : topics) {
@@ -338,36 +338,36 @@ std::vector<lfd::Stream> read_bag_streams(const DemoFiles& files,
   readers.reserve(topics.size());
   for (const TopicConfig& cfg : topics) readers.emplace_back(cfg, &count);
   for (std::size_t k = 0; k < files.parts.size(); ++k)
-    read_part(files.parts[k], files.names[k], topics, readers);
+    readPart(files.parts[k], files.names[k], topics, readers);
   std::vector<lfd::Stream> streams;
   if (roles) roles->clear();
   for (std::size_t k = 0; k < topics.size(); ++k) {
     std::vector<lfd::Stream> topic_streams;
     try {
-      topic_streams = readers[k].take_streams();
+      topic_streams = readers[k].takeStreams();
     } catch (const std::invalid_argument& e) {
       throw std::invalid_argument("bag " + lfd::quoted(path) + ": " + e.what());
     }
-    order_topic(topics[k].topic, topic_streams, warnings);
+    orderTopic(topics[k].topic, topic_streams, warnings);
     if (roles) roles->insert(roles->end(), topic_streams.size(), topics[k].role);
     for (lfd::Stream& s : topic_streams) streams.push_back(std::move(s));
   }
   return streams;
 }
 
-DemoFeatures read_bag_features(const std::string& path, const std::vector<TopicConfig>& topics,
-                               double rate, const RequestLimits& limits) {
-  return read_bag_features(open_demo_files(path), topics, rate, limits);
+DemoFeatures readBagFeatures(const std::string& path, const std::vector<TopicConfig>& topics,
+                             double rate, const RequestLimits& limits) {
+  return readBagFeatures(openDemoFiles(path), topics, rate, limits);
 }
 
-DemoFeatures read_bag_features(const DemoFiles& files, const std::vector<TopicConfig>& topics,
-                               double rate, const RequestLimits& limits) {
+DemoFeatures readBagFeatures(const DemoFiles& files, const std::vector<TopicConfig>& topics,
+                             double rate, const RequestLimits& limits) {
   const std::string& path = files.path;
   std::vector<FeatureRole> roles;
   std::vector<std::string> warnings;
   const std::vector<lfd::Stream> streams =
-      read_bag_streams(files, topics, &roles, &warnings, limits.max_features);
-  check_streams(streams, path, limits);
+      readBagStreams(files, topics, &roles, &warnings, limits.max_features);
+  checkStreams(streams, path, limits);
   double start = -INFINITY, end = INFINITY;  // the span resample() keeps: where all streams overlap
   for (const lfd::Stream& s : streams) {
     if (s.time.empty()) continue;
@@ -397,12 +397,12 @@ DemoFeatures read_bag_features(const DemoFiles& files, const std::vector<TopicCo
   return demo;
 }
 
-std::string describe_bag(const std::string& path) {
+std::string describeBag(const std::string& path) {
   std::ostringstream out;
-  for (const std::string& part : demo_parts(path)) {
+  for (const std::string& part : demoParts(path)) {
     rosbag::Bag bag;
-    const lfd::InputFile file = open_part(part);
-    open_bag(bag, file, part);
+    const lfd::InputFile file = openPart(part);
+    openBag(bag, file, part);
     out << part << "\n";
     try {
       rosbag::View all(bag);
@@ -417,11 +417,11 @@ std::string describe_bag(const std::string& path) {
         }
         std::vector<std::uint8_t> sample;
         const rosbag::MessageInstance first = *view.begin();
-        message_bytes(first, sample);
+        messageBytes(first, sample);
         const rosmsg::MessageSchema schema =
             rosmsg::MessageSchema::parse(connection->datatype, connection->msg_def);
         try {
-          out << field_list(schema, sample) << "\n";
+          out << fieldList(schema, sample) << "\n";
         } catch (const rosmsg::MessageError& e) {
           throw MismatchedMessage(lfd::mismatchedMessageError(part, topic, connection->datatype, 0,
                                                               first.getTime().toSec(), e.what()));

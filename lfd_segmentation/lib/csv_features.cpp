@@ -26,8 +26,8 @@ int timeColumn(const lfd::CsvReader& csv, const std::string& time_column) {
 
 }  // namespace
 
-lfd::FeatureMatrix read_csv_features(const std::string& path, const std::string& time_column,
-                                     double rate, const RequestLimits& limits) {
+lfd::FeatureMatrix readCsvFeatures(const std::string& path, const std::string& time_column,
+                                   double rate, const RequestLimits& limits) {
   lfd::CsvReadOptions options;
   options.max_rows = limits.max_csv_rows;
   options.max_rows_key = "limits/max_csv_rows";
@@ -63,8 +63,8 @@ lfd::FeatureMatrix read_csv_features(const std::string& path, const std::string&
   return m;
 }
 
-std::string clock_gap_warning(const lfd::FeatureMatrix& matrix, const std::string& path,
-                              double max_missing) {
+std::string clockGapWarning(const lfd::FeatureMatrix& matrix, const std::string& path,
+                            double max_missing) {
   if (matrix.time.size() < 3) return "";
   std::size_t row = 1;  // the row after the largest step
   for (std::size_t r = 2; r < matrix.time.size(); ++r)
@@ -72,7 +72,7 @@ std::string clock_gap_warning(const lfd::FeatureMatrix& matrix, const std::strin
   const double gap = matrix.time[row] - matrix.time[row - 1];
   double median = 0.0;  // the pipeline's own step
   try {
-    median = 1.0 / lfd::sample_rate_of(matrix);
+    median = 1.0 / lfd::sampleRateOf(matrix);
   } catch (const std::invalid_argument&) {
     return "";  // a clock that does not increase: the pipeline refuses it, naming the demo
   }

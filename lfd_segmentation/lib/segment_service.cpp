@@ -11,11 +11,11 @@
 
 namespace lfd_segmentation {
 
-SegmentationParams apply_overrides(const SegmentationParams& params,
-                                   const lfd_msgs::Segment::Request& request) {
+SegmentationParams applyOverrides(const SegmentationParams& params,
+                                  const lfd_msgs::Segment::Request& request) {
   SegmentationParams p = params;
   if (!request.combination.empty()) {
-    p.pipeline.segmentation.combination = lfd::parse_profile_combination(request.combination);
+    p.pipeline.segmentation.combination = lfd::parseProfileCombination(request.combination);
   }
   if (std::isnan(request.threshold)) throw std::invalid_argument("threshold is NaN");
   if (request.threshold > 0) {
@@ -25,8 +25,8 @@ SegmentationParams apply_overrides(const SegmentationParams& params,
     }
     p.pipeline.relevance.threshold = request.threshold;
   }
-  check_seconds_override(request.min_segment_seconds, "min_segment_seconds", params.limits);
-  check_seconds_override(request.window_seconds, "window_seconds", params.limits);
+  checkSecondsOverride(request.min_segment_seconds, "min_segment_seconds", params.limits);
+  checkSecondsOverride(request.window_seconds, "window_seconds", params.limits);
   if (request.min_segment_seconds > 0) p.min_segment_seconds = request.min_segment_seconds;
   if (request.window_seconds > 0) p.window_seconds = request.window_seconds;
   const std::size_t max_changepoints = p.pipeline.segmentation.max_changepoints;
@@ -46,7 +46,7 @@ namespace {
 // PreparedCache's key: what the bags' features and their selection depend on. Each file is named by
 // the identity of the descriptor that is read (device, inode, size, mtime and ctime in ns): a bag
 // replaced by a same-size file with the old mtime (touch -r; mv) is another file, never the cache.
-std::string cache_key(const std::vector<DemoFiles>& demos, const SegmentationParams& p) {
+std::string cacheKey(const std::vector<DemoFiles>& demos, const SegmentationParams& p) {
   std::ostringstream key;
   key.precision(17);
   key << "T=" << p.pipeline.relevance.threshold;
@@ -60,21 +60,21 @@ std::string cache_key(const std::vector<DemoFiles>& demos, const SegmentationPar
 
 // Service requests name absolute paths (the node's working directory is not the caller's), every
 // part of a demo written as "a.bag,b.bag" too; the error names the field.
-void check_request_paths(const std::vector<std::string>& bag_paths, const lfd::PathPolicy& policy) {
+void checkRequestPaths(const std::vector<std::string>& bag_paths, const lfd::PathPolicy& policy) {
   for (std::size_t i = 0; i < bag_paths.size(); ++i) {
-    for (const std::string& part : demo_parts(bag_paths[i]))
+    for (const std::string& part : demoParts(bag_paths[i]))
       lfd::checkRequestPath("bag_paths[" + std::to_string(i) + "]", part, policy);
   }
 }
 
-lfd_msgs::DemoSegmentation demo_message(const DemoFeatures& demo,
-                                        const lfd::DemoSegmentationResult& r, double rate) {
+lfd_msgs::DemoSegmentation demoMessage(const DemoFeatures& demo,
+                                       const lfd::DemoSegmentationResult& r, double rate) {
   lfd_msgs::DemoSegmentation m;
   const lfd::FeatureMatrix& x = demo.matrix;
   m.source = demo.source;
   m.num_samples = static_cast<uint32_t>(r.num_samples);
   m.sample_rate = rate;
-  m.start_time = x.time_at(0);
+  m.start_time = x.timeAt(0);
   m.min_segment_length = static_cast<uint32_t>(r.min_segment_length);
   m.changepoints.assign(r.changepoints.begin(), r.changepoints.end());
   m.changepoint_times = r.changepoint_times;
@@ -92,8 +92,8 @@ lfd_msgs::DemoSegmentation demo_message(const DemoFeatures& demo,
     lfd_msgs::ConfidenceZone zone;
     zone.begin_index = static_cast<uint32_t>(z.begin);
     zone.end_index = static_cast<uint32_t>(z.end);
-    zone.begin_time = x.time_at(std::min<Eigen::Index>(z.begin, last));
-    zone.end_time = x.time_at(std::min<Eigen::Index>(z.end, last));
+    zone.begin_time = x.timeAt(std::min<Eigen::Index>(z.begin, last));
+    zone.end_time = x.timeAt(std::min<Eigen::Index>(z.end, last));
     m.zones.push_back(zone);
   }
   return m;
@@ -101,8 +101,7 @@ lfd_msgs::DemoSegmentation demo_message(const DemoFeatures& demo,
 
 // Every string within one bound before anything else: a 10 MB path is refused, not echoed. The
 // bag count is checked before the overrides are parsed.
-void check_request_size(const lfd_msgs::Segment::Request& request,
-                        const SegmentationParams& params) {
+void checkRequestSize(const lfd_msgs::Segment::Request& request, const SegmentationParams& params) {
   lfd::StringBudget strings;
   strings.max_bytes = params.limits.max_request_string_bytes;
   strings.key = "limits/max_request_string_bytes";
@@ -118,22 +117,22 @@ void check_request_size(const lfd_msgs::Segment::Request& request,
 }
 
 // Reads the bags and selects their features unless `cache` already holds them under `key`.
-void ensure_prepared(const std::vector<DemoFiles>& files, const std::string& key,
-                     const SegmentationParams& p, const lfd::SegmentationPipelineConfig& config,
-                     const std::vector<std::string>& bag_paths, PreparedCache& cache) {
+void ensurePrepared(const std::vector<DemoFiles>& files, const std::string& key,
+                    const SegmentationParams& p, const lfd::SegmentationPipelineConfig& config,
+                    const std::vector<std::string>& bag_paths, PreparedCache& cache) {
   if (!cache.key.empty() && cache.key == key) return;
   cache = PreparedCache{};  // the stale entry goes before anything is read
   for (const DemoFiles& demo : files) {
-    cache.demos.push_back(read_bag_features(demo, p.topics, p.rate, p.limits));
+    cache.demos.push_back(readBagFeatures(demo, p.topics, p.rate, p.limits));
     cache.matrices.push_back(cache.demos.back().matrix);
   }
-  check_demos_fit(p, cache.matrices, bag_paths);
-  cache.prepared = lfd::prepare_segmentation(cache.matrices, cache.demos[0].sensor_features, config,
-                                             cache.demos[0].state_features);
+  checkDemosFit(p, cache.matrices, bag_paths);
+  cache.prepared = lfd::prepareSegmentation(cache.matrices, cache.demos[0].sensor_features, config,
+                                            cache.demos[0].state_features);
   cache.key = key;
 }
 
-lfd_msgs::FeatureScore feature_score_message(const lfd::FeatureRelevance& f) {
+lfd_msgs::FeatureScore featureScoreMessage(const lfd::FeatureRelevance& f) {
   lfd_msgs::FeatureScore s;
   s.name = f.name;
   s.mean_correlation = f.mean_correlation;
@@ -152,9 +151,9 @@ lfd_msgs::FeatureScore feature_score_message(const lfd::FeatureRelevance& f) {
   return s;
 }
 
-void fill_response(const std::vector<DemoFeatures>& demos,
-                   const lfd::SegmentationPipelineResult& result, double rate,
-                   lfd_msgs::Segment::Response& response) {
+void fillResponse(const std::vector<DemoFeatures>& demos,
+                  const lfd::SegmentationPipelineResult& result, double rate,
+                  lfd_msgs::Segment::Response& response) {
   response.warnings.clear();
   for (const DemoFeatures& demo : demos)  // the stamps each bag's reader put in order
     response.warnings.insert(response.warnings.end(), demo.warnings.begin(), demo.warnings.end());
@@ -163,40 +162,40 @@ void fill_response(const std::vector<DemoFeatures>& demos,
   response.selected_weights = result.feature_weights;
   response.sensor_features = result.sensor_features;
   for (std::size_t d = 0; d < demos.size(); ++d) {
-    response.demos.push_back(demo_message(demos[d], result.demos[d], rate));
+    response.demos.push_back(demoMessage(demos[d], result.demos[d], rate));
   }
   if (result.relevance_computed) {
     for (const lfd::FeatureRelevance& f : result.relevance.features) {
-      response.features.push_back(feature_score_message(f));
+      response.features.push_back(featureScoreMessage(f));
     }
   }
 }
 
 }  // namespace
 
-void handle_segment_request(const SegmentationParams& params,
-                            const lfd_msgs::Segment::Request& request,
-                            lfd_msgs::Segment::Response& response, PreparedCache* cache) {
+void handleSegmentRequest(const SegmentationParams& params,
+                          const lfd_msgs::Segment::Request& request,
+                          lfd_msgs::Segment::Response& response, PreparedCache* cache) {
   const auto start = std::chrono::steady_clock::now();
   response = lfd_msgs::Segment::Response();
   try {
-    check_request_size(request, params);
-    const SegmentationParams p = apply_overrides(params, request);
+    checkRequestSize(request, params);
+    const SegmentationParams p = applyOverrides(params, request);
     lfd::PathPolicy paths = p.paths;
     paths.require_absolute = true;  // a service: the CLI takes relative paths, the node does not
-    check_request_paths(request.bag_paths, paths);
-    check_request_budget(request.bag_paths, p.limits, paths);  // the expanded work, up front
+    checkRequestPaths(request.bag_paths, paths);
+    checkRequestBudget(request.bag_paths, p.limits, paths);  // the expanded work, up front
     std::vector<DemoFiles> files;  // opened once: the cache key names what is read
-    for (const std::string& path : request.bag_paths) files.push_back(open_demo_files(path, paths));
-    const std::string key = cache_key(files, p);
+    for (const std::string& path : request.bag_paths) files.push_back(openDemoFiles(path, paths));
+    const std::string key = cacheKey(files, p);
     PreparedCache local;  // without a cache
     PreparedCache& used = cache ? *cache : local;
-    const lfd::SegmentationPipelineConfig config = p.pipeline_config();
-    ensure_prepared(files, key, p, config, request.bag_paths, used);
-    check_demos_fit(p, used.matrices, request.bag_paths);  // this request's window_seconds
+    const lfd::SegmentationPipelineConfig config = p.pipelineConfig();
+    ensurePrepared(files, key, p, config, request.bag_paths, used);
+    checkDemosFit(p, used.matrices, request.bag_paths);  // this request's window_seconds
     const lfd::SegmentationPipelineResult result =
-        lfd::segment_prepared(used.prepared, used.matrices, config);
-    fill_response(used.demos, result, p.rate, response);
+        lfd::segmentPrepared(used.prepared, used.matrices, config);
+    fillResponse(used.demos, result, p.rate, response);
     response.success = true;
   } catch (const std::exception& e) {
     response = lfd_msgs::Segment::Response();

@@ -9,7 +9,7 @@ namespace {
 
 using nlohmann::json;
 
-json vector_json(const Eigen::VectorXd& v) {
+json vectorJson(const Eigen::VectorXd& v) {
   json out = json::array();
   for (Eigen::Index k = 0; k < v.size(); ++k) {
     out.push_back(std::isfinite(v[k]) ? json(v[k]) : json(nullptr));
@@ -20,7 +20,7 @@ json vector_json(const Eigen::VectorXd& v) {
 // Decimals of a feature's rounding step (10^-decimals <= kFeatureResolution x its range, or its
 // magnitude when constant); kKeepDigits when there is nothing to scale by.
 constexpr int kKeepDigits = 99;
-int feature_decimals(const Eigen::VectorXd& values) {
+int featureDecimals(const Eigen::VectorXd& values) {
   if (values.size() == 0 || !values.allFinite()) return kKeepDigits;
   const double lo = values.minCoeff(), hi = values.maxCoeff();
   const double span = hi > lo ? hi - lo : std::max(std::abs(lo), std::abs(hi));
@@ -31,7 +31,7 @@ int feature_decimals(const Eigen::VectorXd& values) {
 // x as the double nearest to a multiple of 10^-decimals, which the JSON writer (shortest round
 // trip) prints with no more digits than the step: n / 10^k and n * 10^k are correctly rounded
 // operations on exact integers (|n| < 2^53, 10^k exact for k <= 22).
-double round_decimals(double x, int decimals) {
+double roundDecimals(double x, int decimals) {
   if (!std::isfinite(x) || std::abs(decimals) > 22) return x;
   double scale = 1;
   for (int k = 0; k < std::abs(decimals); ++k) scale *= 10;
@@ -40,17 +40,17 @@ double round_decimals(double x, int decimals) {
   return (decimals >= 0 ? n / scale : n * scale) + 0.0;  // + 0.0: -0 prints as 0
 }
 
-json rounded_json(const Eigen::VectorXd& v) {
-  const int decimals = feature_decimals(v);
+json roundedJson(const Eigen::VectorXd& v) {
+  const int decimals = featureDecimals(v);
   json out = json::array();
   for (Eigen::Index k = 0; k < v.size(); ++k) {
-    out.push_back(std::isfinite(v[k]) ? json(round_decimals(v[k], decimals)) : json(nullptr));
+    out.push_back(std::isfinite(v[k]) ? json(roundDecimals(v[k], decimals)) : json(nullptr));
   }
   return out;
 }
 
-const char* role_of(const std::string& name, const std::vector<std::string>& states,
-                    const std::vector<std::string>& sensors) {
+const char* roleOf(const std::string& name, const std::vector<std::string>& states,
+                   const std::vector<std::string>& sensors) {
   auto in = [&](const std::vector<std::string>& list) {
     return std::find(list.begin(), list.end(), name) != list.end();
   };
@@ -59,53 +59,53 @@ const char* role_of(const std::string& name, const std::vector<std::string>& sta
 
 // Feature names, file names and errors come from the user's files and may hold any bytes: invalid
 // UTF-8 is written as U+FFFD instead of throwing (nlohmann's type_error 316 aborted the CLI).
-std::string dump_text(const json& j) {
+std::string dumpText(const json& j) {
   return j.dump(-1, ' ', false, json::error_handler_t::replace);
 }
 
-bool is_flat(const json& j) {
+bool isFlat(const json& j) {
   return !j.is_structured() || j.empty() ||
          (j.is_array() &&
           std::none_of(j.begin(), j.end(), [](const json& e) { return e.is_structured(); }));
 }
 
-void dump_indented(const json& j, int depth, std::string& out) {
-  if (is_flat(j)) {
-    out += dump_text(j);
+void dumpIndented(const json& j, int depth, std::string& out) {
+  if (isFlat(j)) {
+    out += dumpText(j);
     return;
   }
   const std::string pad(static_cast<std::size_t>(depth) + 1, ' ');
   out += j.is_object() ? '{' : '[';
   for (auto it = j.begin(); it != j.end(); ++it) {
     out += (it == j.begin() ? "\n" : ",\n") + pad;
-    if (j.is_object()) out += dump_text(json(it.key())) + ": ";
-    dump_indented(*it, depth + 1, out);
+    if (j.is_object()) out += dumpText(json(it.key())) + ": ";
+    dumpIndented(*it, depth + 1, out);
   }
   out += "\n" + std::string(static_cast<std::size_t>(depth), ' ') + (j.is_object() ? '}' : ']');
 }
 
-json matrix_json(const Eigen::MatrixXd& m) {
+json matrixJson(const Eigen::MatrixXd& m) {
   json out = json::array();
-  for (Eigen::Index r = 0; r < m.rows(); ++r) out.push_back(vector_json(m.row(r).transpose()));
+  for (Eigen::Index r = 0; r < m.rows(); ++r) out.push_back(vectorJson(m.row(r).transpose()));
   return out;
 }
 
-json times_json(const std::vector<std::size_t>& indices, const lfd::FeatureMatrix& demo) {
+json timesJson(const std::vector<std::size_t>& indices, const lfd::FeatureMatrix& demo) {
   json out = json::array();
-  for (std::size_t i : indices) out.push_back(demo.time_at(static_cast<Eigen::Index>(i)));
+  for (std::size_t i : indices) out.push_back(demo.timeAt(static_cast<Eigen::Index>(i)));
   return out;
 }
 
-json clasp_json(const lfd::MultivariateSegmentation& s, const lfd::FeatureMatrix& demo,
-                const std::vector<std::string>& features, const JsonOptions& options) {
+json claspJson(const lfd::MultivariateSegmentation& s, const lfd::FeatureMatrix& demo,
+               const std::vector<std::string>& features, const JsonOptions& options) {
   json out;
   out["clasp_changepoints"] = s.changepoints;
-  out["clasp_changepoint_times"] = times_json(s.changepoints, demo);
+  out["clasp_changepoint_times"] = timesJson(s.changepoints, demo);
   json candidates = json::array();
   for (const lfd::SplitCandidate& c : s.candidates) {
     candidates.push_back(
         {{"index", c.index},
-         {"time", demo.time_at(static_cast<Eigen::Index>(c.index))},
+         {"time", demo.timeAt(static_cast<Eigen::Index>(c.index))},
          {"range", {c.range_begin, c.range_end}},
          {"score", std::isfinite(c.score) ? json(c.score) : json(nullptr)},
          {"log10_p_value", std::isfinite(c.log10_p_value) ? json(c.log10_p_value) : json(nullptr)},
@@ -121,13 +121,13 @@ json clasp_json(const lfd::MultivariateSegmentation& s, const lfd::FeatureMatrix
   out["window_sizes"] = windows;
   out["min_segment_length"] = s.min_segment_length;
   if (options.profiles) {
-    out["profile"] = vector_json(s.first_profile);
-    out["profile_penalized"] = vector_json(s.first_profile_penalized);
+    out["profile"] = vectorJson(s.first_profile);
+    out["profile_penalized"] = vectorJson(s.first_profile_penalized);
   }
   if (options.feature_profiles) {
     json profiles = json::object();
     for (std::size_t f = 0; f < features.size() && f < s.first_feature_profiles.size(); ++f) {
-      profiles[features[f]] = vector_json(s.first_feature_profiles[f]);
+      profiles[features[f]] = vectorJson(s.first_feature_profiles[f]);
     }
     out["feature_profiles"] = profiles;
   }
@@ -136,8 +136,8 @@ json clasp_json(const lfd::MultivariateSegmentation& s, const lfd::FeatureMatrix
 
 }  // namespace
 
-json to_json(const lfd::SegmentationPipelineResult& r, const std::vector<lfd::FeatureMatrix>& demos,
-             const std::vector<std::string>& sources, const JsonOptions& options) {
+json toJson(const lfd::SegmentationPipelineResult& r, const std::vector<lfd::FeatureMatrix>& demos,
+            const std::vector<std::string>& sources, const JsonOptions& options) {
   json out;
   out["warnings"] = r.warnings;
   out["state_features"] = r.state_features;
@@ -158,8 +158,8 @@ json to_json(const lfd::SegmentationPipelineResult& r, const std::vector<lfd::Fe
                           {"constant", f.constant},
                           {"selected", f.selected},
                           {"selected_correlation_only", f.selected_correlation_only},
-                          {"correlation", matrix_json(f.correlation)},
-                          {"distance", matrix_json(f.distance)}});
+                          {"correlation", matrixJson(f.correlation)},
+                          {"distance", matrixJson(f.distance)}});
     }
     out["relevance"] = {{"features", features},
                         {"selected", r.relevance.selected},
@@ -172,11 +172,11 @@ json to_json(const lfd::SegmentationPipelineResult& r, const std::vector<lfd::Fe
     for (const lfd::Interval& z : s.zones) {
       zones.push_back({{"begin", z.begin},
                        {"end", z.end},
-                       {"begin_time", demos[d].time_at(static_cast<Eigen::Index>(z.begin))},
-                       {"end_time", demos[d].time_at(static_cast<Eigen::Index>(
+                       {"begin_time", demos[d].timeAt(static_cast<Eigen::Index>(z.begin))},
+                       {"end_time", demos[d].timeAt(static_cast<Eigen::Index>(
                                         std::min<std::size_t>(z.end, demos[d].rows() - 1)))}});
     }
-    json demo = clasp_json(s.clasp, demos[d], r.selected_features, options);
+    json demo = claspJson(s.clasp, demos[d], r.selected_features, options);
     demo["source"] = d < sources.size() ? sources[d] : "";
     demo["num_samples"] = s.num_samples;
     demo["changepoints"] = s.changepoints;
@@ -189,11 +189,11 @@ json to_json(const lfd::SegmentationPipelineResult& r, const std::vector<lfd::Fe
     demo["added"] = s.added;
     demo["added_times"] = s.added_times;
     demo["events"] = s.events;
-    demo["event_times"] = times_json(s.events, demos[d]);
+    demo["event_times"] = timesJson(s.events, demos[d]);
     std::vector<std::size_t> rest_edges;
     for (const lfd::SensoryEvent& e : s.event_details)
       if (e.rest_edge) rest_edges.push_back(e.index);
-    demo["rest_edge_event_times"] = times_json(rest_edges, demos[d]);
+    demo["rest_edge_event_times"] = timesJson(rest_edges, demos[d]);
     demo["sample_rate"] = s.sample_rate;
     demo["zones"] = zones;
     demo_list.push_back(demo);
@@ -202,40 +202,40 @@ json to_json(const lfd::SegmentationPipelineResult& r, const std::vector<lfd::Fe
   return out;
 }
 
-json to_json(const lfd::MultivariateSegmentation& s, const lfd::FeatureMatrix& demo,
-             const std::string& source, const JsonOptions& options) {
+json toJson(const lfd::MultivariateSegmentation& s, const lfd::FeatureMatrix& demo,
+            const std::string& source, const JsonOptions& options) {
   json out;
   out["selected_features"] = demo.names;
-  json d = clasp_json(s, demo, demo.names, options);
+  json d = claspJson(s, demo, demo.names, options);
   d["source"] = source;
   d["num_samples"] = demo.rows();
   d["changepoints"] = s.changepoints;
-  d["changepoint_times"] = times_json(s.changepoints, demo);
+  d["changepoint_times"] = timesJson(s.changepoints, demo);
   out["demos"] = json::array({d});
   out["warnings"] = json::array();
   return out;
 }
 
-json feature_matrices_json(const std::vector<lfd::FeatureMatrix>& demos,
-                           const std::vector<std::string>& states,
-                           const std::vector<std::string>& sensors) {
+json featureMatricesJson(const std::vector<lfd::FeatureMatrix>& demos,
+                         const std::vector<std::string>& states,
+                         const std::vector<std::string>& sensors) {
   json out = json::array();
   for (const lfd::FeatureMatrix& demo : demos) {
     json features = json::array();
     for (Eigen::Index c = 0; c < demo.cols(); ++c) {
       const std::string& name = demo.names.at(static_cast<std::size_t>(c));
       features.push_back({{"name", name},
-                          {"role", role_of(name, states, sensors)},
-                          {"values", rounded_json(demo.data.col(c))}});
+                          {"role", roleOf(name, states, sensors)},
+                          {"values", roundedJson(demo.data.col(c))}});
     }
-    json time = json::array();  // time_at: a series without a clock is on its row index
-    for (Eigen::Index r = 0; r < demo.rows(); ++r) time.push_back(demo.time_at(r));
+    json time = json::array();  // timeAt: a series without a clock is on its row index
+    for (Eigen::Index r = 0; r < demo.rows(); ++r) time.push_back(demo.timeAt(r));
     out.push_back({{"time", time}, {"features", features}});
   }
   return out;
 }
 
-lfd::OutputKind segmentation_result_output() {
+lfd::OutputKind segmentationResultOutput() {
   const lfd::OutputKind success_mode =
       lfd::jsonOutput("segmentation result", kSegmentationResultFormat, {"success", "mode"});
   const lfd::OutputKind success_error =
@@ -245,9 +245,9 @@ lfd::OutputKind segmentation_result_output() {
           }};
 }
 
-std::string dump_json(const json& j) {
+std::string dumpJson(const json& j) {
   std::string out;
-  dump_indented(j, 0, out);
+  dumpIndented(j, 0, out);
   return out;
 }
 

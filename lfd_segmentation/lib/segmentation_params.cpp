@@ -7,6 +7,8 @@
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
+#include <string>
+#include <utility>
 
 namespace lfd_segmentation {
 
@@ -23,7 +25,7 @@ T get(const YAML::Node& node, const std::string& key, T fallback) {
   }
 }
 
-double non_negative(double value, const std::string& key) {
+double nonNegative(double value, const std::string& key) {
   if (!(value >= 0) || !std::isfinite(value)) {
     throw std::invalid_argument("segmentation parameter " + lfd::quoted(key) +
                                 " must be >= 0, got " + std::to_string(value));
@@ -49,7 +51,7 @@ std::string seconds(double s) {
   return number(s) + " s";
 }
 
-TopicConfig parse_topic(const YAML::Node& node, std::size_t index) {
+TopicConfig parseTopic(const YAML::Node& node, std::size_t index) {
   const std::string where = "topics[" + std::to_string(index) + "]";
   if (!node.IsMap()) throw std::invalid_argument(where + " must be a map");
   TopicConfig topic;
@@ -91,95 +93,95 @@ double fraction(double value, const std::string& key) {
   return value;
 }
 
+// The numbers of one YAML section, each read over its default, checked, and named in an error by
+// its path ("joint/pauses/rest_fraction").
+class Section {
+ public:
+  Section(const YAML::Node& node, std::string path) : node_(node), path_(std::move(path)) {}
+  Section child(const char* key) const {
+    return Section(node_ ? node_[key] : YAML::Node(), path_ + key + "/");
+  }
+  void readFraction(const char* key, double& value) const {
+    value = fraction(get<double>(node_, key, value), path_ + key);
+  }
+  void readNonNegative(const char* key, double& value) const {
+    value = nonNegative(get<double>(node_, key, value), path_ + key);
+  }
+  void readPositive(const char* key, double& value) const {
+    value = positive(get<double>(node_, key, value), path_ + key);
+  }
+
+ private:
+  YAML::Node node_;
+  std::string path_;
+};
+
 // joint: the joint segmentation's evidence weights, pauses, alignment and agreement.
-void parse_joint(const YAML::Node& node, lfd::JointSegmentationConfig* joint) {
-  const YAML::Node w = node ? node["weights"] : YAML::Node();
+void parseJoint(const YAML::Node& node, lfd::JointSegmentationConfig* joint) {
+  const Section section(node, "joint/");
+  const Section w = section.child("weights");
   auto& weights = joint->weights;
-  weights.contact = fraction(get<double>(w, "contact", weights.contact), "joint/weights/contact");
-  weights.sensor_level =
-      fraction(get<double>(w, "sensor_level", weights.sensor_level), "joint/weights/sensor_level");
-  weights.motion_onset =
-      fraction(get<double>(w, "motion_onset", weights.motion_onset), "joint/weights/motion_onset");
-  weights.motion_stop =
-      fraction(get<double>(w, "motion_stop", weights.motion_stop), "joint/weights/motion_stop");
-  weights.clasp = fraction(get<double>(w, "clasp", weights.clasp), "joint/weights/clasp");
-  const YAML::Node pause = node ? node["pauses"] : YAML::Node();
+  w.readFraction("contact", weights.contact);
+  w.readFraction("sensor_level", weights.sensor_level);
+  w.readFraction("motion_onset", weights.motion_onset);
+  w.readFraction("motion_stop", weights.motion_stop);
+  w.readFraction("clasp", weights.clasp);
+  const Section pause = section.child("pauses");
   auto& pc = joint->pauses;
-  pc.smoothing = non_negative(get<double>(pause, "smoothing_seconds", pc.smoothing),
-                              "joint/pauses/smoothing_seconds");
-  pc.rest_fraction =
-      fraction(get<double>(pause, "rest_fraction", pc.rest_fraction), "joint/pauses/rest_fraction");
-  pc.min_pause = non_negative(get<double>(pause, "min_pause_seconds", pc.min_pause),
-                              "joint/pauses/min_pause_seconds");
-  pc.pause_scale = positive(get<double>(pause, "pause_scale_seconds", pc.pause_scale),
-                            "joint/pauses/pause_scale_seconds");
-  pc.motion_window = positive(get<double>(pause, "motion_window_seconds", pc.motion_window),
-                              "joint/pauses/motion_window_seconds");
-  joint->grid_step =
-      positive(get<double>(node, "grid_step_seconds", joint->grid_step), "joint/grid_step_seconds");
-  joint->alignment_band =
-      positive(get<double>(node, "alignment_band", joint->alignment_band), "joint/alignment_band");
-  joint->spread =
-      positive(get<double>(node, "spread_seconds", joint->spread), "joint/spread_seconds");
-  joint->min_support =
-      fraction(get<double>(node, "min_support", joint->min_support), "joint/min_support");
-  joint->short_phase_support =
-      fraction(get<double>(node, "short_phase_support", joint->short_phase_support),
-               "joint/short_phase_support");
-  joint->match_window = positive(get<double>(node, "match_window_seconds", joint->match_window),
-                                 "joint/match_window_seconds");
-  joint->event_merge_gap =
-      non_negative(get<double>(node, "event_merge_gap_seconds", joint->event_merge_gap),
-                   "joint/event_merge_gap_seconds");
-  joint->ramp_fold = non_negative(get<double>(node, "ramp_fold_seconds", joint->ramp_fold),
-                                  "joint/ramp_fold_seconds");
-  joint->stale_reading =
-      non_negative(get<double>(node, "stale_reading_seconds", joint->stale_reading),
-                   "joint/stale_reading_seconds");
-  joint->min_piece_weight = fraction(get<double>(node, "min_piece_weight", joint->min_piece_weight),
-                                     "joint/min_piece_weight");
-  joint->colocation = non_negative(get<double>(node, "colocation_seconds", joint->colocation),
-                                   "joint/colocation_seconds");
+  pause.readNonNegative("smoothing_seconds", pc.smoothing);
+  pause.readFraction("rest_fraction", pc.rest_fraction);
+  pause.readNonNegative("min_pause_seconds", pc.min_pause);
+  pause.readPositive("pause_scale_seconds", pc.pause_scale);
+  pause.readPositive("motion_window_seconds", pc.motion_window);
+  section.readPositive("grid_step_seconds", joint->grid_step);
+  section.readPositive("alignment_band", joint->alignment_band);
+  section.readPositive("spread_seconds", joint->spread);
+  section.readFraction("min_support", joint->min_support);
+  section.readFraction("short_phase_support", joint->short_phase_support);
+  section.readPositive("match_window_seconds", joint->match_window);
+  section.readNonNegative("event_merge_gap_seconds", joint->event_merge_gap);
+  section.readNonNegative("ramp_fold_seconds", joint->ramp_fold);
+  section.readNonNegative("stale_reading_seconds", joint->stale_reading);
+  section.readFraction("min_piece_weight", joint->min_piece_weight);
+  section.readNonNegative("colocation_seconds", joint->colocation);
   joint->max_speed_correlation =
       get<double>(node, "max_speed_correlation", joint->max_speed_correlation);
-  joint->extra_event_weight =
-      fraction(get<double>(node, "extra_event_weight", joint->extra_event_weight),
-               "joint/extra_event_weight");
+  section.readFraction("extra_event_weight", joint->extra_event_weight);
 }
 
 // The ClaSP profile and its significance test (segmentation.yaml `clasp`, and the combination,
 // window and changepoint keys at the top level).
-void parse_clasp(const YAML::Node& root, SegmentationParams& p) {
+void parseClasp(const YAML::Node& root, SegmentationParams& p) {
   auto& seg = p.pipeline.segmentation;
-  seg.combination = lfd::parse_profile_combination(
-      get<std::string>(root, "combination", lfd::to_string(seg.combination)));
+  seg.combination = lfd::parseProfileCombination(
+      get<std::string>(root, "combination", lfd::toString(seg.combination)));
   p.min_segment_seconds =
-      non_negative(get<double>(root, "min_segment_seconds", 0.0), "min_segment_seconds");
-  p.window_seconds = non_negative(get<double>(root, "window_seconds", 0.0), "window_seconds");
+      nonNegative(get<double>(root, "min_segment_seconds", 0.0), "min_segment_seconds");
+  p.window_seconds = nonNegative(get<double>(root, "window_seconds", 0.0), "window_seconds");
   seg.num_changepoints = get<int>(root, "num_changepoints", seg.num_changepoints);
   seg.max_changepoints = get<std::size_t>(root, "max_changepoints", seg.max_changepoints);
-  seg.kaiser_beta = non_negative(get<double>(root, "kaiser_beta", seg.kaiser_beta), "kaiser_beta");
+  seg.kaiser_beta = nonNegative(get<double>(root, "kaiser_beta", seg.kaiser_beta), "kaiser_beta");
   seg.zone_p_value_threshold =
-      non_negative(get<double>(root, "zone_p_value_threshold", seg.zone_p_value_threshold),
-                   "zone_p_value_threshold");
-  seg.rest_edge_p_value_threshold = non_negative(
-      get<double>(root, "rest_edge_p_value_threshold", seg.rest_edge_p_value_threshold),
-      "rest_edge_p_value_threshold");
+      nonNegative(get<double>(root, "zone_p_value_threshold", seg.zone_p_value_threshold),
+                  "zone_p_value_threshold");
+  seg.rest_edge_p_value_threshold =
+      nonNegative(get<double>(root, "rest_edge_p_value_threshold", seg.rest_edge_p_value_threshold),
+                  "rest_edge_p_value_threshold");
   const YAML::Node clasp = root["clasp"];
   auto& cc = seg.clasp;
-  cc.window_selection = lfd::parse_window_selection(
-      get<std::string>(clasp, "window_selection", lfd::to_string(cc.window_selection)));
-  p.time.min_window = non_negative(get<double>(clasp, "min_window_seconds", p.time.min_window),
-                                   "clasp/min_window_seconds");
+  cc.window_selection = lfd::parseWindowSelection(
+      get<std::string>(clasp, "window_selection", lfd::toString(cc.window_selection)));
+  p.time.min_window = nonNegative(get<double>(clasp, "min_window_seconds", p.time.min_window),
+                                  "clasp/min_window_seconds");
   cc.k = get<std::size_t>(clasp, "k", cc.k);
   cc.distance =
-      lfd::parse_clasp_distance(get<std::string>(clasp, "distance", lfd::to_string(cc.distance)));
-  cc.score = lfd::parse_clasp_score(get<std::string>(clasp, "score", lfd::to_string(cc.score)));
+      lfd::parseClaspDistance(get<std::string>(clasp, "distance", lfd::toString(cc.distance)));
+  cc.score = lfd::parseClaspScore(get<std::string>(clasp, "score", lfd::toString(cc.score)));
   cc.p_value_threshold = get<double>(clasp, "p_value_threshold", cc.p_value_threshold);
   seg.significance_per_sample =
-      non_negative(get<double>(clasp, "significance_per_sample", seg.significance_per_sample),
-                   "clasp/significance_per_sample");
-  cc.tie_jitter = non_negative(get<double>(clasp, "tie_jitter", cc.tie_jitter), "clasp/tie_jitter");
+      nonNegative(get<double>(clasp, "significance_per_sample", seg.significance_per_sample),
+                  "clasp/significance_per_sample");
+  cc.tie_jitter = nonNegative(get<double>(clasp, "tie_jitter", cc.tie_jitter), "clasp/tie_jitter");
 
   if (clasp && clasp["min_window"])
     throw std::invalid_argument(
@@ -187,11 +189,11 @@ void parse_clasp(const YAML::Node& root, SegmentationParams& p) {
 }
 
 // The procedure that combines candidates, zones and consensus (top-level keys).
-void parse_procedure(const YAML::Node& root, SegmentationParams& p) {
+void parseProcedure(const YAML::Node& root, SegmentationParams& p) {
   p.pipeline.validate_with_sensors =
       get<bool>(root, "validate_with_sensors", p.pipeline.validate_with_sensors);
-  p.pipeline.procedure = lfd::parse_segmentation_procedure(
-      get<std::string>(root, "procedure", lfd::to_string(p.pipeline.procedure)));
+  p.pipeline.procedure = lfd::parseSegmentationProcedure(
+      get<std::string>(root, "procedure", lfd::toString(p.pipeline.procedure)));
   if (root["search_in_zones"])
     throw std::invalid_argument(
         "segmentation parameter 'search_in_zones' is now 'procedure' (zone_search or paper)");
@@ -213,11 +215,11 @@ void parse_procedure(const YAML::Node& root, SegmentationParams& p) {
 }
 
 // Sensory events and their confidence zones (segmentation.yaml `events`).
-void parse_events(const YAML::Node& root, SegmentationParams& p) {
+void parseEvents(const YAML::Node& root, SegmentationParams& p) {
   const YAML::Node events = root["events"];
   auto& ev = p.pipeline.events;
-  ev.threshold = lfd::parse_event_threshold(
-      get<std::string>(events, "threshold", lfd::to_string(ev.threshold)));
+  ev.threshold =
+      lfd::parseEventThreshold(get<std::string>(events, "threshold", lfd::toString(ev.threshold)));
   ev.threshold_ratio = get<double>(events, "threshold_ratio", ev.threshold_ratio);
   ev.relative_floor = get<double>(events, "relative_floor", ev.relative_floor);
   ev.noise_floor_sigmas = get<double>(events, "noise_floor_sigmas", ev.noise_floor_sigmas);
@@ -225,27 +227,21 @@ void parse_events(const YAML::Node& root, SegmentationParams& p) {
       get<double>(events, "noise_floor_excursions", ev.noise_floor_excursions);
   ev.hysteresis = get<double>(events, "hysteresis", ev.hysteresis);
   ev.zones_from_rest_edges = get<bool>(events, "zones_from_rest_edges", ev.zones_from_rest_edges);
-  ev.rest_edge_sigmas = non_negative(get<double>(events, "rest_edge_sigmas", ev.rest_edge_sigmas),
-                                     "events/rest_edge_sigmas");
-  ev.placement = lfd::parse_event_placement(
-      get<std::string>(events, "placement", lfd::to_string(ev.placement)));
+  ev.rest_edge_sigmas = nonNegative(get<double>(events, "rest_edge_sigmas", ev.rest_edge_sigmas),
+                                    "events/rest_edge_sigmas");
+  ev.placement =
+      lfd::parseEventPlacement(get<std::string>(events, "placement", lfd::toString(ev.placement)));
   if (events && events["place_on_change"])
     throw std::invalid_argument(
         "segmentation parameter 'events/place_on_change' is now 'events/placement' (threshold, "
         "shift or fit)");
   auto& t = p.time;
-  t.event_median =
-      non_negative(get<double>(events, "median_seconds", t.event_median), "events/median_seconds");
-  t.event_difference_lag =
-      non_negative(get<double>(events, "difference_lag_seconds", t.event_difference_lag),
-                   "events/difference_lag_seconds");
-  t.event_merge_gap = non_negative(get<double>(events, "merge_gap_seconds", t.event_merge_gap),
-                                   "events/merge_gap_seconds");
-  t.event_min_active = non_negative(get<double>(events, "min_active_seconds", t.event_min_active),
-                                    "events/min_active_seconds");
-  t.event_noise_block =
-      non_negative(get<double>(events, "noise_block_seconds", t.event_noise_block),
-                   "events/noise_block_seconds");
+  const Section event_times(events, "events/");
+  event_times.readNonNegative("median_seconds", t.event_median);
+  event_times.readNonNegative("difference_lag_seconds", t.event_difference_lag);
+  event_times.readNonNegative("merge_gap_seconds", t.event_merge_gap);
+  event_times.readNonNegative("min_active_seconds", t.event_min_active);
+  event_times.readNonNegative("noise_block_seconds", t.event_noise_block);
   // Sample counts would silently mean something else at another rate: refuse them.
   for (const char* key : {"median_window", "merge_gap", "difference_lag", "min_active_samples"})
     if (events && events[key])
@@ -254,7 +250,7 @@ void parse_events(const YAML::Node& root, SegmentationParams& p) {
 }
 
 // Request limits (segmentation.yaml `limits`) and the folders a request may name.
-void parse_limits(const YAML::Node& root, SegmentationParams& p) {
+void parseLimits(const YAML::Node& root, SegmentationParams& p) {
   const YAML::Node limits = root["limits"];
   auto& lim = p.limits;
   lim.max_bags = get<std::size_t>(limits, "max_bags", lim.max_bags);
@@ -274,28 +270,28 @@ void parse_limits(const YAML::Node& root, SegmentationParams& p) {
   p.paths.allowed_roots = get<std::vector<std::string>>(root, "allowed_roots", {});
 }
 
-void parse_topics(const YAML::Node& root, SegmentationParams& p) {
+void parseTopics(const YAML::Node& root, SegmentationParams& p) {
   const YAML::Node topics = root["topics"];
   if (topics) {
     if (!topics.IsSequence())
       throw std::invalid_argument("segmentation parameter 'topics' must be a list");
-    for (std::size_t k = 0; k < topics.size(); ++k) p.topics.push_back(parse_topic(topics[k], k));
+    for (std::size_t k = 0; k < topics.size(); ++k) p.topics.push_back(parseTopic(topics[k], k));
   }
 }
 
 }  // namespace
 
-lfd::SegmentationPipelineConfig SegmentationParams::pipeline_config() const {
+lfd::SegmentationPipelineConfig SegmentationParams::pipelineConfig() const {
   lfd::SegmentationPipelineConfig config = pipeline;
   config.seconds = time;
   config.seconds->min_segment = min_segment_seconds;
   config.seconds->window = window_seconds;
-  lfd::SegmentationPipelineConfig nominal = lfd::in_samples(config, rate);
+  lfd::SegmentationPipelineConfig nominal = lfd::inSamples(config, rate);
   nominal.seconds = config.seconds;
   return nominal;
 }
 
-SegmentationParams params_from_yaml(const YAML::Node& root) {
+SegmentationParams paramsFromYaml(const YAML::Node& root) {
   SegmentationParams p;
   p.rate = get<double>(root, "rate", p.rate);
   if (!(p.rate > 0) || !std::isfinite(p.rate)) {
@@ -310,16 +306,16 @@ SegmentationParams params_from_yaml(const YAML::Node& root) {
   relevance.normalize_per_demo =
       get<bool>(root, "normalize_per_demo", relevance.normalize_per_demo);
 
-  parse_clasp(root, p);
-  parse_procedure(root, p);
-  parse_joint(root["joint"], &p.pipeline.joint);
-  parse_events(root, p);
-  parse_limits(root, p);
-  parse_topics(root, p);
+  parseClasp(root, p);
+  parseProcedure(root, p);
+  parseJoint(root["joint"], &p.pipeline.joint);
+  parseEvents(root, p);
+  parseLimits(root, p);
+  parseTopics(root, p);
   return p;
 }
 
-SegmentationParams load_params_file(const std::string& path) {
+SegmentationParams loadParamsFile(const std::string& path) {
   YAML::Node root;
   try {
     root = YAML::LoadFile(lfd::openInputFile(path).readPath());  // no FIFO swapped in
@@ -329,10 +325,10 @@ SegmentationParams load_params_file(const std::string& path) {
     throw std::invalid_argument("cannot read segmentation parameters " + lfd::quoted(path) + ": " +
                                 e.what());
   }
-  return params_from_yaml(root);
+  return paramsFromYaml(root);
 }
 
-void check_seconds_override(double value, const std::string& key, const RequestLimits& limits) {
+void checkSecondsOverride(double value, const std::string& key, const RequestLimits& limits) {
   if (value == 0) return;  // 0 = keep the parameter
   if (!std::isfinite(value) || value > limits.max_demo_seconds) {
     throw std::invalid_argument(key + " = " + seconds(value) +
@@ -341,8 +337,8 @@ void check_seconds_override(double value, const std::string& key, const RequestL
   }
 }
 
-void check_demos_fit(const SegmentationParams& params, const std::vector<lfd::FeatureMatrix>& demos,
-                     const std::vector<std::string>& sources) {
+void checkDemosFit(const SegmentationParams& params, const std::vector<lfd::FeatureMatrix>& demos,
+                   const std::vector<std::string>& sources) {
   const RequestLimits& lim = params.limits;
   std::size_t total = 0;
   for (std::size_t d = 0; d < demos.size(); ++d) {
@@ -358,7 +354,7 @@ void check_demos_fit(const SegmentationParams& params, const std::vector<lfd::Fe
     }
     total += rows;
     if (rows < 2) continue;
-    const double length = m.time_at(m.rows() - 1) - m.time_at(0);
+    const double length = m.timeAt(m.rows() - 1) - m.timeAt(0);
     if (params.window_seconds > 0 && params.window_seconds >= length) {
       throw std::invalid_argument(
           "window_seconds = " + seconds(params.window_seconds) + " is not shorter than '" + source +
@@ -374,8 +370,8 @@ void check_demos_fit(const SegmentationParams& params, const std::vector<lfd::Fe
   }
 }
 
-void check_streams(const std::vector<lfd::Stream>& streams, const std::string& source,
-                   const RequestLimits& limits) {
+void checkStreams(const std::vector<lfd::Stream>& streams, const std::string& source,
+                  const RequestLimits& limits) {
   for (const lfd::Stream& s : streams) {
     if (!s.time.empty()) {
       const auto [first, last] = std::minmax_element(s.time.begin(), s.time.end());

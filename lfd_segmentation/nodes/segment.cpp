@@ -26,10 +26,10 @@
 
 namespace {
 
-using lfd_segmentation::ends_with;
-using lfd_segmentation::split_list;
+using lfd_segmentation::endsWith;
+using lfd_segmentation::splitList;
 
-const char* kUsage = R"(usage: segment [options] FILE...
+const char* const kUsage = R"(usage: segment [options] FILE...
   FILE                      demonstration bags (*.bag) or CSV files (header row, one row per sample);
                             a.bag,b.bag,... = one demonstration recorded in several bags, in order
   --config PATH             parameters (default: )" LFD_CONFIG_DIR R"(/segmentation.yaml)
@@ -65,16 +65,16 @@ const char* kUsage = R"(usage: segment [options] FILE...
   --output PATH             write the JSON there instead of stdout
 )";
 
-std::vector<lfd::ProfileCombination> parse_combinations(const std::string& list) {
+std::vector<lfd::ProfileCombination> parseCombinations(const std::string& list) {
   std::vector<lfd::ProfileCombination> out;
   if (list == "all") {
     for (const char* name : {"average", "product", "weighted_average", "weighted_product",
                              "distance_average", "weighted_distance_average"})
-      out.push_back(lfd::parse_profile_combination(name));
+      out.push_back(lfd::parseProfileCombination(name));
     return out;
   }
-  for (const std::string& name : split_list(list)) {
-    const lfd::ProfileCombination c = lfd::parse_profile_combination(name);
+  for (const std::string& name : splitList(list)) {
+    const lfd::ProfileCombination c = lfd::parseProfileCombination(name);
     if (std::find(out.begin(), out.end(), c) != out.end())
       throw std::invalid_argument("--combination names " + lfd::quoted(name) + " twice");
     out.push_back(c);
@@ -82,7 +82,7 @@ std::vector<lfd::ProfileCombination> parse_combinations(const std::string& list)
   return out;
 }
 
-double seconds_since(std::chrono::steady_clock::time_point t) {
+double secondsSince(std::chrono::steady_clock::time_point t) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
 }
 
@@ -97,11 +97,11 @@ struct Options {
   bool timing = false, feature_profiles = false, profiles = true, features = false;
 };
 
-Options parse_args(int argc, char** argv) {
+Options parseArgs(int argc, char** argv) {
   Options o;
   for (int k = 1; k < argc; ++k) {
     const std::string arg = argv[k];
-    auto value = [&] { return lfd_segmentation::option_value(argc, argv, &k); };
+    auto value = [&] { return lfd_segmentation::optionValue(argc, argv, &k); };
     auto number = [&]() -> double {
       const std::string v = value();
       try {
@@ -123,9 +123,9 @@ Options parse_args(int argc, char** argv) {
     } else if (arg == "--list-fields") {
       o.list_fields = true;
     } else if (arg == "--sensor-columns") {
-      o.sensors = split_list(value());
+      o.sensors = splitList(value());
     } else if (arg == "--state-columns") {
-      o.states = split_list(value());
+      o.states = splitList(value());
     } else if (arg == "--time-column") {
       o.time_column = value();
     } else if (arg == "--rate") {
@@ -174,9 +174,9 @@ Options parse_args(int argc, char** argv) {
 
 // --resample: the clock's span is checked against the per-demo sample limit before anything is
 // allocated (a time column in milliseconds read as seconds would ask for 1000 times the rows).
-lfd::FeatureMatrix resample_within_limits(const lfd::FeatureMatrix& m, double rate,
-                                          const std::string& path,
-                                          const lfd_segmentation::SegmentationParams& params) {
+lfd::FeatureMatrix resampleWithinLimits(const lfd::FeatureMatrix& m, double rate,
+                                        const std::string& path,
+                                        const lfd_segmentation::SegmentationParams& params) {
   const double span = m.time.empty() ? 0.0 : m.time.back() - m.time.front();
   const double rows = span * rate + 1.0;
   if (!(rows <= static_cast<double>(params.limits.max_samples_per_demo)))
@@ -193,24 +193,24 @@ lfd::FeatureMatrix resample_within_limits(const lfd::FeatureMatrix& m, double ra
 }
 
 // The shipped configuration with the command line's overrides.
-lfd_segmentation::SegmentationParams params_for(const Options& o) {
-  lfd_segmentation::SegmentationParams params = lfd_segmentation::load_params_file(o.config);
+lfd_segmentation::SegmentationParams paramsFor(const Options& o) {
+  lfd_segmentation::SegmentationParams params = lfd_segmentation::loadParamsFile(o.config);
   if (!o.topics.empty()) {
-    params.topics = lfd_segmentation::load_params_file(o.topics).topics;
+    params.topics = lfd_segmentation::loadParamsFile(o.topics).topics;
     if (params.topics.empty()) throw std::invalid_argument(o.topics + " has no 'topics:' list");
   }
   if (o.rate > 0) params.rate = o.rate;
-  const std::vector<lfd::ProfileCombination> combinations = parse_combinations(o.combination);
+  const std::vector<lfd::ProfileCombination> combinations = parseCombinations(o.combination);
   if (combinations.size() == 1) params.pipeline.segmentation.combination = combinations[0];
   if (!o.procedure.empty())
-    params.pipeline.procedure = lfd::parse_segmentation_procedure(o.procedure);
+    params.pipeline.procedure = lfd::parseSegmentationProcedure(o.procedure);
   if (o.threshold != 0) {
     if (!(o.threshold > 0 && o.threshold <= 1))
       throw std::invalid_argument("--threshold must be in (0,1]");
     params.pipeline.relevance.threshold = o.threshold;
   }
-  lfd_segmentation::check_seconds_override(o.min_seconds, "--min-segment-seconds", params.limits);
-  lfd_segmentation::check_seconds_override(o.window_seconds, "--window-seconds", params.limits);
+  lfd_segmentation::checkSecondsOverride(o.min_seconds, "--min-segment-seconds", params.limits);
+  lfd_segmentation::checkSecondsOverride(o.window_seconds, "--window-seconds", params.limits);
   if (o.min_seconds > 0) params.min_segment_seconds = o.min_seconds;
   if (o.window_seconds > 0) params.window_seconds = o.window_seconds;
   if (o.threads >= 0) params.pipeline.threads = static_cast<int>(o.threads);
@@ -224,16 +224,16 @@ struct LoadedDemos {
   std::vector<std::string> sensors, states, clock_warnings;
 };
 
-LoadedDemos load_demos(const Options& o, const lfd_segmentation::SegmentationParams& params) {
+LoadedDemos loadDemos(const Options& o, const lfd_segmentation::SegmentationParams& params) {
   LoadedDemos in;
   std::size_t bags = 0;
-  for (const std::string& f : o.files) bags += ends_with(f, ".bag") ? 1 : 0;
+  for (const std::string& f : o.files) bags += endsWith(f, ".bag") ? 1 : 0;
   if (bags != 0 && bags != o.files.size())
     throw std::invalid_argument("do not mix bags and CSV files");
   in.bags = bags != 0;
   // The CLI skips the roots (its user owns the shell) but not the budget.
-  lfd_segmentation::check_request_budget(o.files, params.limits, lfd::PathPolicy{},
-                                         in.bags ? "bag" : "CSV file");
+  lfd_segmentation::checkRequestBudget(o.files, params.limits, lfd::PathPolicy{},
+                                       in.bags ? "bag" : "CSV file");
   if (in.bags && o.resample > 0)
     throw std::invalid_argument("--resample is for CSV files: a bag's clock is set by --rate");
   in.sensors = o.sensors;
@@ -241,26 +241,25 @@ LoadedDemos load_demos(const Options& o, const lfd_segmentation::SegmentationPar
   for (const std::string& f : o.files) {
     if (in.bags) {
       lfd_segmentation::DemoFeatures demo =
-          lfd_segmentation::read_bag_features(f, params.topics, params.rate, params.limits);
+          lfd_segmentation::readBagFeatures(f, params.topics, params.rate, params.limits);
       if (in.demos.empty() && o.sensors.empty()) in.sensors = demo.sensor_features;
       if (in.demos.empty() && o.states.empty()) in.states = demo.state_features;
       in.clock_warnings.insert(in.clock_warnings.end(), demo.warnings.begin(), demo.warnings.end());
       in.demos.push_back(std::move(demo.matrix));
       continue;
     }
-    in.demos.push_back(
-        lfd_segmentation::read_csv_features(f, o.time_column, o.rate, params.limits));
+    in.demos.push_back(lfd_segmentation::readCsvFeatures(f, o.time_column, o.rate, params.limits));
     if (in.demos.back().time.empty())
       throw std::invalid_argument(
           "CSV file " + lfd::quoted(f) +
           " has no time column (time, t, timestamp, stamp or --time-column): give its sample "
           "rate with --rate, the time parameters are in seconds");
     if (o.resample > 0)
-      in.demos.back() = resample_within_limits(in.demos.back(), o.resample, f, params);
-    const std::string gap = lfd_segmentation::clock_gap_warning(in.demos.back(), f);
+      in.demos.back() = resampleWithinLimits(in.demos.back(), o.resample, f, params);
+    const std::string gap = lfd_segmentation::clockGapWarning(in.demos.back(), f);
     if (!gap.empty()) in.clock_warnings.push_back(gap);
   }
-  lfd_segmentation::check_demos_fit(params, in.demos, o.files);
+  lfd_segmentation::checkDemosFit(params, in.demos, o.files);
   return in;
 }
 
@@ -271,35 +270,35 @@ struct Segmented {
 };
 
 // One CSV without sensors: plain parameter-free multivariate ClaSP over the chosen columns.
-Segmented segment_single_series(const Options& o, const LoadedDemos& in,
-                                const lfd::SegmentationPipelineConfig& config,
-                                const lfd_segmentation::JsonOptions& json_options) {
+Segmented segmentSingleSeries(const Options& o, const LoadedDemos& in,
+                              const lfd::SegmentationPipelineConfig& config,
+                              const lfd_segmentation::JsonOptions& json_options) {
   lfd::FeatureMatrix demo = in.states.empty() ? in.demos[0] : in.demos[0].select(in.states);
-  lfd::check_finite(demo, o.files[0]);
-  const lfd::SegmentationPipelineConfig own = lfd::in_samples(config, lfd::sample_rate_of(demo));
+  lfd::checkFinite(demo, o.files[0]);
+  const lfd::SegmentationPipelineConfig own = lfd::inSamples(config, lfd::sampleRateOf(demo));
   lfd::MultivariateSegmentationConfig seg = own.segmentation;
   if (own.window_size > 0) seg.window_sizes.assign(demo.cols(), own.window_size);
-  const lfd::MultivariateSegmentation s = lfd::segment_multivariate(demo.data, {}, seg);
-  Segmented r{lfd_segmentation::to_json(s, demo, o.files[0], json_options), demo.names, {}};
+  const lfd::MultivariateSegmentation s = lfd::segmentMultivariate(demo.data, {}, seg);
+  Segmented r{lfd_segmentation::toJson(s, demo, o.files[0], json_options), demo.names, {}};
   r.out["mode"] = "clasp";
   return r;
 }
 
 // Several combinations: the features are selected once, each combination segments them.
-Segmented segment_each_combination(const Options& o, const LoadedDemos& in,
-                                   const lfd::SegmentationPipelineConfig& config,
-                                   const std::vector<lfd::ProfileCombination>& combinations,
-                                   const lfd_segmentation::JsonOptions& json_options) {
+Segmented segmentEachCombination(const Options& o, const LoadedDemos& in,
+                                 const lfd::SegmentationPipelineConfig& config,
+                                 const std::vector<lfd::ProfileCombination>& combinations,
+                                 const lfd_segmentation::JsonOptions& json_options) {
   const lfd::PreparedSegmentation prepared =
-      lfd::prepare_segmentation(in.demos, in.sensors, config, in.states);
+      lfd::prepareSegmentation(in.demos, in.sensors, config, in.states);
   Segmented r{nlohmann::json::object(), prepared.base.state_features,
               prepared.base.sensor_features};
   r.out["methods"] = nlohmann::json::object();
   for (lfd::ProfileCombination c : combinations) {
     lfd::SegmentationPipelineConfig own = config;
     own.segmentation.combination = c;
-    r.out["methods"][lfd::to_string(c)] = lfd_segmentation::to_json(
-        lfd::segment_prepared(prepared, in.demos, own), in.demos, o.files, json_options);
+    r.out["methods"][lfd::toString(c)] = lfd_segmentation::toJson(
+        lfd::segmentPrepared(prepared, in.demos, own), in.demos, o.files, json_options);
   }
   r.out["mode"] = "pipeline";
   return r;
@@ -307,7 +306,7 @@ Segmented segment_each_combination(const Options& o, const LoadedDemos& in,
 
 Segmented segment(const Options& o, const LoadedDemos& in,
                   const lfd::SegmentationPipelineConfig& config) {
-  const std::vector<lfd::ProfileCombination> combinations = parse_combinations(o.combination);
+  const std::vector<lfd::ProfileCombination> combinations = parseCombinations(o.combination);
   lfd_segmentation::JsonOptions json_options;
   json_options.profiles = o.profiles;
   json_options.feature_profiles = o.feature_profiles;
@@ -315,20 +314,20 @@ Segmented segment(const Options& o, const LoadedDemos& in,
     if (combinations.size() > 1)
       throw std::invalid_argument(
           "several combinations need the pipeline (bags, several CSV files or --sensor-columns)");
-    return segment_single_series(o, in, config, json_options);
+    return segmentSingleSeries(o, in, config, json_options);
   }
   if (combinations.size() > 1)
-    return segment_each_combination(o, in, config, combinations, json_options);
+    return segmentEachCombination(o, in, config, combinations, json_options);
   const lfd::SegmentationPipelineResult r =
-      lfd::run_segmentation_pipeline(in.demos, in.sensors, config, in.states);
-  Segmented s{lfd_segmentation::to_json(r, in.demos, o.files, json_options), r.state_features,
+      lfd::runSegmentationPipeline(in.demos, in.sensors, config, in.states);
+  Segmented s{lfd_segmentation::toJson(r, in.demos, o.files, json_options), r.state_features,
               r.sensor_features};
   s.out["mode"] = "pipeline";
   return s;
 }
 
-nlohmann::json timing_json(const std::vector<lfd::FeatureMatrix>& demos, double load_time,
-                           double compute_time, double total_time) {
+nlohmann::json timingJson(const std::vector<lfd::FeatureMatrix>& demos, double load_time,
+                          double compute_time, double total_time) {
   std::size_t samples = 0;
   for (const auto& d : demos) samples += d.rows();
   std::cerr << "segment: " << demos.size() << " demo(s), " << demos[0].cols() << " features, "
@@ -340,21 +339,19 @@ nlohmann::json timing_json(const std::vector<lfd::FeatureMatrix>& demos, double 
 
 nlohmann::json run(const Options& o) {
   const auto start = std::chrono::steady_clock::now();
-  const lfd_segmentation::SegmentationParams params = params_for(o);
-  lfd::SegmentationPipelineConfig config = params.pipeline_config();
+  const lfd_segmentation::SegmentationParams params = paramsFor(o);
+  lfd::SegmentationPipelineConfig config = params.pipelineConfig();
   if (o.num_changepoints > 0)
     config.segmentation.num_changepoints = static_cast<int>(o.num_changepoints);
-  const LoadedDemos in = load_demos(o, params);
-  const double load_time = seconds_since(start);
+  const LoadedDemos in = loadDemos(o, params);
+  const double load_time = secondsSince(start);
   const auto compute_start = std::chrono::steady_clock::now();
   Segmented s = segment(o, in, config);
-  const double compute_time = seconds_since(compute_start);
+  const double compute_time = secondsSince(compute_start);
   nlohmann::json& out = s.out;
   if (o.features)
-    out["feature_matrices"] =
-        lfd_segmentation::feature_matrices_json(in.demos, s.states, s.sensors);
-  if (o.timing)
-    out["timing"] = timing_json(in.demos, load_time, compute_time, seconds_since(start));
+    out["feature_matrices"] = lfd_segmentation::featureMatricesJson(in.demos, s.states, s.sensors);
+  if (o.timing) out["timing"] = timingJson(in.demos, load_time, compute_time, secondsSince(start));
   for (const std::string& w : in.clock_warnings) {
     out["warnings"].push_back(w);
     std::cerr << "segment: warning: " << w << "\n";
@@ -370,9 +367,9 @@ int main(int argc, char** argv) {
   nlohmann::json out;
   int status = 0;
   try {
-    options = parse_args(argc, argv);
+    options = parseArgs(argc, argv);
     if (options.list_fields) {
-      for (const std::string& f : options.files) std::cout << lfd_segmentation::describe_bag(f);
+      for (const std::string& f : options.files) std::cout << lfd_segmentation::describeBag(f);
       return 0;
     }
     out = run(options);
@@ -386,12 +383,12 @@ int main(int argc, char** argv) {
       if (std::string(argv[k]) == "--output") options.output = argv[k + 1];
   }
   out["format"] = lfd_segmentation::kSegmentationResultFormat;
-  const std::string text = lfd_segmentation::dump_json(out);
+  const std::string text = lfd_segmentation::dumpJson(out);
   if (!options.output.empty()) {
     // A result file: replaced on every run (scripts rerun into their folder), but atomically,
     // never over one of the inputs and only over a result file of its own.
     try {
-      const lfd::OutputKind kind = lfd_segmentation::segmentation_result_output();
+      const lfd::OutputKind kind = lfd_segmentation::segmentationResultOutput();
       lfd::writeTextAtomically(lfd::checkOutputFile(options.output, {}, true, options.files, kind),
                                true, kind, text + "\n");
     } catch (const std::exception& e) {

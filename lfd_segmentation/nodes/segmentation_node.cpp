@@ -12,7 +12,7 @@
 namespace {
 
 // The private parameter tree (XmlRpc) as YAML, so the node and the CLI share one parser.
-YAML::Node to_yaml(const XmlRpc::XmlRpcValue& v) {
+YAML::Node toYaml(const XmlRpc::XmlRpcValue& v) {
   switch (v.getType()) {
     case XmlRpc::XmlRpcValue::TypeBoolean:
       return YAML::Node(static_cast<bool>(const_cast<XmlRpc::XmlRpcValue&>(v)));
@@ -25,13 +25,12 @@ YAML::Node to_yaml(const XmlRpc::XmlRpcValue& v) {
     case XmlRpc::XmlRpcValue::TypeArray: {
       YAML::Node out(YAML::NodeType::Sequence);
       for (int k = 0; k < v.size(); ++k)
-        out.push_back(to_yaml(const_cast<XmlRpc::XmlRpcValue&>(v)[k]));
+        out.push_back(toYaml(const_cast<XmlRpc::XmlRpcValue&>(v)[k]));
       return out;
     }
     case XmlRpc::XmlRpcValue::TypeStruct: {
       YAML::Node out(YAML::NodeType::Map);
-      for (const auto& [key, value] : const_cast<XmlRpc::XmlRpcValue&>(v))
-        out[key] = to_yaml(value);
+      for (const auto& [key, value] : const_cast<XmlRpc::XmlRpcValue&>(v)) out[key] = toYaml(value);
       return out;
     }
     default:
@@ -47,10 +46,10 @@ int main(int argc, char** argv) {
   const lfd_ros::MasterWatch master_watch;  // a restarted master: the node ends, to be respawned
   XmlRpc::XmlRpcValue tree;
   YAML::Node root(YAML::NodeType::Map);
-  if (ros::param::get(ros::this_node::getName(), tree)) root = to_yaml(tree);
+  if (ros::param::get(ros::this_node::getName(), tree)) root = toYaml(tree);
   lfd_segmentation::SegmentationParams params;
   try {
-    params = lfd_segmentation::params_from_yaml(root);
+    params = lfd_segmentation::paramsFromYaml(root);
   } catch (const std::exception& e) {
     ROS_FATAL("segmentation: bad parameters: %s", e.what());
     return 1;
@@ -65,7 +64,7 @@ int main(int argc, char** argv) {
                                     lfd_msgs::Segment::Response& res) {
     const lfd::TrimHeapOnExit trim;  // what the request freed goes back to the system
     ROS_INFO("segmentation: request with %zu bag(s)", req.bag_paths.size());
-    lfd_segmentation::handle_segment_request(params, req, res, &cache);
+    lfd_segmentation::handleSegmentRequest(params, req, res, &cache);
     for (const std::string& w : res.warnings) ROS_WARN("segmentation: %s", w.c_str());
     if (res.success) {
       std::string summary;

@@ -23,9 +23,9 @@
 
 namespace {
 
-using lfd_segmentation::split_list;
+using lfd_segmentation::splitList;
 
-const char* kUsage =
+const char* const kUsage =
     R"(usage: signature [options] --demo FILE --boundaries LIST ... --run FILE --boundaries LIST ...
   --demo FILE               a demonstration: a bag, a.bag,b.bag,... (one demo in parts) or a CSV
   --run FILE                a run to score (same kinds of file)
@@ -55,9 +55,9 @@ struct Options {
   std::vector<Recording> recordings;
 };
 
-std::vector<double> parse_times(const std::string& list) {
+std::vector<double> parseTimes(const std::string& list) {
   std::vector<double> out;
-  for (const std::string& item : split_list(list)) {
+  for (const std::string& item : splitList(list)) {
     std::size_t used = 0;
     double t = NAN;
     try {
@@ -72,11 +72,11 @@ std::vector<double> parse_times(const std::string& list) {
   return out;
 }
 
-Options parse_args(int argc, char** argv) {
+Options parseArgs(int argc, char** argv) {
   Options o;
   for (int k = 1; k < argc; ++k) {
     const std::string arg = argv[k];
-    auto value = [&] { return lfd_segmentation::option_value(argc, argv, &k); };
+    auto value = [&] { return lfd_segmentation::optionValue(argc, argv, &k); };
     if (arg == "-h" || arg == "--help") {
       std::cout << kUsage;
       std::exit(0);
@@ -84,15 +84,15 @@ Options parse_args(int argc, char** argv) {
       o.recordings.push_back({value(), {}, arg == "--run"});
     } else if (arg == "--boundaries") {
       if (o.recordings.empty()) throw std::invalid_argument("--boundaries before any --demo");
-      o.recordings.back().boundaries = parse_times(value());
+      o.recordings.back().boundaries = parseTimes(value());
     } else if (arg == "--topics") {
       o.topics = value();
     } else if (arg == "--config") {
       o.config = value();
     } else if (arg == "--channels") {
-      o.channels = split_list(value());
+      o.channels = splitList(value());
     } else if (arg == "--sensor-columns") {
-      o.sensors = split_list(value());
+      o.sensors = splitList(value());
     } else if (arg == "--time-column") {
       o.time_column = value();
     } else {
@@ -102,26 +102,26 @@ Options parse_args(int argc, char** argv) {
   return o;
 }
 
-nlohmann::json deviation_json(const lfd::Deviation& d) {
+nlohmann::json deviationJson(const lfd::Deviation& d) {
   return {{"channel", d.channel_name}, {"time", d.time},         {"phase", d.phase},
           {"expected", d.expected},    {"measured", d.measured}, {"score", d.score}};
 }
 
 nlohmann::json run(const Options& o) {
-  lfd_segmentation::SegmentationParams params = lfd_segmentation::load_params_file(o.config);
-  if (!o.topics.empty()) params.topics = lfd_segmentation::load_params_file(o.topics).topics;
+  lfd_segmentation::SegmentationParams params = lfd_segmentation::loadParamsFile(o.config);
+  if (!o.topics.empty()) params.topics = lfd_segmentation::loadParamsFile(o.topics).topics;
   std::vector<lfd::SegmentedRecording> demos, runs;
   std::vector<std::string> channels = o.channels, run_files;
   for (const Recording& r : o.recordings) {
     lfd::SegmentedRecording rec;
     rec.boundaries = r.boundaries;
-    if (lfd_segmentation::ends_with(r.file, ".bag")) {
+    if (lfd_segmentation::endsWith(r.file, ".bag")) {
       auto features =
-          lfd_segmentation::read_bag_features(r.file, params.topics, params.rate, params.limits);
+          lfd_segmentation::readBagFeatures(r.file, params.topics, params.rate, params.limits);
       if (channels.empty()) channels = features.sensor_features;
       rec.features = std::move(features.matrix);
     } else {
-      rec.features = lfd_segmentation::read_csv_features(r.file, o.time_column, 0.0, params.limits);
+      rec.features = lfd_segmentation::readCsvFeatures(r.file, o.time_column, 0.0, params.limits);
       if (channels.empty()) channels = o.sensors;
     }
     (r.is_run ? runs : demos).push_back(std::move(rec));
@@ -129,7 +129,7 @@ nlohmann::json run(const Options& o) {
   }
   if (channels.empty())
     throw std::invalid_argument("no channel to monitor: give --channels or sensor features");
-  const lfd::SensorySignature signature = lfd::learn_signature(demos, channels);
+  const lfd::SensorySignature signature = lfd::learnSignature(demos, channels);
   nlohmann::json out = {{"channels", channels}, {"demonstrations", demos.size()}, {"runs", {}}};
   for (const lfd::SegmentSignature& s : signature.segments) {
     nlohmann::json thresholds;
@@ -140,10 +140,10 @@ nlohmann::json run(const Options& o) {
   }
   for (std::size_t k = 0; k < runs.size(); ++k) {
     std::vector<lfd::Deviation> worst;
-    const auto scores = lfd::score_recording(signature, runs[k], &worst);
+    const auto scores = lfd::scoreRecording(signature, runs[k], &worst);
     nlohmann::json segments;
     for (std::size_t s = 0; s < scores.size(); ++s)
-      segments.push_back({{"scores", scores[s]}, {"worst", deviation_json(worst[s])}});
+      segments.push_back({{"scores", scores[s]}, {"worst", deviationJson(worst[s])}});
     out["runs"].push_back({{"file", run_files[k]}, {"segments", segments}});
   }
   out["success"] = true;
@@ -155,7 +155,7 @@ nlohmann::json run(const Options& o) {
 int main(int argc, char** argv) {
   try {
     std::cout
-        << run(parse_args(argc, argv)).dump(1, ' ', false, nlohmann::json::error_handler_t::replace)
+        << run(parseArgs(argc, argv)).dump(1, ' ', false, nlohmann::json::error_handler_t::replace)
         << "\n";
     return 0;
   } catch (const std::exception& e) {

@@ -21,7 +21,7 @@ using lfd_segmentation::TopicConfig;
 
 // A controller state in the style of pr2_controllers_msgs/JointTrajectoryControllerState, with the
 // dependency types written with and without their package.
-const char* kArmDefinition = R"(Header header
+const char* const kArmDefinition = R"(Header header
 string[] joint_names
 Point actual
 robot_pkg/Point error
@@ -38,7 +38,7 @@ duration time_from_start
 )";
 
 // A world model whose stamps are all zero (as the PR2's /ar_world_model): the receive time counts.
-const char* kWorldDefinition = R"(Object[] objects
+const char* const kWorldDefinition = R"(Object[] objects
 ================================================================================
 MSG: robot_pkg/Object
 Header header
@@ -52,8 +52,8 @@ time stamp
 string frame_id
 )";
 
-void write_raw(rosbag::Bag& bag, const std::string& topic, const std::string& type,
-               const std::string& definition, double t, Bytes bytes) {
+void writeRaw(rosbag::Bag& bag, const std::string& topic, const std::string& type,
+              const std::string& definition, double t, Bytes bytes) {
   topic_tools::ShapeShifter shape;
   shape.morph("0123456789abcdef0123456789abcdef", type, definition, "");
   ros::serialization::IStream in(bytes.data.data(), static_cast<std::uint32_t>(bytes.data.size()));
@@ -61,7 +61,7 @@ void write_raw(rosbag::Bag& bag, const std::string& topic, const std::string& ty
   bag.write(topic, ros::Time(t), shape);
 }
 
-Bytes arm_message(double t, double q0, double q1) {
+Bytes armMessage(double t, double q0, double q1) {
   Bytes b;
   const auto sec = static_cast<std::uint32_t>(t);
   b.header(sec, static_cast<std::uint32_t>(std::lround((t - sec) * 1e9)));
@@ -72,7 +72,7 @@ Bytes arm_message(double t, double q0, double q1) {
   return b;
 }
 
-Bytes world_message(double x) {
+Bytes worldMessage(double x) {
   Bytes b;
   b.put<std::uint32_t>(1);
   b.header(0, 0).str("leg").put<std::uint8_t>(1).put(x).put(0.2).put(0.3);
@@ -80,14 +80,14 @@ Bytes world_message(double x) {
 }
 
 // One part: 100 Hz arm states stamped 20 ms before they were received, 20 Hz world models.
-void write_part(const std::string& path, double start, double duration) {
+void writePart(const std::string& path, double start, double duration) {
   rosbag::Bag bag(path, rosbag::bagmode::Write);
   for (long i = 0; i < std::lround(duration * 100); ++i) {
     const double t = start + i * 0.01;
-    write_raw(bag, "/arm/state", "robot_pkg/ArmState", kArmDefinition, t + 0.02,
-              arm_message(t, 1.0 + t - 100, 2.0));
+    writeRaw(bag, "/arm/state", "robot_pkg/ArmState", kArmDefinition, t + 0.02,
+             armMessage(t, 1.0 + t - 100, 2.0));
     if (i % 5 == 0)
-      write_raw(bag, "/world", "robot_pkg/World", kWorldDefinition, t, world_message(t - 100));
+      writeRaw(bag, "/world", "robot_pkg/World", kWorldDefinition, t, worldMessage(t - 100));
   }
   bag.close();
 }
@@ -97,8 +97,8 @@ class BagAnyType : public ::testing::Test {
   static void SetUpTestSuite() {
     dir_ = fs::temp_directory_path() / ("lfd_any_type_" + std::to_string(getpid()));
     fs::create_directories(dir_);
-    write_part(part(1), 100.0, 2.0);
-    write_part(part(2), 102.7, 1.0);  // 0.7 s unrecorded between the parts
+    writePart(part(1), 100.0, 2.0);
+    writePart(part(2), 102.7, 1.0);  // 0.7 s unrecorded between the parts
   }
   static void TearDownTestSuite() { fs::remove_all(dir_); }
   static std::string part(int k) { return (dir_ / ("part" + std::to_string(k) + ".bag")).string(); }
@@ -118,7 +118,7 @@ TEST_F(BagAnyType, ReadsFieldsOfUnknownTypesByPath) {
       {"/arm/state", FeatureRole::kSensor, {"error/positions/*"}},
       {"/world", FeatureRole::kState, {"objects/0/position/0", "objects/*/visible"}}};
   std::vector<FeatureRole> roles;
-  const auto streams = lfd_segmentation::read_bag_streams(part(1), topics, &roles);
+  const auto streams = lfd_segmentation::readBagStreams(part(1), topics, &roles);
   ASSERT_EQ(streams.size(), 7u);
   EXPECT_EQ(streams[3].name, "/arm/state/error/positions/j0");  // "*" expanded by joint name
   EXPECT_EQ(roles[3], FeatureRole::kSensor);
@@ -138,7 +138,7 @@ TEST_F(BagAnyType, ReadsFieldsOfUnknownTypesByPath) {
 
 TEST_F(BagAnyType, UnknownFieldListsTheTopicsFields) {
   try {
-    lfd_segmentation::read_bag_streams(
+    lfd_segmentation::readBagStreams(
         part(1), {{"/arm/state", FeatureRole::kState, {"actual/velocities/0"}}});
     FAIL() << "unknown field accepted";
   } catch (const std::invalid_argument& e) {
@@ -149,8 +149,8 @@ TEST_F(BagAnyType, UnknownFieldListsTheTopicsFields) {
     EXPECT_NE(what.find("\n  header/stamp"), std::string::npos) << what;
   }
   try {
-    lfd_segmentation::read_bag_streams(part(1),
-                                       {{"/world", FeatureRole::kState, {"objects/3/position/0"}}});
+    lfd_segmentation::readBagStreams(part(1),
+                                     {{"/world", FeatureRole::kState, {"objects/3/position/0"}}});
     FAIL() << "a field no message carries was accepted";
   } catch (const std::invalid_argument& e) {
     EXPECT_NE(std::string(e.what()).find("no data for field 'objects/3/position/0'"),
@@ -159,7 +159,7 @@ TEST_F(BagAnyType, UnknownFieldListsTheTopicsFields) {
     EXPECT_NE(std::string(e.what()).find("objects/<0..0>/position/<0..2>"), std::string::npos)
         << e.what();
   }
-  const std::string listing = lfd_segmentation::describe_bag(part(1));
+  const std::string listing = lfd_segmentation::describeBag(part(1));
   EXPECT_NE(listing.find("/world (robot_pkg/World, 40 messages)"), std::string::npos) << listing;
   EXPECT_NE(listing.find("gripper"), std::string::npos) << listing;
 }
@@ -167,29 +167,29 @@ TEST_F(BagAnyType, UnknownFieldListsTheTopicsFields) {
 TEST_F(BagAnyType, PartsInOrderMakeOneDemonstrationWithTheirGaps) {
   const std::vector<TopicConfig> topics{
       {"/arm/state", FeatureRole::kState, {"actual/positions/0"}}};
-  const auto demo = lfd_segmentation::read_bag_features(part(1) + "," + part(2), topics, 50.0);
+  const auto demo = lfd_segmentation::readBagFeatures(part(1) + "," + part(2), topics, 50.0);
   const lfd::FeatureMatrix& m = demo.matrix;
   EXPECT_NEAR(m.time.front(), 100.0, 1e-9);
   EXPECT_NEAR(m.time.back(), 103.68, 0.011);  // the span of both parts, gap included
   // Across the gap the signal is interpolated between the parts' own values.
   const auto row = static_cast<Eigen::Index>(std::lround((102.3 - 100.0) * 50));
   EXPECT_NEAR(m.data(row, 0), 1.0 + 2.3, 1e-6);
-  EXPECT_THROW(lfd_segmentation::read_bag_features(part(1) + "," + (dir_ / "nope.bag").string(),
-                                                   topics, 50.0),
-               std::runtime_error);
+  EXPECT_THROW(
+      lfd_segmentation::readBagFeatures(part(1) + "," + (dir_ / "nope.bag").string(), topics, 50.0),
+      std::runtime_error);
 }
 
 TEST_F(BagAnyType, MessagesThatDoNotMatchTheirDefinitionAreErrors) {
   const std::string bad = (dir_ / "bad.bag").string();
   {
     rosbag::Bag bag(bad, rosbag::bagmode::Write);
-    Bytes b = arm_message(1.0, 0.0, 0.0);
+    Bytes b = armMessage(1.0, 0.0, 0.0);
     b.data.resize(b.data.size() - 3);  // the float32 gripper cut short
-    write_raw(bag, "/arm/state", "robot_pkg/ArmState", kArmDefinition, 1.0, b);
+    writeRaw(bag, "/arm/state", "robot_pkg/ArmState", kArmDefinition, 1.0, b);
   }
   const std::vector<TopicConfig> topics{{"/arm/state", FeatureRole::kState, {"gripper"}}};
   try {
-    lfd_segmentation::read_bag_streams(bad, topics);
+    lfd_segmentation::readBagStreams(bad, topics);
     FAIL() << "truncated message accepted";
   } catch (const std::runtime_error& e) {
     EXPECT_NE(std::string(e.what()).find("field 'gripper' of robot_pkg/ArmState"),
@@ -199,11 +199,11 @@ TEST_F(BagAnyType, MessagesThatDoNotMatchTheirDefinitionAreErrors) {
   const std::string broken = (dir_ / "broken_definition.bag").string();
   {
     rosbag::Bag bag(broken, rosbag::bagmode::Write);
-    write_raw(bag, "/arm/state", "robot_pkg/ArmState", "Point actual\n", 1.0,
-              arm_message(1.0, 0.0, 0.0));
+    writeRaw(bag, "/arm/state", "robot_pkg/ArmState", "Point actual\n", 1.0,
+             armMessage(1.0, 0.0, 0.0));
   }
   try {
-    lfd_segmentation::read_bag_streams(broken, topics);
+    lfd_segmentation::readBagStreams(broken, topics);
     FAIL() << "definition without its dependencies accepted";
   } catch (const std::invalid_argument& e) {
     EXPECT_NE(std::string(e.what()).find("robot_pkg/Point"), std::string::npos) << e.what();

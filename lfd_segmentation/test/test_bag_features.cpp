@@ -15,32 +15,32 @@ namespace fs = std::filesystem;
 using lfd_segmentation::FeatureRole;
 using lfd_segmentation::TopicConfig;
 
-fs::path temp_dir() {
+fs::path tempDir() {
   const fs::path dir = fs::temp_directory_path() / ("lfd_seg_test_" + std::to_string(getpid()));
   fs::create_directories(dir);
   return dir;
 }
 
-std::vector<TopicConfig> default_topics() {
-  return lfd_segmentation::load_params_file(std::string(LFD_CONFIG_DIR) + "/segmentation.yaml")
+std::vector<TopicConfig> defaultTopics() {
+  return lfd_segmentation::loadParamsFile(std::string(LFD_CONFIG_DIR) + "/segmentation.yaml")
       .topics;
 }
 
 TEST(BagFeatures, ReadsConfiguredFieldsOnOneClock) {
-  const std::string bag = (temp_dir() / "good.bag").string();
+  const std::string bag = (tempDir() / "good.bag").string();
   lfd_segmentation_test::DemoBagOptions o;
-  lfd_segmentation_test::write_demo_bag(bag, o);
-  const auto demo = lfd_segmentation::read_bag_features(bag, default_topics(), 50.0);
+  lfd_segmentation_test::writeDemoBag(bag, o);
+  const auto demo = lfd_segmentation::readBagFeatures(bag, defaultTopics(), 50.0);
   const lfd::FeatureMatrix& m = demo.matrix;
-  EXPECT_GE(m.index_of("/ee_twist/twist/linear/x"), 0);
-  EXPECT_GE(m.index_of("/ee_pose/pose/orientation/w"), 0);
-  EXPECT_GE(m.index_of("/gripper/state/position/R_GRIPPER"), 0);
-  EXPECT_GE(m.index_of("/touch/values/r_touch_left"), 0);  // values/* expanded
-  EXPECT_GE(m.index_of("/touch/values/r_touch_right"), 0);
-  EXPECT_GE(m.index_of("/wrist_ft/wrench/force/z"), 0);
+  EXPECT_GE(m.indexOf("/ee_twist/twist/linear/x"), 0);
+  EXPECT_GE(m.indexOf("/ee_pose/pose/orientation/w"), 0);
+  EXPECT_GE(m.indexOf("/gripper/state/position/R_GRIPPER"), 0);
+  EXPECT_GE(m.indexOf("/touch/values/r_touch_left"), 0);  // values/* expanded
+  EXPECT_GE(m.indexOf("/touch/values/r_touch_right"), 0);
+  EXPECT_GE(m.indexOf("/wrist_ft/wrench/force/z"), 0);
   for (const std::string& name : m.names) EXPECT_EQ(name.find("/lfd/phase"), std::string::npos);
   EXPECT_EQ(demo.state_features.size(), 16u);  // 7 pose, 6 twist + 2 speed norms, gripper
-  EXPECT_GE(m.index_of("/ee_twist/twist/linear/norm"), 0);
+  EXPECT_GE(m.indexOf("/ee_twist/twist/linear/norm"), 0);
   EXPECT_EQ(demo.sensor_features.size(), 2u);   // the touch pads
   EXPECT_EQ(demo.context_features.size(), 6u);  // the wrist F/T: read, used by neither
   EXPECT_EQ(demo.state_features.size() + demo.sensor_features.size() + demo.context_features.size(),
@@ -59,23 +59,23 @@ TEST(BagFeatures, ReadsConfiguredFieldsOnOneClock) {
 }
 
 TEST(BagFeatures, ZeroOrderHoldKeepsDiscreteValues) {
-  const std::string bag = (temp_dir() / "zoh.bag").string();
-  lfd_segmentation_test::write_demo_bag(bag);
+  const std::string bag = (tempDir() / "zoh.bag").string();
+  lfd_segmentation_test::writeDemoBag(bag);
   std::vector<TopicConfig> topics{{"/gripper/state",
                                    FeatureRole::kState,
                                    {"effort/R_GRIPPER"},
                                    lfd::Interpolation::kZeroOrderHold}};
-  const auto demo = lfd_segmentation::read_bag_features(bag, topics, 33.0);
+  const auto demo = lfd_segmentation::readBagFeatures(bag, topics, 33.0);
   for (Eigen::Index r = 0; r < demo.matrix.rows(); ++r) {
     const double v = demo.matrix.data(r, 0);
     EXPECT_TRUE(v == 0.0 || v == 5.0) << v;
   }
 }
 
-void expect_invalid(const std::string& bag, const std::vector<TopicConfig>& topics,
-                    const std::string& needle) {
+void expectInvalid(const std::string& bag, const std::vector<TopicConfig>& topics,
+                   const std::string& needle) {
   try {
-    lfd_segmentation::read_bag_features(bag, topics, 50.0);
+    lfd_segmentation::readBagFeatures(bag, topics, 50.0);
     FAIL() << "expected an error mentioning " << needle;
   } catch (const std::invalid_argument& e) {
     EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
@@ -83,53 +83,52 @@ void expect_invalid(const std::string& bag, const std::vector<TopicConfig>& topi
 }
 
 TEST(BagFeatures, MissingTopicOrFieldIsAClearError) {
-  const std::string bag = (temp_dir() / "missing.bag").string();
+  const std::string bag = (tempDir() / "missing.bag").string();
   lfd_segmentation_test::DemoBagOptions o;
   o.with_touch = false;
-  lfd_segmentation_test::write_demo_bag(bag, o);
-  expect_invalid(bag, default_topics(), "no messages on topic /touch");
-  expect_invalid(bag, {{"/ee_twist", FeatureRole::kState, {"twist/linear/w"}}},
-                 "no field 'twist/linear/w'");
-  expect_invalid(bag, {{"/gripper/state", FeatureRole::kState, {"position/L_GRIPPER"}}},
-                 "no data for field 'position/L_GRIPPER'");
-  expect_invalid(bag, {{"/gripper/state", FeatureRole::kState, {"speed/R_GRIPPER"}}},
-                 "no field 'speed/R_GRIPPER'");
-  expect_invalid(bag, {{"/lfd/phase", FeatureRole::kState, {"index"}}}, "ground truth");
+  lfd_segmentation_test::writeDemoBag(bag, o);
+  expectInvalid(bag, defaultTopics(), "no messages on topic /touch");
+  expectInvalid(bag, {{"/ee_twist", FeatureRole::kState, {"twist/linear/w"}}},
+                "no field 'twist/linear/w'");
+  expectInvalid(bag, {{"/gripper/state", FeatureRole::kState, {"position/L_GRIPPER"}}},
+                "no data for field 'position/L_GRIPPER'");
+  expectInvalid(bag, {{"/gripper/state", FeatureRole::kState, {"speed/R_GRIPPER"}}},
+                "no field 'speed/R_GRIPPER'");
+  expectInvalid(bag, {{"/lfd/phase", FeatureRole::kState, {"index"}}}, "ground truth");
 }
 
 TEST(BagFeatures, NaNSampleIsReportedWithItsFeature) {
-  const std::string bag = (temp_dir() / "nan.bag").string();
+  const std::string bag = (tempDir() / "nan.bag").string();
   lfd_segmentation_test::DemoBagOptions o;
   o.nan_in_twist = true;
-  lfd_segmentation_test::write_demo_bag(bag, o);
-  expect_invalid(bag, default_topics(), "/ee_twist/twist/linear/x");
+  lfd_segmentation_test::writeDemoBag(bag, o);
+  expectInvalid(bag, defaultTopics(), "/ee_twist/twist/linear/x");
 }
 
 TEST(BagFeatures, UnreadableOrTruncatedBagIsARuntimeError) {
-  EXPECT_THROW(lfd_segmentation::read_bag_features("/nonexistent/demo.bag", default_topics(), 50),
+  EXPECT_THROW(lfd_segmentation::readBagFeatures("/nonexistent/demo.bag", defaultTopics(), 50),
                std::runtime_error);
-  const std::string bag = (temp_dir() / "truncated.bag").string();
-  lfd_segmentation_test::write_demo_bag(bag);
+  const std::string bag = (tempDir() / "truncated.bag").string();
+  lfd_segmentation_test::writeDemoBag(bag);
   fs::resize_file(bag, fs::file_size(bag) / 2);
-  EXPECT_THROW(lfd_segmentation::read_bag_features(bag, default_topics(), 50), std::runtime_error);
-  const std::string garbage = (temp_dir() / "garbage.bag").string();
+  EXPECT_THROW(lfd_segmentation::readBagFeatures(bag, defaultTopics(), 50), std::runtime_error);
+  const std::string garbage = (tempDir() / "garbage.bag").string();
   std::ofstream(garbage) << "this is not a bag";
-  EXPECT_THROW(lfd_segmentation::read_bag_features(garbage, default_topics(), 50),
-               std::runtime_error);
+  EXPECT_THROW(lfd_segmentation::readBagFeatures(garbage, defaultTopics(), 50), std::runtime_error);
 }
 
 // Regression: a link swapped between a bag and a FIFO while the reader runs never hangs it
 // (the path was checked, then opened again by name: open() blocked on the FIFO forever).
 TEST(BagFeatures, LinkSwappedToFifoNeverHangsTheReader) {
-  const fs::path dir = temp_dir();
+  const fs::path dir = tempDir();
   const std::string bag = (dir / "real.bag").string();
   lfd_segmentation_test::DemoBagOptions o;
   o.duration = 1.0;
-  lfd_segmentation_test::write_demo_bag(bag, o);
-  const std::vector<TopicConfig> topics = default_topics();
+  lfd_segmentation_test::writeDemoBag(bag, o);
+  const std::vector<TopicConfig> topics = defaultTopics();
   const lfd_test::LinkSwapRaceResult r = lfd_test::raceLinkSwap(
       (dir / "link.bag").string(), bag, (dir / "pipe.bag").string(),
-      [&](const std::string& link) { lfd_segmentation::read_bag_streams(link, topics); });
+      [&](const std::string& link) { lfd_segmentation::readBagStreams(link, topics); });
   EXPECT_EQ(r.hung_calls, 0) << "of " << r.calls << " calls";
   EXPECT_GT(r.read_calls, 0);  // the bag itself is still read when the link points at it
 }
@@ -137,14 +136,14 @@ TEST(BagFeatures, LinkSwappedToFifoNeverHangsTheReader) {
 // Regression: one /ee_pose stamped 5 s late is kept, in stamp order, and warned about by the
 // same policy as the learner's reader (lfd_core/io/stamp_order.hpp).
 TEST(BagFeatures, AMessageStampedLateIsPutInOrderAndWarned) {
-  const std::string bag = (temp_dir() / "late_pose.bag").string();
+  const std::string bag = (tempDir() / "late_pose.bag").string();
   lfd_segmentation_test::DemoBagOptions o;
   o.duration = 10.0;
   o.late_pose_seconds = 5.005;  // between two samples' stamps
-  lfd_segmentation_test::write_demo_bag(bag, o);
+  lfd_segmentation_test::writeDemoBag(bag, o);
   std::vector<std::string> warnings;
   const std::vector<lfd::Stream> streams =
-      lfd_segmentation::read_bag_streams(bag, default_topics(), nullptr, &warnings);
+      lfd_segmentation::readBagStreams(bag, defaultTopics(), nullptr, &warnings);
   const auto pose = std::find_if(streams.begin(), streams.end(), [](const lfd::Stream& s) {
     return s.name == "/ee_pose/pose/position/x";
   });
@@ -155,35 +154,35 @@ TEST(BagFeatures, AMessageStampedLateIsPutInOrderAndWarned) {
   EXPECT_NE(warnings[0].find("/ee_pose: of 1000 messages, 1 stamped out of order"),
             std::string::npos)
       << warnings[0];
-  const auto demo = lfd_segmentation::read_bag_features(bag, default_topics(), 50.0);
+  const auto demo = lfd_segmentation::readBagFeatures(bag, defaultTopics(), 50.0);
   ASSERT_EQ(demo.warnings.size(), 1u);  // the service and the CLI pass it on
   EXPECT_NE(demo.warnings[0].find("late_pose.bag"), std::string::npos);
 }
 
 TEST(SegmentationParams, LoadsTheShippedConfigAndRejectsBadValues) {
   const auto p =
-      lfd_segmentation::load_params_file(std::string(LFD_CONFIG_DIR) + "/segmentation.yaml");
+      lfd_segmentation::loadParamsFile(std::string(LFD_CONFIG_DIR) + "/segmentation.yaml");
   EXPECT_DOUBLE_EQ(p.pipeline.relevance.threshold, 0.9);
   EXPECT_EQ(p.pipeline.segmentation.combination, lfd::ProfileCombination::kWeightedProduct);
   EXPECT_DOUBLE_EQ(p.pipeline.events.threshold_ratio, 0.4);
   EXPECT_EQ(p.topics.size(), 5u);
-  EXPECT_THROW(lfd_segmentation::params_from_yaml(YAML::Load("threshold: 1.5")),
+  EXPECT_THROW(lfd_segmentation::paramsFromYaml(YAML::Load("threshold: 1.5")),
                std::invalid_argument);
-  EXPECT_THROW(lfd_segmentation::params_from_yaml(YAML::Load("combination: median")),
+  EXPECT_THROW(lfd_segmentation::paramsFromYaml(YAML::Load("combination: median")),
                std::invalid_argument);
-  EXPECT_THROW(lfd_segmentation::params_from_yaml(YAML::Load("rate: -1")), std::invalid_argument);
-  EXPECT_THROW(lfd_segmentation::params_from_yaml(
+  EXPECT_THROW(lfd_segmentation::paramsFromYaml(YAML::Load("rate: -1")), std::invalid_argument);
+  EXPECT_THROW(lfd_segmentation::paramsFromYaml(
                    YAML::Load("topics: [{topic: /lfd/phase, fields: [index]}]")),
                std::invalid_argument);
-  EXPECT_THROW(lfd_segmentation::params_from_yaml(
+  EXPECT_THROW(lfd_segmentation::paramsFromYaml(
                    YAML::Load("topics: [{topic: /x, role: actuator, fields: [a]}]")),
                std::invalid_argument);
   lfd_segmentation::SegmentationParams s;
   s.rate = 50;
   s.min_segment_seconds = 1.0;
   s.window_seconds = 0.4;
-  EXPECT_EQ(s.pipeline_config().segmentation.min_segment_length, 50u);
-  EXPECT_EQ(s.pipeline_config().window_size, 20u);
+  EXPECT_EQ(s.pipelineConfig().segmentation.min_segment_length, 50u);
+  EXPECT_EQ(s.pipelineConfig().window_size, 20u);
 }
 
 }  // namespace

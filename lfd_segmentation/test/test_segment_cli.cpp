@@ -22,7 +22,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-fs::path temp_dir() {
+fs::path tempDir() {
   const fs::path dir = fs::temp_directory_path() / ("lfd_cli_test_" + std::to_string(getpid()));
   fs::create_directories(dir);
   return dir;
@@ -30,7 +30,7 @@ fs::path temp_dir() {
 
 // A grasp-like CSV: time, gripper (step), speed (texture changes), noise, touch (sensor); one row
 // every `step` seconds.
-std::size_t write_demo_csv(const std::string& path, int n, unsigned seed, double step = 0.02) {
+std::size_t writeDemoCsv(const std::string& path, int n, unsigned seed, double step = 0.02) {
   std::mt19937 rng(seed);
   std::normal_distribution<double> noise(0.0, 1.0);
   const std::size_t grasp = static_cast<std::size_t>(0.4 * n);
@@ -48,8 +48,8 @@ std::size_t write_demo_csv(const std::string& path, int n, unsigned seed, double
   return grasp;
 }
 
-nlohmann::json run_cli(const std::string& args, int* status, const std::string& prefix = "") {
-  const std::string out = (temp_dir() / "out.json").string();
+nlohmann::json runCli(const std::string& args, int* status, const std::string& prefix = "") {
+  const std::string out = (tempDir() / "out.json").string();
   fs::remove(out);  // a run that writes nothing must not be judged by the previous JSON
   const std::string cmd =
       prefix + std::string(SEGMENT_CLI) + " " + args + " --output " + out + " 2>/dev/null";
@@ -60,10 +60,10 @@ nlohmann::json run_cli(const std::string& args, int* status, const std::string& 
 }
 
 TEST(SegmentCli, SingleCsvRunsPlainMultivariateClasp) {
-  const std::string csv = (temp_dir() / "one.csv").string();
-  const std::size_t grasp = write_demo_csv(csv, 500, 1);
+  const std::string csv = (tempDir() / "one.csv").string();
+  const std::size_t grasp = writeDemoCsv(csv, 500, 1);
   int status = -1;
-  const auto j = run_cli("--state-columns gripper,speed " + csv, &status);
+  const auto j = runCli("--state-columns gripper,speed " + csv, &status);
   ASSERT_EQ(status, 0) << j.dump();
   EXPECT_EQ(j["mode"], "clasp");
   ASSERT_EQ(j["demos"].size(), 1u);
@@ -82,12 +82,12 @@ TEST(SegmentCli, SeveralCsvRunThePipelineWithSensorValidation) {
   std::string files;
   std::vector<std::size_t> grasps;
   for (int d = 0; d < 3; ++d) {
-    const std::string csv = (temp_dir() / ("demo" + std::to_string(d) + ".csv")).string();
-    grasps.push_back(write_demo_csv(csv, 450 + 30 * d, 10 + d));
+    const std::string csv = (tempDir() / ("demo" + std::to_string(d) + ".csv")).string();
+    grasps.push_back(writeDemoCsv(csv, 450 + 30 * d, 10 + d));
     files += " " + csv;
   }
   int status = -1;
-  const auto j = run_cli("--sensor-columns touch --timing" + files, &status);
+  const auto j = runCli("--sensor-columns touch --timing" + files, &status);
   ASSERT_EQ(status, 0) << j.dump();
   EXPECT_EQ(j["mode"], "pipeline");
   EXPECT_TRUE(j["relevance_computed"].get<bool>());
@@ -114,22 +114,22 @@ TEST(SegmentCli, SeveralCsvRunThePipelineWithSensorValidation) {
 TEST(SegmentCli, SeveralCombinationsShareOneSelection) {
   std::string files;
   for (int d = 0; d < 3; ++d) {
-    const std::string csv = (temp_dir() / ("multi" + std::to_string(d) + ".csv")).string();
-    write_demo_csv(csv, 450 + 30 * d, 20 + d);
+    const std::string csv = (tempDir() / ("multi" + std::to_string(d) + ".csv")).string();
+    writeDemoCsv(csv, 450 + 30 * d, 20 + d);
     files += " " + csv;
   }
   int status = -1;
   const auto all =
-      run_cli("--sensor-columns touch --no-profiles --combination all" + files, &status);
+      runCli("--sensor-columns touch --no-profiles --combination all" + files, &status);
   ASSERT_EQ(status, 0) << all.dump();
   ASSERT_EQ(all["methods"].size(), 6u);
   const auto two =
-      run_cli("--sensor-columns touch --no-profiles --combination product,weighted_average" + files,
-              &status);
+      runCli("--sensor-columns touch --no-profiles --combination product,weighted_average" + files,
+             &status);
   ASSERT_EQ(status, 0) << two.dump();
   ASSERT_EQ(two["methods"].size(), 2u);
   const auto alone =
-      run_cli("--sensor-columns touch --no-profiles --combination product" + files, &status);
+      runCli("--sensor-columns touch --no-profiles --combination product" + files, &status);
   ASSERT_EQ(status, 0);
   EXPECT_FALSE(alone.contains("methods"));
   for (int d = 0; d < 3; ++d) {
@@ -139,26 +139,26 @@ TEST(SegmentCli, SeveralCombinationsShareOneSelection) {
               alone["demos"][d]["changepoints"]);
   }
   EXPECT_EQ(two["methods"]["product"]["selected_features"], alone["selected_features"]);
-  auto bad = run_cli("--sensor-columns touch --combination product,product" + files, &status);
+  auto bad = runCli("--sensor-columns touch --combination product,product" + files, &status);
   EXPECT_EQ(status, 1);
   EXPECT_NE(bad["error"].get<std::string>().find("twice"), std::string::npos) << bad.dump();
-  bad = run_cli("--combination product,average " + (temp_dir() / "multi0.csv").string(), &status);
+  bad = runCli("--combination product,average " + (tempDir() / "multi0.csv").string(), &status);
   EXPECT_EQ(status, 1);
   EXPECT_NE(bad["error"].get<std::string>().find("several combinations"), std::string::npos);
 }
 
 TEST(SegmentCli, BadInputFailsWithAnErrorInTheJson) {
-  const std::string csv = (temp_dir() / "bad.csv").string();
+  const std::string csv = (tempDir() / "bad.csv").string();
   std::ofstream(csv) << "time,a,b\n0,1,2\n0.1,nan,3\n0.2,1,4\n";
   int status = -1;
-  auto j = run_cli(csv + " " + csv + " --sensor-columns b", &status);
+  auto j = runCli(csv + " " + csv + " --sensor-columns b", &status);
   EXPECT_EQ(status, 1);
   EXPECT_FALSE(j["success"].get<bool>());
   EXPECT_NE(j["error"].get<std::string>().find("'a' has NaN"), std::string::npos) << j.dump();
-  j = run_cli("/nonexistent.csv", &status);
+  j = runCli("/nonexistent.csv", &status);
   EXPECT_EQ(status, 1);
   EXPECT_NE(j["error"].get<std::string>().find("cannot open"), std::string::npos);
-  j = run_cli("--bogus x " + csv, &status);
+  j = runCli("--bogus x " + csv, &status);
   EXPECT_EQ(status, 1);
 }
 
@@ -166,8 +166,8 @@ TEST(SegmentCli, BadInputFailsWithAnErrorInTheJson) {
 // throw (nlohmann type_error 316) and the CLI abort (exit 134). Now the JSON is valid (U+FFFD for
 // the bad bytes), an error quotes the name printably, and never more than ~200 characters of it.
 TEST(SegmentCli, NonUtf8NamesGiveValidJsonAndLongInputIsQuotedShort) {
-  const std::string csv = (temp_dir() / "bad_header.csv").string();
-  write_demo_csv(csv, 300, 7);
+  const std::string csv = (tempDir() / "bad_header.csv").string();
+  writeDemoCsv(csv, 300, 7);
   {  // the header's second column becomes "gr\xffipper"
     std::ifstream in(csv);
     std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
@@ -175,31 +175,31 @@ TEST(SegmentCli, NonUtf8NamesGiveValidJsonAndLongInputIsQuotedShort) {
     std::ofstream(csv) << text;
   }
   int status = -1;
-  auto j = run_cli(csv, &status);
+  auto j = runCli(csv, &status);
   ASSERT_EQ(status, 0) << j.dump();
   EXPECT_EQ(j["selected_features"][0].get<std::string>(), "gr\xef\xbf\xbd\xef\xbf\xbdipper")
       << j["selected_features"].dump();
 
-  const std::string named = (temp_dir() / "demo_\xff\xc3.csv").string();
+  const std::string named = (tempDir() / "demo_\xff\xc3.csv").string();
   fs::copy_file(csv, named, fs::copy_options::overwrite_existing);
-  j = run_cli(named, &status);
+  j = runCli(named, &status);
   ASSERT_EQ(status, 0) << j.dump();
   EXPECT_NE(j["demos"][0]["source"].get<std::string>().find("demo_\xef\xbf\xbd"),
             std::string::npos);
 
-  j = run_cli((temp_dir() / "missing_\xff.csv").string(), &status);
+  j = runCli((tempDir() / "missing_\xff.csv").string(), &status);
   EXPECT_EQ(status, 1);
   EXPECT_NE(j["error"].get<std::string>().find("missing_\\xff.csv"), std::string::npos) << j.dump();
 
   const std::string long_name = "/nonexistent/" + std::string(5000, 'a') + ".csv";
-  j = run_cli(long_name, &status);
+  j = runCli(long_name, &status);
   EXPECT_EQ(status, 1);
   EXPECT_LT(j["error"].get<std::string>().size(), 400u) << j["error"].get<std::string>().size();
   EXPECT_NE(j["error"].get<std::string>().find("(5017 bytes)"), std::string::npos);
 }
 
 // Each feature's role as the bag reader gave it.
-std::map<std::string, std::string> roles_of(const lfd_segmentation::DemoFeatures& demo) {
+std::map<std::string, std::string> rolesOf(const lfd_segmentation::DemoFeatures& demo) {
   std::map<std::string, std::string> roles;
   for (const std::string& name : demo.state_features) roles[name] = "state";
   for (const std::string& name : demo.sensor_features) roles[name] = "sensor";
@@ -216,20 +216,20 @@ std::map<std::string, std::string> roles_of(const lfd_segmentation::DemoFeatures
 TEST(SegmentCli, ResampleAveragesAFastCsvOntoASlowerClock) {
   std::string fast, slow;
   for (unsigned d = 0; d < 3; ++d) {
-    const std::string f = (temp_dir() / ("fast" + std::to_string(d) + ".csv")).string();
-    const std::string g = (temp_dir() / ("slow" + std::to_string(d) + ".csv")).string();
-    write_demo_csv(f, 13000, 40 + d, 0.001);
-    write_demo_csv(g, 650, 40 + d, 0.02);
+    const std::string f = (tempDir() / ("fast" + std::to_string(d) + ".csv")).string();
+    const std::string g = (tempDir() / ("slow" + std::to_string(d) + ".csv")).string();
+    writeDemoCsv(f, 13000, 40 + d, 0.001);
+    writeDemoCsv(g, 650, 40 + d, 0.02);
     fast += " " + f;
     slow += " " + g;
   }
   int status = 0;
-  auto j = run_cli("--sensor-columns touch" + fast, &status);
+  auto j = runCli("--sensor-columns touch" + fast, &status);
   EXPECT_EQ(status, 1);
   EXPECT_NE(j["error"].get<std::string>().find("--resample"), std::string::npos) << j["error"];
-  const auto fast_json = run_cli("--sensor-columns touch --resample 50" + fast, &status);
+  const auto fast_json = runCli("--sensor-columns touch --resample 50" + fast, &status);
   ASSERT_EQ(status, 0) << fast_json.dump();
-  const auto slow_json = run_cli("--sensor-columns touch" + slow, &status);
+  const auto slow_json = runCli("--sensor-columns touch" + slow, &status);
   ASSERT_EQ(status, 0) << slow_json.dump();
   for (std::size_t d = 0; d < 3; ++d) {
     const auto& a = fast_json["demos"][d];
@@ -240,14 +240,14 @@ TEST(SegmentCli, ResampleAveragesAFastCsvOntoASlowerClock) {
     EXPECT_NEAR(a["changepoint_times"][0].get<double>(),
                 slow_json["demos"][d]["changepoint_times"][0].get<double>(), 0.1);
   }
-  j = run_cli("--resample 0 --sensor-columns touch" + fast, &status);
+  j = runCli("--resample 0 --sensor-columns touch" + fast, &status);
   EXPECT_EQ(status, 1);
   EXPECT_NE(j["error"].get<std::string>().find("--resample"), std::string::npos);
   // A time column in milliseconds read as seconds: 13,000 s at 50 Hz is refused before anything
   // is allocated.
-  const std::string ms = (temp_dir() / "milliseconds.csv").string();
-  write_demo_csv(ms, 13000, 7, 1.0);
-  j = run_cli("--sensor-columns touch --resample 50 " + ms + fast, &status);
+  const std::string ms = (tempDir() / "milliseconds.csv").string();
+  writeDemoCsv(ms, 13000, 7, 1.0);
+  j = runCli("--sensor-columns touch --resample 50 " + ms + fast, &status);
   EXPECT_EQ(status, 1);
   EXPECT_NE(j["error"].get<std::string>().find("max_samples_per_demo"), std::string::npos)
       << j["error"];
@@ -259,8 +259,8 @@ TEST(SegmentCli, ResampleAveragesAFastCsvOntoASlowerClock) {
 TEST(SegmentCli, AClockWithAGapIsWarnedAbout) {
   std::string files;
   for (unsigned d = 0; d < 3; ++d) {
-    const std::string f = (temp_dir() / ("gap" + std::to_string(d) + ".csv")).string();
-    write_demo_csv(f, 650, 60 + d);
+    const std::string f = (tempDir() / ("gap" + std::to_string(d) + ".csv")).string();
+    writeDemoCsv(f, 650, 60 + d);
     if (d == 0) {  // one second missing after row 300
       std::ifstream in(f);
       std::vector<std::string> lines;
@@ -283,10 +283,10 @@ TEST(SegmentCli, AClockWithAGapIsWarnedAbout) {
     return false;
   };
   int status = 0;
-  const auto j = run_cli("--sensor-columns touch" + files, &status);
+  const auto j = runCli("--sensor-columns touch" + files, &status);
   ASSERT_EQ(status, 0) << j.dump();
   EXPECT_TRUE(warned(j)) << j["warnings"];
-  const auto uniform = run_cli("--sensor-columns touch --resample 50" + files, &status);
+  const auto uniform = runCli("--sensor-columns touch --resample 50" + files, &status);
   ASSERT_EQ(status, 0) << uniform.dump();
   EXPECT_FALSE(warned(uniform)) << uniform["warnings"];
 }
@@ -298,19 +298,19 @@ TEST(SegmentCli, FeaturesAreTheMatrixTheBagReaderGave) {
     lfd_segmentation_test::DemoBagOptions o;
     o.seed = 40 + d;
     o.duration = 7.0 + 0.5 * d;
-    bags.push_back((temp_dir() / ("features" + std::to_string(d) + ".bag")).string());
-    lfd_segmentation_test::write_demo_bag(bags.back(), o);
+    bags.push_back((tempDir() / ("features" + std::to_string(d) + ".bag")).string());
+    lfd_segmentation_test::writeDemoBag(bags.back(), o);
     files += " " + bags.back();
   }
   int status = -1;
-  const auto j = run_cli("--features --no-profiles" + files, &status);
+  const auto j = runCli("--features --no-profiles" + files, &status);
   ASSERT_EQ(status, 0) << j.dump();
   const auto params =
-      lfd_segmentation::load_params_file(std::string(LFD_CONFIG_DIR) + "/segmentation.yaml");
+      lfd_segmentation::loadParamsFile(std::string(LFD_CONFIG_DIR) + "/segmentation.yaml");
   ASSERT_EQ(j["feature_matrices"].size(), bags.size());
   for (std::size_t d = 0; d < bags.size(); ++d) {
     const lfd_segmentation::DemoFeatures read =
-        lfd_segmentation::read_bag_features(bags[d], params.topics, params.rate, params.limits);
+        lfd_segmentation::readBagFeatures(bags[d], params.topics, params.rate, params.limits);
     const nlohmann::json& m = j["feature_matrices"][d];
     EXPECT_EQ(m["time"].get<std::vector<double>>(), read.matrix.time);
     for (std::size_t k = 0; k < j["demos"][d]["changepoints"].size(); ++k) {
@@ -323,7 +323,7 @@ TEST(SegmentCli, FeaturesAreTheMatrixTheBagReaderGave) {
       const nlohmann::json& f = m["features"][c];
       const std::string name = read.matrix.names[c];
       EXPECT_EQ(f["name"], name);
-      EXPECT_EQ(f["role"], roles_of(read)[name]) << name;
+      EXPECT_EQ(f["role"], rolesOf(read)[name]) << name;
       const std::vector<double> got = f["values"].get<std::vector<double>>();
       const Eigen::VectorXd want = read.matrix.data.col(c);
       ASSERT_EQ(got.size(), static_cast<std::size_t>(want.size())) << name;
@@ -342,29 +342,29 @@ TEST(SegmentCli, FeaturesAreTheMatrixTheBagReaderGave) {
 }
 
 TEST(CsvFeatures, ParsesHeaderTimeAndRejectsRaggedRows) {
-  const std::string csv = (temp_dir() / "parse.csv").string();
+  const std::string csv = (tempDir() / "parse.csv").string();
   std::ofstream(csv) << "a, t ,b\n1,0.0,2\n3,0.5,4\n\n";
-  const auto m = lfd_segmentation::read_csv_features(csv);
+  const auto m = lfd_segmentation::readCsvFeatures(csv);
   EXPECT_EQ(m.names, (std::vector<std::string>{"a", "b"}));
   ASSERT_EQ(m.rows(), 2);
   EXPECT_EQ(m.time, (std::vector<double>{0.0, 0.5}));
   EXPECT_EQ(m.data(1, 0), 3.0);
   EXPECT_EQ(m.data(1, 1), 4.0);
-  const auto no_time = lfd_segmentation::read_csv_features(csv, "b", 0.0);
+  const auto no_time = lfd_segmentation::readCsvFeatures(csv, "b", 0.0);
   EXPECT_EQ(no_time.names, (std::vector<std::string>{"a", "t"}));
   std::ofstream(csv) << "a,b\n1,2\n3\n";
-  EXPECT_THROW(lfd_segmentation::read_csv_features(csv), std::invalid_argument);
+  EXPECT_THROW(lfd_segmentation::readCsvFeatures(csv), std::invalid_argument);
   std::ofstream(csv) << "a,b\n1,x\n";
-  EXPECT_THROW(lfd_segmentation::read_csv_features(csv), std::invalid_argument);
+  EXPECT_THROW(lfd_segmentation::readCsvFeatures(csv), std::invalid_argument);
   std::ofstream(csv) << "a,b\n1,2\n";
-  EXPECT_THROW(lfd_segmentation::read_csv_features(csv, "time"), std::invalid_argument);
-  const auto rated = lfd_segmentation::read_csv_features(csv, "", 10.0);
+  EXPECT_THROW(lfd_segmentation::readCsvFeatures(csv, "time"), std::invalid_argument);
+  const auto rated = lfd_segmentation::readCsvFeatures(csv, "", 10.0);
   EXPECT_EQ(rated.time, (std::vector<double>{0.0}));
 }
 
 // Regression: a 10M-row CSV took 1.9 GB and no result in 300 s; +-1e308 overflowed the distances.
 TEST(CsvFeatures, LimitsStopTheReadAndNameRowAndColumn) {
-  const std::string csv = (temp_dir() / "limits.csv").string();
+  const std::string csv = (tempDir() / "limits.csv").string();
   {
     std::ofstream out(csv);
     out << "time,a,b\n";
@@ -373,14 +373,14 @@ TEST(CsvFeatures, LimitsStopTheReadAndNameRowAndColumn) {
   lfd_segmentation::RequestLimits limits;
   limits.max_csv_rows = 10;
   try {
-    lfd_segmentation::read_csv_features(csv, "", 0.0, limits);
+    lfd_segmentation::readCsvFeatures(csv, "", 0.0, limits);
     ADD_FAILURE() << "50 rows read under a 10-row limit";
   } catch (const std::invalid_argument& e) {
     EXPECT_NE(std::string(e.what()).find("limits/max_csv_rows"), std::string::npos) << e.what();
   }
   std::ofstream(csv) << "time,a,b\n0,1,2\n0.1,1,-1e308\n0.2,1,4\n";
   try {
-    lfd_segmentation::read_csv_features(csv);
+    lfd_segmentation::readCsvFeatures(csv);
     ADD_FAILURE() << "-1e308 accepted";
   } catch (const std::invalid_argument& e) {
     const std::string what = e.what();
@@ -393,18 +393,18 @@ TEST(CsvFeatures, LimitsStopTheReadAndNameRowAndColumn) {
 // time column": the first column was named "\xef\xbb\xbftime". The mark is skipped; UTF-16 is
 // refused saying so.
 TEST(CsvFeatures, AUtf8ByteOrderMarkIsSkippedAndUtf16IsRefused) {
-  const fs::path dir = temp_dir();
+  const fs::path dir = tempDir();
   const std::string plain = (dir / "plain_bom.csv").string();
-  write_demo_csv(plain, 300, 4);
+  writeDemoCsv(plain, 300, 4);
   std::ifstream plain_in(plain);
   const std::string text((std::istreambuf_iterator<char>(plain_in)), {});
   const std::string bom = (dir / "bom.csv").string();
   std::ofstream(bom, std::ios::binary) << "\xEF\xBB\xBF" << text;
-  const lfd::FeatureMatrix m = lfd_segmentation::read_csv_features(bom);
+  const lfd::FeatureMatrix m = lfd_segmentation::readCsvFeatures(bom);
   EXPECT_EQ(m.names, (std::vector<std::string>{"gripper", "speed", "noise", "touch"}));
   EXPECT_EQ(m.time.size(), 300u);
   int status = -1;
-  const auto j = run_cli("--state-columns gripper,speed " + bom, &status);
+  const auto j = runCli("--state-columns gripper,speed " + bom, &status);
   EXPECT_EQ(status, 0) << j.dump();
 
   const std::string utf16 = (dir / "utf16.csv").string();
@@ -414,7 +414,7 @@ TEST(CsvFeatures, AUtf8ByteOrderMarkIsSkippedAndUtf16IsRefused) {
     for (char c : std::string("time,a\n0,1\n")) out << c << '\0';
   }
   try {
-    lfd_segmentation::read_csv_features(utf16);
+    lfd_segmentation::readCsvFeatures(utf16);
     ADD_FAILURE() << "a UTF-16 CSV was read";
   } catch (const std::invalid_argument& e) {
     const std::string what = e.what();
@@ -426,7 +426,7 @@ TEST(CsvFeatures, AUtf8ByteOrderMarkIsSkippedAndUtf16IsRefused) {
 // Regression: 10,000 feature columns took 1.1 GB. The header is checked against
 // limits/max_features before any row is read.
 TEST(CsvFeatures, TooManyFeatureColumnsAreRefusedOnTheHeader) {
-  const std::string csv = (temp_dir() / "wide.csv").string();
+  const std::string csv = (tempDir() / "wide.csv").string();
   {
     std::ofstream out(csv);
     out << "time";
@@ -441,7 +441,7 @@ TEST(CsvFeatures, TooManyFeatureColumnsAreRefusedOnTheHeader) {
   lfd_segmentation::RequestLimits limits;
   ASSERT_EQ(limits.max_features, 256u);
   try {
-    lfd_segmentation::read_csv_features(csv, "", 0.0, limits);
+    lfd_segmentation::readCsvFeatures(csv, "", 0.0, limits);
     ADD_FAILURE() << "300 feature columns read under a limit of 256";
   } catch (const std::invalid_argument& e) {
     EXPECT_NE(std::string(e.what()).find("300 feature columns, over the limit of 256 "
@@ -450,7 +450,7 @@ TEST(CsvFeatures, TooManyFeatureColumnsAreRefusedOnTheHeader) {
         << e.what();
   }
   int status = -1;
-  const auto j = run_cli(csv, &status);  // the CLI, with the shipped config
+  const auto j = runCli(csv, &status);  // the CLI, with the shipped config
   EXPECT_EQ(status, 1);
   EXPECT_NE(j["error"].get<std::string>().find("limits/max_features"), std::string::npos)
       << j.dump();
@@ -459,9 +459,9 @@ TEST(CsvFeatures, TooManyFeatureColumnsAreRefusedOnTheHeader) {
 // Regression: an output replaced any regular file. --output replaces a result file the CLI wrote
 // (scripts rerun into their folder), never another file: it is kept and the error says why.
 TEST(SegmentCli, OutputReplacesOnlyAResultFileItWrote) {
-  const fs::path dir = temp_dir();
+  const fs::path dir = tempDir();
   const std::string csv = (dir / "output_demo.csv").string();
-  write_demo_csv(csv, 300, 6);
+  writeDemoCsv(csv, 300, 6);
   const std::string bashrc = (dir / ".bashrc").string();
   std::ofstream(bashrc) << "export PATH=$HOME/bin:$PATH\n";
   const std::string err = (dir / "stderr.txt").string();
@@ -477,7 +477,7 @@ TEST(SegmentCli, OutputReplacesOnlyAResultFileItWrote) {
   EXPECT_NE(message.find("was not written by lfd"), std::string::npos) << message;
   // Its own result is replaced, run after run (also one written before the format marker).
   int status = -1;
-  auto j = run_cli(csv, &status);
+  auto j = runCli(csv, &status);
   EXPECT_EQ(status, 0);
   EXPECT_EQ(j["format"], "lfd_segmentation_result");
   const std::string out = (dir / "result.json").string();
@@ -491,17 +491,17 @@ TEST(SegmentCli, OutputReplacesOnlyAResultFileItWrote) {
 }
 
 TEST(SegmentCli, RefusesAPipeAndNeverWritesOverAnInput) {
-  const fs::path dir = temp_dir();
+  const fs::path dir = tempDir();
   const std::string fifo = (dir / "pipe.csv").string();
   ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
   int status = -1;
   // `timeout` turns a hang on the old code into a failure instead of a stuck test.
-  auto j = run_cli(fifo, &status, "timeout 20 ");
+  auto j = runCli(fifo, &status, "timeout 20 ");
   EXPECT_EQ(status, 1);
   EXPECT_NE(j["error"].get<std::string>().find("named pipe"), std::string::npos) << j.dump();
   fs::remove(fifo);
   const std::string csv = (dir / "input.csv").string();
-  write_demo_csv(csv, 300, 3);
+  writeDemoCsv(csv, 300, 3);
   std::ifstream before_in(csv);
   const std::string before((std::istreambuf_iterator<char>(before_in)), {});
   const std::string cmd =
@@ -512,7 +512,7 @@ TEST(SegmentCli, RefusesAPipeAndNeverWritesOverAnInput) {
   // Durations no demo can have, and a window longer than the demo (6 s), are errors.
   for (const std::string bad : {"--min-segment-seconds inf", "--min-segment-seconds 1e300",
                                 "--window-seconds 1e300", "--window-seconds 60"}) {
-    j = run_cli(csv + " " + bad, &status);
+    j = runCli(csv + " " + bad, &status);
     EXPECT_EQ(status, 1) << bad;
     EXPECT_FALSE(j["success"].get<bool>()) << bad;
   }
@@ -522,10 +522,10 @@ TEST(SegmentCli, RefusesAPipeAndNeverWritesOverAnInput) {
 // files. Each run ends (under `timeout`) with exit 0 and a result or exit 1 and an error in the
 // JSON, never a crash, and the input CSV keeps its bytes. About 2 s.
 TEST(SegmentCli, RandomExtremeCommandLinesGiveAResultOrAClearError) {
-  const fs::path dir = temp_dir() / "fuzz";
+  const fs::path dir = tempDir() / "fuzz";
   fs::create_directories(dir);
   const std::string csv = (dir / "demo.csv").string();
-  write_demo_csv(csv, 400, 5);
+  writeDemoCsv(csv, 400, 5);
   const std::string fifo = (dir / "pipe.csv").string();
   ::mkfifo(fifo.c_str(), 0600);
   std::ifstream before_in(csv);
@@ -548,7 +548,7 @@ TEST(SegmentCli, RandomExtremeCommandLinesGiveAResultOrAClearError) {
     int status = -1;
     nlohmann::json j;
     try {
-      j = run_cli(args, &status, "timeout 20 ");
+      j = runCli(args, &status, "timeout 20 ");
     } catch (const std::exception& e) {
       ADD_FAILURE() << args << ": no JSON (" << e.what() << ")";
       continue;

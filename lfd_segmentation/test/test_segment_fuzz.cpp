@@ -37,7 +37,7 @@ TEST(SegmentServiceFuzz, RandomExtremeRequestsGiveAResultOrAClearError) {
   fs::remove_all(dir);
   fs::create_directories(dir);
   lfd_segmentation::SegmentationParams params =
-      lfd_segmentation::load_params_file(std::string(LFD_CONFIG_DIR) + "/segmentation.yaml");
+      lfd_segmentation::loadParamsFile(std::string(LFD_CONFIG_DIR) + "/segmentation.yaml");
   params.paths.allowed_roots = {dir.string()};
   std::vector<std::string> good;
   for (int d = 0; d < 3; ++d) {
@@ -45,14 +45,14 @@ TEST(SegmentServiceFuzz, RandomExtremeRequestsGiveAResultOrAClearError) {
     o.seed = 100 + d;
     o.duration = 7.0 + 0.5 * d;
     good.push_back((dir / ("good" + std::to_string(d) + ".bag")).string());
-    lfd_segmentation_test::write_demo_bag(good.back(), o);
+    lfd_segmentation_test::writeDemoBag(good.back(), o);
   }
   DemoBagOptions late, huge;
   late.late_twist_seconds = 20000;
   huge.huge_twist = 1e308;
   const std::string late_bag = (dir / "late.bag").string(), huge_bag = (dir / "huge.bag").string();
-  lfd_segmentation_test::write_demo_bag(late_bag, late);
-  lfd_segmentation_test::write_demo_bag(huge_bag, huge);
+  lfd_segmentation_test::writeDemoBag(late_bag, late);
+  lfd_segmentation_test::writeDemoBag(huge_bag, huge);
   const std::string corrupt = (dir / "corrupt.bag").string();
   std::ofstream(corrupt) << std::string(4096, 'x');
   const std::string fifo = (dir / "pipe.bag").string();
@@ -90,7 +90,7 @@ TEST(SegmentServiceFuzz, RandomExtremeRequestsGiveAResultOrAClearError) {
     // On a thread: code that blocks on the pipe is released (the test opens the other end) and
     // the request fails instead of hanging the test.
     auto done = std::async(std::launch::async,
-                           [&] { lfd_segmentation::handle_segment_request(params, request, r); });
+                           [&] { lfd_segmentation::handleSegmentRequest(params, request, r); });
     if (done.wait_for(std::chrono::seconds(20)) == std::future_status::timeout) {
       const int fd = ::open(fifo.c_str(), O_WRONLY | O_NONBLOCK);
       if (fd >= 0) ::close(fd);
@@ -120,7 +120,7 @@ TEST(SegmentServiceFuzz, RandomExtremeRequestsGiveAResultOrAClearError) {
   lfd_msgs::Segment::Request valid;
   valid.bag_paths = good;
   lfd_msgs::Segment::Response r;
-  lfd_segmentation::handle_segment_request(params, valid, r);
+  lfd_segmentation::handleSegmentRequest(params, valid, r);
   EXPECT_TRUE(r.success) << r.error;
   fs::remove_all(dir);
 }

@@ -51,14 +51,14 @@ SensorBinding bindRow(const lfd::SensorEntry& entry) {
 }  // namespace
 
 const std::vector<MessageLayout>& sensorMessageLayouts() {
-  static const std::vector<MessageLayout> layouts = {
+  static const std::vector<MessageLayout> kLayouts = {
       {"geometry_msgs/WrenchStamped", {{"force", 3, false}, {"torque", 3, false}}},
       {"sensor_msgs/Imu",
        {{"orientation", 4, false},
         {"angular_velocity", 3, false},
         {"linear_acceleration", 3, false}}},
       {"lfd_msgs/Touch", {{"values", 1, true}}}};
-  return layouts;
+  return kLayouts;
 }
 
 std::vector<SensorBinding> bindSensorTable(const std::vector<lfd::SensorEntry>& table) {

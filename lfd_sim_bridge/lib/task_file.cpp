@@ -297,26 +297,26 @@ class TaskReader {
     if (const YAML::Node g = root["gripper_at_start"]) {
       const std::string s = r_.text(g, "gripper_at_start");
       if (s != "open" && s != "closed") r_.fail("gripper_at_start", "expected open or closed");
-      t_.gripper_closed_at_start = s == "closed";
+      task_.gripper_closed_at_start = s == "closed";
     }
     readVariation(root["variation"], root["teleop_placement"]);
     readFrames(root["frames"]);
     readPhases(root["phases"]);
     if (!root["success"]) r_.fail("success", "missing: the physical success criterion");
     for (const char* mode : kModes) {
-      t_.configurations[mode] = readConfigurations(root["configurations"][mode],
-                                                   std::string("configurations.") + mode, true);
+      task_.configurations[mode] = readConfigurations(root["configurations"][mode],
+                                                      std::string("configurations.") + mode, true);
       if (root["unseen"])
-        t_.unseen[mode] =
+        task_.unseen[mode] =
             readConfigurations(root["unseen"][mode], std::string("unseen.") + mode, false);
     }
     checkIds();
-    return t_;
+    return task_;
   }
 
-  TaskDefinition t_;
-
  private:
+  TaskDefinition task_;  // what read() fills and returns
+
   void readObjects(const YAML::Node& n) {
     if (!n || !n.IsSequence()) r_.fail("objects", "expected a list of scene objects ([] for none)");
     for (size_t i = 0; i < n.size(); ++i) {
@@ -324,12 +324,12 @@ class TaskReader {
       if (!scene_.find(name))
         r_.fail("objects[" + std::to_string(i) + "]",
                 "'" + name + "' is not an object of the scene file '" + scene_.path + "'");
-      t_.objects.push_back(name);
+      task_.objects.push_back(name);
     }
   }
 
   bool isObject(const std::string& name) const {
-    return std::find(t_.objects.begin(), t_.objects.end(), name) != t_.objects.end();
+    return std::find(task_.objects.begin(), task_.objects.end(), name) != task_.objects.end();
   }
 
   // An object of the task or one of its frames ("drawer.handle").
@@ -342,7 +342,7 @@ class TaskReader {
 
   bool isFrame(const std::string& name) const {
     if (isBuiltinFrame(name) || isObjectOrPart(name)) return true;
-    return std::any_of(t_.frames.begin(), t_.frames.end(),
+    return std::any_of(task_.frames.begin(), task_.frames.end(),
                        [&](const auto& f) { return f.first == name; });
   }
 
@@ -372,8 +372,8 @@ class TaskReader {
   }
 
   void readVariation(const YAML::Node& variation, const YAML::Node& placement) {
-    t_.variation = readJitters(variation, "variation");
-    t_.teleop_placement = readJitters(placement, "teleop_placement");
+    task_.variation = readJitters(variation, "variation");
+    task_.teleop_placement = readJitters(placement, "teleop_placement");
   }
 
   PoseSpec poseSpec(const YAML::Node& n, const std::string& key) const {
@@ -428,7 +428,7 @@ class TaskReader {
         needFixedFrame(f.relative.frame, key + ".frame");
         if (!f.relative.axes.empty()) needFixedFrame(f.relative.axes, key + ".axes");
       }
-      t_.frames.emplace_back(name, f);
+      task_.frames.emplace_back(name, f);
     }
   }
 
@@ -440,11 +440,11 @@ class TaskReader {
 
   Step readStep(const YAML::Node& n, const std::string& key) const {
     if (!n.IsMap()) r_.fail(key, "expected a mapping with one primitive");
-    static const std::set<std::string> primitives = {"move",    "carry", "push",   "gripper",
-                                                     "release", "hold",  "retreat"};
+    static const std::set<std::string> kPrimitives = {"move",    "carry", "push",   "gripper",
+                                                      "release", "hold",  "retreat"};
     std::vector<std::string> found;
     for (const auto& kv : n)
-      if (primitives.count(kv.first.Scalar())) found.push_back(kv.first.Scalar());
+      if (kPrimitives.count(kv.first.Scalar())) found.push_back(kv.first.Scalar());
     if (found.size() != 1)
       r_.fail(key,
               "expected exactly one primitive of move, carry, push, gripper, release, hold, "
@@ -525,9 +525,9 @@ class TaskReader {
         if (s.kind == StepKind::kGripper) closed = !s.open;
         phase.steps.push_back(s);
       }
-      t_.phases.push_back(phase);
+      task_.phases.push_back(phase);
     }
-    const auto& ph = t_.phases;
+    const auto& ph = task_.phases;
     if (ph.front().window || ph.back().window)
       r_.fail("phases", "the first and the last phase are skills, not windows");
     for (size_t i = 1; i < ph.size(); ++i)
@@ -542,7 +542,7 @@ class TaskReader {
       return {};
     }
     if (!n.IsSequence() || (required && n.size() == 0)) r_.fail(key, "expected a non-empty list");
-    const std::vector<std::string> joints = t_.joints(scene_);
+    const std::vector<std::string> joints = task_.joints(scene_);
     std::vector<Configuration> out;
     for (size_t i = 0; i < n.size(); ++i) {
       const std::string ckey = key + "[" + std::to_string(i) + "]";
@@ -550,7 +550,7 @@ class TaskReader {
       if (!e.IsMap()) r_.fail(ckey, "expected a mapping");
       Configuration c;
       c.id = r_.whole(e["id"], ckey + ".id", 0);
-      for (const std::string& object : t_.objects)
+      for (const std::string& object : task_.objects)
         c.objects[object] = r_.pose(e[object], ckey + "." + object);
       c.goal = r_.pose(e["goal"], ckey + ".goal");
       for (const auto& kv : e) {
@@ -573,7 +573,7 @@ class TaskReader {
   void checkIds() {
     for (const char* mode : kModes) {
       std::set<int> ids;
-      for (const auto* list : {&t_.configurations[mode], &t_.unseen[mode]})
+      for (const auto* list : {&task_.configurations[mode], &task_.unseen[mode]})
         for (const Configuration& c : *list)
           if (!ids.insert(c.id).second)
             r_.fail(std::string("configurations/unseen.") + mode,

@@ -126,23 +126,44 @@ WorkcellSim::WorkcellSim(const std::string& mjcf_path, const WorkcellConfig& con
     : config_(config), log_(std::move(log)), rng_(config.noise_seed) {
   mju_user_warning = mujocoWarning;
   mju_user_error = mujocoError;
+  loadModel(mjcf_path);
+  try {
+    configureFromModel();
+  } catch (...) {  // the destructor does not run for a constructor that throws
+    releaseModel();
+    throw;
+  }
+}
+
+void WorkcellSim::loadModel(const std::string& mjcf_path) {
   char error[1024] = "";
   m_ = mj_loadXML(mjcf_path.c_str(), nullptr, error, sizeof(error));
   if (!m_) {
     throw std::runtime_error("cannot load MJCF '" + mjcf_path +
                              "': " + (error[0] ? error : "unknown MuJoCo error"));
   }
-  if (error[0]) this->log(LogLevel::kWarn, std::string("MJCF load warning: ") + error);
+  if (error[0]) log(LogLevel::kWarn, std::string("MJCF load warning: ") + error);
   d_ = mj_makeData(m_);
   if (!d_) {
-    mj_deleteModel(m_);
+    releaseModel();
     throw std::runtime_error("MuJoCo could not allocate data for '" + mjcf_path + "'");
   }
   if (m_->opt.integrator == mjINT_RK4) {
     // mj_step1/mj_step2 (needed to compute controls from fresh kinematics) fall back to Euler.
-    this->log(LogLevel::kWarn, "model asks for RK4; the split step integrates with Euler");
+    log(LogLevel::kWarn, "model asks for RK4; the split step integrates with Euler");
   }
+}
 
+void WorkcellSim::releaseModel() {
+  if (d_) mj_deleteData(d_);
+  if (m_) mj_deleteModel(m_);
+  d_ = nullptr;
+  m_ = nullptr;
+}
+
+// Everything the constructor derives from the loaded model: joints, actuators, the base, the
+// configured names checked against the model, sensors, objects, and the initial scene.
+void WorkcellSim::configureFromModel() {
   for (int j = 0; j < m_->njnt; ++j) {
     if (m_->jnt_type[j] == mjJNT_HINGE || m_->jnt_type[j] == mjJNT_SLIDE) {
       joint_names_.push_back(jointName(m_, j));
@@ -158,20 +179,13 @@ WorkcellSim::WorkcellSim(const std::string& mjcf_path, const WorkcellConfig& con
     object_joint_.push_back(m_->body_rootid[m_->jnt_bodyid[j]] != m_->body_rootid[base_body_]);
   ee_site_ = mj_name2id(m_, mjOBJ_SITE, config_.ee_site.c_str());
   gripper_ = actuatedIndex(config_.gripper_joint);
-
-  try {
-    checkRobotNames();
-    configureSensors();
-  } catch (...) {  // the destructor does not run for a constructor that throws
-    mj_deleteData(d_);
-    mj_deleteModel(m_);
-    throw;
-  }
+  checkRobotNames();
+  configureSensors();
 
   for (const std::string& name : config_.objects) {
     const int body = mj_name2id(m_, mjOBJ_BODY, name.c_str());
     if (body <= 0) {
-      this->log(LogLevel::kWarn, "no body '" + name + "'; it will not be reported");
+      log(LogLevel::kWarn, "no body '" + name + "'; it will not be reported");
       continue;
     }
     objects_.emplace_back(name, body);
@@ -230,8 +244,7 @@ void WorkcellSim::checkRobotNames() const {
 }
 
 WorkcellSim::~WorkcellSim() {
-  if (d_) mj_deleteData(d_);
-  if (m_) mj_deleteModel(m_);
+  releaseModel();
 }
 
 void WorkcellSim::configureActuators() {

@@ -68,7 +68,7 @@ struct Options {
   std::exit(2);
 }
 
-double parse_number(const std::string& text, const std::string& what) {
+double parseNumber(const std::string& text, const std::string& what) {
   try {
     std::size_t used = 0;
     double v = std::stod(text, &used);
@@ -88,7 +88,7 @@ std::vector<std::string> split(const std::string& text, char sep) {
   return parts;
 }
 
-Options parse_options(int argc, char** argv) {
+Options parseOptions(int argc, char** argv) {
   Options o;
   for (int i = 1; i < argc; ++i) {
     std::string key = argv[i];
@@ -108,21 +108,21 @@ Options parse_options(int argc, char** argv) {
     else if (key == "--times")
       o.times = value;
     else if (key == "--width")
-      o.width = static_cast<int>(parse_number(value, key));
+      o.width = static_cast<int>(parseNumber(value, key));
     else if (key == "--height")
-      o.height = static_cast<int>(parse_number(value, key));
+      o.height = static_cast<int>(parseNumber(value, key));
     else if (key == "--camera")
       o.camera = value;
     else if (key == "--distance")
-      o.distance = parse_number(value, key);
+      o.distance = parseNumber(value, key);
     else if (key == "--azimuth")
-      o.azimuth = parse_number(value, key);
+      o.azimuth = parseNumber(value, key);
     else if (key == "--elevation")
-      o.elevation = parse_number(value, key);
+      o.elevation = parseNumber(value, key);
     else if (key == "--lookat") {
       auto parts = split(value, ',');
       if (parts.size() != 3) usage("--lookat needs x,y,z");
-      for (int k = 0; k < 3; ++k) o.lookat[k] = parse_number(parts[k], key);
+      for (int k = 0; k < 3; ++k) o.lookat[k] = parseNumber(parts[k], key);
     } else {
       usage("unknown option " + key);
     }
@@ -152,7 +152,7 @@ struct Recording {
       segment_ends;  // last /lfd/phase message of each ground-truth phase but the last
 };
 
-Recording read_recording(const std::string& path) {
+Recording readRecording(const std::string& path) {
   if (!std::filesystem::is_regular_file(path))
     throw std::runtime_error("bag '" + path + "' does not exist");
   rosbag::Bag bag(path, rosbag::bagmode::Read);
@@ -200,7 +200,7 @@ const Msg& latest(const std::vector<Stamped<Msg>>& samples, double t) {
   return it == samples.begin() ? it->msg : std::prev(it)->msg;
 }
 
-std::vector<double> requested_times(const Options& o, const Recording& r) {
+std::vector<double> requestedTimes(const Options& o, const Recording& r) {
   std::vector<double> times;
   if (o.times.empty()) {
     times = r.segment_ends;
@@ -208,7 +208,7 @@ std::vector<double> requested_times(const Options& o, const Recording& r) {
     return times;
   }
   for (const std::string& part : split(o.times, ',')) {
-    double t = part == "end" ? r.end : parse_number(part, "--times");
+    double t = part == "end" ? r.end : parseNumber(part, "--times");
     if (o.relative && part != "end") t += r.start;
     if (t < r.start - 1e-6 || t > r.end + 1e-6) {
       std::ostringstream msg;
@@ -235,7 +235,7 @@ void setPose(const geometry_msgs::Pose& p, mjtNum* pos, mjtNum* quat) {
   mju_normalize4(quat);
 }
 
-void apply_joints(const mjModel* m, mjData* d, const sensor_msgs::JointState& js) {
+void applyJoints(const mjModel* m, mjData* d, const sensor_msgs::JointState& js) {
   for (std::size_t k = 0; k < js.name.size() && k < js.position.size(); ++k) {
     int id = mj_name2id(m, mjOBJ_JOINT, js.name[k].c_str());
     if (id < 0) continue;  // a joint of the robot's description unknown to the scene
@@ -244,10 +244,10 @@ void apply_joints(const mjModel* m, mjData* d, const sensor_msgs::JointState& js
   }
 }
 
-void apply_state(const mjModel* m, mjData* d, const Recording& r, double t) {
-  apply_joints(m, d, latest(r.joints, t));
+void applyState(const mjModel* m, mjData* d, const Recording& r, double t) {
+  applyJoints(m, d, latest(r.joints, t));
   // Bags recorded before the split carry the drawer's slide on /joint_states (applied above).
-  if (!r.object_joints.empty()) apply_joints(m, d, latest(r.object_joints, t));
+  if (!r.object_joints.empty()) applyJoints(m, d, latest(r.object_joints, t));
   for (const auto& [name, samples] : r.objects) {
     const geometry_msgs::Pose& p = latest(samples, t).pose;
     const int body = mj_name2id(m, mjOBJ_BODY, name.c_str());
@@ -293,8 +293,8 @@ struct DataDeleter {
 };
 
 int run(const Options& o) {
-  Recording rec = read_recording(o.bag);
-  std::vector<double> times = requested_times(o, rec);
+  Recording rec = readRecording(o.bag);
+  std::vector<double> times = requestedTimes(o, rec);
 
   char error[1000] = "";
   std::unique_ptr<mjModel, ModelDeleter> model(mj_loadXML(o.model.c_str(), nullptr, error, 1000));
@@ -337,7 +337,7 @@ int run(const Options& o) {
   std::vector<std::uint8_t> bottom_up(static_cast<std::size_t>(o.width) * o.height * 3);
   std::vector<std::uint8_t> rgb(bottom_up.size());
   for (std::size_t k = 0; k < times.size(); ++k) {
-    apply_state(m, data.get(), rec, times[k]);
+    applyState(m, data.get(), rec, times[k]);
     mjv_updateScene(m, data.get(), &opt, nullptr, &cam, mjCAT_ALL, &scene);
     mjr_render(viewport, &scene, &con);
     mjr_readPixels(bottom_up.data(), nullptr, viewport, &con);
@@ -358,7 +358,7 @@ int run(const Options& o) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  Options o = parse_options(argc, argv);
+  Options o = parseOptions(argc, argv);
   try {
     return run(o);
   } catch (const std::exception& e) {

@@ -101,11 +101,11 @@ Factory factory() {
 
 // One entry per type of sensorMessageLayouts().
 const std::map<std::string, Factory>& factories() {
-  static const std::map<std::string, Factory> all = {
+  static const std::map<std::string, Factory> kAll = {
       {"geometry_msgs/WrenchStamped", factory<geometry_msgs::WrenchStamped>()},
       {"sensor_msgs/Imu", factory<sensor_msgs::Imu>()},
       {"lfd_msgs/Touch", factory<lfd_msgs::Touch>()}};
-  return all;
+  return kAll;
 }
 
 }  // namespace

@@ -79,7 +79,7 @@ demo::Pose phaseEnd(const demo::DemoPlan& p, size_t index) {
 }
 
 // The grasp of config/tasks/grasp.yaml without its per-demo variation (exact geometry).
-const char* kGrasp = R"(
+const char* const kGrasp = R"(
 objects: [stick]
 phases:
   - name: approach

@@ -398,7 +398,7 @@ TEST_P(ModelConsistency, TheWorkcellSimulatesTheReadyPostureAndTheGripper) {
   const int tip = mj_name2id(m.get(), mjOBJ_SITE, setup.tip_link.c_str());
   const Eigen::Vector3d tip_start = sitePose(d.get(), tip).translation();
   const int root = mj_name2id(m.get(), mjOBJ_BODY, robot.root.c_str());
-  const auto robotBody = [&](int body) {
+  const auto robot_body = [&](int body) {
     while (body > 0 && body != root) body = m->body_parentid[body];
     return body == root;
   };
@@ -410,8 +410,8 @@ TEST_P(ModelConsistency, TheWorkcellSimulatesTheReadyPostureAndTheGripper) {
   const auto finger = [&](int joint) { return d->qpos[m->jnt_qposadr[joint]]; };
   ASSERT_NO_FATAL_FAILURE(step(1.0));
   for (int c = 0; c < d->ncon; ++c)  // the hand above the table, the stand beside it
-    EXPECT_FALSE(robotBody(m->geom_bodyid[d->contact[c].geom1]) ||
-                 robotBody(m->geom_bodyid[d->contact[c].geom2]))
+    EXPECT_FALSE(robot_body(m->geom_bodyid[d->contact[c].geom1]) ||
+                 robot_body(m->geom_bodyid[d->contact[c].geom2]))
         << "the robot touches " << mj_id2name(m.get(), mjOBJ_GEOM, d->contact[c].geom1) << " / "
         << mj_id2name(m.get(), mjOBJ_GEOM, d->contact[c].geom2) << " in its ready posture";
   const double sag = (sitePose(d.get(), tip).translation() - tip_start).norm();

@@ -78,7 +78,7 @@ TEST(WorkcellSim, ATableSensorTheModelLacksIsAClearError) {
 // A robot file for another robot (or with a typo) is refused before anything runs: a gripper
 // joint, tip frame or posture joint the model lacks would record demos with an idle gripper.
 TEST(WorkcellSim, RobotFileNamesTheModelLacksAreClearErrors) {
-  const auto expectRefused = [](const lfd_sim::WorkcellConfig& c, const std::string& needle) {
+  const auto expect_refused = [](const lfd_sim::WorkcellConfig& c, const std::string& needle) {
     try {
       lfd_sim::WorkcellSim sim(kModel, c);
       ADD_FAILURE() << "accepted a robot file naming " << needle;
@@ -88,13 +88,13 @@ TEST(WorkcellSim, RobotFileNamesTheModelLacksAreClearErrors) {
   };
   lfd_sim::WorkcellConfig c = readyConfig();
   c.gripper_joint = "finger_joint";
-  expectRefused(c, "gripper joint 'finger_joint'");
+  expect_refused(c, "gripper joint 'finger_joint'");
   c = readyConfig();
   c.ee_site = "tcp";
-  expectRefused(c, "'tcp'");
+  expect_refused(c, "'tcp'");
   c = readyConfig();
   c.initial_posture["arm_joint_1"] = 0.1;
-  expectRefused(c, "'arm_joint_1'");
+  expect_refused(c, "'arm_joint_1'");
 }
 
 // The table bound to the message types: fields in the message's order, dimensions checked.
@@ -104,7 +104,7 @@ TEST(SensorTable, BindsRowsAndRefusesWrongOnes) {
   const auto dim = [&](const std::string& n) { return sim.sensorDimension(n); };
   const auto bindings = lfd_sim::bindSensorTable(robot.sensors);
   EXPECT_NO_THROW(lfd_sim::checkSensorDimensions(bindings, dim));
-  const auto expectError = [&](const lfd::SensorEntry& row, const std::string& needle) {
+  const auto expect_error = [&](const lfd::SensorEntry& row, const std::string& needle) {
     try {
       lfd_sim::checkSensorDimensions(lfd_sim::bindSensorTable({row}), dim);
       ADD_FAILURE() << "accepted a row with " << needle;
@@ -113,14 +113,14 @@ TEST(SensorTable, BindsRowsAndRefusesWrongOnes) {
       EXPECT_NE(std::string(e.what()).find("/x"), std::string::npos) << e.what();
     }
   };
-  expectError({"/x", "geometry_msgs/Wrench", "f", {{"force", {"r_wrist_force"}}}},
-              "unknown message type");
-  expectError({"/x", "geometry_msgs/WrenchStamped", "f", {{"forces", {"r_wrist_force"}}}},
-              "no field 'forces'");
-  expectError({"/x", "geometry_msgs/WrenchStamped", "f", {{"force", {"r_touch_left"}}}},
-              "dimension 3; 'r_touch_left' has 1");
-  expectError({"/x", "sensor_msgs/Imu", "f", {{"angular_velocity", {"imu_gyro", "imu_accel"}}}},
-              "takes one sensor, not 2");
+  expect_error({"/x", "geometry_msgs/Wrench", "f", {{"force", {"r_wrist_force"}}}},
+               "unknown message type");
+  expect_error({"/x", "geometry_msgs/WrenchStamped", "f", {{"forces", {"r_wrist_force"}}}},
+               "no field 'forces'");
+  expect_error({"/x", "geometry_msgs/WrenchStamped", "f", {{"force", {"r_touch_left"}}}},
+               "dimension 3; 'r_touch_left' has 1");
+  expect_error({"/x", "sensor_msgs/Imu", "f", {{"angular_velocity", {"imu_gyro", "imu_accel"}}}},
+               "takes one sensor, not 2");
   // Fields are read in the message's order, whatever the file's.
   const auto imu = lfd_sim::bindSensorTable(
       {{"/x",
@@ -128,6 +128,20 @@ TEST(SensorTable, BindsRowsAndRefusesWrongOnes) {
         "f",
         {{"linear_acceleration", {"imu_accel"}}, {"orientation", {"imu_quat"}}}}});
   EXPECT_EQ(imu[0].group.sensors, (std::vector<std::string>{"imu_quat", "imu_accel"}));
+}
+
+// A gain the robot file sets to zero is refused after the model is loaded: the constructor
+// frees the model it already holds (the sanitized run of this test fails on a leak).
+TEST(WorkcellSim, ANonPositiveGainIsAClearErrorThatFreesTheModel) {
+  lfd_sim::WorkcellConfig c = readyConfig();
+  c.kp["R_ELBOW_P"] = 0.0;
+  try {
+    lfd_sim::WorkcellSim sim(kModel, c);
+    FAIL() << "a zero gain was accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("R_ELBOW_P has a non-positive kp"), std::string::npos)
+        << e.what();
+  }
 }
 
 TEST(WorkcellSim, BadModelPathGivesMuJoCoMessage) {

@@ -15,21 +15,21 @@ namespace fs = std::filesystem;
 using lfd_segmentation_test::DemoBagOptions;
 
 const fs::path& dir() {
-  static const fs::path d = [] {
+  static const fs::path kD = [] {
     fs::path p = fs::temp_directory_path() / ("lfd_rostest_seg_" + std::to_string(getpid()));
     fs::create_directories(p);
     return p;
   }();
-  return d;
+  return kD;
 }
 
 std::string bag(const std::string& name, DemoBagOptions o = {}) {
   const std::string path = (dir() / (name + ".bag")).string();
-  if (!fs::exists(path)) lfd_segmentation_test::write_demo_bag(path, o);
+  if (!fs::exists(path)) lfd_segmentation_test::writeDemoBag(path, o);
   return path;
 }
 
-std::vector<std::string> good_bags(int count) {
+std::vector<std::string> goodBags(int count) {
   std::vector<std::string> bags;
   for (int d = 0; d < count; ++d) {
     DemoBagOptions o;
@@ -49,7 +49,7 @@ lfd_msgs::Segment::Response call(const std::vector<std::string>& bags,
   return srv.response;
 }
 
-void expect_error(const lfd_msgs::Segment::Response& r, const std::string& needle) {
+void expectError(const lfd_msgs::Segment::Response& r, const std::string& needle) {
   EXPECT_FALSE(r.success);
   EXPECT_NE(r.error.find(needle), std::string::npos) << r.error;
 }
@@ -57,29 +57,29 @@ void expect_error(const lfd_msgs::Segment::Response& r, const std::string& needl
 TEST(SegmentationService, SurvivesBadInputAndSegmentsGoodInput) {
   ASSERT_TRUE(ros::service::waitForService("/segmentation/segment", ros::Duration(30)));
 
-  expect_error(call({}), "empty request");
+  expectError(call({}), "empty request");
 
   DemoBagOptions no_touch;
   no_touch.with_touch = false;
-  expect_error(call({good_bags(1)[0], bag("no_touch", no_touch)}), "/touch");
+  expectError(call({goodBags(1)[0], bag("no_touch", no_touch)}), "/touch");
 
   DemoBagOptions nan;
   nan.nan_in_twist = true;
-  expect_error(call({good_bags(1)[0], bag("nan", nan)}), "NaN");
+  expectError(call({goodBags(1)[0], bag("nan", nan)}), "NaN");
 
   lfd_msgs::Segment::Request long_min_s;
   long_min_s.min_segment_seconds = 5.0;
-  expect_error(call(good_bags(2), long_min_s), "2 * min_s");
+  expectError(call(goodBags(2), long_min_s), "2 * min_s");
 
   const std::string truncated = (dir() / "truncated.bag").string();
-  fs::copy_file(good_bags(1)[0], truncated, fs::copy_options::overwrite_existing);
+  fs::copy_file(goodBags(1)[0], truncated, fs::copy_options::overwrite_existing);
   fs::resize_file(truncated, fs::file_size(truncated) / 3);
-  expect_error(call({good_bags(1)[0], truncated}), "truncated.bag");
-  expect_error(call({"/nonexistent/demo.bag"}), "cannot open bag");
+  expectError(call({goodBags(1)[0], truncated}), "truncated.bag");
+  expectError(call({"/nonexistent/demo.bag"}), "cannot open bag");
 
   DemoBagOptions other_touch;
   other_touch.touch_name = "r_touch_palm";
-  expect_error(call({good_bags(1)[0], bag("other_touch", other_touch)}), "features differ");
+  expectError(call({goodBags(1)[0], bag("other_touch", other_touch)}), "features differ");
 
   DemoBagOptions constant;
   constant.constant_gripper = true;
@@ -87,11 +87,11 @@ TEST(SegmentationService, SurvivesBadInputAndSegmentsGoodInput) {
   EXPECT_TRUE(constant_response.success) << constant_response.error;
   EXPECT_FALSE(constant_response.warnings.empty());
 
-  const auto single = call({good_bags(1)[0]});
+  const auto single = call({goodBags(1)[0]});
   EXPECT_TRUE(single.success) << single.error;
   EXPECT_FALSE(single.warnings.empty());
 
-  const auto good = call(good_bags(3));
+  const auto good = call(goodBags(3));
   ASSERT_TRUE(good.success) << good.error;
   ASSERT_EQ(good.demos.size(), 3u);
   // Every validated changepoint is the grasp; ClaSP may place a step up to ~one window late, so
@@ -103,7 +103,7 @@ TEST(SegmentationService, SurvivesBadInputAndSegmentsGoodInput) {
     EXPECT_LE(good.demos[d].changepoints.size(), 1u) << "demo " << d;
     EXPECT_FALSE(good.demos[d].candidates.empty()) << "demo " << d;
     for (double t : good.demos[d].changepoint_times) {
-      EXPECT_NEAR(t, lfd_segmentation_test::grasp_time(o), 0.1 * o.duration);
+      EXPECT_NEAR(t, lfd_segmentation_test::graspTime(o), 0.1 * o.duration);
       ++validated;
     }
   }
@@ -137,7 +137,7 @@ TEST(SegmentationService, LinkSwappedToFifoNeverHangsTheNode) {
       3.0, 2.0);
   EXPECT_EQ(r.hung_calls, 0) << "of " << r.calls << " calls";
   EXPECT_EQ(r.read_calls, r.calls);  // every call answered (a refusal is an answer)
-  EXPECT_TRUE(call(good_bags(2)).success);
+  EXPECT_TRUE(call(goodBags(2)).success);
   fs::remove_all(dir());
 }
 

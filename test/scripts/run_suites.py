@@ -16,7 +16,11 @@ summarize_results.py counts like any other (a lint fails with its report, or wit
 what is missing when it cannot run); all run from the repository root:
 - python_lint: Debian's flake8 with the repository's .flake8 over every Python file git tracks
   (*.py and extension-less scripts with a python shebang);
-- catkin_lint: every package.xml and CMakeLists.txt, warnings included.
+- catkin_lint: every package.xml and CMakeLists.txt, warnings included;
+- cxx_format: clang-format (the repository's .clang-format) over every C++ file git tracks;
+- cxx_naming: clang-tidy's readability-identifier-naming (the repository's .clang-tidy) over every
+  translation unit of the build's compile_commands.json, with the headers they include. It is the
+  slow one (minutes of parsing): it runs beside the targets, on one core, not before them.
 
 Usage: run_suites.py BUILD_DIR [--jobs N] [--only SUBSTRING]
 """
@@ -35,6 +39,10 @@ from xml.sax.saxutils import escape, quoteattr
 REPO_ROOT = os.path.abspath(os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", ".."))
 COMMITTED_DURATIONS = os.path.join(REPO_ROOT, "test", "durations.json")
 LINT_TIMEOUT_S = 600  # each lint takes seconds; this only bounds a hang
+NAMING_TIMEOUT_S = 1800  # the naming lint parses every translation unit (~7 min on one core)
+CXX_SUFFIXES = (".cpp", ".hpp", ".h", ".inc")
+NAMING_WARNING = re.compile(
+    r"^(/\S+):(\d+):(\d+): warning: (.*) \[readability-identifier-naming\]$", re.M)
 # A per-target limit well above the slowest target's quiet time (about 10 min), so one hung
 # target cannot eat CI's 90 minutes; rostest's own time limits normally end a hang first.
 TARGET_TIMEOUT_S = 1500
@@ -94,13 +102,18 @@ def run_target(build_dir, target, makefile, log_dir):
     return target, rc, time.monotonic() - start, log_path
 
 
+def tracked_files(suffixes=("",)):
+    """The files git tracks whose name ends with one of suffixes, relative to the root."""
+    listed = subprocess.run(["git", "ls-files", "-z"], cwd=REPO_ROOT, stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, check=True).stdout.decode()
+    return [p for p in filter(None, listed.split("\0")) if p.endswith(tuple(suffixes))]
+
+
 def tracked_python_files():
     """Every Python file git tracks, relative to the repository root: *.py, and the files without
     an extension whose first line is a python shebang."""
-    listed = subprocess.run(["git", "ls-files", "-z"], cwd=REPO_ROOT, stdout=subprocess.PIPE,
-                            stderr=subprocess.PIPE, check=True).stdout.decode()
     files = []
-    for path in filter(None, listed.split("\0")):
+    for path in tracked_files():
         if path.endswith(".py"):
             files.append(path)
         elif "." not in os.path.basename(path) and os.path.isfile(os.path.join(REPO_ROOT, path)):
@@ -153,11 +166,69 @@ def lint_python():
                       "the %d Python files git tracks" % len(files), "flake8")
 
 
+def lint_cxx_format(build_dir):
+    """clang-format --dry-run --Werror over the tracked C++ files (with .clang-format)."""
+    try:
+        files = tracked_files(CXX_SUFFIXES)
+    except (OSError, subprocess.CalledProcessError) as exc:
+        return False, "cannot list the C++ files git tracks in %s: %s" % (REPO_ROOT, exc), ""
+    lint_cmd = ["/usr/bin/clang-format", "--dry-run", "--Werror"]  # (the install guard reads it)
+    return run_linter(lint_cmd + files, "clang-format",
+                      "the %d C++ files git tracks" % len(files), "clang-format")
+
+
+def naming_translation_units(build_dir):
+    """The repository's translation units of the build's compile database (generated sources in
+    the build tree excluded)."""
+    with open(os.path.join(build_dir, "compile_commands.json")) as f:
+        entries = json.load(f)
+    inside = os.path.join(REPO_ROOT, "")
+    generated = (os.path.join(build_dir, ""), os.path.join(REPO_ROOT, "devel", ""))
+    return sorted({e["file"] for e in entries
+                   if e["file"].startswith(inside) and not e["file"].startswith(generated)})
+
+
+def lint_cxx_naming(build_dir):
+    """clang-tidy with the repository's .clang-tidy (readability-identifier-naming only) over
+    every translation unit; passes when no identifier breaks the convention. A header's
+    warning, reported once per unit that includes it, is listed once."""
+    try:
+        units = naming_translation_units(build_dir)
+    except (OSError, ValueError, KeyError) as exc:
+        return False, ("no usable compile_commands.json in %s (`./lfd build` exports it): %s"
+                       % (build_dir, exc)), ""
+    lint_cmd = ["/usr/bin/clang-tidy", "--quiet", "-p", build_dir]  # (the install guard reads it)
+    try:
+        done = subprocess.run(lint_cmd + units, cwd=REPO_ROOT, stdout=subprocess.PIPE,
+                              stderr=subprocess.STDOUT, universal_newlines=True,
+                              errors="replace", timeout=NAMING_TIMEOUT_S)
+    except FileNotFoundError:
+        return False, ("clang-tidy is not installed: it is the Debian package clang-tidy of "
+                       ".ci/apt-packages.txt, which `./lfd deps` installs"), ""
+    except subprocess.TimeoutExpired:
+        return False, "clang-tidy took over %d s" % NAMING_TIMEOUT_S, ""
+    found = sorted(set(NAMING_WARNING.findall(done.stdout)),
+                   key=lambda w: (w[0], int(w[1]), int(w[2])))
+    listing = "\n".join("%s:%s:%s: %s" % (os.path.relpath(f, REPO_ROOT), line, col, text)
+                        for f, line, col, text in found)
+    what = "the %d translation units of compile_commands.json" % len(units)
+    if found:
+        return False, "clang-tidy naming: %d identifiers break .clang-tidy's convention in %s" % (
+            len(found), what), listing
+    if done.returncode != 0:  # no naming warning, but clang-tidy failed (a unit did not parse)
+        return False, "clang-tidy (exit %d) could not check %s" % (done.returncode, what), \
+            done.stdout.strip()
+    return True, "clang-tidy naming: %s clean" % what, ""
+
+
 def xml_text(text):
     return re.sub("[^\t\n\r\x20-\ud7ff\ue000-\ufffd]", "?", text)  # XML 1.0 characters only
 
 
-LINTS = {"python_lint": lint_python, "catkin_lint": lint_catkin}
+LINTS = {"python_lint": lambda build_dir: lint_python(),
+         "catkin_lint": lambda build_dir: lint_catkin(),
+         "cxx_format": lint_cxx_format}
+BACKGROUND_LINTS = {"cxx_naming": lint_cxx_naming}  # run beside the targets
 
 
 def write_lint_result(results_dir, name, passed, headline, output, seconds):
@@ -174,18 +245,16 @@ def write_lint_result(results_dir, name, passed, headline, output, seconds):
 
 
 def run_lint(build_dir, name):
-    """One lint of LINTS: runs, writes its result, prints its report; returns its wall time."""
+    """One lint of LINTS or BACKGROUND_LINTS: runs and writes its result; returns its wall time
+    and its report for the log."""
     start = time.monotonic()
-    passed, headline, output = LINTS[name]()
+    passed, headline, output = dict(LINTS, **BACKGROUND_LINTS)[name](build_dir)
     seconds = time.monotonic() - start
     write_lint_result(os.path.join(build_dir, "test_results", name), name, passed, headline,
                       output, seconds)
-    print(headline)
-    if not passed and output:
-        print(output)
-    print("[tests] %s: %.1f s%s" % (name, seconds, "" if passed else " (FAILED)"),
-          flush=True)
-    return seconds
+    report = [headline] + ([output] if not passed and output else [])
+    report.append("[tests] %s: %.1f s%s" % (name, seconds, "" if passed else " (FAILED)"))
+    return seconds, "\n".join(report)
 
 
 def main():
@@ -195,7 +264,7 @@ def main():
                         default=int(os.environ.get("LFD_TEST_JOBS", os.cpu_count() or 1)))
     parser.add_argument("--only", default="",
                         help="run only targets whose name contains this (the lints': %s)"
-                        % ", ".join(LINTS))
+                        % ", ".join(list(LINTS) + list(BACKGROUND_LINTS)))
     args = parser.parse_args()
     build_dir = os.path.abspath(args.build_dir)
     log_dir = os.path.join(build_dir, "test_logs")
@@ -207,9 +276,21 @@ def main():
     start = time.monotonic()
     for name in LINTS:
         if args.only in name:
-            measured[name] = round(run_lint(build_dir, name), 1)
+            seconds, report_text = run_lint(build_dir, name)
+            measured[name] = round(seconds, 1)
+            print(report_text, flush=True)
     print("[tests] %d targets, %d at a time" % (len(targets), args.jobs), flush=True)
     printing = threading.Lock()
+
+    def background_lint(name):
+        seconds, report_text = run_lint(build_dir, name)
+        with printing:
+            measured[name] = round(seconds, 1)
+            print(report_text, flush=True)
+    background = [threading.Thread(target=background_lint, args=(name,))
+                  for name in BACKGROUND_LINTS if args.only in name]
+    for thread in background:
+        thread.start()
 
     def report(result):
         target, rc, seconds, log_path = result
@@ -223,6 +304,8 @@ def main():
         for future in [pool.submit(run_target, build_dir, t, makefiles[t], log_dir)
                        for t in targets]:
             future.add_done_callback(lambda f: report(f.result()))
+    for thread in background:
+        thread.join()
     durations.update(measured)
     with open(os.path.join(build_dir, "test_durations.json"), "w") as f:
         json.dump(durations, f, indent=1, sort_keys=True)

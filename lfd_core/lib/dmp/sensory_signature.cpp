@@ -9,21 +9,21 @@ namespace lfd {
 namespace {
 
 // Segment edges of a recording, in s from its first sample: 0, its boundaries, its end.
-std::vector<double> segment_edges(const SegmentedRecording& r) {
+std::vector<double> segmentEdges(const SegmentedRecording& r) {
   std::vector<double> edges{0.0};
   edges.insert(edges.end(), r.boundaries.begin(), r.boundaries.end());
-  edges.push_back(r.features.time_at(r.features.rows() - 1) - r.features.time_at(0));
+  edges.push_back(r.features.timeAt(r.features.rows() - 1) - r.features.timeAt(0));
   return edges;
 }
 
-void check_recording(const SegmentedRecording& r, std::size_t boundaries,
-                     const std::vector<std::string>& channels, const std::string& what) {
+void checkRecording(const SegmentedRecording& r, std::size_t boundaries,
+                    const std::vector<std::string>& channels, const std::string& what) {
   if (r.features.time.empty() || r.features.rows() < 2)
     throw std::invalid_argument(what + " has no clock or fewer than 2 samples");
   if (r.boundaries.size() != boundaries)
     throw std::invalid_argument(what + " has " + std::to_string(r.boundaries.size()) +
                                 " boundaries, the others " + std::to_string(boundaries));
-  const std::vector<double> edges = segment_edges(r);
+  const std::vector<double> edges = segmentEdges(r);
   for (std::size_t k = 1; k < edges.size(); ++k)
     if (!(edges[k] > edges[k - 1]))
       throw std::invalid_argument(what + ": boundaries must increase within (0, " +
@@ -33,14 +33,14 @@ void check_recording(const SegmentedRecording& r, std::size_t boundaries,
 
 // The channel's profile over one segment: the mean of the samples in each phase bin, linearly
 // interpolated at the bin's centre where a bin holds no sample (a short segment, a slow sensor).
-Eigen::VectorXd phase_profile(const SegmentedRecording& r, int column, double start, double end,
-                              std::size_t bins) {
+Eigen::VectorXd phaseProfile(const SegmentedRecording& r, int column, double start, double end,
+                             std::size_t bins) {
   Eigen::VectorXd sum = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(bins));
   Eigen::VectorXd count = sum;
   std::vector<double> phases, values;
-  const double t0 = r.features.time_at(0);
+  const double t0 = r.features.timeAt(0);
   for (Eigen::Index i = 0; i < r.features.rows(); ++i) {
-    const double phase = (r.features.time_at(i) - t0 - start) / (end - start);
+    const double phase = (r.features.timeAt(i) - t0 - start) / (end - start);
     if (phase < 0.0 || phase > 1.0) continue;
     const auto b = std::min<Eigen::Index>(static_cast<Eigen::Index>(phase * bins),
                                           static_cast<Eigen::Index>(bins) - 1);
@@ -72,7 +72,7 @@ Eigen::VectorXd phase_profile(const SegmentedRecording& r, int column, double st
 
 // A channel's measurement noise: the robust sigma of its sample-to-sample differences (median
 // absolute deviation), the median over the demonstrations.
-double noise_sigma(const std::vector<SegmentedRecording>& demos, int column) {
+double noiseSigma(const std::vector<SegmentedRecording>& demos, int column) {
   std::vector<double> sigmas;
   for (const SegmentedRecording& r : demos) {
     std::vector<double> diff;
@@ -86,7 +86,7 @@ double noise_sigma(const std::vector<SegmentedRecording>& demos, int column) {
   return sigmas[sigmas.size() / 2];
 }
 
-double task_range(const std::vector<SegmentedRecording>& demos, int column) {
+double taskRange(const std::vector<SegmentedRecording>& demos, int column) {
   double lo = std::numeric_limits<double>::infinity(), hi = -lo;
   for (const SegmentedRecording& r : demos) {
     lo = std::min(lo, r.features.data.col(column).minCoeff());
@@ -95,9 +95,9 @@ double task_range(const std::vector<SegmentedRecording>& demos, int column) {
   return hi - lo;
 }
 
-std::size_t slack_bins(const SignatureOptions& o, const SegmentSignature& segment) {
+std::size_t slackBins(const SignatureOptions& o, const SegmentSignature& segment) {
   return static_cast<std::size_t>(
-      std::ceil(segment_slack(o, segment) * static_cast<double>(o.phase_bins)));
+      std::ceil(segmentSlack(o, segment) * static_cast<double>(o.phase_bins)));
 }
 
 // Mean and spread per bin from the profiles of the demonstrations; the variance is pooled over
@@ -126,14 +126,14 @@ struct ChannelFloors {
   std::vector<double> floors;
 };
 
-ChannelFloors channel_floors(const std::vector<SegmentedRecording>& demos,
-                             const std::vector<std::string>& channels, const SignatureOptions& o) {
+ChannelFloors channelFloors(const std::vector<SegmentedRecording>& demos,
+                            const std::vector<std::string>& channels, const SignatureOptions& o) {
   ChannelFloors f;
   for (const std::string& name : channels) {
     const int column = demos.front().features.require(name);
     f.columns.push_back(column);
-    const double floor = std::max(o.min_spread_fraction * task_range(demos, column),
-                                  o.noise_sigmas * noise_sigma(demos, column));
+    const double floor = std::max(o.min_spread_fraction * taskRange(demos, column),
+                                  o.noise_sigmas * noiseSigma(demos, column));
     // A channel that never changed: any change is a deviation, measured against a tiny unit.
     f.floors.push_back(std::max(floor, 1e-9));
   }
@@ -148,7 +148,7 @@ std::vector<SegmentSignature> expectations(const std::vector<SegmentedRecording>
   for (std::size_t s = 0; s < segments; ++s) {
     std::vector<double> durations;
     for (const SegmentedRecording& r : demos) {
-      const std::vector<double> e = segment_edges(r);
+      const std::vector<double> e = segmentEdges(r);
       durations.push_back(e[s + 1] - e[s]);
     }
     Eigen::Map<Eigen::VectorXd> d(durations.data(), static_cast<Eigen::Index>(durations.size()));
@@ -157,10 +157,10 @@ std::vector<SegmentSignature> expectations(const std::vector<SegmentedRecording>
     for (std::size_t c = 0; c < floors.columns.size(); ++c) {
       std::vector<Eigen::VectorXd> profiles;
       for (const SegmentedRecording& r : demos) {
-        const std::vector<double> e = segment_edges(r);
-        profiles.push_back(phase_profile(r, floors.columns[c], e[s], e[s + 1], o.phase_bins));
+        const std::vector<double> e = segmentEdges(r);
+        profiles.push_back(phaseProfile(r, floors.columns[c], e[s], e[s + 1], o.phase_bins));
       }
-      out[s].channels.push_back(expectation(profiles, floors.floors[c], slack_bins(o, out[s])));
+      out[s].channels.push_back(expectation(profiles, floors.floors[c], slackBins(o, out[s])));
     }
   }
   return out;
@@ -171,25 +171,25 @@ struct RawScores {
   std::vector<std::vector<Deviation>> worst;  // [segment][channel], at the highest score
 };
 
-RawScores raw_scores(const std::vector<SegmentSignature>& segments,
-                     const std::vector<std::string>& channels, const SignatureOptions& o,
-                     const SegmentedRecording& run) {
+RawScores rawScores(const std::vector<SegmentSignature>& segments,
+                    const std::vector<std::string>& channels, const SignatureOptions& o,
+                    const SegmentedRecording& run) {
   RawScores out;
   out.scores.assign(segments.size(), std::vector<double>(channels.size(), 0.0));
   out.worst.assign(segments.size(), std::vector<Deviation>(channels.size()));
-  const std::vector<double> edges = segment_edges(run);
-  const double t0 = run.features.time_at(0);
+  const std::vector<double> edges = segmentEdges(run);
+  const double t0 = run.features.timeAt(0);
   for (std::size_t c = 0; c < channels.size(); ++c) {
     const int column = run.features.require(channels[c]);
     for (std::size_t s = 0; s < segments.size(); ++s) {
       SustainedDeviation sustained(o.persistence);
       const ChannelSignature& sig = segments[s].channels[c];
       for (Eigen::Index i = 0; i < run.features.rows(); ++i) {
-        const double t = run.features.time_at(i) - t0;
+        const double t = run.features.timeAt(i) - t0;
         if (t < edges[s] || t > edges[s + 1]) continue;
         const double phase = (t - edges[s]) / (edges[s + 1] - edges[s]);
         const double value = run.features.data(i, column);
-        const double d = sustained.push(t, deviation_at(segments, o, s, c, phase, value));
+        const double d = sustained.push(t, deviationAt(segments, o, s, c, phase, value));
         if (d <= out.scores[s][c]) continue;
         out.scores[s][c] = d;
         const auto bin = std::min<Eigen::Index>(static_cast<Eigen::Index>(phase * o.phase_bins),
@@ -202,14 +202,14 @@ RawScores raw_scores(const std::vector<SegmentSignature>& segments,
 }
 
 // Each channel's nominal score: the worst of the demonstrations, each judged by the others.
-void set_thresholds(const std::vector<SegmentedRecording>& demos, const ChannelFloors& floors,
-                    const std::vector<std::string>& channels, SensorySignature* signature) {
+void setThresholds(const std::vector<SegmentedRecording>& demos, const ChannelFloors& floors,
+                   const std::vector<std::string>& channels, SensorySignature* signature) {
   const SignatureOptions& o = signature->options;
   for (std::size_t held_out = 0; held_out < demos.size(); ++held_out) {
     std::vector<SegmentedRecording> others;
     for (std::size_t d = 0; d < demos.size(); ++d)
       if (d != held_out) others.push_back(demos[d]);
-    const RawScores raw = raw_scores(expectations(others, floors, o), channels, o, demos[held_out]);
+    const RawScores raw = rawScores(expectations(others, floors, o), channels, o, demos[held_out]);
     for (std::size_t s = 0; s < raw.scores.size(); ++s)
       for (std::size_t c = 0; c < channels.size(); ++c) {
         ChannelSignature& sig = signature->segments[s].channels[c];
@@ -223,7 +223,7 @@ void set_thresholds(const std::vector<SegmentedRecording>& demos, const ChannelF
 
 }  // namespace
 
-void check_signature_options(const SignatureOptions& o) {
+void checkSignatureOptions(const SignatureOptions& o) {
   if (o.phase_bins < 2 || o.phase_bins > 1000)
     throw std::invalid_argument("phase_bins must be in [2, 1000], got " +
                                 std::to_string(o.phase_bins));
@@ -241,28 +241,28 @@ void check_signature_options(const SignatureOptions& o) {
     throw std::invalid_argument("threshold_margin and min_threshold must be finite and > 0");
 }
 
-SensorySignature learn_signature(const std::vector<SegmentedRecording>& demos,
-                                 const std::vector<std::string>& channels,
-                                 const SignatureOptions& options) {
+SensorySignature learnSignature(const std::vector<SegmentedRecording>& demos,
+                                const std::vector<std::string>& channels,
+                                const SignatureOptions& options) {
   if (demos.size() < 2)
     throw std::invalid_argument("a sensory signature needs at least 2 demonstrations, got " +
                                 std::to_string(demos.size()));
   if (channels.empty()) throw std::invalid_argument("a sensory signature needs a channel");
-  check_signature_options(options);
+  checkSignatureOptions(options);
   for (std::size_t d = 0; d < demos.size(); ++d)
-    check_recording(demos[d], demos.front().boundaries.size(), channels,
-                    "demonstration " + std::to_string(d));
+    checkRecording(demos[d], demos.front().boundaries.size(), channels,
+                   "demonstration " + std::to_string(d));
   SensorySignature signature;
   signature.channels = channels;
   signature.options = options;
   signature.demonstrations = demos.size();
-  const ChannelFloors floors = channel_floors(demos, channels, options);
+  const ChannelFloors floors = channelFloors(demos, channels, options);
   signature.segments = expectations(demos, floors, options);
-  set_thresholds(demos, floors, channels, &signature);
+  setThresholds(demos, floors, channels, &signature);
   return signature;
 }
 
-double segment_slack(const SignatureOptions& options, const SegmentSignature& segment) {
+double segmentSlack(const SignatureOptions& options, const SegmentSignature& segment) {
   return segment.duration_mean > 0
              ? std::max(options.phase_slack, options.time_slack / segment.duration_mean)
              : options.phase_slack;
@@ -271,8 +271,8 @@ double segment_slack(const SignatureOptions& options, const SegmentSignature& se
 namespace {
 
 // The smallest distance to the expected level over the phase bins [from, to] of one segment.
-double deviation_over(const ChannelSignature& channel, std::size_t phase_bins, double from,
-                      double to, double value) {
+double deviationOver(const ChannelSignature& channel, std::size_t phase_bins, double from,
+                     double to, double value) {
   const auto last = static_cast<long>(channel.mean.size()) - 1;
   const auto bin = [&](double p) {
     return std::clamp(static_cast<long>(std::floor(std::clamp(p, 0.0, 1.0) * phase_bins)), 0L,
@@ -286,25 +286,25 @@ double deviation_over(const ChannelSignature& channel, std::size_t phase_bins, d
 
 }  // namespace
 
-double deviation_at(const std::vector<SegmentSignature>& segments, const SignatureOptions& options,
-                    std::size_t segment, std::size_t channel, double phase, double value) {
+double deviationAt(const std::vector<SegmentSignature>& segments, const SignatureOptions& options,
+                   std::size_t segment, std::size_t channel, double phase, double value) {
   const SegmentSignature& here = segments[segment];
-  const double slack = segment_slack(options, here);
+  const double slack = segmentSlack(options, here);
   const double p = std::clamp(phase, 0.0, 1.0);
   double best =
-      deviation_over(here.channels[channel], options.phase_bins, p - slack, p + slack, value);
+      deviationOver(here.channels[channel], options.phase_bins, p - slack, p + slack, value);
   // The part of the slack beyond this segment's edge, in seconds, then in the neighbour's phase.
   const double before = (slack - p) * here.duration_mean;
   if (before > 0 && segment > 0 && segments[segment - 1].duration_mean > 0) {
     const SegmentSignature& previous = segments[segment - 1];
-    best = std::min(best, deviation_over(previous.channels[channel], options.phase_bins,
-                                         1.0 - before / previous.duration_mean, 1.0, value));
+    best = std::min(best, deviationOver(previous.channels[channel], options.phase_bins,
+                                        1.0 - before / previous.duration_mean, 1.0, value));
   }
   const double after = (p + slack - 1.0) * here.duration_mean;
   if (after > 0 && segment + 1 < segments.size() && segments[segment + 1].duration_mean > 0) {
     const SegmentSignature& next = segments[segment + 1];
-    best = std::min(best, deviation_over(next.channels[channel], options.phase_bins, 0.0,
-                                         after / next.duration_mean, value));
+    best = std::min(best, deviationOver(next.channels[channel], options.phase_bins, 0.0,
+                                        after / next.duration_mean, value));
   }
   return best;
 }
@@ -345,7 +345,7 @@ Deviation SignatureMonitor::observe(std::size_t segment, double phase, double ti
   Deviation worst;
   for (std::size_t c = 0; c < recent_.size(); ++c) {
     const ChannelSignature& sig = signature_.segments[segment].channels[c];
-    const double d = deviation_at(signature_.segments, o, segment, c, phase, values[c]);
+    const double d = deviationAt(signature_.segments, o, segment, c, phase, values[c]);
     const double score = recent_[c].push(time, d) / sig.threshold;
     if (c > 0 && score <= worst.score) continue;
     const auto bin = std::min<Eigen::Index>(
@@ -355,11 +355,11 @@ Deviation SignatureMonitor::observe(std::size_t segment, double phase, double ti
   return worst;
 }
 
-std::vector<std::vector<double>> score_recording(const SensorySignature& signature,
-                                                 const SegmentedRecording& run,
-                                                 std::vector<Deviation>* worst) {
-  check_recording(run, signature.segments.size() - 1, signature.channels, "the run");
-  const RawScores raw = raw_scores(signature.segments, signature.channels, signature.options, run);
+std::vector<std::vector<double>> scoreRecording(const SensorySignature& signature,
+                                                const SegmentedRecording& run,
+                                                std::vector<Deviation>* worst) {
+  checkRecording(run, signature.segments.size() - 1, signature.channels, "the run");
+  const RawScores raw = rawScores(signature.segments, signature.channels, signature.options, run);
   std::vector<std::vector<double>> scores = raw.scores;
   if (worst) worst->clear();
   for (std::size_t s = 0; s < scores.size(); ++s) {

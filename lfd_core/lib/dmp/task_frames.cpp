@@ -14,11 +14,11 @@ namespace {
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
 const std::map<SceneFrame::Kind, std::string>& kindNames() {
-  static const std::map<SceneFrame::Kind, std::string> names = {
+  static const std::map<SceneFrame::Kind, std::string> kNames = {
       {SceneFrame::Kind::kBase, "base"},       {SceneFrame::Kind::kStart, "start"},
       {SceneFrame::Kind::kObject, "object"},   {SceneFrame::Kind::kGoal, "goal"},
       {SceneFrame::Kind::kHeading, "heading"}, {SceneFrame::Kind::kGoalHeading, "goal_heading"}};
-  return names;
+  return kNames;
 }
 
 bool namesObject(SceneFrame::Kind k) {

@@ -38,7 +38,7 @@ void checkRequestString(const std::string& field, std::string_view value,
 
 void checkMessageStrings(const rosmsg::MessageSchema& schema, const std::uint8_t* data,
                          std::size_t size, const StringBudget& budget) {
-  rosmsg::for_each_string(schema, data, size, [&](const std::string& path, std::string_view value) {
+  rosmsg::forEachString(schema, data, size, [&](const std::string& path, std::string_view value) {
     checkRequestString(path, value, budget);
   });
 }

@@ -30,14 +30,14 @@ std::string head(const InputFile& file, std::size_t n) {
 // (returning false ends the parse), so a large file is never held in memory.
 class TopLevelMembers : public nlohmann::json::json_sax_t {
  public:
-  using json = nlohmann::json;
+  using Json = nlohmann::json;
   bool null() override { return value(); }
   bool boolean(bool) override { return value(); }
-  bool number_integer(json::number_integer_t) override { return value(); }
-  bool number_unsigned(json::number_unsigned_t) override { return value(); }
-  bool number_float(json::number_float_t, const json::string_t&) override { return value(); }
-  bool binary(json::binary_t&) override { return value(); }
-  bool string(json::string_t& s) override {
+  bool number_integer(Json::number_integer_t) override { return value(); }
+  bool number_unsigned(Json::number_unsigned_t) override { return value(); }
+  bool number_float(Json::number_float_t, const Json::string_t&) override { return value(); }
+  bool binary(Json::binary_t&) override { return value(); }
+  bool string(Json::string_t& s) override {
     if (depth_ == 1 && key_ == "format") {
       format_ = s;
       found_format_ = true;
@@ -49,7 +49,7 @@ class TopLevelMembers : public nlohmann::json::json_sax_t {
   bool end_object() override { return close(); }
   bool start_array(std::size_t) override { return open(false); }
   bool end_array() override { return close(); }
-  bool key(json::string_t& k) override {
+  bool key(Json::string_t& k) override {
     if (depth_ == 1) {
       key_ = k;
       members_.insert(k);
@@ -61,10 +61,10 @@ class TopLevelMembers : public nlohmann::json::json_sax_t {
     return false;
   }
 
-  bool found_format() const { return found_format_; }
+  bool foundFormat() const { return found_format_; }
   const std::string& format() const { return format_; }
   // A whole, valid document whose root is an object.
-  bool complete_object() const { return valid_ && root_object_ && depth_ == 0; }
+  bool completeObject() const { return valid_ && root_object_ && depth_ == 0; }
   bool has(const std::string& member) const { return members_.count(member) > 0; }
 
  private:
@@ -111,9 +111,9 @@ OutputKind jsonOutput(const std::string& name, const std::string& format,
             if (!in) return false;
             TopLevelMembers members;
             nlohmann::json::sax_parse(in, &members);
-            if (members.found_format()) return members.format() == format;
+            if (members.foundFormat()) return members.format() == format;
             // No "format" at all: a file lfd wrote before it had one, by its structure.
-            if (legacy_members.empty() || !members.complete_object()) return false;
+            if (legacy_members.empty() || !members.completeObject()) return false;
             for (const std::string& m : legacy_members)
               if (!members.has(m)) return false;
             return true;

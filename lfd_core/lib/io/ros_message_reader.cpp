@@ -57,39 +57,39 @@ std::string join(const std::vector<std::string>& parts, std::size_t count, char 
   return out;
 }
 
-std::string field_names(const MessageType& type) {
+std::string fieldNames(const MessageType& type) {
   std::string out;
   for (const FieldDefinition& f : type.fields) out += (out.empty() ? "" : ", ") + f.name;
   return out.empty() ? "no fields" : out;
 }
 
-bool is_index(const std::string& s) {
+bool isIndex(const std::string& s) {
   return !s.empty() && s.size() <= 10 &&
          std::all_of(s.begin(), s.end(), [](char c) { return c >= '0' && c <= '9'; });
 }
 
-bool is_key_array(const FieldDefinition& f) {
-  if (f.kind != Kind::kString || !f.is_array()) return false;
+bool isKeyArray(const FieldDefinition& f) {
+  if (f.kind != Kind::kString || !f.isArray()) return false;
   const std::string& n = f.name;
   return n == "name" || n == "names" || (n.size() > 6 && n.compare(n.size() - 6, 6, "_names") == 0);
 }
 
 // Message type at each depth of a resolved path: depth 0 is the root, depth k + 1 the message
 // hop k leads into (only meaningful for hops into messages).
-std::vector<std::size_t> level_types(const MessageSchema& schema, const std::vector<Hop>& hops) {
+std::vector<std::size_t> levelTypes(const MessageSchema& schema, const std::vector<Hop>& hops) {
   std::vector<std::size_t> levels{0};
   for (const Hop& h : hops) levels.push_back(schema.type(h.type).fields[h.field].message);
   return levels;
 }
 
 // The nearest key array of the array field reached by `hops`: its depth and field, or false.
-bool find_key_array(const MessageSchema& schema, const std::vector<Hop>& hops, std::size_t* level,
-                    std::size_t* field) {
-  const std::vector<std::size_t> levels = level_types(schema, hops);
+bool findKeyArray(const MessageSchema& schema, const std::vector<Hop>& hops, std::size_t* level,
+                  std::size_t* field) {
+  const std::vector<std::size_t> levels = levelTypes(schema, hops);
   for (std::size_t l = hops.size(); l-- > 0;) {
     const MessageType& t = schema.type(levels[l]);
     for (std::size_t f = 0; f < t.fields.size(); ++f) {
-      if (is_key_array(t.fields[f])) {
+      if (isKeyArray(t.fields[f])) {
         *level = l;
         *field = f;
         return true;
@@ -99,11 +99,11 @@ bool find_key_array(const MessageSchema& schema, const std::vector<Hop>& hops, s
   return false;
 }
 
-bool find_xyz(const MessageType& t, std::array<std::size_t, 3>* fields) {
+bool findXyz(const MessageType& t, std::array<std::size_t, 3>* fields) {
   const char* names[3] = {"x", "y", "z"};
   for (int k = 0; k < 3; ++k) {
-    const int f = t.field_index(names[k]);
-    if (f < 0 || t.fields[f].is_array() || !is_numeric(t.fields[f].kind)) return false;
+    const int f = t.fieldIndex(names[k]);
+    if (f < 0 || t.fields[f].isArray() || !isNumeric(t.fields[f].kind)) return false;
     (*fields)[k] = static_cast<std::size_t>(f);
   }
   return true;
@@ -114,8 +114,8 @@ bool find_xyz(const MessageType& t, std::array<std::size_t, 3>* fields) {
 }
 
 // "field=value" after an array of messages: the first element whose scalar field equals value.
-void select_by_value(const MessageSchema& schema, const FieldDefinition& array,
-                     const std::vector<std::string>& path, std::size_t i, Hop& hop) {
+void selectByValue(const MessageSchema& schema, const FieldDefinition& array,
+                   const std::vector<std::string>& path, std::size_t i, Hop& hop) {
   const std::string& selector = path[i];
   const MessageType& element = schema.type(array.message);
   const auto equals = selector.find('=');
@@ -124,10 +124,10 @@ void select_by_value(const MessageSchema& schema, const FieldDefinition& array,
     unknown(path, name + " is an array of " + array.type_name +
                       ": index it with a number, *, or <field>=<value> (e.g. id=3)");
   }
-  const int f = element.field_index(selector.substr(0, equals));
-  if (f < 0 || element.fields[f].is_array() || element.fields[f].kind == Kind::kMessage) {
+  const int f = element.fieldIndex(selector.substr(0, equals));
+  if (f < 0 || element.fields[f].isArray() || element.fields[f].kind == Kind::kMessage) {
     unknown(path, "'" + selector.substr(0, equals) + "' is no number or string field of " +
-                      element.name + " (it has " + field_names(element) + ")");
+                      element.name + " (it has " + fieldNames(element) + ")");
   }
   const std::string value = selector.substr(equals + 1);
   if (element.fields[f].kind != Kind::kString) {
@@ -150,21 +150,21 @@ Resolved resolve(const MessageSchema& schema, const std::vector<std::string>& pa
   for (std::size_t i = 0; i < path.size(); ++i) {
     const MessageType& t = schema.type(type);
     const std::string here = i == 0 ? t.name : "'" + join(path, i) + "' (" + t.name + ")";
-    const int f = t.field_index(path[i]);
+    const int f = t.fieldIndex(path[i]);
     if (f < 0) {
-      if (path[i] == "norm" && i + 1 == path.size() && find_xyz(t, &r.norm)) {
+      if (path[i] == "norm" && i + 1 == path.size() && findXyz(t, &r.norm)) {
         r.end = End::kNorm;
         r.message_type = type;
         return r;
       }
       std::array<std::size_t, 3> xyz;
-      unknown(path, here + " has no field '" + path[i] + "' (it has " + field_names(t) +
-                        (find_xyz(t, &xyz) ? ", norm" : "") + ")");
+      unknown(path, here + " has no field '" + path[i] + "' (it has " + fieldNames(t) +
+                        (findXyz(t, &xyz) ? ", norm" : "") + ")");
     }
     const FieldDefinition& fd = t.fields[f];
     r.hops.push_back({type, static_cast<std::size_t>(f), -1});
     const std::string name = "'" + join(path, i + 1) + "'";
-    if (!fd.is_array()) {
+    if (!fd.isArray()) {
       if (fd.kind == Kind::kMessage) {
         type = fd.message;
         continue;
@@ -180,7 +180,7 @@ Resolved resolve(const MessageSchema& schema, const std::vector<std::string>& pa
     }
     const std::string& index = path[++i];
     if (index == "*") unknown(path, "'*' is only expanded in the fields of a configuration");
-    if (is_index(index)) {
+    if (isIndex(index)) {
       const unsigned long long value = std::stoull(index);
       if (value > std::numeric_limits<std::uint32_t>::max() ||
           (fd.array_length >= 0 && value >= static_cast<unsigned long long>(fd.array_length))) {
@@ -200,7 +200,7 @@ Resolved resolve(const MessageSchema& schema, const std::vector<std::string>& pa
       return r;
     }
     if (fd.kind == Kind::kMessage) {
-      select_by_value(schema, fd, path, i, r.hops.back());
+      selectByValue(schema, fd, path, i, r.hops.back());
       type = fd.message;
       continue;
     }
@@ -208,7 +208,7 @@ Resolved resolve(const MessageSchema& schema, const std::vector<std::string>& pa
       unknown(path, name + " is an array of " + fd.type_name + "[" +
                         std::to_string(fd.array_length) + "]: index it with a number or *");
     }
-    if (!find_key_array(schema, r.hops, &r.key_level, &r.key_field)) {
+    if (!findKeyArray(schema, r.hops, &r.key_level, &r.key_field)) {
       unknown(path, name + " is an array of " + fd.type_name +
                         " without a string[] name/names/*_names to look '" + index +
                         "' up in: index it with a number or *");
@@ -223,13 +223,13 @@ Resolved resolve(const MessageSchema& schema, const std::vector<std::string>& pa
   return r;
 }
 
-const FieldDefinition& last_field(const MessageSchema& schema, const Resolved& r) {
+const FieldDefinition& lastField(const MessageSchema& schema, const Resolved& r) {
   return schema.type(r.hops.back().type).fields[r.hops.back().field];
 }
 
 // Numbers only: the ends a FieldReader output may have.
-void require_numeric(const MessageSchema& schema, const Resolved& r,
-                     const std::vector<std::string>& path) {
+void requireNumeric(const MessageSchema& schema, const Resolved& r,
+                    const std::vector<std::string>& path) {
   const std::string name = "'" + join(path, path.size()) + "'";
   switch (r.end) {
     case End::kNumber:
@@ -237,24 +237,24 @@ void require_numeric(const MessageSchema& schema, const Resolved& r,
     case End::kNorm:
       return;
     case End::kElement:
-      if (last_field(schema, r).kind != Kind::kString) return;
+      if (lastField(schema, r).kind != Kind::kString) return;
       unknown(path, name + " is a string, not a number");
     case End::kString:
       unknown(path, name + " is a string, not a number");
     case End::kArray:
-      unknown(path, name + " is an array of " + last_field(schema, r).type_name +
+      unknown(path, name + " is an array of " + lastField(schema, r).type_name +
                         ": add an index, a name or *");
     case End::kMessage: {
       const MessageType& t = schema.type(r.message_type);
-      unknown(path, (path.empty() ? t.name : name + " is a " + t.name) + " with fields " +
-                        field_names(t));
+      unknown(path,
+              (path.empty() ? t.name : name + " is a " + t.name) + " with fields " + fieldNames(t));
     }
   }
 }
 
 // The path (as components) of the message at depth `level` of r, e.g. {"objects", "0"}.
-std::vector<std::string> path_to_level(const MessageSchema& schema, const Resolved& r,
-                                       std::size_t level) {
+std::vector<std::string> pathToLevel(const MessageSchema& schema, const Resolved& r,
+                                     std::size_t level) {
   std::vector<std::string> out;
   for (std::size_t k = 0; k < level; ++k) {
     const Hop& h = r.hops[k];
@@ -315,14 +315,14 @@ double load(const std::uint8_t* p) {
 
 // Same arithmetic as ros::Time::toSec(), so stamps match the typed reader's bit for bit.
 template <typename T>
-double load_time(const std::uint8_t* p) {
+double loadTime(const std::uint8_t* p) {
   T sec, nsec;
   std::memcpy(&sec, p, 4);
   std::memcpy(&nsec, p + 4, 4);
   return static_cast<double>(sec) + 1e-9 * static_cast<double>(nsec);
 }
 
-double to_double(Kind kind, const std::uint8_t* p) {
+double toDouble(Kind kind, const std::uint8_t* p) {
   switch (kind) {
     case Kind::kBool:
       return p[0] != 0 ? 1.0 : 0.0;
@@ -347,9 +347,9 @@ double to_double(Kind kind, const std::uint8_t* p) {
     case Kind::kFloat64:
       return load<double>(p);
     case Kind::kTime:
-      return load_time<std::uint32_t>(p);
+      return loadTime<std::uint32_t>(p);
     case Kind::kDuration:
-      return load_time<std::int32_t>(p);
+      return loadTime<std::int32_t>(p);
     case Kind::kString:
     case Kind::kMessage:
       break;
@@ -413,21 +413,21 @@ class Plan {
       case End::kElement:
       case End::kKey:
       case End::kArray:
-        out.kind = last_field(schema_, r).kind;
+        out.kind = lastField(schema_, r).kind;
         out.slot = slot(action(r)->array_slot, arrays_);
         out.index = r.index;
         out.key = r.key;
         if (r.end == End::kKey) {
-          const std::size_t type = level_types(schema_, r.hops)[r.key_level];
+          const std::size_t type = levelTypes(schema_, r.hops)[r.key_level];
           out.key_slot =
-              slot(ensure(node_at(r, r.key_level), type, r.key_field)->strings_slot, strings_);
+              slot(ensure(nodeAt(r, r.key_level), type, r.key_field)->strings_slot, strings_);
         }
         break;
       case End::kString:
         out.slot = slot(action(r)->strings_slot, strings_);
         break;
       case End::kNorm: {
-        PlanNode* n = node_at(r, r.hops.size());
+        PlanNode* n = nodeAt(r, r.hops.size());
         for (int k = 0; k < 3; ++k)
           out.norm[k] = slot(ensure(n, r.message_type, r.norm[k])->scalar_slot, scalars_);
         break;
@@ -505,7 +505,7 @@ class Plan {
     return n->actions[field].get();
   }
   // The node of the message at depth `level` (creating the way there).
-  PlanNode* node_at(const Resolved& r, std::size_t level) {
+  PlanNode* nodeAt(const Resolved& r, std::size_t level) {
     PlanNode* n = root_.get();
     for (std::size_t k = 0; k < level; ++k) {
       const Hop& h = r.hops[k];
@@ -548,7 +548,7 @@ class Plan {
     return a->selectors.back().plan.get();
   }
   FieldAction* action(const Resolved& r) {
-    return ensure(node_at(r, r.hops.size() - 1), r.hops.back().type, r.hops.back().field);
+    return ensure(nodeAt(r, r.hops.size() - 1), r.hops.back().type, r.hops.back().field);
   }
   template <typename Slots>
   static int slot(int& existing, Slots& slots) {
@@ -560,13 +560,13 @@ class Plan {
   }
   static bool element(const ArrayCapture& a, Kind kind, std::uint32_t index, double* v) {
     if (!a.set || index >= a.count) return false;
-    *v = to_double(kind, a.data + static_cast<std::size_t>(index) * builtin_size(kind));
+    *v = toDouble(kind, a.data + static_cast<std::size_t>(index) * builtinSize(kind));
     return true;
   }
 
-  std::size_t element_min(const FieldDefinition& f) const {
+  std::size_t elementMin(const FieldDefinition& f) const {
     if (f.kind == Kind::kMessage) return schema_.type(f.message).min_size;
-    return f.kind == Kind::kString ? 4 : builtin_size(f.kind);
+    return f.kind == Kind::kString ? 4 : builtinSize(f.kind);
   }
 
   void walk(const PlanNode* n, const MessageType& type, Cursor& c) {
@@ -584,7 +584,7 @@ class Plan {
     }
   }
 
-  void read_string(const FieldDefinition& f, const MessageType& owner, Cursor& c, int slot) {
+  void readString(const FieldDefinition& f, const MessageType& owner, Cursor& c, int slot) {
     const std::uint32_t n = c.length(f, owner);
     const std::uint8_t* p = c.take(n, 1, f, owner);
     if (slot >= 0) {
@@ -594,51 +594,51 @@ class Plan {
   }
 
   void visit(const FieldDefinition& f, const FieldAction& a, const MessageType& owner, Cursor& c) {
-    if (!f.is_array()) {
+    if (!f.isArray()) {
       if (f.kind == Kind::kMessage) {
         walk(a.child.get(), schema_.type(f.message), c);
       } else if (f.kind == Kind::kString) {
-        read_string(f, owner, c, a.strings_slot);
+        readString(f, owner, c, a.strings_slot);
       } else {
-        const std::uint8_t* p = c.take(1, builtin_size(f.kind), f, owner);
+        const std::uint8_t* p = c.take(1, builtinSize(f.kind), f, owner);
         if (a.scalar_slot >= 0) {
-          scalars_[a.scalar_slot] = to_double(f.kind, p);
+          scalars_[a.scalar_slot] = toDouble(f.kind, p);
           scalar_set_[a.scalar_slot] = 1;
         }
       }
       return;
     }
-    const std::uint32_t count = array_count(f, owner, c);
+    const std::uint32_t count = arrayCount(f, owner, c);
     if (a.array_slot >= 0) arrays_[a.array_slot] = {nullptr, count, true};
     if (f.kind == Kind::kString) {
       if (a.strings_slot >= 0) strings_set_[a.strings_slot] = 1;
-      for (std::uint32_t k = 0; k < count; ++k) read_string(f, owner, c, a.strings_slot);
+      for (std::uint32_t k = 0; k < count; ++k) readString(f, owner, c, a.strings_slot);
     } else if (f.kind != Kind::kMessage) {
-      const std::uint8_t* p = c.take(count, builtin_size(f.kind), f, owner);
+      const std::uint8_t* p = c.take(count, builtinSize(f.kind), f, owner);
       if (a.array_slot >= 0) arrays_[a.array_slot].data = p;
     } else {
-      visit_elements(f, a, owner, count, c);
+      visitElements(f, a, owner, count, c);
     }
   }
 
-  void visit_elements(const FieldDefinition& f, const FieldAction& a, const MessageType& owner,
-                      std::uint32_t count, Cursor& c) {
+  void visitElements(const FieldDefinition& f, const FieldAction& a, const MessageType& owner,
+                     std::uint32_t count, Cursor& c) {
     const MessageType& type = schema_.type(f.message);
-    if (!a.selectors.empty()) return visit_selected(type, a, count, c);
+    if (!a.selectors.empty()) return visitSelected(type, a, count, c);
     std::uint32_t next = 0;  // first element not yet consumed
     for (const auto& [index, plan] : a.elements) {
       if (index >= count) break;
-      skip_elements(f, type, owner, index - next, c);
+      skipElements(f, type, owner, index - next, c);
       walk(plan.get(), type, c);
       next = index + 1;
     }
-    skip_elements(f, type, owner, count - std::min(next, count), c);
+    skipElements(f, type, owner, count - std::min(next, count), c);
   }
 
   // Every element is probed for the selectors' fields, then walked again by the plan of its
   // index and of each selector it is the first match of.
-  void visit_selected(const MessageType& type, const FieldAction& a, std::uint32_t count,
-                      Cursor& c) {
+  void visitSelected(const MessageType& type, const FieldAction& a, std::uint32_t count,
+                     Cursor& c) {
     std::vector<char> matched(a.selectors.size(), 0);
     auto element_plan = a.elements.begin();
     for (std::uint32_t k = 0; k < count; ++k) {
@@ -674,8 +674,8 @@ class Plan {
     return scalar_set_[s.key_slot] && scalars_[s.key_slot] == s.number;
   }
 
-  void skip_elements(const FieldDefinition& f, const MessageType& type, const MessageType& owner,
-                     std::uint32_t count, Cursor& c) {
+  void skipElements(const FieldDefinition& f, const MessageType& type, const MessageType& owner,
+                    std::uint32_t count, Cursor& c) {
     if (type.fixed_size) {
       c.take(count, *type.fixed_size, f, owner);
       return;
@@ -683,12 +683,12 @@ class Plan {
     for (std::uint32_t k = 0; k < count; ++k) walk(nullptr, type, c);
   }
 
-  std::uint32_t array_count(const FieldDefinition& f, const MessageType& owner, Cursor& c) {
+  std::uint32_t arrayCount(const FieldDefinition& f, const MessageType& owner, Cursor& c) {
     if (f.array_length >= 0) return static_cast<std::uint32_t>(f.array_length);
     const std::uint32_t count = c.length(f, owner);
     // Every element takes at least element_min bytes: a corrupt count fails here, before any
     // loop trusts it.
-    const std::size_t min = element_min(f);
+    const std::size_t min = elementMin(f);
     if (min != 0 && count > c.remaining() / min) {
       throw MessageError("message truncated or corrupt: array '" + f.name + "' of " + owner.name +
                          " claims " + std::to_string(count) + " elements, only " +
@@ -698,23 +698,23 @@ class Plan {
   }
 
   void skip(const FieldDefinition& f, const MessageType& owner, Cursor& c) {
-    if (!f.is_array()) {
+    if (!f.isArray()) {
       if (f.kind == Kind::kMessage) {
         walk(nullptr, schema_.type(f.message), c);
       } else if (f.kind == Kind::kString) {
         c.take(c.length(f, owner), 1, f, owner);
       } else {
-        c.take(1, builtin_size(f.kind), f, owner);
+        c.take(1, builtinSize(f.kind), f, owner);
       }
       return;
     }
-    const std::uint32_t count = array_count(f, owner, c);
+    const std::uint32_t count = arrayCount(f, owner, c);
     if (f.kind == Kind::kMessage) {
-      skip_elements(f, schema_.type(f.message), owner, count, c);
+      skipElements(f, schema_.type(f.message), owner, count, c);
     } else if (f.kind == Kind::kString) {
       for (std::uint32_t k = 0; k < count; ++k) c.take(c.length(f, owner), 1, f, owner);
     } else {
-      c.take(count, builtin_size(f.kind), f, owner);
+      c.take(count, builtinSize(f.kind), f, owner);
     }
   }
 
@@ -730,7 +730,7 @@ class Plan {
 
 }  // namespace
 
-std::vector<std::string> split_path(const std::string& path) {
+std::vector<std::string> splitPath(const std::string& path) {
   std::vector<std::string> parts;
   std::size_t begin = path.rfind('/', 0) == 0 ? 1 : 0;
   if (begin >= path.size()) throw UnknownField("empty field path '" + path + "'");
@@ -760,17 +760,17 @@ struct FieldReader::Impl {
 FieldReader::FieldReader(const MessageSchema& schema, const std::vector<std::string>& paths)
     : impl_(std::make_unique<Impl>(schema)) {
   for (const std::string& path : paths) {
-    const std::vector<std::string> parts = split_path(path);
+    const std::vector<std::string> parts = splitPath(path);
     const Resolved r = resolve(schema, parts);
-    require_numeric(schema, r, parts);
+    requireNumeric(schema, r, parts);
     impl_->outputs.push_back(impl_->plan.add(r));
   }
-  const int header = schema.root().field_index("header");
+  const int header = schema.root().fieldIndex("header");
   if (header >= 0 && schema.root().fields[header].type_name == "std_msgs/Header" &&
-      !schema.root().fields[header].is_array()) {
+      !schema.root().fields[header].isArray()) {
     const MessageType& h = schema.type(schema.root().fields[header].message);
-    const int stamp = h.field_index("stamp");
-    if (stamp >= 0 && h.fields[stamp].kind == Kind::kTime && !h.fields[stamp].is_array())
+    const int stamp = h.fieldIndex("stamp");
+    if (stamp >= 0 && h.fields[stamp].kind == Kind::kTime && !h.fields[stamp].isArray())
       impl_->stamp_output =
           static_cast<long>(impl_->plan.add(resolve(schema, {"header", "stamp"})));
   }
@@ -801,7 +801,7 @@ bool FieldReader::present(std::size_t k) const {
 double FieldReader::value(std::size_t k) const {
   return impl_->values.at(k);
 }
-double FieldReader::header_stamp() const {
+double FieldReader::headerStamp() const {
   return impl_->stamp;
 }
 
@@ -811,8 +811,8 @@ double FieldReader::header_stamp() const {
 namespace {
 
 // Runs one query on a sample message; the output of `r` after the walk.
-std::size_t length_of(const MessageSchema& schema, const std::uint8_t* sample, std::size_t size,
-                      const Resolved& r) {
+std::size_t lengthOf(const MessageSchema& schema, const std::uint8_t* sample, std::size_t size,
+                     const Resolved& r) {
   Plan plan(schema);
   const std::size_t k = plan.add(r);
   plan.run(sample, size);
@@ -820,8 +820,8 @@ std::size_t length_of(const MessageSchema& schema, const std::uint8_t* sample, s
   return plan.value(k, &v) ? static_cast<std::size_t>(v) : 0;
 }
 
-std::vector<std::string> strings_of(const MessageSchema& schema, const std::uint8_t* sample,
-                                    std::size_t size, const Resolved& r) {
+std::vector<std::string> stringsOf(const MessageSchema& schema, const std::uint8_t* sample,
+                                   std::size_t size, const Resolved& r) {
   Plan plan(schema);
   Resolved q = r;
   q.end = End::kString;
@@ -833,25 +833,25 @@ std::vector<std::string> strings_of(const MessageSchema& schema, const std::uint
 }
 
 // The key array of the array reached by r (resolved as a whole array), as a path.
-bool key_path(const MessageSchema& schema, const Resolved& r, std::vector<std::string>* path) {
+bool keyPath(const MessageSchema& schema, const Resolved& r, std::vector<std::string>* path) {
   std::size_t level = 0, field = 0;
-  const FieldDefinition& array = last_field(schema, r);
+  const FieldDefinition& array = lastField(schema, r);
   if (array.kind == Kind::kMessage || array.kind == Kind::kString ||
-      array.array_length != kVariableLength || !find_key_array(schema, r.hops, &level, &field))
+      array.array_length != kVariableLength || !findKeyArray(schema, r.hops, &level, &field))
     return false;
-  *path = path_to_level(schema, r, level);
-  path->push_back(schema.type(level_types(schema, r.hops)[level]).fields[field].name);
+  *path = pathToLevel(schema, r, level);
+  path->push_back(schema.type(levelTypes(schema, r.hops)[level]).fields[field].name);
   return true;
 }
 
 // The names that index the array reached by r in the sample: its key array's strings when they
 // are as many as the array's elements (a key array of another length describes something else).
-std::vector<std::string> key_names(const MessageSchema& schema, const std::uint8_t* sample,
-                                   std::size_t size, const Resolved& r) {
+std::vector<std::string> keyNames(const MessageSchema& schema, const std::uint8_t* sample,
+                                  std::size_t size, const Resolved& r) {
   std::vector<std::string> keys;
-  if (!key_path(schema, r, &keys)) return {};
-  std::vector<std::string> names = strings_of(schema, sample, size, resolve(schema, keys));
-  if (names.size() != length_of(schema, sample, size, r)) return {};
+  if (!keyPath(schema, r, &keys)) return {};
+  std::vector<std::string> names = stringsOf(schema, sample, size, resolve(schema, keys));
+  if (names.size() != lengthOf(schema, sample, size, r)) return {};
   return names;
 }
 
@@ -859,16 +859,16 @@ void expand(const MessageSchema& schema, const std::uint8_t* sample, std::size_t
             const std::vector<std::string>& parts, std::vector<std::string>& out) {
   const auto star = std::find(parts.begin(), parts.end(), "*");
   if (star == parts.end()) {
-    require_numeric(schema, resolve(schema, parts), parts);
+    requireNumeric(schema, resolve(schema, parts), parts);
     out.push_back(join(parts, parts.size()));
     return;
   }
   const std::vector<std::string> prefix(parts.begin(), star);
   const Resolved r = resolve(schema, prefix);
   if (r.end != End::kArray) unknown(parts, "'*' must follow an array");
-  std::vector<std::string> names = key_names(schema, sample, size, r);
+  std::vector<std::string> names = keyNames(schema, sample, size, r);
   if (names.empty()) {
-    const std::size_t n = length_of(schema, sample, size, r);
+    const std::size_t n = lengthOf(schema, sample, size, r);
     for (std::size_t k = 0; k < n; ++k) names.push_back(std::to_string(k));
   }
   for (const std::string& name : names) {
@@ -883,17 +883,17 @@ std::string range(std::size_t n) {
   return n == 0 ? "<empty>" : "<0.." + std::to_string(n - 1) + ">";
 }
 
-void list_fields(const MessageSchema& schema, const std::uint8_t* sample, std::size_t size,
-                 std::size_t type, const std::vector<std::string>& path, const std::string& shown,
-                 std::size_t max_names, std::vector<std::string>& out) {
+void listFields(const MessageSchema& schema, const std::uint8_t* sample, std::size_t size,
+                std::size_t type, const std::vector<std::string>& path, const std::string& shown,
+                std::size_t max_names, std::vector<std::string>& out) {
   const MessageType& t = schema.type(type);
   for (const FieldDefinition& f : t.fields) {
     std::vector<std::string> p = path;
     p.push_back(f.name);
     const std::string name = shown + f.name;
-    if (!f.is_array()) {
+    if (!f.isArray()) {
       if (f.kind == Kind::kMessage) {
-        list_fields(schema, sample, size, f.message, p, name + "/", max_names, out);
+        listFields(schema, sample, size, f.message, p, name + "/", max_names, out);
       } else if (f.kind != Kind::kString) {
         out.push_back(name);
       }
@@ -901,19 +901,18 @@ void list_fields(const MessageSchema& schema, const std::uint8_t* sample, std::s
     }
     if (f.kind == Kind::kString) continue;
     const Resolved r = resolve(schema, p);
-    const std::size_t n = length_of(schema, sample, size, r);
+    const std::size_t n = lengthOf(schema, sample, size, r);
     if (f.kind == Kind::kMessage) {
       if (n == 0) {
         out.push_back(name + "/<empty> (array of " + f.type_name + ")");
       } else {
         p.push_back("0");
-        list_fields(schema, sample, size, f.message, p, name + "/" + range(n) + "/", max_names,
-                    out);
+        listFields(schema, sample, size, f.message, p, name + "/" + range(n) + "/", max_names, out);
       }
       continue;
     }
     std::string entry = name + "/" + range(n);
-    const std::vector<std::string> names = key_names(schema, sample, size, r);
+    const std::vector<std::string> names = keyNames(schema, sample, size, r);
     if (!names.empty()) {
       entry += " or <name: ";
       for (std::size_t k = 0; k < names.size() && k < max_names; ++k)
@@ -924,20 +923,20 @@ void list_fields(const MessageSchema& schema, const std::uint8_t* sample, std::s
     out.push_back(entry);
   }
   std::array<std::size_t, 3> xyz;
-  if (find_xyz(t, &xyz) && t.field_index("norm") < 0) out.push_back(shown + "norm");
+  if (findXyz(t, &xyz) && t.fieldIndex("norm") < 0) out.push_back(shown + "norm");
 }
 
 }  // namespace
 
-std::vector<std::string> expand_fields(const MessageSchema& schema, const std::uint8_t* sample,
-                                       std::size_t size, const std::vector<std::string>& patterns) {
+std::vector<std::string> expandFields(const MessageSchema& schema, const std::uint8_t* sample,
+                                      std::size_t size, const std::vector<std::string>& patterns) {
   std::vector<std::string> out;
   for (const std::string& pattern : patterns) {
     try {
-      expand(schema, sample, size, split_path(pattern), out);
+      expand(schema, sample, size, splitPath(pattern), out);
     } catch (const UnknownField& e) {
       std::string fields;
-      for (const std::string& f : list_numeric_fields(schema, sample, size)) fields += "\n  " + f;
+      for (const std::string& f : listNumericFields(schema, sample, size)) fields += "\n  " + f;
       throw UnknownField(std::string(e.what()) + "\nnumeric fields of " + schema.root().name +
                          " (first message):" + fields);
     }
@@ -945,30 +944,29 @@ std::vector<std::string> expand_fields(const MessageSchema& schema, const std::u
   return out;
 }
 
-std::vector<std::string> list_numeric_fields(const MessageSchema& schema,
-                                             const std::uint8_t* sample, std::size_t size,
-                                             std::size_t max_names) {
+std::vector<std::string> listNumericFields(const MessageSchema& schema, const std::uint8_t* sample,
+                                           std::size_t size, std::size_t max_names) {
   std::vector<std::string> out;
-  list_fields(schema, sample, size, 0, {}, "", max_names, out);
+  listFields(schema, sample, size, 0, {}, "", max_names, out);
   return out;
 }
 
-std::size_t array_length(const MessageSchema& schema, const std::uint8_t* sample, std::size_t size,
-                         const std::string& path) {
-  const std::vector<std::string> parts = split_path(path);
+std::size_t arrayLength(const MessageSchema& schema, const std::uint8_t* sample, std::size_t size,
+                        const std::string& path) {
+  const std::vector<std::string> parts = splitPath(path);
   const Resolved r = resolve(schema, parts);
   if (r.end != End::kArray) unknown(parts, "'" + path + "' is not an array");
-  return length_of(schema, sample, size, r);
+  return lengthOf(schema, sample, size, r);
 }
 
-std::vector<std::string> string_values(const MessageSchema& schema, const std::uint8_t* sample,
-                                       std::size_t size, const std::string& path) {
-  const std::vector<std::string> parts = split_path(path);
+std::vector<std::string> stringValues(const MessageSchema& schema, const std::uint8_t* sample,
+                                      std::size_t size, const std::string& path) {
+  const std::vector<std::string> parts = splitPath(path);
   const Resolved r = resolve(schema, parts);
   if (r.end != End::kString &&
-      !(r.end == End::kArray && last_field(schema, r).kind == Kind::kString))
+      !(r.end == End::kArray && lastField(schema, r).kind == Kind::kString))
     unknown(parts, "'" + path + "' is not a string or string[]");
-  return strings_of(schema, sample, size, r);
+  return stringsOf(schema, sample, size, r);
 }
 
 }  // namespace lfd::rosmsg

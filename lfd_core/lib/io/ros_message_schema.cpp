@@ -8,7 +8,7 @@
 
 namespace lfd::rosmsg {
 
-std::size_t builtin_size(Kind kind) {
+std::size_t builtinSize(Kind kind) {
   switch (kind) {
     case Kind::kBool:
     case Kind::kInt8:
@@ -34,11 +34,11 @@ std::size_t builtin_size(Kind kind) {
   return 0;
 }
 
-bool is_numeric(Kind kind) {
+bool isNumeric(Kind kind) {
   return kind != Kind::kString && kind != Kind::kMessage;
 }
 
-int MessageType::field_index(const std::string& field) const {
+int MessageType::fieldIndex(const std::string& field) const {
   for (std::size_t k = 0; k < fields.size(); ++k) {
     if (fields[k].name == field) return static_cast<int>(k);
   }
@@ -47,16 +47,16 @@ int MessageType::field_index(const std::string& field) const {
 
 namespace {
 
-std::optional<Kind> builtin_kind(const std::string& name) {
-  static const std::map<std::string, Kind> kinds{
+std::optional<Kind> builtinKind(const std::string& name) {
+  static const std::map<std::string, Kind> kInds{
       {"bool", Kind::kBool},        {"int8", Kind::kInt8},     {"byte", Kind::kInt8},
       {"uint8", Kind::kUint8},      {"char", Kind::kUint8},    {"int16", Kind::kInt16},
       {"uint16", Kind::kUint16},    {"int32", Kind::kInt32},   {"uint32", Kind::kUint32},
       {"int64", Kind::kInt64},      {"uint64", Kind::kUint64}, {"float32", Kind::kFloat32},
       {"float64", Kind::kFloat64},  {"string", Kind::kString}, {"time", Kind::kTime},
       {"duration", Kind::kDuration}};
-  const auto it = kinds.find(name);
-  if (it == kinds.end()) return std::nullopt;
+  const auto it = kInds.find(name);
+  if (it == kInds.end()) return std::nullopt;
   return it->second;
 }
 
@@ -66,19 +66,19 @@ std::string trim(const std::string& s) {
   return s.substr(first, s.find_last_not_of(" \t\r") - first + 1);
 }
 
-bool is_identifier(const std::string& s) {
+bool isIdentifier(const std::string& s) {
   if (s.empty() || !std::isalpha(static_cast<unsigned char>(s[0]))) return false;
   return std::all_of(s.begin(), s.end(), [](char c) {
     return std::isalnum(static_cast<unsigned char>(c)) || c == '_';
   });
 }
 
-bool is_separator(const std::string& line) {
+bool isSeparator(const std::string& line) {
   const std::string t = trim(line);
   return t.size() >= 3 && t.find_first_not_of('=') == std::string::npos;
 }
 
-std::string package_of(const std::string& type) {
+std::string packageOf(const std::string& type) {
   const auto slash = type.find('/');
   return slash == std::string::npos ? "" : type.substr(0, slash);
 }
@@ -89,13 +89,13 @@ struct Block {
   std::vector<std::pair<std::size_t, std::string>> lines;
 };
 
-std::vector<Block> split_blocks(const std::string& datatype, const std::string& definition) {
+std::vector<Block> splitBlocks(const std::string& datatype, const std::string& definition) {
   std::vector<Block> blocks{{datatype, {}}};
   std::istringstream in(definition);
   std::string line;
   bool expect_name = false;
   for (std::size_t number = 1; std::getline(in, line); ++number) {
-    if (is_separator(line)) {
+    if (isSeparator(line)) {
       expect_name = true;
       continue;
     }
@@ -116,7 +116,7 @@ std::vector<Block> split_blocks(const std::string& datatype, const std::string& 
 }
 
 // "float64[7]" -> base "float64", length 7; "Point[]" -> kVariableLength.
-std::pair<std::string, int> split_array(const std::string& token, const std::string& where) {
+std::pair<std::string, int> splitArray(const std::string& token, const std::string& where) {
   const auto open = token.find('[');
   if (open == std::string::npos) return {token, kScalar};
   if (token.back() != ']') throw MessageError(where + ": bad type '" + token + "'");
@@ -131,8 +131,8 @@ std::pair<std::string, int> split_array(const std::string& token, const std::str
 }
 
 // Parses one line into a field (returns true) or a constant (appended to `type`).
-bool parse_line(const std::string& raw, const std::string& package, const std::string& where,
-                MessageType& type, FieldDefinition& field) {
+bool parseLine(const std::string& raw, const std::string& package, const std::string& where,
+               MessageType& type, FieldDefinition& field) {
   std::string line = trim(raw);
   if (line.empty() || line[0] == '#') return false;
   const auto space = line.find_first_of(" \t");
@@ -142,21 +142,21 @@ bool parse_line(const std::string& raw, const std::string& package, const std::s
   std::string rest = line.substr(space + 1);
   const auto equals = rest.find('=');
   const auto hash = rest.find('#');
-  const auto [base, length] = split_array(type_token, where);
-  const std::optional<Kind> builtin = builtin_kind(base);
+  const auto [base, length] = splitArray(type_token, where);
+  const std::optional<Kind> builtin = builtinKind(base);
   if (equals != std::string::npos && (hash == std::string::npos || equals < hash)) {
     // A constant: "int32 X=1", "string S=text # kept" (a string constant's value is the rest).
     const std::string name = trim(rest.substr(0, equals));
     std::string value = rest.substr(equals + 1);
     if (base != "string") value = value.substr(0, value.find('#'));
-    if (!builtin || length != kScalar || !is_identifier(name)) {
+    if (!builtin || length != kScalar || !isIdentifier(name)) {
       throw MessageError(where + ": bad constant '" + line + "'");
     }
     type.constants.push_back(name + "=" + trim(value));
     return false;
   }
   const std::string name = trim(rest.substr(0, hash));
-  if (!is_identifier(name)) throw MessageError(where + ": bad field name in '" + line + "'");
+  if (!isIdentifier(name)) throw MessageError(where + ": bad field name in '" + line + "'");
   field = FieldDefinition{};
   field.name = name;
   field.array_length = length;
@@ -176,8 +176,8 @@ bool parse_line(const std::string& raw, const std::string& package, const std::s
   return true;
 }
 
-std::size_t find_type(const std::vector<MessageType>& types, const FieldDefinition& field,
-                      const std::string& user) {
+std::size_t findType(const std::vector<MessageType>& types, const FieldDefinition& field,
+                     const std::string& user) {
   for (std::size_t k = 0; k < types.size(); ++k) {
     if (types[k].name == field.type_name) return k;
   }
@@ -197,7 +197,7 @@ std::size_t find_type(const std::vector<MessageType>& types, const FieldDefiniti
 // No real message is a terabyte; the cap keeps every size sum and product far from overflowing.
 constexpr std::size_t kMaxMessageBytes = std::size_t(1) << 40;
 
-std::size_t capped_product(std::size_t count, std::size_t item, const std::string& type) {
+std::size_t cappedProduct(std::size_t count, std::size_t item, const std::string& type) {
   if (item != 0 && count > kMaxMessageBytes / item)
     throw MessageError("message type " + type + " has fixed arrays larger than 1 TB");
   return count * item;
@@ -205,7 +205,7 @@ std::size_t capped_product(std::size_t count, std::size_t item, const std::strin
 
 // Fixed and minimal sizes, bottom-up; a type that contains itself (not valid ROS) is rejected so
 // that no walk can recurse forever.
-void compute_sizes(std::vector<MessageType>& types) {
+void computeSizes(std::vector<MessageType>& types) {
   enum class State { kTodo, kBusy, kDone };
   std::vector<State> state(types.size(), State::kTodo);
   std::function<void(std::size_t)> visit = [&](std::size_t k) {
@@ -223,7 +223,7 @@ void compute_sizes(std::vector<MessageType>& types) {
         element = types[f.message].fixed_size;
         element_min = types[f.message].min_size;
       } else if (f.kind != Kind::kString) {
-        element = builtin_size(f.kind);
+        element = builtinSize(f.kind);
         element_min = *element;
       }
       const std::size_t count = f.array_length >= 0 ? static_cast<std::size_t>(f.array_length) : 1;
@@ -231,9 +231,9 @@ void compute_sizes(std::vector<MessageType>& types) {
         size.reset();
         min_size += 4;
       } else {
-        min_size += capped_product(count, element_min, types[k].name);
+        min_size += cappedProduct(count, element_min, types[k].name);
         if (size && element) {
-          *size += capped_product(count, *element, types[k].name);
+          *size += cappedProduct(count, *element, types[k].name);
         } else {
           size.reset();
         }
@@ -253,15 +253,15 @@ void compute_sizes(std::vector<MessageType>& types) {
 MessageSchema MessageSchema::parse(const std::string& datatype, const std::string& definition) {
   if (datatype.empty()) throw MessageError("message definition without a type name");
   MessageSchema schema;
-  for (const Block& block : split_blocks(datatype, definition)) {
+  for (const Block& block : splitBlocks(datatype, definition)) {
     MessageType type;
     type.name = block.name == "Header" ? "std_msgs/Header" : block.name;
-    const std::string package = package_of(type.name);
+    const std::string package = packageOf(type.name);
     for (const auto& [number, line] : block.lines) {
       FieldDefinition field;
       const std::string where = type.name + " (definition line " + std::to_string(number) + ")";
-      if (parse_line(line, package, where, type, field)) {
-        if (type.field_index(field.name) >= 0)
+      if (parseLine(line, package, where, type, field)) {
+        if (type.fieldIndex(field.name) >= 0)
           throw MessageError(where + ": field '" + field.name + "' defined twice");
         type.fields.push_back(std::move(field));
       }
@@ -271,11 +271,11 @@ MessageSchema MessageSchema::parse(const std::string& datatype, const std::strin
   for (MessageType& type : schema.types_) {
     for (FieldDefinition& field : type.fields) {
       if (field.kind != Kind::kMessage) continue;
-      field.message = find_type(schema.types_, field, type.name);
+      field.message = findType(schema.types_, field, type.name);
       field.type_name = schema.types_[field.message].name;
     }
   }
-  compute_sizes(schema.types_);
+  computeSizes(schema.types_);
   return schema;
 }
 

@@ -25,7 +25,7 @@ class Walk {
     }
     for (const FieldDefinition& f : type.fields) {
       const std::string path = prefix.empty() ? f.name : prefix + "." + f.name;
-      if (!f.is_array()) {
+      if (!f.isArray()) {
         value(f, path);
         continue;
       }
@@ -48,7 +48,7 @@ class Walk {
   void elements(const FieldDefinition& f, std::uint32_t count, const std::string& path) {
     const std::size_t fixed = f.kind == Kind::kMessage
                                   ? schema_.type(f.message).fixed_size.value_or(0)
-                                  : builtin_size(f.kind);
+                                  : builtinSize(f.kind);
     if (fixed > 0) {  // numbers, or messages of fixed size: skipped at once
       take(count, fixed, path);
       return;
@@ -69,7 +69,7 @@ class Walk {
       const std::uint8_t* p = take(n, 1, path);
       visit_(path, std::string_view(reinterpret_cast<const char*>(p), n));
     } else {
-      take(1, builtin_size(f.kind), path);
+      take(1, builtinSize(f.kind), path);
     }
   }
 
@@ -101,15 +101,15 @@ class Walk {
 
 }  // namespace
 
-void for_each_string(const MessageSchema& schema, const std::uint8_t* data, std::size_t size,
-                     const StringVisitor& visit) {
+void forEachString(const MessageSchema& schema, const std::uint8_t* data, std::size_t size,
+                   const StringVisitor& visit) {
   Walk walk(schema, data, size, visit);
   walk.message(schema.root(), "");
   walk.finish(schema.root().name);
 }
 
-void check_message_bytes(const MessageSchema& schema, const std::uint8_t* data, std::size_t size) {
-  for_each_string(schema, data, size, [](const std::string&, std::string_view) {});
+void checkMessageBytes(const MessageSchema& schema, const std::uint8_t* data, std::size_t size) {
+  forEachString(schema, data, size, [](const std::string&, std::string_view) {});
 }
 
 }  // namespace lfd::rosmsg

@@ -96,13 +96,13 @@ KinematicChain KinematicChain::fromUrdfString(const std::string& urdf_xml,
     effort.push_back(has_effort ? joint->limits->effort : inf);
   }
   chain.tip_offset_ = pending;
-  const auto toVector = [](const std::vector<double>& v) {
+  const auto to_vector = [](const std::vector<double>& v) {
     return Eigen::VectorXd(Eigen::Map<const Eigen::VectorXd>(v.data(), v.size()));
   };
-  chain.lower_ = toVector(lower);
-  chain.upper_ = toVector(upper);
-  chain.velocity_ = toVector(velocity);
-  chain.effort_ = toVector(effort);
+  chain.lower_ = to_vector(lower);
+  chain.upper_ = to_vector(upper);
+  chain.velocity_ = to_vector(velocity);
+  chain.effort_ = to_vector(effort);
   return chain;
 }
 

@@ -20,7 +20,7 @@ double percentile(Eigen::VectorXd values, double fraction) {
 
 // Samples in motion: above the rest threshold, in a bout whose peak reaches the small-motion
 // level.
-std::vector<bool> moving_samples(const Eigen::VectorXd& speed, double rest, double small) {
+std::vector<bool> movingSamples(const Eigen::VectorXd& speed, double rest, double small) {
   const std::size_t n = static_cast<std::size_t>(speed.size());
   std::vector<bool> moving(n, false);
   for (std::size_t i = 0; i < n;) {
@@ -40,8 +40,8 @@ std::vector<bool> moving_samples(const Eigen::VectorXd& speed, double rest, doub
 }
 
 // Peak speed in [from, time[from] + window).
-double peak_speed_after(const Eigen::VectorXd& speed, const std::vector<double>& time,
-                        std::size_t from, double window) {
+double peakSpeedAfter(const Eigen::VectorXd& speed, const std::vector<double>& time,
+                      std::size_t from, double window) {
   double peak = 0.0;
   for (std::size_t i = from; i < time.size() && time[i] < time[from] + window; ++i)
     peak = std::max(peak, speed[static_cast<Eigen::Index>(i)]);
@@ -49,13 +49,13 @@ double peak_speed_after(const Eigen::VectorXd& speed, const std::vector<double>&
 }
 
 // Every rest run [begin, end) of the speed, the demo's first and last included.
-std::vector<Pause> rest_runs(const Eigen::VectorXd& speed, const std::vector<double>& time,
-                             const PauseConfig& config) {
+std::vector<Pause> restRuns(const Eigen::VectorXd& speed, const std::vector<double>& time,
+                            const PauseConfig& config) {
   std::vector<Pause> runs;
   const double typical = percentile(speed, 0.95);
   if (!(typical > 0) || time.size() != static_cast<std::size_t>(speed.size())) return runs;
   const std::vector<bool> moving =
-      moving_samples(speed, config.rest_fraction * typical, config.small_motion_fraction * typical);
+      movingSamples(speed, config.rest_fraction * typical, config.small_motion_fraction * typical);
   for (std::size_t i = 0; i < moving.size();) {
     std::size_t j = i;
     while (j < moving.size() && !moving[j]) ++j;
@@ -69,13 +69,13 @@ double duration(const Pause& run, const std::vector<double>& time) {
   return (run.end < time.size() ? time[run.end] : time.back()) - time[run.begin];
 }
 
-bool at_an_end(const Pause& run, std::size_t samples) {
+bool atAnEnd(const Pause& run, std::size_t samples) {
   return run.begin == 0 || run.end >= samples;
 }
 
 }  // namespace
 
-std::string to_string(EvidenceKind kind) {
+std::string toString(EvidenceKind kind) {
   switch (kind) {
     case EvidenceKind::kContact:
       return "contact";
@@ -91,8 +91,8 @@ std::string to_string(EvidenceKind kind) {
   return "clasp";
 }
 
-Eigen::VectorXd state_speed(const Eigen::MatrixXd& scaled_states, const std::vector<double>& time,
-                            double smoothing_seconds) {
+Eigen::VectorXd stateSpeed(const Eigen::MatrixXd& scaled_states, const std::vector<double>& time,
+                           double smoothing_seconds) {
   const Eigen::Index n = scaled_states.rows();
   if (static_cast<std::size_t>(n) != time.size())
     throw std::invalid_argument("state_speed: " + std::to_string(n) + " samples but " +
@@ -108,21 +108,20 @@ Eigen::VectorXd state_speed(const Eigen::MatrixXd& scaled_states, const std::vec
   return speed;
 }
 
-std::vector<Pause> find_pauses(const Eigen::VectorXd& speed, const std::vector<double>& time,
-                               const PauseConfig& config) {
+std::vector<Pause> findPauses(const Eigen::VectorXd& speed, const std::vector<double>& time,
+                              const PauseConfig& config) {
   std::vector<Pause> pauses;
-  for (const Pause& run : rest_runs(speed, time, config))
-    if (duration(run, time) >= config.min_pause || at_an_end(run, time.size()))
-      pauses.push_back(run);
+  for (const Pause& run : restRuns(speed, time, config))
+    if (duration(run, time) >= config.min_pause || atAnEnd(run, time.size())) pauses.push_back(run);
   return pauses;
 }
 
-std::vector<BoundaryEvidence> motion_stop_evidence(const Eigen::VectorXd& speed,
-                                                   const std::vector<double>& time,
-                                                   const PauseConfig& config, double weight) {
+std::vector<BoundaryEvidence> motionStopEvidence(const Eigen::VectorXd& speed,
+                                                 const std::vector<double>& time,
+                                                 const PauseConfig& config, double weight) {
   std::vector<BoundaryEvidence> out;
-  for (const Pause& run : rest_runs(speed, time, config)) {
-    if (duration(run, time) >= config.min_pause || at_an_end(run, time.size())) continue;
+  for (const Pause& run : restRuns(speed, time, config)) {
+    if (duration(run, time) >= config.min_pause || atAnEnd(run, time.size())) continue;
     Eigen::Index slowest = 0;
     speed
         .segment(static_cast<Eigen::Index>(run.begin),
@@ -134,10 +133,10 @@ std::vector<BoundaryEvidence> motion_stop_evidence(const Eigen::VectorXd& speed,
   return out;
 }
 
-std::vector<BoundaryEvidence> motion_onset_evidence(const Eigen::VectorXd& speed,
-                                                    const std::vector<double>& time,
-                                                    const std::vector<Pause>& pauses,
-                                                    const PauseConfig& config, double weight) {
+std::vector<BoundaryEvidence> motionOnsetEvidence(const Eigen::VectorXd& speed,
+                                                  const std::vector<double>& time,
+                                                  const std::vector<Pause>& pauses,
+                                                  const PauseConfig& config, double weight) {
   std::vector<BoundaryEvidence> out;
   const double typical = percentile(speed, 0.95);
   if (!(typical > 0)) return out;
@@ -145,7 +144,7 @@ std::vector<BoundaryEvidence> motion_onset_evidence(const Eigen::VectorXd& speed
     // The demo starts and ends at rest: neither is a boundary between skills.
     if (p.begin == 0 || p.end >= time.size()) continue;
     const double pause = time[p.end] - time[p.begin];
-    const double motion = std::min(1.0, peak_speed_after(speed, time, p.end, config.motion_window) /
+    const double motion = std::min(1.0, peakSpeedAfter(speed, time, p.end, config.motion_window) /
                                             (config.full_motion_fraction * typical));
     out.push_back({p.end, weight * (1.0 - std::exp(-pause / config.pause_scale)) * motion,
                    EvidenceKind::kMotionOnset});
@@ -153,8 +152,8 @@ std::vector<BoundaryEvidence> motion_onset_evidence(const Eigen::VectorXd& speed
   return out;
 }
 
-void gather_into_pauses(const std::vector<Pause>& pauses, std::size_t samples,
-                        std::size_t start_samples, std::vector<BoundaryEvidence>* evidence) {
+void gatherIntoPauses(const std::vector<Pause>& pauses, std::size_t samples,
+                      std::size_t start_samples, std::vector<BoundaryEvidence>* evidence) {
   for (const Pause& p : pauses) {
     if (p.begin == 0 || p.end >= samples) continue;
     for (BoundaryEvidence& e : *evidence)
@@ -162,9 +161,9 @@ void gather_into_pauses(const std::vector<Pause>& pauses, std::size_t samples,
   }
 }
 
-std::vector<BoundaryEvidence> sensory_evidence(const SensorEvents& events,
-                                               const EvidenceWeights& weights,
-                                               std::size_t fold_samples) {
+std::vector<BoundaryEvidence> sensoryEvidence(const SensorEvents& events,
+                                              const EvidenceWeights& weights,
+                                              std::size_t fold_samples) {
   std::vector<BoundaryEvidence> out;
   for (const SensoryEvent& e : events.details) {
     if (e.rest_edge) {
@@ -185,7 +184,7 @@ std::vector<BoundaryEvidence> sensory_evidence(const SensorEvents& events,
   return out;
 }
 
-std::vector<BoundaryEvidence> clasp_evidence(const MultivariateSegmentation& clasp, double weight) {
+std::vector<BoundaryEvidence> claspEvidence(const MultivariateSegmentation& clasp, double weight) {
   std::vector<BoundaryEvidence> out;
   for (std::size_t cp : clasp.changepoints) out.push_back({cp, weight, EvidenceKind::kClasp});
   return out;

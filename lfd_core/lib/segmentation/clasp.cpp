@@ -25,7 +25,7 @@ namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
-double score_from_confusion(const std::size_t cm[2][2], ClaspScore score) {
+double scoreFromConfusion(const std::size_t cm[2][2], ClaspScore score) {
   const double tn = static_cast<double>(cm[0][0]), fp = static_cast<double>(cm[0][1]);
   const double fn = static_cast<double>(cm[1][0]), tp = static_cast<double>(cm[1][1]);
   if (tp + fn == 0.0 || tn + fp == 0.0) return kNaN;  // one class is empty
@@ -38,7 +38,7 @@ double score_from_confusion(const std::size_t cm[2][2], ClaspScore score) {
 constexpr unsigned char kStraddles = 2;
 
 // Predicted labels at one split (kStraddles for the subsequences that straddle it).
-std::vector<unsigned char> predicted_labels(const KnnResult& knn, std::size_t split) {
+std::vector<unsigned char> predictedLabels(const KnnResult& knn, std::size_t split) {
   const std::size_t m = knn.num_subsequences, k = knn.k, w = knn.window;
   std::vector<unsigned char> pred(m, 0);
   for (std::size_t i = 0; i < m; ++i) {
@@ -57,7 +57,7 @@ std::vector<unsigned char> predicted_labels(const KnnResult& knn, std::size_t sp
 
 // log10 of the two-sided normal tail 2 * (1 - Phi(|z|)), exact down to ~1e-300 and asymptotic
 // beyond (erfc underflows there).
-double log10_two_sided_p(double z) {
+double log10TwoSidedP(double z) {
   const double x = std::abs(z) / std::sqrt(2.0);
   const double p = std::erfc(x);
   if (p > 1e-290) return std::log10(p);
@@ -67,8 +67,8 @@ double log10_two_sided_p(double z) {
 
 }  // namespace
 
-Eigen::VectorXd classification_score_profile(const KnnResult& knn, std::size_t min_split,
-                                             ClaspScore score) {
+Eigen::VectorXd classificationScoreProfile(const KnnResult& knn, std::size_t min_split,
+                                           ClaspScore score) {
   const std::size_t m = knn.num_subsequences, k = knn.k, w = knn.window;
   if (m == 0 || k == 0 || knn.indices.size() != m * k)
     throw std::invalid_argument("ClaSP profile: malformed k-NN result");
@@ -120,7 +120,7 @@ Eigen::VectorXd classification_score_profile(const KnnResult& knn, std::size_t m
   std::vector<std::size_t> affected;
   affected.reserve(2 + 4 * k);
   for (std::size_t step = 1;; ++step, ++s) {
-    profile[static_cast<Eigen::Index>(s)] = score_from_confusion(cm, score);
+    profile[static_cast<Eigen::Index>(s)] = scoreFromConfusion(cm, score);
     if (s == hi) break;
     // Moving to s + 1: s becomes left, s - w stops straddling, s's referrers lose a "right" vote.
     affected.clear();
@@ -140,10 +140,10 @@ Eigen::VectorXd classification_score_profile(const KnnResult& knn, std::size_t m
   return profile;
 }
 
-double split_log10_p_value(const KnnResult& knn, std::size_t split) {
+double splitLog10PValue(const KnnResult& knn, std::size_t split) {
   const std::size_t m = knn.num_subsequences;
   if (split == 0 || split >= m) return 0.0;  // one side empty: no evidence
-  const std::vector<unsigned char> pred = predicted_labels(knn, split);
+  const std::vector<unsigned char> pred = predictedLabels(knn, split);
   // Wilcoxon rank-sum on binary data: all zeros share one mid-rank, all ones another.
   double zeros = 0.0, left_zeros = 0.0, left = 0.0, total = 0.0;
   for (std::size_t i = 0; i < m; ++i) {
@@ -163,11 +163,11 @@ double split_log10_p_value(const KnnResult& knn, std::size_t split) {
   const double rank_sum = left_zeros * rank_zero + (n1 - left_zeros) * rank_one;
   const double expected = n1 * (total + 1.0) / 2.0;
   const double sd = std::sqrt(n1 * n2 * (total + 1.0) / 12.0);
-  return log10_two_sided_p((rank_sum - expected) / sd);
+  return log10TwoSidedP((rank_sum - expected) / sd);
 }
 
-ClaspProfile compute_clasp_profile(const Eigen::Ref<const Eigen::VectorXd>& series,
-                                   const ClaspConfig& config) {
+ClaspProfile computeClaspProfile(const Eigen::Ref<const Eigen::VectorXd>& series,
+                                 const ClaspConfig& config) {
   const std::size_t n = static_cast<std::size_t>(series.size());
   if (!series.allFinite()) throw std::invalid_argument("ClaSP: series has NaN/Inf values");
   if (config.k < 1 || config.k > 255) throw std::invalid_argument("ClaSP: k must be in [1, 255]");
@@ -178,7 +178,7 @@ ClaspProfile compute_clasp_profile(const Eigen::Ref<const Eigen::VectorXd>& seri
   ClaspProfile out;
   out.window_size = config.window_size
                         ? config.window_size
-                        : select_window_size(series, config.window_selection, config.min_window);
+                        : selectWindowSize(series, config.window_selection, config.min_window);
   const std::size_t w = out.window_size;
   out.min_segment_size = config.min_segment_size ? config.min_segment_size : 5 * w;
   if (w < 2 || n < 3 * w || n < 2 * out.min_segment_size + 1)
@@ -192,16 +192,16 @@ ClaspProfile compute_clasp_profile(const Eigen::Ref<const Eigen::VectorXd>& seri
     std::normal_distribution<double> gauss(0.0, config.tie_jitter * (range > 0.0 ? range : 1.0));
     Eigen::VectorXd jittered = series;
     for (Eigen::Index i = 0; i < jittered.size(); ++i) jittered[i] += gauss(rng);
-    out.knn = self_join_knn(jittered, w, config.k, exclusion, config.distance);
+    out.knn = selfJoinKnn(jittered, w, config.k, exclusion, config.distance);
   } else {
-    out.knn = self_join_knn(series, w, config.k, exclusion, config.distance);
+    out.knn = selfJoinKnn(series, w, config.k, exclusion, config.distance);
   }
-  out.profile = classification_score_profile(out.knn, out.min_segment_size, config.score);
+  out.profile = classificationScoreProfile(out.knn, out.min_segment_size, config.score);
   return out;
 }
 
-ClaspSegmentation clasp_segment(const Eigen::Ref<const Eigen::VectorXd>& series,
-                                const ClaspConfig& config, int num_changepoints) {
+ClaspSegmentation claspSegment(const Eigen::Ref<const Eigen::VectorXd>& series,
+                               const ClaspConfig& config, int num_changepoints) {
   const std::size_t n = static_cast<std::size_t>(series.size());
   if (!series.allFinite()) throw std::invalid_argument("ClaSP: series has NaN/Inf values");
   ClaspSegmentation out;
@@ -210,7 +210,7 @@ ClaspSegmentation clasp_segment(const Eigen::Ref<const Eigen::VectorXd>& series,
   ClaspConfig cfg = config;
   cfg.window_size = config.window_size
                         ? config.window_size
-                        : select_window_size(series, config.window_selection, config.min_window);
+                        : selectWindowSize(series, config.window_selection, config.min_window);
   cfg.min_segment_size = config.min_segment_size ? config.min_segment_size : 5 * cfg.window_size;
   out.window_size = cfg.window_size;
   const bool learn = num_changepoints < 0;
@@ -227,13 +227,13 @@ ClaspSegmentation clasp_segment(const Eigen::Ref<const Eigen::VectorXd>& series,
   // Profile of one range; pushes its best split if it may be split and (when learning) passes.
   const auto evaluate = [&](std::size_t begin, std::size_t end, bool first) {
     if (end - begin < 2 * cfg.min_segment_size + 1 || end - begin < 3 * cfg.window_size) return;
-    const ClaspProfile p = compute_clasp_profile(series.segment(begin, end - begin), cfg);
+    const ClaspProfile p = computeClaspProfile(series.segment(begin, end - begin), cfg);
     if (first) out.first_profile = p.profile;
     Eigen::Index best = -1;
     for (Eigen::Index i = 0; i < p.profile.size(); ++i)
       if (!std::isnan(p.profile[i]) && (best < 0 || p.profile[i] > p.profile[best])) best = i;
     if (best < 0) return;
-    const double log10_p = split_log10_p_value(p.knn, static_cast<std::size_t>(best));
+    const double log10_p = splitLog10PValue(p.knn, static_cast<std::size_t>(best));
     if (learn && log10_p > std::log10(cfg.p_value_threshold)) return;
     queue.push({p.profile[best], begin, end, begin + static_cast<std::size_t>(best), log10_p});
   };

@@ -46,9 +46,9 @@ Channel prepare(const Eigen::Ref<const Eigen::VectorXd>& x, std::size_t w) {
 
 }  // namespace
 
-KnnResult distance_average_knn(const Eigen::MatrixXd& series, const std::vector<double>& weights,
-                               std::size_t window, std::size_t k, std::size_t exclusion_zone,
-                               ClaspDistance distance) {
+KnnResult distanceAverageKnn(const Eigen::MatrixXd& series, const std::vector<double>& weights,
+                             std::size_t window, std::size_t k, std::size_t exclusion_zone,
+                             ClaspDistance distance) {
   const std::size_t n = static_cast<std::size_t>(series.rows());
   const std::size_t d = static_cast<std::size_t>(series.cols());
   if (d == 0) throw std::invalid_argument("distance averaging: no channel");

@@ -36,7 +36,7 @@ struct PairTerms {
 };
 
 // Per-subsequence constants of the similarity formula (see file comment). `x` is mean-centred.
-PairTerms pair_terms(const std::vector<double>& x, std::size_t w, ClaspDistance distance) {
+PairTerms pairTerms(const std::vector<double>& x, std::size_t w, ClaspDistance distance) {
   const std::size_t n = x.size();
   const std::size_t m = n - w + 1;
   PairTerms t;
@@ -74,7 +74,7 @@ PairTerms pair_terms(const std::vector<double>& x, std::size_t w, ClaspDistance 
   return t;
 }
 
-double to_distance(double s, std::size_t w, ClaspDistance distance) {
+double toDistance(double s, std::size_t w, ClaspDistance distance) {
   if (distance == ClaspDistance::kEuclidean) return std::sqrt(std::max(0.0, -s));
   return std::sqrt(std::max(0.0, 2.0 * static_cast<double>(w) * (1.0 - s)));
 }
@@ -120,7 +120,7 @@ class TopK {
     r.distances.resize(score_.size());
     for (std::size_t i = 0; i < score_.size(); ++i)
       r.distances[i] = index_[i] < 0 ? std::numeric_limits<double>::infinity()
-                                     : to_distance(score_[i], w, distance);
+                                     : toDistance(score_[i], w, distance);
     return r;
   }
 
@@ -131,8 +131,8 @@ class TopK {
   std::vector<double> worst_;
 };
 
-std::vector<double> centred_copy(const Eigen::Ref<const Eigen::VectorXd>& series,
-                                 std::size_t window, std::size_t k) {
+std::vector<double> centredCopy(const Eigen::Ref<const Eigen::VectorXd>& series, std::size_t window,
+                                std::size_t k) {
   const std::size_t n = static_cast<std::size_t>(series.size());
   if (window < 2) throw std::invalid_argument("ClaSP k-NN: window must be >= 2");
   if (k < 1) throw std::invalid_argument("ClaSP k-NN: k must be >= 1");
@@ -169,7 +169,7 @@ struct RowSweep {
 };
 
 template <bool kZNorm>
-inline __attribute__((always_inline)) void sweep_row(const RowSweep& r, std::size_t i) {
+inline __attribute__((always_inline)) void sweepRow(const RowSweep& r, std::size_t i) {
   constexpr std::size_t kBlock = 32;
   double block_sim[kBlock];
   const std::size_t d_end = r.m - i;  // j = i + d < m
@@ -214,18 +214,18 @@ inline __attribute__((always_inline)) void sweep_row(const RowSweep& r, std::siz
 }
 
 // Chosen per CPU at load time. AVX2 without FMA: both versions give bit-identical similarities.
-__attribute__((target_clones("avx2", "default"))) void sweep_row_znorm(const RowSweep& r,
-                                                                       std::size_t i) {
-  sweep_row<true>(r, i);
+__attribute__((target_clones("avx2", "default"))) void sweepRowZnorm(const RowSweep& r,
+                                                                     std::size_t i) {
+  sweepRow<true>(r, i);
 }
-__attribute__((target_clones("avx2", "default"))) void sweep_row_euclidean(const RowSweep& r,
-                                                                           std::size_t i) {
-  sweep_row<false>(r, i);
+__attribute__((target_clones("avx2", "default"))) void sweepRowEuclidean(const RowSweep& r,
+                                                                         std::size_t i) {
+  sweepRow<false>(r, i);
 }
 
 // Rows i = 0 .. m-1 of the upper triangle. `qt` holds row 0 on entry (diagonals >= d0).
-void join_rows(const std::vector<double>& x, std::size_t w, std::size_t d0, const PairTerms& t,
-               ClaspDistance distance, std::vector<double>& qt, TopK& top) {
+void joinRows(const std::vector<double>& x, std::size_t w, std::size_t d0, const PairTerms& t,
+              ClaspDistance distance, std::vector<double>& qt, TopK& top) {
   RowSweep r;
   r.x = x.data();
   r.w = w;
@@ -244,22 +244,22 @@ void join_rows(const std::vector<double>& x, std::size_t w, std::size_t d0, cons
   const bool znorm = distance != ClaspDistance::kEuclidean;
   for (std::size_t i = 0; i + d0 < r.m; ++i) {
     if (znorm) {
-      sweep_row_znorm(r, i);
+      sweepRowZnorm(r, i);
     } else {
-      sweep_row_euclidean(r, i);
+      sweepRowEuclidean(r, i);
     }
   }
 }
 
 }  // namespace
 
-KnnResult self_join_knn(const Eigen::Ref<const Eigen::VectorXd>& series, std::size_t window,
-                        std::size_t k, std::size_t exclusion_zone, ClaspDistance distance) {
-  const std::vector<double> x = centred_copy(series, window, k);
+KnnResult selfJoinKnn(const Eigen::Ref<const Eigen::VectorXd>& series, std::size_t window,
+                      std::size_t k, std::size_t exclusion_zone, ClaspDistance distance) {
+  const std::vector<double> x = centredCopy(series, window, k);
   const std::size_t n = x.size();
   const std::size_t w = window;
   const std::size_t m = n - w + 1;
-  const PairTerms t = pair_terms(x, w, distance);
+  const PairTerms t = pairTerms(x, w, distance);
   TopK top(m, k);
   const std::size_t d0 = exclusion_zone + 1;  // smallest admissible diagonal
   if (d0 >= m) return top.finish(w, m, distance);
@@ -271,17 +271,17 @@ KnnResult self_join_knn(const Eigen::Ref<const Eigen::VectorXd>& series, std::si
     for (std::size_t l = 0; l < w; ++l) acc += x[l] * x[d + l];
     qt[d] = acc;
   }
-  join_rows(x, w, d0, t, distance, qt, top);
+  joinRows(x, w, d0, t, distance, qt, top);
   return top.finish(w, m, distance);
 }
 
-KnnResult brute_force_knn(const Eigen::Ref<const Eigen::VectorXd>& series, std::size_t window,
-                          std::size_t k, std::size_t exclusion_zone, ClaspDistance distance) {
-  const std::vector<double> x = centred_copy(series, window, k);
+KnnResult bruteForceKnn(const Eigen::Ref<const Eigen::VectorXd>& series, std::size_t window,
+                        std::size_t k, std::size_t exclusion_zone, ClaspDistance distance) {
+  const std::vector<double> x = centredCopy(series, window, k);
   const std::size_t n = x.size();
   const std::size_t w = window;
   const std::size_t m = n - w + 1;
-  const PairTerms t = pair_terms(x, w, distance);
+  const PairTerms t = pairTerms(x, w, distance);
   TopK top(m, k);
   for (std::size_t i = 0; i < m; ++i) {
     for (std::size_t j = 0; j < m; ++j) {

@@ -14,15 +14,15 @@
 namespace lfd {
 namespace {
 
-void require_finite(const Eigen::Ref<const Eigen::VectorXd>& series, const char* who) {
+void requireFinite(const Eigen::Ref<const Eigen::VectorXd>& series, const char* who) {
   if (!series.allFinite())
     throw std::invalid_argument(std::string(who) + ": series has NaN/Inf values");
 }
 
 // Mean distance between each window's (mean, std, range) and the whole series' ones, divided by
 // sqrt(w) (SuSS score; small = the window summarises the series well). `x` is min-max normalised.
-double suss_score(const std::vector<double>& x, std::size_t w, const std::vector<double>& sum,
-                  const std::vector<double>& sum_sq, double mean, double std, double range) {
+double sussScore(const std::vector<double>& x, std::size_t w, const std::vector<double>& sum,
+                 const std::vector<double>& sum_sq, double mean, double std, double range) {
   const std::size_t n = x.size();
   std::deque<std::size_t> max_q, min_q;  // monotonic queues for the rolling extrema
   double total = 0.0;
@@ -49,27 +49,27 @@ double suss_score(const std::vector<double>& x, std::size_t w, const std::vector
 
 }  // namespace
 
-WindowSelection parse_window_selection(const std::string& name) {
+WindowSelection parseWindowSelection(const std::string& name) {
   if (name == "suss") return WindowSelection::kSuss;
   if (name == "fft" || name == "dominant_fourier") return WindowSelection::kDominantFourier;
   if (name == "acf" || name == "autocorrelation") return WindowSelection::kAutocorrelation;
   throw std::invalid_argument("unknown window selection '" + name + "' (suss, fft, acf)");
 }
 
-ClaspDistance parse_clasp_distance(const std::string& name) {
+ClaspDistance parseClaspDistance(const std::string& name) {
   if (name == "znorm_euclidean" || name == "znormed_euclidean_distance")
     return ClaspDistance::kZNormalizedEuclidean;
   if (name == "euclidean" || name == "euclidean_distance") return ClaspDistance::kEuclidean;
   throw std::invalid_argument("unknown ClaSP distance '" + name + "' (znorm_euclidean, euclidean)");
 }
 
-ClaspScore parse_clasp_score(const std::string& name) {
+ClaspScore parseClaspScore(const std::string& name) {
   if (name == "roc_auc") return ClaspScore::kRocAuc;
   if (name == "f1" || name == "macro_f1") return ClaspScore::kMacroF1;
   throw std::invalid_argument("unknown ClaSP score '" + name + "' (roc_auc, f1)");
 }
 
-std::string to_string(WindowSelection selection) {
+std::string toString(WindowSelection selection) {
   switch (selection) {
     case WindowSelection::kSuss:
       return "suss";
@@ -81,17 +81,17 @@ std::string to_string(WindowSelection selection) {
   return "?";
 }
 
-std::string to_string(ClaspDistance distance) {
+std::string toString(ClaspDistance distance) {
   return distance == ClaspDistance::kEuclidean ? "euclidean" : "znorm_euclidean";
 }
 
-std::string to_string(ClaspScore score) {
+std::string toString(ClaspScore score) {
   return score == ClaspScore::kMacroF1 ? "f1" : "roc_auc";
 }
 
-std::size_t suss_window_size(const Eigen::Ref<const Eigen::VectorXd>& series, std::size_t lbound,
-                             double threshold) {
-  require_finite(series, "SuSS");
+std::size_t sussWindowSize(const Eigen::Ref<const Eigen::VectorXd>& series, std::size_t lbound,
+                           double threshold) {
+  requireFinite(series, "SuSS");
   const std::size_t n = static_cast<std::size_t>(series.size());
   lbound = std::max<std::size_t>(lbound, 2);
   if (n < 2 * lbound) return std::max<std::size_t>(2, n / 2);
@@ -107,7 +107,7 @@ std::size_t suss_window_size(const Eigen::Ref<const Eigen::VectorXd>& series, st
   const double mean = sum[n] / static_cast<double>(n);
   const double std = std::sqrt(std::max(0.0, sum_sq[n] / static_cast<double>(n) - mean * mean));
   const double range = 1.0;
-  const auto raw = [&](std::size_t w) { return suss_score(x, w, sum, sum_sq, mean, std, range); };
+  const auto raw = [&](std::size_t w) { return sussScore(x, w, sum, sum_sq, mean, std, range); };
   const double max_score = raw(1);
   const double min_score = raw(n - 1);
   if (max_score == min_score) return lbound;
@@ -139,9 +139,9 @@ std::size_t suss_window_size(const Eigen::Ref<const Eigen::VectorXd>& series, st
   return std::clamp(low, lbound, std::max(lbound, cap));
 }
 
-std::size_t dominant_fourier_window_size(const Eigen::Ref<const Eigen::VectorXd>& series,
-                                         std::size_t lbound) {
-  require_finite(series, "dominant Fourier period");
+std::size_t dominantFourierWindowSize(const Eigen::Ref<const Eigen::VectorXd>& series,
+                                      std::size_t lbound) {
+  requireFinite(series, "dominant Fourier period");
   const std::size_t n = static_cast<std::size_t>(series.size());
   lbound = std::max<std::size_t>(lbound, 2);
   if (n < 4 * lbound) return std::max<std::size_t>(2, n / 4);
@@ -165,9 +165,9 @@ std::size_t dominant_fourier_window_size(const Eigen::Ref<const Eigen::VectorXd>
   return best;
 }
 
-std::size_t autocorrelation_window_size(const Eigen::Ref<const Eigen::VectorXd>& series,
-                                        std::size_t lbound) {
-  require_finite(series, "autocorrelation period");
+std::size_t autocorrelationWindowSize(const Eigen::Ref<const Eigen::VectorXd>& series,
+                                      std::size_t lbound) {
+  requireFinite(series, "autocorrelation period");
   const std::size_t n = static_cast<std::size_t>(series.size());
   lbound = std::max<std::size_t>(lbound, 2);
   if (n < 4 * lbound) return std::max<std::size_t>(2, n / 4);
@@ -197,8 +197,8 @@ std::size_t autocorrelation_window_size(const Eigen::Ref<const Eigen::VectorXd>&
   return best;
 }
 
-std::size_t select_window_size(const Eigen::Ref<const Eigen::VectorXd>& series,
-                               WindowSelection selection, std::size_t lbound) {
+std::size_t selectWindowSize(const Eigen::Ref<const Eigen::VectorXd>& series,
+                             WindowSelection selection, std::size_t lbound) {
   const std::size_t n = static_cast<std::size_t>(series.size());
   if (n < 6)
     throw std::invalid_argument("window selection: series of " + std::to_string(n) +
@@ -206,14 +206,14 @@ std::size_t select_window_size(const Eigen::Ref<const Eigen::VectorXd>& series,
   std::size_t w = 0;
   switch (selection) {
     case WindowSelection::kSuss:
-      w = suss_window_size(series, lbound);
+      w = sussWindowSize(series, lbound);
       break;
     // A period covers one full cycle; ClaSP (claspy) uses half of it as the subsequence length.
     case WindowSelection::kDominantFourier:
-      w = dominant_fourier_window_size(series, 2 * lbound) / 2;
+      w = dominantFourierWindowSize(series, 2 * lbound) / 2;
       break;
     case WindowSelection::kAutocorrelation:
-      w = autocorrelation_window_size(series, 2 * lbound) / 2;
+      w = autocorrelationWindowSize(series, 2 * lbound) / 2;
       break;
   }
   return std::clamp<std::size_t>(w, 2, n / 3);

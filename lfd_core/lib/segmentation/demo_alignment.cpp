@@ -11,15 +11,15 @@ namespace lfd {
 
 namespace {
 
-void check_pair(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
+void checkPair(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
   if (a.rows() == 0 || b.rows() == 0 || a.cols() != b.cols())
     throw std::invalid_argument("multivariate DTW needs two non-empty series of as many features");
 }
 
 }  // namespace
 
-Eigen::MatrixXd on_uniform_grid(const Eigen::MatrixXd& features, const std::vector<double>& time,
-                                double step) {
+Eigen::MatrixXd onUniformGrid(const Eigen::MatrixXd& features, const std::vector<double>& time,
+                              double step) {
   if (time.size() != static_cast<std::size_t>(features.rows()) || time.empty() || !(step > 0))
     throw std::invalid_argument("on_uniform_grid: a timestamp per row and a positive step needed");
   const double span = time.back() - time.front();
@@ -41,14 +41,14 @@ Eigen::MatrixXd on_uniform_grid(const Eigen::MatrixXd& features, const std::vect
   return out;
 }
 
-double multivariate_dtw_cost(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b, double band) {
-  check_pair(a, b);
+double multivariateDtwCost(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b, double band) {
+  checkPair(a, b);
   return dtwRows(a, b, nullptr, band);
 }
 
-std::vector<double> multivariate_dtw_map(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b,
-                                         double band) {
-  check_pair(a, b);
+std::vector<double> multivariateDtwMap(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b,
+                                       double band) {
+  checkPair(a, b);
   std::vector<std::pair<int, int>> path;
   dtwRows(a, b, &path, band);
   std::vector<double> sum(static_cast<std::size_t>(a.rows()), 0.0);
@@ -61,10 +61,10 @@ std::vector<double> multivariate_dtw_map(const Eigen::MatrixXd& a, const Eigen::
   return sum;
 }
 
-std::vector<double> anchored_dtw_map(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b,
-                                     const std::vector<std::size_t>& a_anchors,
-                                     const std::vector<std::size_t>& b_anchors, double band) {
-  check_pair(a, b);
+std::vector<double> anchoredDtwMap(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b,
+                                   const std::vector<std::size_t>& a_anchors,
+                                   const std::vector<std::size_t>& b_anchors, double band) {
+  checkPair(a, b);
   if (a_anchors.size() != b_anchors.size())
     throw std::invalid_argument("anchored DTW needs as many anchors in both series");
   std::vector<std::size_t> a_cuts{0}, b_cuts{0};
@@ -84,14 +84,14 @@ std::vector<double> anchored_dtw_map(const Eigen::MatrixXd& a, const Eigen::Matr
     const auto rows_a = static_cast<Eigen::Index>(a_cuts[k + 1] - a_cuts[k]);
     const auto rows_b = static_cast<Eigen::Index>(b_cuts[k + 1] - b_cuts[k]);
     const std::vector<double> part =
-        multivariate_dtw_map(a.middleRows(static_cast<Eigen::Index>(a_cuts[k]), rows_a),
-                             b.middleRows(static_cast<Eigen::Index>(b_cuts[k]), rows_b), band);
+        multivariateDtwMap(a.middleRows(static_cast<Eigen::Index>(a_cuts[k]), rows_a),
+                           b.middleRows(static_cast<Eigen::Index>(b_cuts[k]), rows_b), band);
     for (double row : part) map.push_back(row + static_cast<double>(b_cuts[k]));
   }
   return map;
 }
 
-double map_row(const std::vector<double>& map, double row) {
+double mapRow(const std::vector<double>& map, double row) {
   if (map.empty()) return 0.0;
   if (row <= 0) return map.front();
   const double last = static_cast<double>(map.size() - 1);
@@ -101,18 +101,17 @@ double map_row(const std::vector<double>& map, double row) {
   return (1.0 - w) * map[k] + w * map[k + 1];
 }
 
-DemoAlignment align_to_medoid(const std::vector<Eigen::MatrixXd>& gridded, int threads,
-                              double band) {
+DemoAlignment alignToMedoid(const std::vector<Eigen::MatrixXd>& gridded, int threads, double band) {
   const std::size_t n = gridded.size();
   if (n == 0) throw std::invalid_argument("no demonstrations to align");
-  for (const Eigen::MatrixXd& g : gridded) check_pair(g, gridded.front());
+  for (const Eigen::MatrixXd& g : gridded) checkPair(g, gridded.front());
   std::vector<std::pair<std::size_t, std::size_t>> pairs;
   for (std::size_t a = 0; a < n; ++a)
     for (std::size_t b = a + 1; b < n; ++b) pairs.emplace_back(a, b);
   std::vector<double> cost(pairs.size());
-  parallel_for(pairs.size(), threads, [&](std::size_t p) {
+  parallelFor(pairs.size(), threads, [&](std::size_t p) {
     const auto [a, b] = pairs[p];
-    cost[p] = multivariate_dtw_cost(gridded[a], gridded[b], band) /
+    cost[p] = multivariateDtwCost(gridded[a], gridded[b], band) /
               static_cast<double>(gridded[a].rows() + gridded[b].rows());
   });
   std::vector<double> total(n, 0.0);
@@ -127,9 +126,9 @@ DemoAlignment align_to_medoid(const std::vector<Eigen::MatrixXd>& gridded, int t
   out.from_reference.resize(n);
   out.mean_cost.assign(n, 0.0);
   const Eigen::MatrixXd& ref = gridded[out.reference];
-  parallel_for(n, threads, [&](std::size_t d) {
-    out.to_reference[d] = multivariate_dtw_map(gridded[d], ref, band);
-    out.from_reference[d] = multivariate_dtw_map(ref, gridded[d], band);
+  parallelFor(n, threads, [&](std::size_t d) {
+    out.to_reference[d] = multivariateDtwMap(gridded[d], ref, band);
+    out.from_reference[d] = multivariateDtwMap(ref, gridded[d], band);
   });
   for (std::size_t p = 0; p < pairs.size(); ++p) {
     if (pairs[p].first == out.reference) out.mean_cost[pairs[p].second] = cost[p];

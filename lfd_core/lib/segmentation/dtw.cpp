@@ -21,7 +21,7 @@ double DtwResult::distance() const {
   return std::sqrt(std::max(0.0, cost));
 }
 
-bool dtw_in_band(long i, long j, long n, long m, int band) {
+bool dtwInBand(long i, long j, long n, long m, int band) {
   if (band < 0) return true;
   const long radius = std::max<long>(band, std::labs(n - m));
   return std::labs(i - j) <= radius;
@@ -33,7 +33,7 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 // Largest direction matrix we allocate (bytes); beyond it the caller must use a band or costs.
 constexpr std::size_t kMaxDirectionBytes = std::size_t(1) << 31;
 
-void check_pair(const double* a, std::size_t n, const double* b, std::size_t m) {
+void checkPair(const double* a, std::size_t n, const double* b, std::size_t m) {
   if (n == 0 || m == 0 || a == nullptr || b == nullptr) {
     throw std::invalid_argument("DTW needs two non-empty series (got lengths " + std::to_string(n) +
                                 " and " + std::to_string(m) + ")");
@@ -46,36 +46,27 @@ void check_pair(const double* a, std::size_t n, const double* b, std::size_t m) 
 // Step codes of the scalar direction matrix.
 enum Step : std::uint8_t { kDiag = 0, kUp = 1, kLeft = 2 };
 
-WarpingPath backtrack(long n, long m, const std::uint8_t* steps /* n*m */) {
-  WarpingPath path;
+// Traces the warping path back from cell (n-1, m-1) to (0, 0). step_at(i, j) gives the step
+// that reached cell (i, j) for i, j > 0; the first row and column only step along themselves.
+// Shared by the scalar direction matrix and the batched kernel's per-lane step bits.
+template <typename StepAt>
+void traceBack(long n, long m, StepAt step_at, WarpingPath& path) {
+  path.clear();
   path.reserve(static_cast<std::size_t>(n + m));
   long i = n - 1, j = m - 1;
   while (i > 0 || j > 0) {
     path.emplace_back(static_cast<int>(i), static_cast<int>(j));
-    if (i == 0) {
-      --j;
-    } else if (j == 0) {
-      --i;
-    } else {
-      const std::uint8_t s = steps[i * m + j];
-      if (s == kLeft) {
-        --j;
-      } else if (s == kUp) {
-        --i;
-      } else {
-        --i;
-        --j;
-      }
-    }
+    const Step step = i == 0 ? kLeft : j == 0 ? kUp : step_at(i, j);
+    if (step != kLeft) --i;
+    if (step != kUp) --j;
   }
   path.emplace_back(0, 0);
   std::reverse(path.begin(), path.end());
-  return path;
 }
 
 // Columns [lo, hi] of row i that lie in the band (the whole row without a band).
-std::pair<std::size_t, std::size_t> band_columns(std::size_t i, std::size_t n, std::size_t m,
-                                                 int band) {
+std::pair<std::size_t, std::size_t> bandColumns(std::size_t i, std::size_t n, std::size_t m,
+                                                int band) {
   if (band < 0) return {0, m - 1};
   const long radius = std::max<long>(band, std::labs(long(n) - long(m)));
   const long lo = std::max<long>(0, long(i) - radius);
@@ -85,16 +76,16 @@ std::pair<std::size_t, std::size_t> band_columns(std::size_t i, std::size_t n, s
 
 }  // namespace
 
-double dtw_cost(const double* a, std::size_t n, const double* b, std::size_t m,
-                const DtwOptions& options) {
-  check_pair(a, n, b, m);
+double dtwCost(const double* a, std::size_t n, const double* b, std::size_t m,
+               const DtwOptions& options) {
+  checkPair(a, n, b, m);
   if (m > n) {  // the cost is symmetric: keep the rows short
     std::swap(a, b);
     std::swap(n, m);
   }
   std::vector<double> prev(m, kInf), cur(m, kInf);
   for (std::size_t i = 0; i < n; ++i) {
-    const auto [lo, hi] = band_columns(i, n, m, options.band);
+    const auto [lo, hi] = bandColumns(i, n, m, options.band);
     std::fill(cur.begin(), cur.end(), kInf);  // cells outside the band stay infinite
     double left = kInf;
     double diag = i == 0 ? 0.0 : (lo > 0 ? prev[lo - 1] : kInf);
@@ -112,14 +103,14 @@ double dtw_cost(const double* a, std::size_t n, const double* b, std::size_t m,
   return prev[m - 1];
 }
 
-double dtw_cost(const std::vector<double>& a, const std::vector<double>& b,
-                const DtwOptions& options) {
-  return dtw_cost(a.data(), a.size(), b.data(), b.size(), options);
+double dtwCost(const std::vector<double>& a, const std::vector<double>& b,
+               const DtwOptions& options) {
+  return dtwCost(a.data(), a.size(), b.data(), b.size(), options);
 }
 
 DtwResult dtw(const double* a, std::size_t n, const double* b, std::size_t m,
               const DtwOptions& options) {
-  check_pair(a, n, b, m);
+  checkPair(a, n, b, m);
   if (n * m > kMaxDirectionBytes) {
     throw std::invalid_argument("DTW path of " + std::to_string(n) + "x" + std::to_string(m) +
                                 " cells needs too much memory; use a band or dtw_cost");
@@ -127,7 +118,7 @@ DtwResult dtw(const double* a, std::size_t n, const double* b, std::size_t m,
   std::vector<std::uint8_t> steps(n * m, kDiag);
   std::vector<double> prev(m, kInf), cur(m, kInf);
   for (std::size_t i = 0; i < n; ++i) {
-    const auto [lo, hi] = band_columns(i, n, m, options.band);
+    const auto [lo, hi] = bandColumns(i, n, m, options.band);
     std::fill(cur.begin(), cur.end(), kInf);
     double left = kInf;
     double diag = i == 0 ? 0.0 : (lo > 0 ? prev[lo - 1] : kInf);
@@ -153,7 +144,8 @@ DtwResult dtw(const double* a, std::size_t n, const double* b, std::size_t m,
   }
   DtwResult result;
   result.cost = prev[m - 1];
-  result.path = backtrack(long(n), long(m), steps.data());
+  const auto step_at = [&](long i, long j) { return Step(steps[std::size_t(i) * m + j]); };
+  traceBack(long(n), long(m), step_at, result.path);
   return result;
 }
 
@@ -162,9 +154,8 @@ DtwResult dtw(const std::vector<double>& a, const std::vector<double>& b,
   return dtw(a.data(), a.size(), b.data(), b.size(), options);
 }
 
-std::pair<std::vector<double>, std::vector<double>> dtw_aligned_pair(const double* a,
-                                                                     const double* b,
-                                                                     const WarpingPath& path) {
+std::pair<std::vector<double>, std::vector<double>> dtwAlignedPair(const double* a, const double* b,
+                                                                   const WarpingPath& path) {
   std::pair<std::vector<double>, std::vector<double>> out;
   out.first.reserve(path.size());
   out.second.reserve(path.size());
@@ -175,7 +166,7 @@ std::pair<std::vector<double>, std::vector<double>> dtw_aligned_pair(const doubl
   return out;
 }
 
-double dtw_path_cost(const double* a, const double* b, const WarpingPath& path) {
+double dtwPathCost(const double* a, const double* b, const WarpingPath& path) {
   double cost = 0.0;
   for (const auto& [i, j] : path) cost += (a[i] - b[j]) * (a[i] - b[j]);
   return cost;
@@ -243,12 +234,12 @@ namespace avx2_isa {
 #pragma GCC pop_options
 
 template <bool kPaths, bool kBand>
-void sweep_rows(const SweepArgs& args) {
-  static const bool has_avx2 = __builtin_cpu_supports("avx2");
-  if (has_avx2) {
-    avx2_isa::sweep_rows<kPaths, kBand>(args);
+void sweepRows(const SweepArgs& args) {
+  static const bool kHasAvx2 = __builtin_cpu_supports("avx2");
+  if (kHasAvx2) {
+    avx2_isa::sweepRows<kPaths, kBand>(args);
   } else {
-    baseline_isa::sweep_rows<kPaths, kBand>(args);
+    baseline_isa::sweepRows<kPaths, kBand>(args);
   }
 }
 
@@ -269,37 +260,19 @@ void interleave(const DtwPairView* const* lanes, int used, std::size_t padded_ro
 }
 
 // Lane k's warping path (n x m cells), traced back through the sweep's step bits.
-void lane_path(const std::uint8_t* steps, std::size_t cols, long n, long m, int k,
-               WarpingPath& path) {
-  path.clear();
-  path.reserve(static_cast<std::size_t>(n + m));
-  long i = n - 1, j = m - 1;
+void lanePath(const std::uint8_t* steps, std::size_t cols, long n, long m, int k,
+              WarpingPath& path) {
   const unsigned bit = 1u << k;
-  while (i > 0 || j > 0) {
-    path.emplace_back(static_cast<int>(i), static_cast<int>(j));
-    if (i == 0) {
-      --j;
-    } else if (j == 0) {
-      --i;
-    } else {
-      const std::uint8_t* s = steps + (std::size_t(i) * cols + std::size_t(j)) * 2;
-      if (s[1] & bit) {
-        --j;
-      } else if (s[0] & bit) {
-        --i;
-      } else {
-        --i;
-        --j;
-      }
-    }
-  }
-  path.emplace_back(0, 0);
-  std::reverse(path.begin(), path.end());
+  const auto step_at = [&](long i, long j) {
+    const std::uint8_t* s = steps + (std::size_t(i) * cols + std::size_t(j)) * 2;
+    return (s[1] & bit) ? kLeft : (s[0] & bit) ? kUp : kDiag;
+  };
+  traceBack(n, m, step_at, path);
 }
 
 template <bool kPaths, bool kBand>
-void run_group(const DtwPairView* const* lanes, int used, int band, Workspace& ws, double* costs,
-               WarpingPath* paths) {
+void runGroup(const DtwPairView* const* lanes, int used, int band, Workspace& ws, double* costs,
+              WarpingPath* paths) {
   std::size_t rows = 0, cols = 0;
   for (int k = 0; k < used; ++k) {
     rows = std::max(rows, lanes[k]->n);
@@ -336,19 +309,19 @@ void run_group(const DtwPairView* const* lanes, int used, int band, Workspace& w
   args.lanes = lanes;
   args.used = used;
   args.costs = costs;
-  sweep_rows<kPaths, kBand>(args);
+  sweepRows<kPaths, kBand>(args);
 
   if (kPaths) {
     for (int k = 0; k < used; ++k) {
-      lane_path(ws.steps.data(), cols, long(lanes[k]->n), long(lanes[k]->m), k, paths[k]);
+      lanePath(ws.steps.data(), cols, long(lanes[k]->n), long(lanes[k]->m), k, paths[k]);
     }
   }
 }
 
 template <bool kPaths>
-void run_batches(const std::vector<DtwPairView>& pairs, const DtwOptions& options, int threads,
-                 std::vector<double>& costs, std::vector<WarpingPath>* paths) {
-  for (const DtwPairView& p : pairs) check_pair(p.a, p.n, p.b, p.m);
+void runBatches(const std::vector<DtwPairView>& pairs, const DtwOptions& options, int threads,
+                std::vector<double>& costs, std::vector<WarpingPath>* paths) {
+  for (const DtwPairView& p : pairs) checkPair(p.a, p.n, p.b, p.m);
   // Group pairs of similar shapes so that lanes waste little padding.
   std::vector<std::size_t> order(pairs.size());
   std::iota(order.begin(), order.end(), 0);
@@ -359,7 +332,7 @@ void run_batches(const std::vector<DtwPairView>& pairs, const DtwOptions& option
   costs.assign(pairs.size(), 0.0);
   if (paths) paths->assign(pairs.size(), {});
   // One workspace per worker thread: its buffers grow to the largest group and are reused.
-  parallel_for_with_scratch<Workspace>(groups, threads, [&](std::size_t g, Workspace& ws) {
+  parallelForWithScratch<Workspace>(groups, threads, [&](std::size_t g, Workspace& ws) {
     const DtwPairView* lanes[kDtwLanes];
     double lane_costs[kDtwLanes] = {};
     WarpingPath lane_paths[kDtwLanes];
@@ -367,9 +340,9 @@ void run_batches(const std::vector<DtwPairView>& pairs, const DtwOptions& option
     const int used = static_cast<int>(std::min<std::size_t>(kDtwLanes, pairs.size() - first));
     for (int k = 0; k < used; ++k) lanes[k] = &pairs[order[first + k]];
     if (options.band >= 0) {
-      run_group<kPaths, true>(lanes, used, options.band, ws, lane_costs, lane_paths);
+      runGroup<kPaths, true>(lanes, used, options.band, ws, lane_costs, lane_paths);
     } else {
-      run_group<kPaths, false>(lanes, used, options.band, ws, lane_costs, lane_paths);
+      runGroup<kPaths, false>(lanes, used, options.band, ws, lane_costs, lane_paths);
     }
     for (int k = 0; k < used; ++k) {
       costs[order[first + k]] = lane_costs[k];
@@ -380,18 +353,18 @@ void run_batches(const std::vector<DtwPairView>& pairs, const DtwOptions& option
 
 }  // namespace
 
-std::vector<double> dtw_cost_batch(const std::vector<DtwPairView>& pairs, const DtwOptions& options,
-                                   int threads) {
+std::vector<double> dtwCostBatch(const std::vector<DtwPairView>& pairs, const DtwOptions& options,
+                                 int threads) {
   std::vector<double> costs;
-  run_batches<false>(pairs, options, threads, costs, nullptr);
+  runBatches<false>(pairs, options, threads, costs, nullptr);
   return costs;
 }
 
-std::vector<DtwResult> dtw_batch(const std::vector<DtwPairView>& pairs, const DtwOptions& options,
-                                 int threads) {
+std::vector<DtwResult> dtwBatch(const std::vector<DtwPairView>& pairs, const DtwOptions& options,
+                                int threads) {
   std::vector<double> costs;
   std::vector<WarpingPath> paths;
-  run_batches<true>(pairs, options, threads, costs, &paths);
+  runBatches<true>(pairs, options, threads, costs, &paths);
   std::vector<DtwResult> results(pairs.size());
   for (std::size_t p = 0; p < pairs.size(); ++p) {
     results[p].cost = costs[p];

@@ -14,13 +14,13 @@ const FeatureRelevance& FeatureRelevanceResult::feature(const std::string& name)
   throw std::invalid_argument("no relevance computed for feature '" + name + "'");
 }
 
-std::vector<double> FeatureRelevanceResult::selected_scores() const {
+std::vector<double> FeatureRelevanceResult::selectedScores() const {
   std::vector<double> scores;
   for (const std::string& name : selected) scores.push_back(feature(name).score);
   return scores;
 }
 
-double pearson_correlation(const std::vector<double>& x, const std::vector<double>& y) {
+double pearsonCorrelation(const std::vector<double>& x, const std::vector<double>& y) {
   const std::size_t n = std::min(x.size(), y.size());
   if (n < 2) return 0.0;
   double mx = 0, my = 0;
@@ -37,8 +37,8 @@ double pearson_correlation(const std::vector<double>& x, const std::vector<doubl
   return std::clamp(sxy / std::sqrt(sxx * syy), -1.0, 1.0);
 }
 
-std::vector<std::size_t> select_by_threshold(const std::vector<double>& scores,
-                                             const std::vector<bool>& excluded, double threshold) {
+std::vector<std::size_t> selectByThreshold(const std::vector<double>& scores,
+                                           const std::vector<bool>& excluded, double threshold) {
   std::vector<std::size_t> candidates;
   for (std::size_t f = 0; f < scores.size(); ++f) {
     if ((excluded.empty() || !excluded[f]) && std::isfinite(scores[f])) candidates.push_back(f);
@@ -65,19 +65,19 @@ struct NormalizedSignals {
   std::size_t longest = 0;
 };
 
-NormalizedSignals read_signals(const std::vector<FeatureMatrix>& demos,
-                               const std::vector<std::string>& features) {
+NormalizedSignals readSignals(const std::vector<FeatureMatrix>& demos,
+                              const std::vector<std::string>& features) {
   NormalizedSignals n;
   n.signal.resize(demos.size());
   n.constant_in.resize(demos.size());
   for (std::size_t d = 0; d < demos.size(); ++d) {
     const FeatureMatrix& demo = demos[d];
     const std::string context = "demonstration " + std::to_string(d);
-    demo.validate_shape();
+    demo.validateShape();
     if (demo.rows() < 2) throw std::invalid_argument(context + " has fewer than 2 samples");
     n.longest = std::max<std::size_t>(n.longest, demo.rows());
     for (const std::string& name : features) {
-      const int col = demo.index_of(name);
+      const int col = demo.indexOf(name);
       if (col < 0) throw std::invalid_argument(context + " has no feature '" + name + "'");
       Eigen::VectorXd x = demo.data.col(col);
       for (Eigen::Index r = 0; r < x.size(); ++r) {
@@ -119,8 +119,8 @@ void normalize(NormalizedSignals& n, std::size_t num_features, bool per_demo) {
 // Each feature's pairwise correlation (after DTW) and distance matrices. Every (pair, feature)
 // alignment runs in one batch; pairs of one demonstration pair share shapes, so they fill the
 // SIMD lanes without padding.
-void align_pairs(const NormalizedSignals& n, const FeatureRelevanceConfig& config,
-                 FeatureRelevanceResult& result) {
+void alignPairs(const NormalizedSignals& n, const FeatureRelevanceConfig& config,
+                FeatureRelevanceResult& result) {
   const std::size_t num_demos = n.signal.size(), num_features = result.features.size();
   std::vector<std::pair<std::size_t, std::size_t>> demo_pairs;
   for (std::size_t p = 0; p < num_demos; ++p) {
@@ -138,16 +138,16 @@ void align_pairs(const NormalizedSignals& n, const FeatureRelevanceConfig& confi
   if (config.band_fraction >= 0) {
     dtw_options.band = static_cast<int>(std::ceil(config.band_fraction * double(n.longest)));
   }
-  const std::vector<DtwResult> alignments = dtw_batch(views, dtw_options, config.threads);
+  const std::vector<DtwResult> alignments = dtwBatch(views, dtw_options, config.threads);
   for (std::size_t k = 0; k < demo_pairs.size(); ++k) {
     const auto [p, q] = demo_pairs[k];
     for (std::size_t f = 0; f < num_features; ++f) {
       const DtwResult& r = alignments[k * num_features + f];
       const DtwPairView& v = views[k * num_features + f];
-      const auto aligned = dtw_aligned_pair(v.a, v.b, r.path);
+      const auto aligned = dtwAlignedPair(v.a, v.b, r.path);
       FeatureRelevance& fr = result.features[f];
       fr.correlation(p, q) = fr.correlation(q, p) =
-          pearson_correlation(aligned.first, aligned.second);
+          pearsonCorrelation(aligned.first, aligned.second);
       fr.distance(p, q) = fr.distance(q, p) =
           std::sqrt(std::max(0.0, r.cost) / double(r.path.size()));
     }
@@ -155,7 +155,7 @@ void align_pairs(const NormalizedSignals& n, const FeatureRelevanceConfig& confi
 }
 
 // The paper's score: mean correlation weighted by 1 - the normalized mean DTW distance.
-void score_features(FeatureRelevanceResult& result) {
+void scoreFeatures(FeatureRelevanceResult& result) {
   const double n = double(result.num_demos), pairs = n * (n - 1) / 2.0;
   double dmin = INFINITY, dmax = -INFINITY;
   for (FeatureRelevance& fr : result.features) {
@@ -179,7 +179,7 @@ void score_features(FeatureRelevanceResult& result) {
   }
 }
 
-void select_features(FeatureRelevanceResult& result, double threshold) {
+void selectFeatures(FeatureRelevanceResult& result, double threshold) {
   std::vector<double> weighted, correlation_only;
   std::vector<bool> excluded;
   for (const FeatureRelevance& fr : result.features) {
@@ -187,11 +187,11 @@ void select_features(FeatureRelevanceResult& result, double threshold) {
     correlation_only.push_back(fr.mean_correlation);
     excluded.push_back(fr.constant);
   }
-  for (std::size_t f : select_by_threshold(weighted, excluded, threshold)) {
+  for (std::size_t f : selectByThreshold(weighted, excluded, threshold)) {
     result.features[f].selected = true;
     result.selected.push_back(result.features[f].name);
   }
-  for (std::size_t f : select_by_threshold(correlation_only, excluded, threshold)) {
+  for (std::size_t f : selectByThreshold(correlation_only, excluded, threshold)) {
     result.features[f].selected_correlation_only = true;
     result.selected_correlation_only.push_back(result.features[f].name);
   }
@@ -199,7 +199,7 @@ void select_features(FeatureRelevanceResult& result, double threshold) {
     result.warnings.push_back("no feature varies in any demonstration: nothing selected");
     return;
   }
-  const auto best =  // the best scored feature (select_by_threshold lists the best first)
+  const auto best =  // the best scored feature (selectByThreshold lists the best first)
       std::find_if(result.features.begin(), result.features.end(),
                    [&](const FeatureRelevance& fr) { return fr.name == result.selected[0]; });
   if (best->score <= 0) {
@@ -210,9 +210,9 @@ void select_features(FeatureRelevanceResult& result, double threshold) {
 
 }  // namespace
 
-FeatureRelevanceResult compute_feature_relevance(const std::vector<FeatureMatrix>& demos,
-                                                 std::vector<std::string> features,
-                                                 const FeatureRelevanceConfig& config) {
+FeatureRelevanceResult computeFeatureRelevance(const std::vector<FeatureMatrix>& demos,
+                                               std::vector<std::string> features,
+                                               const FeatureRelevanceConfig& config) {
   if (demos.size() < 2) {
     throw std::invalid_argument("feature relevance needs at least 2 demonstrations, got " +
                                 std::to_string(demos.size()));
@@ -224,7 +224,7 @@ FeatureRelevanceResult compute_feature_relevance(const std::vector<FeatureMatrix
   if (features.empty()) features = demos.front().names;
   if (features.empty()) throw std::invalid_argument("feature relevance: no features");
   const std::size_t num_demos = demos.size(), num_features = features.size();
-  NormalizedSignals signals = read_signals(demos, features);
+  NormalizedSignals signals = readSignals(demos, features);
   normalize(signals, num_features, config.normalize_per_demo);
 
   FeatureRelevanceResult result;
@@ -239,9 +239,9 @@ FeatureRelevanceResult compute_feature_relevance(const std::vector<FeatureMatrix
     for (std::size_t d = 0; d < num_demos; ++d)
       fr.constant = fr.constant && signals.constant_in[d][f];
   }
-  align_pairs(signals, config, result);
-  score_features(result);
-  select_features(result, config.threshold);
+  alignPairs(signals, config, result);
+  scoreFeatures(result);
+  selectFeatures(result, config.threshold);
   return result;
 }
 

@@ -38,8 +38,8 @@ std::string describe(const std::string& what, std::size_t d) {
 }
 
 // State features that move in at least one demo.
-std::vector<std::string> moving_states(const std::vector<FeatureMatrix>& demos,
-                                       const std::vector<std::string>& states) {
+std::vector<std::string> movingStates(const std::vector<FeatureMatrix>& demos,
+                                      const std::vector<std::string>& states) {
   std::vector<std::string> out;
   for (const std::string& name : states) {
     for (const FeatureMatrix& demo : demos) {
@@ -55,8 +55,8 @@ std::vector<std::string> moving_states(const std::vector<FeatureMatrix>& demos,
 
 // The moving state features of every demo, each divided by its largest range over the task, so
 // that DTW and the speed weigh a joint angle and a position alike.
-std::vector<Eigen::MatrixXd> scaled_states(const std::vector<FeatureMatrix>& demos,
-                                           const std::vector<std::string>& names) {
+std::vector<Eigen::MatrixXd> scaledStates(const std::vector<FeatureMatrix>& demos,
+                                          const std::vector<std::string>& names) {
   std::vector<Eigen::MatrixXd> out;
   for (const FeatureMatrix& demo : demos) out.push_back(demo.select(names).data);
   for (Eigen::Index c = 0; c < static_cast<Eigen::Index>(names.size()); ++c) {
@@ -72,9 +72,9 @@ std::vector<Eigen::MatrixXd> scaled_states(const std::vector<FeatureMatrix>& dem
 // Per sensor, how far its channels are from their level at the demo's start (the norm over the
 // channels), divided by the largest such distance over the task: which pad or which axis feels a
 // contact may differ between demos, that a contact is felt does not.
-std::vector<Eigen::MatrixXd> sensor_magnitudes(const std::vector<FeatureMatrix>& demos,
-                                               const std::vector<std::string>& names,
-                                               const std::vector<std::size_t>& groups) {
+std::vector<Eigen::MatrixXd> sensorMagnitudes(const std::vector<FeatureMatrix>& demos,
+                                              const std::vector<std::string>& names,
+                                              const std::vector<std::size_t>& groups) {
   const std::size_t sensors =
       groups.empty() ? 0 : *std::max_element(groups.begin(), groups.end()) + 1;
   std::vector<Eigen::MatrixXd> out;
@@ -99,7 +99,7 @@ std::vector<Eigen::MatrixXd> sensor_magnitudes(const std::vector<FeatureMatrix>&
 // Each feature over its own range in this demo (at least half its range over the task, so that
 // a feature this demo barely moves is not blown up to noise): demos toward other goals move to
 // other places, and the alignment should follow the shape of the motion, as II-B's DTW does.
-Eigen::MatrixXd own_shape(const Eigen::MatrixXd& scaled) {
+Eigen::MatrixXd ownShape(const Eigen::MatrixXd& scaled) {
   Eigen::MatrixXd out = scaled;
   for (Eigen::Index c = 0; c < out.cols(); ++c) {
     const double lo = out.col(c).minCoeff(), range = out.col(c).maxCoeff() - lo;
@@ -120,7 +120,7 @@ double percentile95(const Eigen::VectorXd& values) {
 // weighing as much as all the state features together: they stand still through a pause, and
 // only the speed says where motion resumes; a phase is a motion between pauses more than a
 // place.
-Eigen::MatrixXd with_speed(const Eigen::MatrixXd& states, const Eigen::VectorXd& speed) {
+Eigen::MatrixXd withSpeed(const Eigen::MatrixXd& states, const Eigen::VectorXd& speed) {
   Eigen::MatrixXd out(states.rows(), states.cols() + 1);
   out.leftCols(states.cols()) = states;
   const double typical = percentile95(speed);
@@ -130,17 +130,17 @@ Eigen::MatrixXd with_speed(const Eigen::MatrixXd& states, const Eigen::VectorXd&
   return out;
 }
 
-std::vector<double> clock_of(const FeatureMatrix& demo) {
+std::vector<double> clockOf(const FeatureMatrix& demo) {
   std::vector<double> t(static_cast<std::size_t>(demo.rows()));
-  for (Eigen::Index i = 0; i < demo.rows(); ++i) t[static_cast<std::size_t>(i)] = demo.time_at(i);
+  for (Eigen::Index i = 0; i < demo.rows(); ++i) t[static_cast<std::size_t>(i)] = demo.timeAt(i);
   return t;
 }
 
-std::size_t sample_at(const FeatureMatrix& demo, double grid_row, double step) {
-  const double t = demo.time_at(0) + grid_row * step;
+std::size_t sampleAt(const FeatureMatrix& demo, double grid_row, double step) {
+  const double t = demo.timeAt(0) + grid_row * step;
   std::size_t i = 0;
   while (i + 1 < static_cast<std::size_t>(demo.rows()) &&
-         demo.time_at(static_cast<Eigen::Index>(i + 1)) <= t)
+         demo.timeAt(static_cast<Eigen::Index>(i + 1)) <= t)
     ++i;
   return i;
 }
@@ -149,8 +149,8 @@ std::size_t sample_at(const FeatureMatrix& demo, double grid_row, double step) {
 // after DTW, clipped to [0, 1]): a wrist that turns a little at random in each demo would
 // otherwise hide the pauses from the speed and mislead the alignment. All 1 without II-B (one
 // demo).
-Eigen::VectorXd consistency_weights(const SegmentationPipelineResult& result,
-                                    const std::vector<std::string>& states) {
+Eigen::VectorXd consistencyWeights(const SegmentationPipelineResult& result,
+                                   const std::vector<std::string>& states) {
   Eigen::VectorXd weights = Eigen::VectorXd::Ones(static_cast<Eigen::Index>(states.size()));
   if (!result.relevance_computed) return weights;
   for (std::size_t c = 0; c < states.size(); ++c)
@@ -177,11 +177,11 @@ double correlation(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
 // arm's tracking error, or a wrist F/T feeling the hand's inertia, rises and falls with every
 // motion: its "contacts" are the motion's starts and stops, which the motion evidence already
 // holds. Pooled over the demos, per sensor.
-SensorSelection contact_sensors(const std::vector<std::string>& names,
-                                const std::vector<std::size_t>& groups,
-                                const std::vector<Eigen::MatrixXd>& magnitudes,
-                                const std::vector<Eigen::VectorXd>& speeds, double max_correlation,
-                                std::vector<std::string>* warnings) {
+SensorSelection contactSensors(const std::vector<std::string>& names,
+                               const std::vector<std::size_t>& groups,
+                               const std::vector<Eigen::MatrixXd>& magnitudes,
+                               const std::vector<Eigen::VectorXd>& speeds, double max_correlation,
+                               std::vector<std::string>* warnings) {
   SensorSelection out;
   std::vector<bool> keep;
   for (Eigen::Index g = 0; g < (magnitudes.empty() ? 0 : magnitudes[0].cols()); ++g) {
@@ -221,16 +221,16 @@ SensorSelection contact_sensors(const std::vector<std::string>& names,
 
 // Per demo, where a contact sensor repeated one reading although it has noise (stale_readings.hpp):
 // the union over the sensors, each reported.
-std::vector<std::vector<SampleSpan>> stale_contact_readings(const std::vector<FeatureMatrix>& demos,
-                                                            const SensorSelection& contact,
-                                                            double min_seconds,
-                                                            std::vector<std::string>* warnings) {
+std::vector<std::vector<SampleSpan>> staleContactReadings(const std::vector<FeatureMatrix>& demos,
+                                                          const SensorSelection& contact,
+                                                          double min_seconds,
+                                                          std::vector<std::string>* warnings) {
   std::vector<std::vector<SampleSpan>> out(demos.size());
   if (!(min_seconds > 0.0) || contact.names.empty()) return out;
   std::vector<std::size_t> min_samples;
   for (const FeatureMatrix& demo : demos)
     min_samples.push_back(std::max<std::size_t>(
-        2, static_cast<std::size_t>(std::lround(min_seconds * sample_rate_of(demo)))));
+        2, static_cast<std::size_t>(std::lround(min_seconds * sampleRateOf(demo)))));
   const std::size_t sensors = *std::max_element(contact.groups.begin(), contact.groups.end()) + 1;
   for (std::size_t g = 0; g < sensors; ++g) {
     std::vector<std::string> names;
@@ -238,7 +238,7 @@ std::vector<std::vector<SampleSpan>> stale_contact_readings(const std::vector<Fe
       if (contact.groups[c] == g) names.push_back(contact.names[c]);
     std::vector<Eigen::MatrixXd> channels;
     for (const FeatureMatrix& demo : demos) channels.push_back(demo.select(names).data);
-    const auto stale = stale_readings(channels, min_samples);
+    const auto stale = staleReadings(channels, min_samples);
     for (std::size_t d = 0; d < demos.size(); ++d) {
       for (const SampleSpan& s : stale[d]) {
         if (s.begin == 0 && s.end == static_cast<std::size_t>(demos[d].rows())) continue;  // dead
@@ -246,8 +246,8 @@ std::vector<std::vector<SampleSpan>> stale_contact_readings(const std::vector<Fe
         std::ostringstream msg;
         msg.precision(3);
         msg << "sensor " << names.front() << (names.size() > 1 ? ", ..." : "")
-            << " repeats one reading from " << demos[d].time_at(static_cast<Eigen::Index>(s.begin))
-            << " s to " << demos[d].time_at(static_cast<Eigen::Index>(s.end - 1))
+            << " repeats one reading from " << demos[d].timeAt(static_cast<Eigen::Index>(s.begin))
+            << " s to " << demos[d].timeAt(static_cast<Eigen::Index>(s.end - 1))
             << " s (a driver's cached value?): its events there are not used";
         warnings->push_back(describe(msg.str(), d));
       }
@@ -257,8 +257,8 @@ std::vector<std::vector<SampleSpan>> stale_contact_readings(const std::vector<Fe
 }
 
 // Drops the events within `margin` samples of a stale stretch: the sensor wakes up there.
-void drop_stale_events(const std::vector<SampleSpan>& stale, std::size_t margin,
-                       SensorEvents* events) {
+void dropStaleEvents(const std::vector<SampleSpan>& stale, std::size_t margin,
+                     SensorEvents* events) {
   const auto stale_at = [&](std::size_t index) {
     return std::any_of(stale.begin(), stale.end(), [&](const SampleSpan& s) {
       return index + margin >= s.begin && index <= s.end + margin;
@@ -272,43 +272,43 @@ void drop_stale_events(const std::vector<SampleSpan>& stale, std::size_t margin,
 }
 
 // A demo's evidence of every kind, and its features and speed on the alignment grid.
-void gather_evidence(const FeatureMatrix& demo, const Eigen::MatrixXd& scaled,
-                     const Eigen::VectorXd& consistency, const Eigen::VectorXd& speed,
-                     const Eigen::MatrixXd& scaled_sensors, const SegmentationPipelineResult& base,
-                     const SensorSelection& contact, const std::vector<SampleSpan>& stale,
-                     const SegmentationPipelineConfig& config, DemoSegmentationResult* out,
-                     DemoEvidence* evidence, Eigen::MatrixXd* grid) {
+void gatherEvidence(const FeatureMatrix& demo, const Eigen::MatrixXd& scaled,
+                    const Eigen::VectorXd& consistency, const Eigen::VectorXd& speed,
+                    const Eigen::MatrixXd& scaled_sensors, const SegmentationPipelineResult& base,
+                    const SensorSelection& contact, const std::vector<SampleSpan>& stale,
+                    const SegmentationPipelineConfig& config, DemoSegmentationResult* out,
+                    DemoEvidence* evidence, Eigen::MatrixXd* grid) {
   const JointSegmentationConfig& joint = config.joint;
-  const double rate = sample_rate_of(demo);
-  SegmentationPipelineConfig own = in_samples(config, rate);
+  const double rate = sampleRateOf(demo);
+  SegmentationPipelineConfig own = inSamples(config, rate);
   if (joint.event_merge_gap > 0)
     own.events.merge_gap = static_cast<std::size_t>(std::lround(joint.event_merge_gap * rate));
   out->num_samples = static_cast<std::size_t>(demo.rows());
   out->sample_rate = rate;
-  out->clasp = segment_multivariate(demo.select(base.selected_features).data, base.feature_weights,
-                                    own.segmentation);
+  out->clasp = segmentMultivariate(demo.select(base.selected_features).data, base.feature_weights,
+                                   own.segmentation);
   out->min_segment_length = out->clasp.min_segment_length;
   std::vector<BoundaryEvidence>& pieces = evidence->pieces;
-  pieces = clasp_evidence(out->clasp, joint.weights.clasp);
+  pieces = claspEvidence(out->clasp, joint.weights.clasp);
   if (!contact.names.empty()) {
     SensorEvents events =
-        detect_sensor_events(demo.select(contact.names).data, own.events, contact.groups);
-    drop_stale_events(stale, own.events.difference_lag, &events);
+        detectSensorEvents(demo.select(contact.names).data, own.events, contact.groups);
+    dropStaleEvents(stale, own.events.difference_lag, &events);
     out->events = events.all;
     out->event_details = events.details;
-    const auto s = sensory_evidence(events, joint.weights,
-                                    static_cast<std::size_t>(std::lround(joint.ramp_fold * rate)));
+    const auto s = sensoryEvidence(events, joint.weights,
+                                   static_cast<std::size_t>(std::lround(joint.ramp_fold * rate)));
     pieces.insert(pieces.end(), s.begin(), s.end());
   }
-  const std::vector<double> clock = clock_of(demo);
-  const std::vector<Pause> pauses = find_pauses(speed, clock, joint.pauses);
+  const std::vector<double> clock = clockOf(demo);
+  const std::vector<Pause> pauses = findPauses(speed, clock, joint.pauses);
   const auto m =
-      motion_onset_evidence(speed, clock, pauses, joint.pauses, joint.weights.motion_onset);
+      motionOnsetEvidence(speed, clock, pauses, joint.pauses, joint.weights.motion_onset);
   pieces.insert(pieces.end(), m.begin(), m.end());
-  const auto stops = motion_stop_evidence(speed, clock, joint.pauses, joint.weights.motion_stop);
+  const auto stops = motionStopEvidence(speed, clock, joint.pauses, joint.weights.motion_stop);
   pieces.insert(pieces.end(), stops.begin(), stops.end());
-  gather_into_pauses(pauses, out->num_samples,
-                     static_cast<std::size_t>(std::lround(joint.colocation * rate)), &pieces);
+  gatherIntoPauses(pauses, out->num_samples,
+                   static_cast<std::size_t>(std::lround(joint.colocation * rate)), &pieces);
   for (const BoundaryEvidence& p : pieces)
     evidence->grid_rows.push_back((clock[p.index] - clock.front()) / joint.grid_step);
   evidence->claimed.assign(pieces.size(), false);
@@ -317,14 +317,13 @@ void gather_evidence(const FeatureMatrix& demo, const Eigen::MatrixXd& scaled,
   // A sensor weighs as much as the state features together, as the speed does: where contact
   // begins and ends is the surest landmark two demos share.
   const double weight = std::sqrt(static_cast<double>(std::max<Eigen::Index>(1, scaled.cols())));
-  aligned << with_speed(own_shape(scaled) * consistency.asDiagonal(), speed),
-      weight * scaled_sensors;
-  *grid = on_uniform_grid(aligned, clock, joint.grid_step);
+  aligned << withSpeed(ownShape(scaled) * consistency.asDiagonal(), speed), weight * scaled_sensors;
+  *grid = onUniformGrid(aligned, clock, joint.grid_step);
 }
 
 // Noisy-OR of a demo's unclaimed evidence around each reference row: how sure this demo is that
 // a boundary lies there.
-Eigen::VectorXd demo_support(const DemoEvidence& e, Eigen::Index rows, double spread_rows) {
+Eigen::VectorXd demoSupport(const DemoEvidence& e, Eigen::Index rows, double spread_rows) {
   Eigen::VectorXd none = Eigen::VectorXd::Ones(rows);
   const Eigen::Index reach = static_cast<Eigen::Index>(std::ceil(4 * spread_rows));
   for (std::size_t p = 0; p < e.pieces.size(); ++p) {
@@ -343,8 +342,8 @@ Eigen::VectorXd demo_support(const DemoEvidence& e, Eigen::Index rows, double sp
 // The support a boundary needs at `distance` rows from its nearest anchor: min_support beyond
 // min_segment, rising linearly to short_phase_support as it comes closer (a prior on the
 // length of a phase, not a wall).
-double needed_support(double distance, const JointSegmentationConfig& config,
-                      double min_segment_rows) {
+double neededSupport(double distance, const JointSegmentationConfig& config,
+                     double min_segment_rows) {
   if (distance >= min_segment_rows) return config.min_support;
   return config.min_support +
          (config.short_phase_support - config.min_support) * (1.0 - distance / min_segment_rows);
@@ -352,8 +351,8 @@ double needed_support(double distance, const JointSegmentationConfig& config,
 
 // The best supported peak that may join the anchors (it reaches the support its distance to
 // them needs); -1 when none.
-double next_boundary(const Eigen::VectorXd& support, const std::vector<Anchor>& anchors,
-                     const JointSegmentationConfig& config, double min_segment_rows) {
+double nextBoundary(const Eigen::VectorXd& support, const std::vector<Anchor>& anchors,
+                    const JointSegmentationConfig& config, double min_segment_rows) {
   double best_row = -1.0, best = 0.0;
   for (Eigen::Index r = 1; r + 1 < support.size(); ++r) {
     const double s = support[r];
@@ -361,7 +360,7 @@ double next_boundary(const Eigen::VectorXd& support, const std::vector<Anchor>& 
     double distance = min_segment_rows;
     for (const Anchor& a : anchors)
       distance = std::min(distance, std::abs(a.reference_row - static_cast<double>(r)));
-    if (s < needed_support(distance, config, min_segment_rows)) continue;
+    if (s < neededSupport(distance, config, min_segment_rows)) continue;
     best = s;
     best_row = static_cast<double>(r);
   }
@@ -378,7 +377,7 @@ struct PlacementRows {
 
 // How sharply a kind of evidence times a change: a sensor's rest edge to a sample, a pause's
 // end closely, ClaSP only to within its window.
-int timing_precision(EvidenceKind kind) {
+int timingPrecision(EvidenceKind kind) {
   switch (kind) {
     case EvidenceKind::kContact:
       return 4;
@@ -399,7 +398,7 @@ int timing_precision(EvidenceKind kind) {
 // being the noisy-OR of the unclaimed pieces at its place (a contact and a ClaSP changepoint at
 // one instant reinforce each other) times its closeness to u. -1 when there is none.
 // Noisy-OR of the unclaimed pieces of a demo within colocation_rows of piece p.
-double colocated_strength(const DemoEvidence& e, std::size_t p, double colocation_rows) {
+double colocatedStrength(const DemoEvidence& e, std::size_t p, double colocation_rows) {
   double none = 1.0;
   for (std::size_t q = 0; q < e.pieces.size(); ++q)
     if (!e.claimed[q] && std::abs(e.grid_rows[q] - e.grid_rows[p]) <= colocation_rows)
@@ -429,8 +428,8 @@ long sharpen(const DemoEvidence& e, long chosen, double spread_rows, double min_
   return best;
 }
 
-long best_piece(const DemoEvidence& e, double u, const PlacementRows& rows, double after_row,
-                double before_row) {
+long bestPiece(const DemoEvidence& e, double u, const PlacementRows& rows, double after_row,
+               double before_row) {
   long best = -1;
   double best_score = 0.0;
   for (std::size_t p = 0; p < e.pieces.size(); ++p) {
@@ -438,13 +437,13 @@ long best_piece(const DemoEvidence& e, double u, const PlacementRows& rows, doub
     if (e.claimed[p] || distance > rows.window || e.grid_rows[p] <= after_row ||
         e.grid_rows[p] >= before_row)
       continue;
-    const double strength = colocated_strength(e, p, rows.colocation);
+    const double strength = colocatedStrength(e, p, rows.colocation);
     if (strength < rows.min_weight) continue;
     const double none = 1.0 - strength;
     const double z = distance / rows.spread;
     // Among pieces of equal support, the one whose kind times a change best places it.
     const double score =
-        (1.0 - none) * std::exp(-0.5 * z * z) + 1e-3 * timing_precision(e.pieces[p].kind);
+        (1.0 - none) * std::exp(-0.5 * z * z) + 1e-3 * timingPrecision(e.pieces[p].kind);
     if (score > best_score) {
       best_score = score;
       best = static_cast<long>(p);
@@ -454,8 +453,8 @@ long best_piece(const DemoEvidence& e, double u, const PlacementRows& rows, doub
 }
 
 // The demo's grid rows of the anchors before and after reference row u (or its ends).
-std::pair<double, double> neighbouring_rows(const std::vector<Anchor>& anchors, std::size_t d,
-                                            double u, double demo_rows) {
+std::pair<double, double> neighbouringRows(const std::vector<Anchor>& anchors, std::size_t d,
+                                           double u, double demo_rows) {
   double after = -1.0, before = demo_rows;
   for (const Anchor& a : anchors) {
     if (a.piece[d] < 0) continue;
@@ -467,11 +466,11 @@ std::pair<double, double> neighbouring_rows(const std::vector<Anchor>& anchors, 
 }
 
 // "contact+clasp": the kinds of the demo's pieces at the chosen piece's place.
-std::string evidence_kinds(const DemoEvidence& e, std::size_t chosen, double colocation_rows) {
+std::string evidenceKinds(const DemoEvidence& e, std::size_t chosen, double colocation_rows) {
   std::vector<std::string> kinds;
   for (std::size_t p = 0; p < e.pieces.size(); ++p) {
     if (std::abs(e.grid_rows[p] - e.grid_rows[chosen]) > colocation_rows) continue;
-    const std::string k = to_string(e.pieces[p].kind);
+    const std::string k = toString(e.pieces[p].kind);
     if (std::find(kinds.begin(), kinds.end(), k) == kinds.end()) kinds.push_back(k);
   }
   std::string out;
@@ -492,7 +491,7 @@ class JointAgreement {
         window_rows_(config.match_window / config.grid_step),
         colocation_rows_(config.colocation / config.grid_step),
         threads_(threads) {
-    const DemoAlignment alignment = align_to_medoid(grids_, threads_, config_.alignment_band);
+    const DemoAlignment alignment = alignToMedoid(grids_, threads_, config_.alignment_band);
     reference_ = alignment.reference;
     to_reference_ = alignment.to_reference;
     from_reference_ = alignment.from_reference;
@@ -501,38 +500,38 @@ class JointAgreement {
   // Adds agreed boundaries, best supported first, re-aligning between them after each.
   void run(std::size_t max_boundaries) {
     while (anchors_.size() < max_boundaries) {
-      map_evidence();
-      const double u = next_boundary(support(), anchors_, config_, min_segment_rows_);
+      mapEvidence();
+      const double u = nextBoundary(support(), anchors_, config_, min_segment_rows_);
       if (u < 0) break;
-      if (!add_anchor(u)) break;
+      if (!addAnchor(u)) break;
       realign();
-      map_evidence();
-      retry_missing();
+      mapEvidence();
+      retryMissing();
     }
-    map_evidence();
+    mapEvidence();
   }
 
   const std::vector<Anchor>& anchors() const { return anchors_; }
   const DemoEvidence& evidence(std::size_t d) const { return evidence_[d]; }
-  double expected_row(std::size_t d, double reference_row) const {
-    return map_row(from_reference_[d], reference_row);
+  double expectedRow(std::size_t d, double reference_row) const {
+    return mapRow(from_reference_[d], reference_row);
   }
-  double colocation_rows() const { return colocation_rows_; }
-  double window_rows() const { return window_rows_; }
+  double colocationRows() const { return colocation_rows_; }
+  double windowRows() const { return window_rows_; }
 
  private:
-  void map_evidence() {
+  void mapEvidence() {
     for (DemoEvidence& e : evidence_) e.reference_rows.clear();
     for (std::size_t d = 0; d < evidence_.size(); ++d)
       for (double row : evidence_[d].grid_rows)
-        evidence_[d].reference_rows.push_back(map_row(to_reference_[d], row));
+        evidence_[d].reference_rows.push_back(mapRow(to_reference_[d], row));
   }
 
   Eigen::VectorXd support() const {
     const Eigen::Index rows = grids_[reference_].rows();
     Eigen::VectorXd s = Eigen::VectorXd::Zero(rows);
     for (const DemoEvidence& e : evidence_)
-      s += demo_support(e, rows, spread_rows_) / static_cast<double>(evidence_.size());
+      s += demoSupport(e, rows, spread_rows_) / static_cast<double>(evidence_.size());
     // Support above the background: evidence that is everywhere (a contact force varying all
     // along a wipe, in every demo at other times) supports every instant alike and so none.
     const double background = s.mean();
@@ -544,7 +543,7 @@ class JointAgreement {
   // Adds the boundary and places it in every demo; false (and nothing added) when no demo has
   // a piece for it (the support came from pieces the order forbids), so the search stops rather
   // than loop.
-  bool add_anchor(double u) {
+  bool addAnchor(double u) {
     Anchor a;
     a.reference_row = u;
     a.piece.assign(evidence_.size(), -1);
@@ -563,8 +562,8 @@ class JointAgreement {
   // Places anchor `a` in demo d on its best piece between the demo's neighbouring anchors.
   bool place(Anchor* a, std::size_t d) {
     const double rows = static_cast<double>(grids_[d].rows());
-    const auto [after, before] = neighbouring_rows(anchors_, d, a->reference_row, rows);
-    const long p = best_piece(
+    const auto [after, before] = neighbouringRows(anchors_, d, a->reference_row, rows);
+    const long p = bestPiece(
         evidence_[d], a->reference_row,
         {window_rows_, spread_rows_, colocation_rows_, config_.min_piece_weight}, after, before);
     if (p < 0) return false;
@@ -578,7 +577,7 @@ class JointAgreement {
 
   // A demo that had no piece for a boundary may have one once the alignment holds at the other
   // boundaries.
-  void retry_missing() {
+  void retryMissing() {
     for (Anchor& a : anchors_)
       for (std::size_t d = 0; d < evidence_.size(); ++d)
         if (a.piece[d] < 0) place(&a, d);
@@ -594,7 +593,7 @@ class JointAgreement {
   // The alignment of every demo, held at the boundaries placed in it (a boundary the demo lacks
   // says nothing of where it would be).
   void realign() {
-    parallel_for(evidence_.size(), threads_, [&](std::size_t d) {
+    parallelFor(evidence_.size(), threads_, [&](std::size_t d) {
       if (d == reference_) return;
       std::vector<std::size_t> own, reference_rows;
       for (const Anchor& a : anchors_) {
@@ -602,10 +601,10 @@ class JointAgreement {
         own.push_back(a.demo_row[d]);
         reference_rows.push_back(static_cast<std::size_t>(std::lround(a.reference_row)));
       }
-      to_reference_[d] = anchored_dtw_map(grids_[d], grids_[reference_], own, reference_rows,
+      to_reference_[d] = anchoredDtwMap(grids_[d], grids_[reference_], own, reference_rows,
+                                        config_.alignment_band);
+      from_reference_[d] = anchoredDtwMap(grids_[reference_], grids_[d], reference_rows, own,
                                           config_.alignment_band);
-      from_reference_[d] = anchored_dtw_map(grids_[reference_], grids_[d], reference_rows, own,
-                                            config_.alignment_band);
     });
   }
 
@@ -619,23 +618,23 @@ class JointAgreement {
   std::vector<Anchor> anchors_;
 };
 
-std::string seconds_after_start(const FeatureMatrix& demo, std::size_t index) {
+std::string secondsAfterStart(const FeatureMatrix& demo, std::size_t index) {
   std::ostringstream out;
   out.precision(3);
-  out << demo.time_at(static_cast<Eigen::Index>(index)) - demo.time_at(0) << " s";
+  out << demo.timeAt(static_cast<Eigen::Index>(index)) - demo.timeAt(0) << " s";
   return out.str();
 }
 
 // The demo's changepoints, zones (the match windows), and what it lacks or has in excess.
-void report_demo(const JointAgreement& agreement, const FeatureMatrix& demo, std::size_t d,
-                 const JointSegmentationConfig& config, DemoSegmentationResult* out,
-                 std::vector<std::string>* warnings) {
+void reportDemo(const JointAgreement& agreement, const FeatureMatrix& demo, std::size_t d,
+                const JointSegmentationConfig& config, DemoSegmentationResult* out,
+                std::vector<std::string>* warnings) {
   const DemoEvidence& e = agreement.evidence(d);
   const std::size_t half = static_cast<std::size_t>(config.match_window * out->sample_rate);
   const auto& anchors = agreement.anchors();
   for (std::size_t k = 0; k < anchors.size(); ++k) {
     const std::size_t expected =
-        sample_at(demo, agreement.expected_row(d, anchors[k].reference_row), config.grid_step);
+        sampleAt(demo, agreement.expectedRow(d, anchors[k].reference_row), config.grid_step);
     out->zones.push_back(
         {expected > half ? expected - half : 0, std::min(expected + half, out->num_samples - 1)});
     const long p = anchors[k].piece[d];
@@ -643,21 +642,21 @@ void report_demo(const JointAgreement& agreement, const FeatureMatrix& demo, std
       warnings->push_back(describe(
           "no evidence of boundary " + std::to_string(k + 1) + " of " +
               std::to_string(anchors.size()) + " (the others agree on it near " +
-              seconds_after_start(demo, expected) + "): this demonstration may lack that phase",
+              secondsAfterStart(demo, expected) + "): this demonstration may lack that phase",
           d));
       continue;
     }
     out->changepoints.push_back(e.pieces[static_cast<std::size_t>(p)].index);
     out->changepoint_evidence.push_back(
-        evidence_kinds(e, static_cast<std::size_t>(p), agreement.colocation_rows()));
+        evidenceKinds(e, static_cast<std::size_t>(p), agreement.colocationRows()));
   }
   std::vector<std::string> extra;
   for (std::size_t p = 0; p < e.pieces.size(); ++p) {
     if (e.claimed[p]) continue;
     out->rejected.push_back(e.pieces[p].index);
     if (e.pieces[p].weight >= config.extra_event_weight)
-      extra.push_back(to_string(e.pieces[p].kind) + " at " +
-                      seconds_after_start(demo, e.pieces[p].index));
+      extra.push_back(toString(e.pieces[p].kind) + " at " +
+                      secondsAfterStart(demo, e.pieces[p].index));
   }
   if (!extra.empty()) {
     std::string list;
@@ -671,16 +670,16 @@ void report_demo(const JointAgreement& agreement, const FeatureMatrix& demo, std
   std::sort(out->rejected.begin(), out->rejected.end());
   out->rejected.erase(std::unique(out->rejected.begin(), out->rejected.end()), out->rejected.end());
   for (std::size_t cp : out->changepoints)
-    out->changepoint_times.push_back(demo.time_at(static_cast<Eigen::Index>(cp)));
+    out->changepoint_times.push_back(demo.timeAt(static_cast<Eigen::Index>(cp)));
   for (std::size_t cp : out->rejected)
-    out->rejected_times.push_back(demo.time_at(static_cast<Eigen::Index>(cp)));
+    out->rejected_times.push_back(demo.timeAt(static_cast<Eigen::Index>(cp)));
 }
 
 }  // namespace
 
-SegmentationPipelineResult segment_jointly(const PreparedSegmentation& prepared,
-                                           const std::vector<FeatureMatrix>& demos,
-                                           const SegmentationPipelineConfig& config) {
+SegmentationPipelineResult segmentJointly(const PreparedSegmentation& prepared,
+                                          const std::vector<FeatureMatrix>& demos,
+                                          const SegmentationPipelineConfig& config) {
   if (!config.seconds)
     throw std::invalid_argument(
         "the joint segmentation needs its time parameters in seconds (demos with a clock)");
@@ -688,34 +687,34 @@ SegmentationPipelineResult segment_jointly(const PreparedSegmentation& prepared,
   SegmentationPipelineResult result = prepared.base;
   const std::size_t n = demos.size();
   result.demos.resize(n);
-  const std::vector<std::string> states = moving_states(demos, result.state_features);
-  const std::vector<Eigen::MatrixXd> scaled = scaled_states(demos, states);
-  const Eigen::VectorXd consistency = consistency_weights(result, states);
-  const std::vector<std::size_t> groups = sensor_channel_groups(result.sensor_features);
+  const std::vector<std::string> states = movingStates(demos, result.state_features);
+  const std::vector<Eigen::MatrixXd> scaled = scaledStates(demos, states);
+  const Eigen::VectorXd consistency = consistencyWeights(result, states);
+  const std::vector<std::size_t> groups = sensorChannelGroups(result.sensor_features);
   const bool sensors = !result.sensor_features.empty() && config.validate_with_sensors;
   const std::vector<Eigen::MatrixXd> scaled_sensors =
-      sensor_magnitudes(demos, sensors ? result.sensor_features : std::vector<std::string>{},
-                        sensors ? groups : std::vector<std::size_t>{});
+      sensorMagnitudes(demos, sensors ? result.sensor_features : std::vector<std::string>{},
+                       sensors ? groups : std::vector<std::size_t>{});
 
   std::vector<Eigen::VectorXd> speeds(n);
-  parallel_for(n, config.threads, [&](std::size_t d) {
-    speeds[d] = state_speed(scaled[d] * consistency.asDiagonal(), clock_of(demos[d]),
-                            config.joint.pauses.smoothing);
+  parallelFor(n, config.threads, [&](std::size_t d) {
+    speeds[d] = stateSpeed(scaled[d] * consistency.asDiagonal(), clockOf(demos[d]),
+                           config.joint.pauses.smoothing);
   });
   const SensorSelection contact =
-      sensors ? contact_sensors(result.sensor_features, groups, scaled_sensors, speeds,
-                                config.joint.max_speed_correlation, &result.warnings)
+      sensors ? contactSensors(result.sensor_features, groups, scaled_sensors, speeds,
+                               config.joint.max_speed_correlation, &result.warnings)
               : SensorSelection{};
 
   const std::vector<std::vector<SampleSpan>> stale =
-      stale_contact_readings(demos, contact, config.joint.stale_reading, &result.warnings);
+      staleContactReadings(demos, contact, config.joint.stale_reading, &result.warnings);
 
   std::vector<DemoEvidence> evidence(n);
   std::vector<Eigen::MatrixXd> grids(n);
-  parallel_for(n, config.threads, [&](std::size_t d) {
+  parallelFor(n, config.threads, [&](std::size_t d) {
     try {
-      gather_evidence(demos[d], scaled[d], consistency, speeds[d], scaled_sensors[d], result,
-                      contact, stale[d], config, &result.demos[d], &evidence[d], &grids[d]);
+      gatherEvidence(demos[d], scaled[d], consistency, speeds[d], scaled_sensors[d], result,
+                     contact, stale[d], config, &result.demos[d], &evidence[d], &grids[d]);
     } catch (const std::invalid_argument& e) {
       throw std::invalid_argument(describe(e.what(), d));
     }
@@ -724,8 +723,8 @@ SegmentationPipelineResult segment_jointly(const PreparedSegmentation& prepared,
                            config.seconds->min_segment, config.threads);
   agreement.run(config.segmentation.max_changepoints);
   for (std::size_t d = 0; d < n; ++d)
-    report_demo(agreement, demos[d], d, config.joint, &result.demos[d], &result.warnings);
-  add_sensor_warnings(demos, sensors, &result);
+    reportDemo(agreement, demos[d], d, config.joint, &result.demos[d], &result.warnings);
+  addSensorWarnings(demos, sensors, &result);
   result.segmentation_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;

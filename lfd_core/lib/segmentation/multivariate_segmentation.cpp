@@ -36,13 +36,13 @@ namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
-bool is_weighted(ProfileCombination c) {
+bool isWeighted(ProfileCombination c) {
   return c == ProfileCombination::kWeightedAverage || c == ProfileCombination::kWeightedProduct ||
          c == ProfileCombination::kWeightedDistanceAverage;
 }
 
-void check_inputs(const Eigen::MatrixXd& features, const std::vector<double>& weights,
-                  const MultivariateSegmentationConfig& config) {
+void checkInputs(const Eigen::MatrixXd& features, const std::vector<double>& weights,
+                 const MultivariateSegmentationConfig& config) {
   const std::size_t num_features = static_cast<std::size_t>(features.cols());
   if (num_features == 0) throw std::invalid_argument("segment_multivariate: no feature columns");
   if (!features.allFinite())
@@ -63,31 +63,31 @@ void check_inputs(const Eigen::MatrixXd& features, const std::vector<double>& we
 }
 
 // The window of one feature: fixed by the config, or chosen on the whole demonstration.
-std::size_t window_of(const Eigen::Ref<const Eigen::VectorXd>& column, std::size_t f,
-                      const MultivariateSegmentationConfig& config) {
+std::size_t windowOf(const Eigen::Ref<const Eigen::VectorXd>& column, std::size_t f,
+                     const MultivariateSegmentationConfig& config) {
   if (!config.window_sizes.empty()) return config.window_sizes[f];
   if (config.clasp.window_size) return config.clasp.window_size;
   // Automatic windows are capped at n / 10 so that one slowly varying feature cannot push the
   // automatic min_s (2 x largest window) past what leaves room for a split.
   const std::size_t n = static_cast<std::size_t>(column.size());
   const std::size_t chosen =
-      select_window_size(column, config.clasp.window_selection, config.clasp.min_window);
+      selectWindowSize(column, config.clasp.window_selection, config.clasp.min_window);
   return std::max<std::size_t>(2, std::min(chosen, n / 10));
 }
 
 // The informative features (varying, positive weight), their windows set in out->window_sizes.
 // A constant feature has no changepoint to offer and would only flatten the combination.
-std::vector<std::size_t> active_features(const Eigen::MatrixXd& features,
-                                         const std::vector<double>& w,
-                                         const MultivariateSegmentationConfig& config,
-                                         MultivariateSegmentation* out) {
+std::vector<std::size_t> activeFeatures(const Eigen::MatrixXd& features,
+                                        const std::vector<double>& w,
+                                        const MultivariateSegmentationConfig& config,
+                                        MultivariateSegmentation* out) {
   const std::size_t n = static_cast<std::size_t>(features.rows());
   std::vector<std::size_t> active;
   for (std::size_t f = 0; f < w.size(); ++f) {
     const auto col = features.col(static_cast<Eigen::Index>(f));
     const double range = n ? col.maxCoeff() - col.minCoeff() : 0.0;
     if (n < 6 || !(range > 1e-12 * (1.0 + col.cwiseAbs().maxCoeff())) || w[f] <= 0.0) continue;
-    out->window_sizes[f] = window_of(col, f, config);
+    out->window_sizes[f] = windowOf(col, f, config);
     if (out->window_sizes[f] < 2)
       throw std::invalid_argument("segment_multivariate: window size of feature " +
                                   std::to_string(f) + " must be >= 2");
@@ -97,9 +97,9 @@ std::vector<std::size_t> active_features(const Eigen::MatrixXd& features,
 }
 
 // min_s: configured, or room for two of the largest windows and at most 20 segments.
-std::size_t min_segment_length(const MultivariateSegmentation& out,
-                               const std::vector<std::size_t>& active, std::size_t n,
-                               const MultivariateSegmentationConfig& config) {
+std::size_t minSegmentLength(const MultivariateSegmentation& out,
+                             const std::vector<std::size_t>& active, std::size_t n,
+                             const MultivariateSegmentationConfig& config) {
   if (config.min_segment_length) return config.min_segment_length;
   std::size_t max_window = 0;
   for (std::size_t f : active) max_window = std::max(max_window, out.window_sizes[f]);
@@ -108,14 +108,14 @@ std::size_t min_segment_length(const MultivariateSegmentation& out,
 
 // The highest penalized score of the range that may be a candidate (in an open zone not yet
 // tested in this range); -1 = none.
-Eigen::Index best_open_sample(const Eigen::VectorXd& penalized, std::size_t begin,
-                              const ZoneGuide& guide, const std::vector<bool>& tested) {
+Eigen::Index bestOpenSample(const Eigen::VectorXd& penalized, std::size_t begin,
+                            const ZoneGuide& guide, const std::vector<bool>& tested) {
   Eigen::Index best = -1;
   for (Eigen::Index t = 0; t < penalized.size(); ++t) {
     if (std::isnan(penalized[t]) || (best >= 0 && penalized[t] <= penalized[best])) continue;
     const std::size_t at = begin + static_cast<std::size_t>(t);
     if (!guide.open(at)) continue;
-    if (guide.restricted() && tested[static_cast<std::size_t>(guide.zone_of(at))]) continue;
+    if (guide.restricted() && tested[static_cast<std::size_t>(guide.zoneOf(at))]) continue;
     best = t;
   }
   return best;
@@ -123,17 +123,17 @@ Eigen::Index best_open_sample(const Eigen::VectorXd& penalized, std::size_t begi
 
 // ClaSP's own evidence (the significance at its argmax) decides whether the zone holds a
 // changepoint; the zone's sensory event then says when (zone_anchors).
-SplitCandidate candidate_at(const RangeProfile& r, std::size_t begin, std::size_t end,
-                            Eigen::Index best, const ZoneGuide& guide) {
+SplitCandidate candidateAt(const RangeProfile& r, std::size_t begin, std::size_t end,
+                           Eigen::Index best, const ZoneGuide& guide) {
   SplitCandidate c;
-  const Eigen::Index anchor = guide.anchor_for(r.penalized, begin, best);
+  const Eigen::Index anchor = guide.anchorFor(r.penalized, begin, best);
   c.index = begin + static_cast<std::size_t>(anchor >= 0 ? anchor : best);
   c.profile_argmax = begin + static_cast<std::size_t>(best);
   c.anchored = anchor >= 0;
   c.range_begin = begin;
   c.range_end = end;
   c.score = r.penalized[best];
-  c.log10_p_value = split_log10_p(r, static_cast<std::size_t>(best));
+  c.log10_p_value = splitLog10P(r, static_cast<std::size_t>(best));
   return c;
 }
 
@@ -149,7 +149,7 @@ class ClaspRecursion {
     const std::size_t max_cps = learn ? std::min(in_.config.max_changepoints, n_ / in_.min_s)
                                       : static_cast<std::size_t>(in_.config.num_changepoints);
     evaluate(0, n_, true);
-    while (!queue_.empty() && out_->changepoints.size() < max_cps) accept_best();
+    while (!queue_.empty() && out_->changepoints.size() < max_cps) acceptBest();
     std::sort(out_->changepoints.begin(), out_->changepoints.end());
   }
 
@@ -163,36 +163,35 @@ class ClaspRecursion {
   // Queues the range's significant candidate, if any.
   void evaluate(std::size_t begin, std::size_t end, bool first) {
     if (end - begin < 2 * in_.min_s + 1) return;
-    const std::optional<RangeProfile> r = range_profile(in_, begin, end - begin);
+    const std::optional<RangeProfile> r = rangeProfile(in_, begin, end - begin);
     if (!r) return;
-    if (first) record_first_profile(*r, out_);
-    const std::optional<std::size_t> chosen = choose_candidate(*r, begin, end);
+    if (first) recordFirstProfile(*r, out_);
+    const std::optional<std::size_t> chosen = chooseCandidate(*r, begin, end);
     if (chosen) queue_.push({out_->candidates[*chosen].score, *chosen});
   }
 
   // Each zone is its own hypothesis: when the best in-zone split of the range is not significant,
   // the range's other zones are still tested (next best first). Every candidate examined is
   // recorded; returns the significant one's index in out_->candidates.
-  std::optional<std::size_t> choose_candidate(const RangeProfile& r, std::size_t begin,
-                                              std::size_t end) {
+  std::optional<std::size_t> chooseCandidate(const RangeProfile& r, std::size_t begin,
+                                             std::size_t end) {
     const bool learn = in_.config.num_changepoints < 0;
-    std::vector<bool> tested = guide_.closed_zones(begin, end, r.penalized);
+    std::vector<bool> tested = guide_.closedZones(begin, end, r.penalized);
     for (;;) {
-      const Eigen::Index best = best_open_sample(r.penalized, begin, guide_, tested);
+      const Eigen::Index best = bestOpenSample(r.penalized, begin, guide_, tested);
       if (best < 0) return std::nullopt;
-      const SplitCandidate c = candidate_at(r, begin, end, best, guide_);
+      const SplitCandidate c = candidateAt(r, begin, end, best, guide_);
       out_->candidates.push_back(c);
-      const bool significant =
-          !(learn && c.log10_p_value > guide_.needed_log10_p(c.profile_argmax));
+      const bool significant = !(learn && c.log10_p_value > guide_.neededLog10P(c.profile_argmax));
       if (significant) return out_->candidates.size() - 1;
       if (!guide_.restricted()) return std::nullopt;  // plain ClaSP: the range stays whole
-      tested[static_cast<std::size_t>(guide_.zone_of(c.profile_argmax))] = true;
+      tested[static_cast<std::size_t>(guide_.zoneOf(c.profile_argmax))] = true;
     }
   }
 
   // Accepts the best queued candidate and searches both halves; a candidate whose zone was taken
   // meanwhile searches its range again instead.
-  void accept_best() {
+  void acceptBest() {
     const std::size_t i = queue_.top().candidate_index;
     queue_.pop();
     const SplitCandidate c = out_->candidates[i];
@@ -215,7 +214,7 @@ class ClaspRecursion {
 
 // The result before any range is searched: no window, NaN combined profiles, zero per-feature
 // ones (a feature left out of the combination keeps its zero profile).
-MultivariateSegmentation empty_result(std::size_t n, std::size_t num_features) {
+MultivariateSegmentation emptyResult(std::size_t n, std::size_t num_features) {
   MultivariateSegmentation out;
   out.window_sizes.assign(num_features, 0);
   out.first_profile = Eigen::VectorXd::Constant(static_cast<Eigen::Index>(n), kNaN);
@@ -227,19 +226,19 @@ MultivariateSegmentation empty_result(std::size_t n, std::size_t num_features) {
 
 }  // namespace
 
-MultivariateSegmentation segment_multivariate(const Eigen::MatrixXd& features,
-                                              const std::vector<double>& weights,
-                                              const MultivariateSegmentationConfig& config) {
-  check_inputs(features, weights, config);
+MultivariateSegmentation segmentMultivariate(const Eigen::MatrixXd& features,
+                                             const std::vector<double>& weights,
+                                             const MultivariateSegmentationConfig& config) {
+  checkInputs(features, weights, config);
   const std::size_t n = static_cast<std::size_t>(features.rows());
   const std::size_t num_features = static_cast<std::size_t>(features.cols());
   // Weights used both for the combination and to average the features' p-values.
   std::vector<double> w(num_features, 1.0);
-  if (is_weighted(config.combination) && !weights.empty()) w = weights;
+  if (isWeighted(config.combination) && !weights.empty()) w = weights;
 
-  MultivariateSegmentation out = empty_result(n, num_features);
-  const std::vector<std::size_t> active = active_features(features, w, config, &out);
-  out.min_segment_length = min_segment_length(out, active, n, config);
+  MultivariateSegmentation out = emptyResult(n, num_features);
+  const std::vector<std::size_t> active = activeFeatures(features, w, config, &out);
+  out.min_segment_length = minSegmentLength(out, active, n, config);
   const std::size_t min_s = std::max<std::size_t>(out.min_segment_length, 1);
   if (active.empty() || n < 2 * min_s + 1) return out;
   const ProfileInputs in{features, w, active, out.window_sizes, min_s, config};

@@ -14,14 +14,14 @@ namespace {
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr double kMinScoreForLog = 1e-12;
 
-bool is_weighted(ProfileCombination c) {
+bool isWeighted(ProfileCombination c) {
   return c == ProfileCombination::kWeightedAverage || c == ProfileCombination::kWeightedProduct ||
          c == ProfileCombination::kWeightedDistanceAverage;
 }
 
 }  // namespace
 
-ProfileCombination parse_profile_combination(const std::string& name) {
+ProfileCombination parseProfileCombination(const std::string& name) {
   if (name == "average") return ProfileCombination::kAverage;
   if (name == "product") return ProfileCombination::kProduct;
   if (name == "weighted_average") return ProfileCombination::kWeightedAverage;
@@ -33,7 +33,7 @@ ProfileCombination parse_profile_combination(const std::string& name) {
                               "distance_average, weighted_distance_average)");
 }
 
-std::string to_string(ProfileCombination combination) {
+std::string toString(ProfileCombination combination) {
   switch (combination) {
     case ProfileCombination::kAverage:
       return "average";
@@ -51,15 +51,15 @@ std::string to_string(ProfileCombination combination) {
   return "?";
 }
 
-Eigen::VectorXd combine_profiles(const std::vector<Eigen::VectorXd>& profiles,
-                                 const std::vector<double>& weights,
-                                 ProfileCombination combination) {
+Eigen::VectorXd combineProfiles(const std::vector<Eigen::VectorXd>& profiles,
+                                const std::vector<double>& weights,
+                                ProfileCombination combination) {
   if (profiles.empty()) throw std::invalid_argument("combine_profiles: no profiles");
   const Eigen::Index n = profiles.front().size();
   for (const auto& p : profiles)
     if (p.size() != n) throw std::invalid_argument("combine_profiles: profiles differ in length");
   std::vector<double> w(profiles.size(), 1.0);
-  if (is_weighted(combination) && !weights.empty()) {
+  if (isWeighted(combination) && !weights.empty()) {
     if (weights.size() != profiles.size())
       throw std::invalid_argument("combine_profiles: " + std::to_string(weights.size()) +
                                   " weights for " + std::to_string(profiles.size()) + " profiles");
@@ -92,7 +92,7 @@ Eigen::VectorXd combine_profiles(const std::vector<Eigen::VectorXd>& profiles,
   return out;
 }
 
-Eigen::VectorXd kaiser_window(std::size_t n, double beta) {
+Eigen::VectorXd kaiserWindow(std::size_t n, double beta) {
   if (!(beta >= 0.0) || !std::isfinite(beta))
     throw std::invalid_argument("kaiser_window: beta must be finite and >= 0");
   Eigen::VectorXd win(static_cast<Eigen::Index>(n));

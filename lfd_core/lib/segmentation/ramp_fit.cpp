@@ -9,7 +9,7 @@
 
 namespace lfd {
 
-RampFit fit_ramp(const std::vector<double>& y, std::size_t begin, std::size_t end) {
+RampFit fitRamp(const std::vector<double>& y, std::size_t begin, std::size_t end) {
   end = std::min(end, y.size());
   if (begin >= end || end - begin < 2)
     throw std::invalid_argument("fit_ramp: the window needs at least 2 samples");

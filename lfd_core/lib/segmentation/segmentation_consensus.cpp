@@ -9,7 +9,7 @@
 namespace lfd {
 namespace {
 
-std::string demo_context(std::size_t d) {
+std::string demoContext(std::size_t d) {
   return "demonstration " + std::to_string(d);
 }
 
@@ -21,7 +21,7 @@ struct Agreement {
   std::size_t count = 0, votes = 0, voters = 0;
 };
 
-Agreement agreed_count(const SegmentationPipelineResult& result, bool validated) {
+Agreement agreedCount(const SegmentationPipelineResult& result, bool validated) {
   std::map<std::size_t, std::size_t> votes;  // changepoint count -> demos
   Agreement a;
   for (const DemoSegmentationResult& d : result.demos) {
@@ -44,17 +44,17 @@ Agreement agreed_count(const SegmentationPipelineResult& result, bool validated)
   return a;
 }
 
-double log10_p_of(const DemoSegmentationResult& d, std::size_t cp) {
+double log10POf(const DemoSegmentationResult& d, std::size_t cp) {
   for (const SplitCandidate& c : d.clasp.candidates)
     if (c.accepted && c.index == cp) return c.log10_p_value;
   return 0.0;
 }
 
 // A demo with more changepoints than agreed keeps its `k` most significant.
-void prune_to(std::size_t k, const FeatureMatrix& demo, DemoSegmentationResult* out,
-              std::ostringstream* msg) {
+void pruneTo(std::size_t k, const FeatureMatrix& demo, DemoSegmentationResult* out,
+             std::ostringstream* msg) {
   std::vector<std::pair<double, std::size_t>> by_p;  // (log10 p, changepoint)
-  for (std::size_t cp : out->changepoints) by_p.emplace_back(log10_p_of(*out, cp), cp);
+  for (std::size_t cp : out->changepoints) by_p.emplace_back(log10POf(*out, cp), cp);
   std::stable_sort(by_p.begin(), by_p.end());
   *msg << "; dropped the least significant:";
   out->changepoints.clear();
@@ -64,7 +64,7 @@ void prune_to(std::size_t k, const FeatureMatrix& demo, DemoSegmentationResult* 
       continue;
     }
     out->pruned.push_back(by_p[i].second);
-    *msg << " t=" << demo.time_at(by_p[i].second) << " (p=1e" << std::lround(by_p[i].first) << ")";
+    *msg << " t=" << demo.timeAt(by_p[i].second) << " (p=1e" << std::lround(by_p[i].first) << ")";
   }
 }
 
@@ -72,8 +72,8 @@ void prune_to(std::size_t k, const FeatureMatrix& demo, DemoSegmentationResult* 
 // best in-zone candidates that were not significant on their own but reach `log10_p` (the
 // other demos' agreement is evidence too), most significant first. Only candidates of ranges
 // that are still whole (no changepoint inside) count: the others were found before a split.
-void fill_to(std::size_t k, double log10_p, const FeatureMatrix& demo, DemoSegmentationResult* out,
-             std::ostringstream* msg) {
+void fillTo(std::size_t k, double log10_p, const FeatureMatrix& demo, DemoSegmentationResult* out,
+            std::ostringstream* msg) {
   std::vector<const SplitCandidate*> pool;
   for (const SplitCandidate& c : out->clasp.candidates) {
     if (c.accepted || c.log10_p_value > log10_p) continue;
@@ -103,7 +103,7 @@ void fill_to(std::size_t k, double log10_p, const FeatureMatrix& demo, DemoSegme
     if (zone < 0 || taken || too_close) continue;
     out->changepoints.push_back(c->index);
     out->added.push_back(c->index);
-    *msg << " t=" << demo.time_at(c->index) << " (p=1e" << std::lround(c->log10_p_value) << ")";
+    *msg << " t=" << demo.timeAt(c->index) << " (p=1e" << std::lround(c->log10_p_value) << ")";
   }
   std::sort(out->changepoints.begin(), out->changepoints.end());
   std::sort(out->added.begin(), out->added.end());
@@ -111,9 +111,9 @@ void fill_to(std::size_t k, double log10_p, const FeatureMatrix& demo, DemoSegme
 
 }  // namespace
 
-void agree_on_changepoint_count(const std::vector<FeatureMatrix>& demos, bool validated,
-                                double fill_p, SegmentationPipelineResult* result) {
-  const Agreement a = agreed_count(*result, validated);
+void agreeOnChangepointCount(const std::vector<FeatureMatrix>& demos, bool validated, double fill_p,
+                             SegmentationPipelineResult* result) {
+  const Agreement a = agreedCount(*result, validated);
   if (a.count == 0) return;
   for (std::size_t d = 0; d < result->demos.size(); ++d) {
     DemoSegmentationResult& out = result->demos[d];
@@ -121,21 +121,21 @@ void agree_on_changepoint_count(const std::vector<FeatureMatrix>& demos, bool va
     const bool can_fill = fill_p > 0.0 && validated && !out.events.empty();
     if (had == a.count || (had < a.count && !can_fill)) continue;
     std::ostringstream msg;
-    msg << demo_context(d) << ": " << had << " changepoints where " << a.votes << " of the "
+    msg << demoContext(d) << ": " << had << " changepoints where " << a.votes << " of the "
         << a.voters << " voting demonstrations have " << a.count;
     if (had > a.count)
-      prune_to(a.count, demos[d], &out, &msg);
+      pruneTo(a.count, demos[d], &out, &msg);
     else
-      fill_to(a.count, std::log10(fill_p), demos[d], &out, &msg);
+      fillTo(a.count, std::log10(fill_p), demos[d], &out, &msg);
     if (out.changepoints.size() == had && out.pruned.empty()) continue;  // nothing to add
     std::sort(out.changepoints.begin(), out.changepoints.end());
     std::sort(out.pruned.begin(), out.pruned.end());
     out.changepoint_times.clear();
     out.pruned_times.clear();
     out.added_times.clear();
-    for (std::size_t cp : out.changepoints) out.changepoint_times.push_back(demos[d].time_at(cp));
-    for (std::size_t cp : out.pruned) out.pruned_times.push_back(demos[d].time_at(cp));
-    for (std::size_t cp : out.added) out.added_times.push_back(demos[d].time_at(cp));
+    for (std::size_t cp : out.changepoints) out.changepoint_times.push_back(demos[d].timeAt(cp));
+    for (std::size_t cp : out.pruned) out.pruned_times.push_back(demos[d].timeAt(cp));
+    for (std::size_t cp : out.added) out.added_times.push_back(demos[d].timeAt(cp));
     result->warnings.push_back(msg.str());
   }
 }

@@ -23,7 +23,7 @@ class JointSegmentation : public SegmentationMethod {
   SegmentationPipelineResult segment(const PreparedSegmentation& prepared,
                                      const std::vector<FeatureMatrix>& demos,
                                      const SegmentationPipelineConfig& config) const override {
-    return segment_jointly(prepared, demos, config);
+    return segmentJointly(prepared, demos, config);
   }
 };
 
@@ -36,20 +36,20 @@ std::pair<std::string, Factory> entry() {
 
 // One line per method; the order is the one names are listed in.
 const std::vector<std::pair<std::string, Factory>>& registry() {
-  static const std::vector<std::pair<std::string, Factory>> methods = {
+  static const std::vector<std::pair<std::string, Factory>> kMethods = {
       entry<ZoneSearchSegmentation>(), entry<PaperSegmentation>(), entry<JointSegmentation>()};
-  return methods;
+  return kMethods;
 }
 
 }  // namespace
 
-std::vector<std::string> segmentation_method_names() {
+std::vector<std::string> segmentationMethodNames() {
   std::vector<std::string> names;
   for (const auto& [name, factory] : registry()) names.push_back(name);
   return names;
 }
 
-std::unique_ptr<SegmentationMethod> make_segmentation_method(const std::string& name) {
+std::unique_ptr<SegmentationMethod> makeSegmentationMethod(const std::string& name) {
   std::string known;
   for (const auto& [method, factory] : registry()) {
     if (method == name) return factory();

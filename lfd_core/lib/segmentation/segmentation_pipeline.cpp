@@ -22,15 +22,15 @@ std::string join(const std::vector<std::string>& names) {
 }
 
 // Every demonstration must carry the same feature names (in any order).
-void check_same_features(const std::vector<FeatureMatrix>& demos) {
+void checkSameFeatures(const std::vector<FeatureMatrix>& demos) {
   const std::set<std::string> reference(demos[0].names.begin(), demos[0].names.end());
   if (reference.size() != demos[0].names.size()) {
-    throw std::invalid_argument(demo_label(0) + " has duplicate feature names");
+    throw std::invalid_argument(demoLabel(0) + " has duplicate feature names");
   }
   for (std::size_t d = 1; d < demos.size(); ++d) {
     const std::set<std::string> names(demos[d].names.begin(), demos[d].names.end());
     if (names.size() != demos[d].names.size()) {
-      throw std::invalid_argument(demo_label(d) + " has duplicate feature names");
+      throw std::invalid_argument(demoLabel(d) + " has duplicate feature names");
     }
     if (names == reference) continue;
     std::vector<std::string> missing, extra;
@@ -38,21 +38,21 @@ void check_same_features(const std::vector<FeatureMatrix>& demos) {
                         std::back_inserter(missing));
     std::set_difference(names.begin(), names.end(), reference.begin(), reference.end(),
                         std::back_inserter(extra));
-    std::string msg = "features differ between demonstrations: " + demo_label(d);
+    std::string msg = "features differ between demonstrations: " + demoLabel(d);
     if (!missing.empty()) msg += " lacks " + join(missing);
     if (!extra.empty()) msg += (missing.empty() ? " has extra " : " and has extra ") + join(extra);
-    throw std::invalid_argument(msg + " (compared with " + demo_label(0) + ")");
+    throw std::invalid_argument(msg + " (compared with " + demoLabel(0) + ")");
   }
 }
 
-bool is_constant(const FeatureMatrix& demo, int col) {
+bool isConstant(const FeatureMatrix& demo, int col) {
   const double lo = demo.data.col(col).minCoeff(), hi = demo.data.col(col).maxCoeff();
   return !(hi - lo > 1e-12 * (1.0 + std::max(std::abs(hi), std::abs(lo))));
 }
 
 }  // namespace
 
-std::vector<std::size_t> sensor_channel_groups(const std::vector<std::string>& names) {
+std::vector<std::size_t> sensorChannelGroups(const std::vector<std::string>& names) {
   std::map<std::string, std::size_t> ids;
   std::vector<std::size_t> groups;
   for (const std::string& name : names) {
@@ -69,7 +69,7 @@ std::size_t samples(double seconds, double rate, std::size_t at_least) {
 }
 }  // namespace
 
-SegmentationProcedure parse_segmentation_procedure(const std::string& name) {
+SegmentationProcedure parseSegmentationProcedure(const std::string& name) {
   if (name == "zone_search") return SegmentationProcedure::kZoneSearch;
   if (name == "paper") return SegmentationProcedure::kPaper;
   if (name == "joint") return SegmentationProcedure::kJoint;
@@ -77,7 +77,7 @@ SegmentationProcedure parse_segmentation_procedure(const std::string& name) {
                               "' (zone_search, paper, joint)");
 }
 
-std::string to_string(SegmentationProcedure procedure) {
+std::string toString(SegmentationProcedure procedure) {
   switch (procedure) {
     case SegmentationProcedure::kPaper:
       return "paper";
@@ -89,7 +89,7 @@ std::string to_string(SegmentationProcedure procedure) {
   return "zone_search";
 }
 
-SegmentationPipelineConfig in_samples(const SegmentationPipelineConfig& config, double rate) {
+SegmentationPipelineConfig inSamples(const SegmentationPipelineConfig& config, double rate) {
   SegmentationPipelineConfig s = config;
   if (!config.seconds) return s;
   if (!(rate > 0) || !std::isfinite(rate))
@@ -107,7 +107,7 @@ SegmentationPipelineConfig in_samples(const SegmentationPipelineConfig& config, 
   return s;
 }
 
-double sample_rate_of(const FeatureMatrix& demo) {
+double sampleRateOf(const FeatureMatrix& demo) {
   if (demo.time.size() < 2 || demo.time.size() != static_cast<std::size_t>(demo.rows()))
     throw std::invalid_argument(
         "no clock: time parameters are in seconds, so the samples need timestamps (a time "
@@ -125,27 +125,26 @@ double sample_rate_of(const FeatureMatrix& demo) {
 namespace {
 
 // Every demonstration is a well-formed matrix with at least 2 samples.
-void check_demo_shapes(const std::vector<FeatureMatrix>& demos) {
+void checkDemoShapes(const std::vector<FeatureMatrix>& demos) {
   for (std::size_t d = 0; d < demos.size(); ++d) {
     try {
-      demos[d].validate_shape();
+      demos[d].validateShape();
     } catch (const std::invalid_argument& e) {
-      throw std::invalid_argument(demo_label(d) + ": " + e.what());
+      throw std::invalid_argument(demoLabel(d) + ": " + e.what());
     }
     if (demos[d].rows() < 2) {
-      throw std::invalid_argument(demo_label(d) + " has " + std::to_string(demos[d].rows()) +
+      throw std::invalid_argument(demoLabel(d) + " has " + std::to_string(demos[d].rows()) +
                                   " samples; at least 2 are needed");
     }
   }
 }
 
 // The named roles exist; without named state features, every feature that is not a sensor is one.
-void assign_feature_roles(const FeatureMatrix& first,
-                          const std::vector<std::string>& sensor_features,
-                          const std::vector<std::string>& state_features,
-                          SegmentationPipelineResult* result) {
+void assignFeatureRoles(const FeatureMatrix& first, const std::vector<std::string>& sensor_features,
+                        const std::vector<std::string>& state_features,
+                        SegmentationPipelineResult* result) {
   for (const std::string& s : sensor_features) {
-    if (first.index_of(s) < 0) {
+    if (first.indexOf(s) < 0) {
       throw std::invalid_argument("sensor feature '" + s + "' is not in the demonstrations");
     }
   }
@@ -156,7 +155,7 @@ void assign_feature_roles(const FeatureMatrix& first,
     }
   } else {
     for (const std::string& s : state_features) {
-      if (first.index_of(s) < 0) {
+      if (first.indexOf(s) < 0) {
         throw std::invalid_argument("state feature '" + s + "' is not in the demonstrations");
       }
     }
@@ -169,13 +168,13 @@ void assign_feature_roles(const FeatureMatrix& first,
 }
 
 // Constant state features carry no information: they are dropped with a warning.
-std::vector<std::string> informative_state_features(const std::vector<FeatureMatrix>& demos,
-                                                    SegmentationPipelineResult* result) {
+std::vector<std::string> informativeStateFeatures(const std::vector<FeatureMatrix>& demos,
+                                                  SegmentationPipelineResult* result) {
   std::vector<std::string> informative;
   for (const std::string& name : result->state_features) {
     bool constant_everywhere = true;
     for (const FeatureMatrix& demo : demos) {
-      constant_everywhere = constant_everywhere && is_constant(demo, demo.require(name));
+      constant_everywhere = constant_everywhere && isConstant(demo, demo.require(name));
     }
     if (constant_everywhere) {
       result->warnings.push_back("state feature '" + name +
@@ -192,18 +191,18 @@ std::vector<std::string> informative_state_features(const std::vector<FeatureMat
 
 // II-B feature relevance picks and weighs the features; it needs >= 2 demonstrations, so a single
 // one uses every informative feature with equal weights.
-void select_weighted_features(const std::vector<FeatureMatrix>& demos,
-                              const std::vector<std::string>& informative,
-                              const SegmentationPipelineConfig& config,
-                              SegmentationPipelineResult* result) {
+void selectWeightedFeatures(const std::vector<FeatureMatrix>& demos,
+                            const std::vector<std::string>& informative,
+                            const SegmentationPipelineConfig& config,
+                            SegmentationPipelineResult* result) {
   if (demos.size() >= 2) {
     FeatureRelevanceConfig relevance_config = config.relevance;
     relevance_config.threads = config.threads;
-    result->relevance = compute_feature_relevance(demos, informative, relevance_config);
+    result->relevance = computeFeatureRelevance(demos, informative, relevance_config);
     result->relevance_computed = true;
     for (const std::string& w : result->relevance.warnings) result->warnings.push_back(w);
     result->selected_features = result->relevance.selected;
-    for (double score : result->relevance.selected_scores()) {
+    for (double score : result->relevance.selectedScores()) {
       // Weights must be positive; a non-positive best score (warned above) keeps weight 1.
       result->feature_weights.push_back(score > 0 ? score : 1.0);
     }
@@ -221,57 +220,58 @@ void select_weighted_features(const std::vector<FeatureMatrix>& demos,
 
 }  // namespace
 
-PreparedSegmentation prepare_segmentation(const std::vector<FeatureMatrix>& demos,
-                                          const std::vector<std::string>& sensor_features,
-                                          const SegmentationPipelineConfig& config,
-                                          const std::vector<std::string>& state_features) {
+PreparedSegmentation prepareSegmentation(const std::vector<FeatureMatrix>& demos,
+                                         const std::vector<std::string>& sensor_features,
+                                         const SegmentationPipelineConfig& config,
+                                         const std::vector<std::string>& state_features) {
   if (demos.empty()) throw std::invalid_argument("no demonstrations to segment");
   PreparedSegmentation prepared;
   SegmentationPipelineResult& result = prepared.base;
 
   // ---- input checks: shape, same features, roles, finite samples, lengths
-  check_demo_shapes(demos);
-  check_same_features(demos);
-  assign_feature_roles(demos[0], sensor_features, state_features, &result);
+  checkDemoShapes(demos);
+  checkSameFeatures(demos);
+  assignFeatureRoles(demos[0], sensor_features, state_features, &result);
   std::vector<std::string> used = result.state_features;
   used.insert(used.end(), sensor_features.begin(), sensor_features.end());
-  for (std::size_t d = 0; d < demos.size(); ++d) check_finite(demos[d].select(used), demo_label(d));
+  for (std::size_t d = 0; d < demos.size(); ++d) checkFinite(demos[d].select(used), demoLabel(d));
 
-  demo_settings(demos, config);  // checks every demo's clock and length
+  demoSettings(demos, config);  // checks every demo's clock and length
 
-  const std::vector<std::string> informative = informative_state_features(demos, &result);
+  const std::vector<std::string> informative = informativeStateFeatures(demos, &result);
 
   const auto relevance_start = std::chrono::steady_clock::now();
-  select_weighted_features(demos, informative, config, &result);
+  selectWeightedFeatures(demos, informative, config, &result);
   result.relevance_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - relevance_start).count();
   return prepared;
 }
 
-SegmentationPipelineResult segment_prepared(const PreparedSegmentation& prepared,
-                                            const std::vector<FeatureMatrix>& demos,
-                                            const SegmentationPipelineConfig& config) {
-  return make_segmentation_method(to_string(config.procedure))->segment(prepared, demos, config);
+SegmentationPipelineResult segmentPrepared(const PreparedSegmentation& prepared,
+                                           const std::vector<FeatureMatrix>& demos,
+                                           const SegmentationPipelineConfig& config) {
+  return makeSegmentationMethod(toString(config.procedure))->segment(prepared, demos, config);
 }
 
-void add_sensor_warnings(const std::vector<FeatureMatrix>& demos, bool validated,
-                         SegmentationPipelineResult* result) {
+void addSensorWarnings(const std::vector<FeatureMatrix>& demos, bool validated,
+                       SegmentationPipelineResult* result) {
   for (std::size_t d = 0; d < demos.size() && validated; ++d) {
     for (const std::string& sensor : result->sensor_features) {
-      if (is_constant(demos[d], demos[d].require(sensor)))
-        result->warnings.push_back(demo_label(d) + ": sensor '" + sensor +
+      if (isConstant(demos[d], demos[d].require(sensor)))
+        result->warnings.push_back(demoLabel(d) + ": sensor '" + sensor +
                                    "' is constant (dead or disconnected?): no event from it");
     }
     if (result->demos[d].events.empty())
-      result->warnings.push_back(demo_label(d) + ": no sensory event detected");
+      result->warnings.push_back(demoLabel(d) + ": no sensory event detected");
   }
 }
 
-SegmentationPipelineResult run_segmentation_pipeline(
-    const std::vector<FeatureMatrix>& demos, const std::vector<std::string>& sensor_features,
-    const SegmentationPipelineConfig& config, const std::vector<std::string>& state_features) {
-  return segment_prepared(prepare_segmentation(demos, sensor_features, config, state_features),
-                          demos, config);
+SegmentationPipelineResult runSegmentationPipeline(const std::vector<FeatureMatrix>& demos,
+                                                   const std::vector<std::string>& sensor_features,
+                                                   const SegmentationPipelineConfig& config,
+                                                   const std::vector<std::string>& state_features) {
+  return segmentPrepared(prepareSegmentation(demos, sensor_features, config, state_features), demos,
+                         config);
 }
 
 }  // namespace lfd

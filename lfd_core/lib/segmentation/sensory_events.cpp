@@ -13,7 +13,7 @@
 namespace lfd {
 namespace {
 
-void check_config(const SensoryEventConfig& c) {
+void checkConfig(const SensoryEventConfig& c) {
   if (!(c.relative_floor >= 0.0 && c.relative_floor <= 1.0))
     throw std::invalid_argument("sensory events: relative_floor must be in [0, 1]");
   if (!(c.threshold_ratio > 0.0 && c.threshold_ratio <= 1.0))
@@ -31,22 +31,22 @@ void check_config(const SensoryEventConfig& c) {
     throw std::invalid_argument("sensory events: difference_lag must be >= 1");
 }
 
-double median_of(std::vector<double> v);
+double medianOf(std::vector<double> v);
 
 // Robust sigma (1.4826 x MAD about the median) of v.
-double robust_sigma(std::vector<double> v) {
-  const double med = median_of(v);
+double robustSigma(std::vector<double> v) {
+  const double med = medianOf(v);
   for (double& x : v) x = std::abs(x - med);
-  return 1.4826 * median_of(v);
+  return 1.4826 * medianOf(v);
 }
 
 // SensoryEventConfig::noise_block: the quiet blocks' sigma (10th percentile of the blocks that
 // move at all); block 0 = one sigma over everything.
-double noise_sigma(const std::vector<double>& d, std::size_t block) {
-  if (block == 0 || d.size() < 2 * block) return robust_sigma(d);
+double noiseSigma(const std::vector<double>& d, std::size_t block) {
+  if (block == 0 || d.size() < 2 * block) return robustSigma(d);
   std::vector<double> sigmas;
   for (std::size_t b = 0; b + block <= d.size(); b += block) {
-    const double s = robust_sigma(std::vector<double>(d.begin() + b, d.begin() + b + block));
+    const double s = robustSigma(std::vector<double>(d.begin() + b, d.begin() + b + block));
     if (s > 0.0) sigmas.push_back(s);
   }
   if (sigmas.empty()) return 0.0;
@@ -69,8 +69,8 @@ double noise_sigma(const std::vector<double>& d, std::size_t block) {
 // DriftWithoutContact...).
 constexpr std::size_t kQuietBlocksPerQuiet = 15;
 
-double quiet_excursion(const Eigen::Ref<const Eigen::VectorXd>& signal,
-                       const std::vector<double>& mag, std::size_t block) {
+double quietExcursion(const Eigen::Ref<const Eigen::VectorXd>& signal,
+                      const std::vector<double>& mag, std::size_t block) {
   const std::size_t n = mag.size();
   if (block == 0 || n < 2 * block) return 0.0;
   std::vector<double> maxima;
@@ -85,7 +85,7 @@ double quiet_excursion(const Eigen::Ref<const Eigen::VectorXd>& signal,
   return maxima[k];
 }
 
-double median_of(std::vector<double> v) {
+double medianOf(std::vector<double> v) {
   if (v.empty()) return 0.0;
   const std::size_t mid = v.size() / 2;
   std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(mid), v.end());
@@ -95,7 +95,7 @@ double median_of(std::vector<double> v) {
 }
 
 // Running median with a window shrunk symmetrically at the ends (so edges are not invented).
-std::vector<double> running_median(const Eigen::Ref<const Eigen::VectorXd>& x, std::size_t window) {
+std::vector<double> runningMedian(const Eigen::Ref<const Eigen::VectorXd>& x, std::size_t window) {
   const std::size_t n = static_cast<std::size_t>(x.size());
   std::vector<double> out(n);
   if (window < 2) {
@@ -115,13 +115,13 @@ std::vector<double> running_median(const Eigen::Ref<const Eigen::VectorXd>& x, s
 
 }  // namespace
 
-EventThreshold parse_event_threshold(const std::string& name) {
+EventThreshold parseEventThreshold(const std::string& name) {
   if (name == "ratio_of_max") return EventThreshold::kRatioOfMax;
   if (name == "noise") return EventThreshold::kNoise;
   throw std::invalid_argument("unknown event threshold '" + name + "' (ratio_of_max, noise)");
 }
 
-std::string to_string(EventThreshold threshold) {
+std::string toString(EventThreshold threshold) {
   return threshold == EventThreshold::kNoise ? "noise" : "ratio_of_max";
 }
 
@@ -151,8 +151,8 @@ struct Channel {
 
 // The detector's statistic: |y[t + ahead] - y[t - behind]| of the smoothed y, 0 where it would
 // use the median's shrunk edges (a single noisy sample there would look like a level change).
-std::vector<double> lagged_differences(const std::vector<double>& y, std::size_t lag,
-                                       std::size_t edge) {
+std::vector<double> laggedDifferences(const std::vector<double>& y, std::size_t lag,
+                                      std::size_t edge) {
   const std::size_t n = y.size(), ahead = lag / 2, behind = lag - ahead;
   std::vector<double> mag(n, 0.0);
   for (std::size_t t = behind + edge; t + ahead + edge < n; ++t)
@@ -162,9 +162,9 @@ std::vector<double> lagged_differences(const std::vector<double>& y, std::size_t
 
 // On-threshold of the activity: the paper's ratio of the largest difference (or the noise rule),
 // never below the noise floors.
-void set_activity_threshold(const Eigen::Ref<const Eigen::VectorXd>& signal,
-                            const std::vector<double>& mag, double peak,
-                            const SensoryEventConfig& config, Channel* c) {
+void setActivityThreshold(const Eigen::Ref<const Eigen::VectorXd>& signal,
+                          const std::vector<double>& mag, double peak,
+                          const SensoryEventConfig& config, Channel* c) {
   // The sigma floor is measured on the RAW first differences (nearly independent samples) and
   // scaled to the lagged differences of a median of w samples (white noise: x 1.2533 / sqrt(w)).
   double sigma = 0.0;
@@ -174,10 +174,10 @@ void set_activity_threshold(const Eigen::Ref<const Eigen::VectorXd>& signal,
     const double smoothing = config.difference_lag > 1 && config.median_window > 1
                                  ? 1.2533 / std::sqrt(static_cast<double>(config.median_window))
                                  : 1.0;
-    sigma = smoothing * noise_sigma(diffs, config.noise_block);
+    sigma = smoothing * noiseSigma(diffs, config.noise_block);
   }
   const double excursion =
-      config.noise_floor_excursions > 0.0 ? quiet_excursion(signal, mag, config.noise_block) : 0.0;
+      config.noise_floor_excursions > 0.0 ? quietExcursion(signal, mag, config.noise_block) : 0.0;
   const double floor =
       std::max(config.noise_floor_sigmas * sigma, config.noise_floor_excursions * excursion);
   const double ratio =
@@ -186,8 +186,8 @@ void set_activity_threshold(const Eigen::Ref<const Eigen::VectorXd>& signal,
   c->noise_limited = floor > ratio * peak;
 }
 
-std::vector<Burst> find_bursts(const std::vector<double>& mag, double on, double off,
-                               bool walk_back) {
+std::vector<Burst> findBursts(const std::vector<double>& mag, double on, double off,
+                              bool walk_back) {
   const std::size_t n = mag.size();
   std::vector<Burst> bursts;
   bool active = false;
@@ -209,7 +209,7 @@ std::vector<Burst> find_bursts(const std::vector<double>& mag, double on, double
   return bursts;
 }
 
-std::vector<Burst> merge_bursts(const std::vector<Burst>& bursts, std::size_t gap, std::size_t n) {
+std::vector<Burst> mergeBursts(const std::vector<Burst>& bursts, std::size_t gap, std::size_t n) {
   std::vector<Burst> merged;
   for (const Burst& b : bursts) {
     if (!merged.empty() && merged.back().end != n && b.begin - merged.back().end <= gap) {
@@ -223,22 +223,22 @@ std::vector<Burst> merge_bursts(const std::vector<Burst>& bursts, std::size_t ga
 }
 
 // EventPlacement::kFit: the burst's start where the level starts to change and its end where it
-// settles (fit_ramp around each end); the ends of a short ramp or step are one event. An event
+// settles (fitRamp around each end); the ends of a short ramp or step are one event. An event
 // whose outer level is the rest level (the level at the demo's start, within the activity
 // threshold) leaves or regains rest on this channel.
-void place_by_fit(const Burst& b, const Channel& c, const SensoryEventConfig& config,
-                  std::vector<PlacedEvent>* events) {
+void placeByFit(const Burst& b, const Channel& c, const SensoryEventConfig& config,
+                std::vector<PlacedEvent>* events) {
   const std::size_t n = c.y.size(), lag = config.difference_lag;
   const double strength = b.peak / c.on;
   const std::size_t lo = b.begin > lag ? b.begin - lag : 0;
-  const RampFit first = fit_ramp(c.y, lo, std::min(n, b.begin + 2 * lag + 1));
+  const RampFit first = fitRamp(c.y, lo, std::min(n, b.begin + 2 * lag + 1));
   const bool from_rest = std::abs(first.before - c.rest) < c.on;
   if (b.end == n) {
     events->push_back({{first.start, from_rest, strength}, from_rest, false});
     return;
   }
   const std::size_t hi = std::min(n, b.end + lag + 1);
-  const RampFit last = fit_ramp(c.y, b.end > 2 * lag + lo ? b.end - 2 * lag : lo, hi);
+  const RampFit last = fitRamp(c.y, b.end > 2 * lag + lo ? b.end - 2 * lag : lo, hi);
   const bool to_rest = std::abs(last.after - c.rest) < c.on;
   if (last.end <= first.start + lag / 2) {  // one step: the rest side says where
     const std::size_t at = !from_rest && to_rest ? last.end : first.start;
@@ -251,8 +251,8 @@ void place_by_fit(const Burst& b, const Channel& c, const SensoryEventConfig& co
 
 // EventPlacement::kThreshold and kShift: at the burst's ends, shifted back onto the change by
 // half a lag (kShift; a burst that spans less than half a lag after the shifts is one step).
-void place_at_burst_ends(const Burst& b, std::size_t n, const SensoryEventConfig& config,
-                         double strength, std::vector<PlacedEvent>* events) {
+void placeAtBurstEnds(const Burst& b, std::size_t n, const SensoryEventConfig& config,
+                      double strength, std::vector<PlacedEvent>* events) {
   const std::size_t lag = config.difference_lag, ahead = lag / 2, behind = lag - ahead;
   const bool shift = config.placement == EventPlacement::kShift && lag > 1;
   const std::size_t begin = std::min(b.begin + (shift ? ahead : 0), n - 1);
@@ -270,8 +270,8 @@ void place_at_burst_ends(const Burst& b, std::size_t n, const SensoryEventConfig
 // smoothed level shows it, where the fit sees only the main change. The edge moves only outwards
 // (an earlier onset, a later release), within merge_gap (activity separated by less is one
 // activity) and never past the channel's neighbouring events.
-void place_rest_edges_by_cusum(const Eigen::Ref<const Eigen::VectorXd>& x, std::size_t head,
-                               double peak, const SensoryEventConfig& config, Channel* c) {
+void placeRestEdgesByCusum(const Eigen::Ref<const Eigen::VectorXd>& x, std::size_t head,
+                           double peak, const SensoryEventConfig& config, Channel* c) {
   const std::size_t n = static_cast<std::size_t>(x.size()), lag = config.difference_lag,
                     gap = config.merge_gap;
   const auto rest = x.head(static_cast<Eigen::Index>(head));
@@ -311,53 +311,52 @@ void place_rest_edges_by_cusum(const Eigen::Ref<const Eigen::VectorXd>& x, std::
 }
 
 // One channel: smoothed signal, rest level, activity threshold and its events.
-Channel analyse_channel(const Eigen::Ref<const Eigen::VectorXd>& signal,
-                        const SensoryEventConfig& config) {
+Channel analyseChannel(const Eigen::Ref<const Eigen::VectorXd>& signal,
+                       const SensoryEventConfig& config) {
   if (!signal.allFinite()) throw std::invalid_argument("sensory events: signal has NaN/Inf values");
   Channel c;
   const std::size_t n = static_cast<std::size_t>(signal.size());
   if (n < 2) return c;
-  c.y = running_median(signal, config.median_window);
+  c.y = runningMedian(signal, config.median_window);
   const std::size_t edge = config.median_window > 1 ? config.median_window / 2 : 0;
-  const std::vector<double> mag = lagged_differences(c.y, config.difference_lag, edge);
+  const std::vector<double> mag = laggedDifferences(c.y, config.difference_lag, edge);
   const double peak = *std::max_element(mag.begin(), mag.end());
   if (!(peak > 0.0)) return c;
-  set_activity_threshold(signal, mag, peak, config, &c);
+  setActivityThreshold(signal, mag, peak, config, &c);
   const bool walk_back = config.placement != EventPlacement::kThreshold;
-  const std::vector<Burst> bursts = merge_bursts(
-      find_bursts(mag, c.on, config.hysteresis * c.on, walk_back), config.merge_gap, n);
+  const std::vector<Burst> bursts =
+      mergeBursts(findBursts(mag, c.on, config.hysteresis * c.on, walk_back), config.merge_gap, n);
   // The rest level: where the sensor starts, before the robot interacts with anything.
   const std::size_t head =
       std::min(n, std::max<std::size_t>(config.noise_block, config.difference_lag));
-  c.rest = median_of(std::vector<double>(c.y.begin(), c.y.begin() + head));
+  c.rest = medianOf(std::vector<double>(c.y.begin(), c.y.begin() + head));
   const bool fit = config.placement == EventPlacement::kFit && config.difference_lag > 1;
   for (const Burst& b : bursts) {
     if (b.end != n && b.end - b.begin < config.min_active_samples) continue;
     if (fit)
-      place_by_fit(b, c, config, &c.events);
+      placeByFit(b, c, config, &c.events);
     else
-      place_at_burst_ends(b, n, config, b.peak / c.on, &c.events);
+      placeAtBurstEnds(b, n, config, b.peak / c.on, &c.events);
   }
   std::sort(c.events.begin(), c.events.end(), [](const PlacedEvent& a, const PlacedEvent& b) {
     return a.event.index < b.event.index;
   });
-  if (fit && config.rest_edge_sigmas > 0.0)
-    place_rest_edges_by_cusum(signal, head, peak, config, &c);
+  if (fit && config.rest_edge_sigmas > 0.0) placeRestEdgesByCusum(signal, head, peak, config, &c);
   return c;
 }
 
 // Whether channel c sits at its rest level over [from, to) (median distance within its threshold).
-bool at_rest(const Channel& c, std::size_t from, std::size_t to) {
+bool atRest(const Channel& c, std::size_t from, std::size_t to) {
   if (c.events.empty()) return true;  // never active
   to = std::min(to, c.y.size());
   if (from >= to) return true;
   std::vector<double> d;
   for (std::size_t t = from; t < to; ++t) d.push_back(std::abs(c.y[t] - c.rest));
-  return median_of(d) < c.on;
+  return medianOf(d) < c.on;
 }
 
 // Whether channel c leaves its rest level (`leaving`) or regains it at a sample of [from, to).
-bool rest_edge_within(const Channel& c, bool leaving, std::size_t from, std::size_t to) {
+bool restEdgeWithin(const Channel& c, bool leaving, std::size_t from, std::size_t to) {
   return std::any_of(c.events.begin(), c.events.end(), [&](const PlacedEvent& p) {
     return (leaving ? p.from_rest : p.to_rest) && p.event.index >= from && p.event.index < to;
   });
@@ -365,8 +364,8 @@ bool rest_edge_within(const Channel& c, bool leaving, std::size_t from, std::siz
 
 // For every sample, the length of the run of samples around it where the whole group sits at
 // rest (0 where it does not).
-std::vector<std::size_t> rest_run_lengths(const std::vector<Channel>& channels,
-                                          const std::vector<std::size_t>& group) {
+std::vector<std::size_t> restRunLengths(const std::vector<Channel>& channels,
+                                        const std::vector<std::size_t>& group) {
   const std::size_t n = channels[group.front()].y.size();
   std::vector<std::size_t> run(n, 0);
   std::size_t t = 0;
@@ -393,8 +392,8 @@ std::vector<std::size_t> rest_run_lengths(const std::vector<Channel>& channels,
 
 // The channels that say when the sensor is at rest: those whose contact stands clear of their
 // noise, when it has any (else all of them).
-std::vector<std::size_t> deciding_channels(const std::vector<Channel>& channels,
-                                           const std::vector<std::size_t>& group) {
+std::vector<std::size_t> decidingChannels(const std::vector<Channel>& channels,
+                                          const std::vector<std::size_t>& group) {
   std::vector<std::size_t> clear;
   for (std::size_t c : group)
     if (!channels[c].events.empty() && !channels[c].noise_limited) clear.push_back(c);
@@ -409,10 +408,10 @@ std::vector<std::size_t> deciding_channels(const std::vector<Channel>& channels,
 // a rest shorter than `min_rest` samples (the merge gap: activity separated by less is one
 // activity) is a pause within the interaction, not its end: a teleoperator's hesitation, an arm
 // slowing between two strokes. Only the deciding channels (above) can hold the sensor off rest.
-void flag_rest_edges_of_group(std::vector<Channel>* channels, const std::vector<std::size_t>& group,
-                              std::size_t lag, std::size_t min_rest) {
-  const std::vector<std::size_t> deciding = deciding_channels(*channels, group);
-  const std::vector<std::size_t> run = rest_run_lengths(*channels, deciding);
+void flagRestEdgesOfGroup(std::vector<Channel>* channels, const std::vector<std::size_t>& group,
+                          std::size_t lag, std::size_t min_rest) {
+  const std::vector<std::size_t> deciding = decidingChannels(*channels, group);
+  const std::vector<std::size_t> run = restRunLengths(*channels, deciding);
   const auto longest = [&](std::size_t from, std::size_t to) {
     std::size_t best = 0;
     for (std::size_t t = from; t < std::min(to, run.size()); ++t) best = std::max(best, run[t]);
@@ -426,16 +425,16 @@ void flag_rest_edges_of_group(std::vector<Channel>* channels, const std::vector<
       for (std::size_t o : deciding) {
         if (o == c) continue;
         const Channel& other = (*channels)[o];
-        before = before && at_rest(other, lo, e) && !rest_edge_within(other, true, lo, e);
-        after = after && at_rest(other, e, e + lag) &&
-                !rest_edge_within(other, false, e + 1, e + lag + 1);
+        before = before && atRest(other, lo, e) && !restEdgeWithin(other, true, lo, e);
+        after =
+            after && atRest(other, e, e + lag) && !restEdgeWithin(other, false, e + 1, e + lag + 1);
       }
       p.event.rest_edge = before || after;
     }
   }
 }
 
-std::vector<SensoryEvent> unique_by_index(std::vector<SensoryEvent> events) {
+std::vector<SensoryEvent> uniqueByIndex(std::vector<SensoryEvent> events) {
   std::stable_sort(events.begin(), events.end(),
                    [](const SensoryEvent& a, const SensoryEvent& b) { return a.index < b.index; });
   std::vector<SensoryEvent> unique;
@@ -452,14 +451,14 @@ std::vector<SensoryEvent> unique_by_index(std::vector<SensoryEvent> events) {
 
 }  // namespace
 
-EventPlacement parse_event_placement(const std::string& name) {
+EventPlacement parseEventPlacement(const std::string& name) {
   if (name == "threshold") return EventPlacement::kThreshold;
   if (name == "shift") return EventPlacement::kShift;
   if (name == "fit") return EventPlacement::kFit;
   throw std::invalid_argument("unknown event placement '" + name + "' (threshold, shift, fit)");
 }
 
-std::string to_string(EventPlacement placement) {
+std::string toString(EventPlacement placement) {
   switch (placement) {
     case EventPlacement::kThreshold:
       return "threshold";
@@ -471,23 +470,23 @@ std::string to_string(EventPlacement placement) {
   return "?";
 }
 
-std::vector<SensoryEvent> detect_sensory_event_details(
-    const Eigen::Ref<const Eigen::VectorXd>& signal, const SensoryEventConfig& config) {
-  check_config(config);
+std::vector<SensoryEvent> detectSensoryEventDetails(const Eigen::Ref<const Eigen::VectorXd>& signal,
+                                                    const SensoryEventConfig& config) {
+  checkConfig(config);
   std::vector<SensoryEvent> events;
-  for (const PlacedEvent& p : analyse_channel(signal, config).events) events.push_back(p.event);
-  return unique_by_index(events);
+  for (const PlacedEvent& p : analyseChannel(signal, config).events) events.push_back(p.event);
+  return uniqueByIndex(events);
 }
 
-std::vector<std::size_t> detect_sensory_events(const Eigen::Ref<const Eigen::VectorXd>& signal,
-                                               const SensoryEventConfig& config) {
+std::vector<std::size_t> detectSensoryEvents(const Eigen::Ref<const Eigen::VectorXd>& signal,
+                                             const SensoryEventConfig& config) {
   std::vector<std::size_t> out;
-  for (const SensoryEvent& e : detect_sensory_event_details(signal, config)) out.push_back(e.index);
+  for (const SensoryEvent& e : detectSensoryEventDetails(signal, config)) out.push_back(e.index);
   return out;
 }
 
-std::vector<Interval> confidence_zones(const std::vector<std::size_t>& events, std::size_t min_s,
-                                       std::size_t length) {
+std::vector<Interval> confidenceZones(const std::vector<std::size_t>& events, std::size_t min_s,
+                                      std::size_t length) {
   const std::size_t half = min_s / 2;
   std::vector<Interval> raw;
   raw.reserve(events.size());
@@ -505,8 +504,8 @@ std::vector<Interval> confidence_zones(const std::vector<std::size_t>& events, s
   return zones;
 }
 
-ChangepointValidation validate_with_zones(const std::vector<std::size_t>& candidates,
-                                          const std::vector<Interval>& zones) {
+ChangepointValidation validateWithZones(const std::vector<std::size_t>& candidates,
+                                        const std::vector<Interval>& zones) {
   ChangepointValidation out;
   out.zones = zones;
   std::vector<std::size_t> sorted = candidates;
@@ -519,9 +518,9 @@ ChangepointValidation validate_with_zones(const std::vector<std::size_t>& candid
   return out;
 }
 
-SensorEvents detect_sensor_events(const Eigen::MatrixXd& sensors, const SensoryEventConfig& config,
-                                  const std::vector<std::size_t>& groups) {
-  check_config(config);
+SensorEvents detectSensorEvents(const Eigen::MatrixXd& sensors, const SensoryEventConfig& config,
+                                const std::vector<std::size_t>& groups) {
+  checkConfig(config);
   const std::size_t cols = static_cast<std::size_t>(sensors.cols());
   if (!groups.empty() && groups.size() != cols)
     throw std::invalid_argument("sensory events: " + std::to_string(groups.size()) +
@@ -529,7 +528,7 @@ SensorEvents detect_sensor_events(const Eigen::MatrixXd& sensors, const SensoryE
   std::vector<Channel> channels;
   for (std::size_t c = 0; c < cols; ++c) {
     try {
-      channels.push_back(analyse_channel(sensors.col(static_cast<Eigen::Index>(c)), config));
+      channels.push_back(analyseChannel(sensors.col(static_cast<Eigen::Index>(c)), config));
     } catch (const std::invalid_argument&) {
       throw std::invalid_argument("sensory events: sensor column " + std::to_string(c) +
                                   " has NaN/Inf values");
@@ -539,7 +538,7 @@ SensorEvents detect_sensor_events(const Eigen::MatrixXd& sensors, const SensoryE
   for (std::size_t c = 0; c < cols; ++c) members[groups.empty() ? c : groups[c]].push_back(c);
   SensorEvents out;
   for (const auto& [id, group] : members) {
-    flag_rest_edges_of_group(&channels, group, config.difference_lag, config.merge_gap);
+    flagRestEdgesOfGroup(&channels, group, config.difference_lag, config.merge_gap);
     // zone_events: a sensor's rest edges, or all its events when it never leaves rest cleanly.
     bool any_rest_edge = false;
     for (std::size_t c : group)
@@ -562,16 +561,16 @@ SensorEvents detect_sensor_events(const Eigen::MatrixXd& sensors, const SensoryE
   }
   std::sort(out.all.begin(), out.all.end());
   out.all.erase(std::unique(out.all.begin(), out.all.end()), out.all.end());
-  out.details = unique_by_index(out.details);
+  out.details = uniqueByIndex(out.details);
   return out;
 }
 
-ChangepointValidation validate_changepoints(const std::vector<std::size_t>& candidates,
-                                            const Eigen::MatrixXd& sensors, std::size_t min_s,
-                                            const SensoryEventConfig& config) {
-  SensorEvents events = detect_sensor_events(sensors, config);
-  ChangepointValidation out = validate_with_zones(
-      candidates, confidence_zones(events.all, min_s, static_cast<std::size_t>(sensors.rows())));
+ChangepointValidation validateChangepoints(const std::vector<std::size_t>& candidates,
+                                           const Eigen::MatrixXd& sensors, std::size_t min_s,
+                                           const SensoryEventConfig& config) {
+  SensorEvents events = detectSensorEvents(sensors, config);
+  ChangepointValidation out = validateWithZones(
+      candidates, confidenceZones(events.all, min_s, static_cast<std::size_t>(sensors.rows())));
   out.events = std::move(events.all);
   out.events_per_sensor = std::move(events.per_sensor);
   return out;

@@ -5,8 +5,7 @@
 
 namespace lfd {
 
-std::vector<SampleSpan> repeated_readings(const Eigen::MatrixXd& channels,
-                                          std::size_t min_samples) {
+std::vector<SampleSpan> repeatedReadings(const Eigen::MatrixXd& channels, std::size_t min_samples) {
   if (min_samples < 2) throw std::invalid_argument("repeated readings: min_samples must be >= 2");
   const auto same = [&](Eigen::Index k) {
     return (channels.row(k).array() == channels.row(k - 1).array()).all();
@@ -30,14 +29,14 @@ std::vector<SampleSpan> repeated_readings(const Eigen::MatrixXd& channels,
 
 namespace lfd {
 
-std::vector<std::vector<SampleSpan>> stale_readings(const std::vector<Eigen::MatrixXd>& channels,
-                                                    const std::vector<std::size_t>& min_samples) {
+std::vector<std::vector<SampleSpan>> staleReadings(const std::vector<Eigen::MatrixXd>& channels,
+                                                   const std::vector<std::size_t>& min_samples) {
   if (channels.size() != min_samples.size())
     throw std::invalid_argument("stale readings: one minimum length per demo needed");
   std::vector<std::vector<SampleSpan>> runs(channels.size());
   std::size_t never_repeat = 0, dead = 0;
   for (std::size_t d = 0; d < channels.size(); ++d) {
-    runs[d] = repeated_readings(channels[d], min_samples[d]);
+    runs[d] = repeatedReadings(channels[d], min_samples[d]);
     if (runs[d].empty()) ++never_repeat;
     // A sensor dead throughout says nothing of its noise (it is reported as constant).
     const bool whole = runs[d].size() == 1 && runs[d][0].begin == 0 &&

@@ -7,18 +7,18 @@
 
 namespace lfd {
 
-int FeatureMatrix::index_of(const std::string& name) const {
+int FeatureMatrix::indexOf(const std::string& name) const {
   auto it = std::find(names.begin(), names.end(), name);
   return it == names.end() ? -1 : static_cast<int>(it - names.begin());
 }
 
 int FeatureMatrix::require(const std::string& name) const {
-  const int index = index_of(name);
+  const int index = indexOf(name);
   if (index < 0) throw std::invalid_argument("feature '" + name + "' not found");
   return index;
 }
 
-double FeatureMatrix::time_at(Eigen::Index row) const {
+double FeatureMatrix::timeAt(Eigen::Index row) const {
   return time.empty() ? static_cast<double>(row) : time.at(static_cast<size_t>(row));
 }
 
@@ -31,7 +31,7 @@ FeatureMatrix FeatureMatrix::select(const std::vector<std::string>& features) co
   return out;
 }
 
-void FeatureMatrix::validate_shape() const {
+void FeatureMatrix::validateShape() const {
   if (static_cast<Eigen::Index>(names.size()) != cols()) {
     throw std::invalid_argument("feature matrix has " + std::to_string(cols()) + " columns but " +
                                 std::to_string(names.size()) + " names");
@@ -44,7 +44,7 @@ void FeatureMatrix::validate_shape() const {
 
 namespace {
 
-void check_stream(const Stream& s) {
+void checkStream(const Stream& s) {
   if (s.time.size() != s.values.size()) {
     throw std::invalid_argument("stream '" + s.name + "': " + std::to_string(s.time.size()) +
                                 " timestamps but " + std::to_string(s.values.size()) + " values");
@@ -72,8 +72,8 @@ void check_stream(const Stream& s) {
 // weak contact stays visible. Where a period holds fewer than two samples (a stream at or below
 // the clock's rate) the interpolated value stays. Discrete (zero-order-hold) streams are not
 // averaged: a mean of two flag values is no flag value.
-void average_within_periods(const Stream& s, const std::vector<double>& clock, double period,
-                            std::vector<double>* values) {
+void averageWithinPeriods(const Stream& s, const std::vector<double>& clock, double period,
+                          std::vector<double>* values) {
   size_t first = 0;  // first sample of the current period; clock and samples both increase
   for (size_t k = 0; k < clock.size(); ++k) {
     const double from = clock[k] - 0.5 * period, to = clock[k] + 0.5 * period;
@@ -88,7 +88,7 @@ void average_within_periods(const Stream& s, const std::vector<double>& clock, d
 }  // namespace
 
 std::vector<double> interpolate(const Stream& s, const std::vector<double>& query) {
-  check_stream(s);
+  checkStream(s);
   std::vector<double> out(query.size());
   size_t k = 0;  // queries are usually sorted: walk forward, fall back to binary search
   for (size_t q = 0; q < query.size(); ++q) {
@@ -120,7 +120,7 @@ FeatureMatrix resample(const std::vector<Stream>& streams, double rate_hz) {
   }
   double start = -INFINITY, end = INFINITY;
   for (const Stream& s : streams) {
-    check_stream(s);
+    checkStream(s);
     start = std::max(start, s.time.front());
     end = std::min(end, s.time.back());
   }
@@ -139,14 +139,14 @@ FeatureMatrix resample(const std::vector<Stream>& streams, double rate_hz) {
     out.names.push_back(streams[c].name);
     std::vector<double> v = interpolate(streams[c], out.time);
     if (streams[c].interpolation == Interpolation::kLinear)
-      average_within_periods(streams[c], out.time, period, &v);
+      averageWithinPeriods(streams[c], out.time, period, &v);
     out.data.col(c) = Eigen::Map<const Eigen::VectorXd>(v.data(), v.size());
   }
   return out;
 }
 
 FeatureMatrix resample(const FeatureMatrix& matrix, double rate_hz) {
-  matrix.validate_shape();
+  matrix.validateShape();
   if (matrix.time.empty()) throw std::invalid_argument("resample: the matrix has no clock");
   std::vector<Stream> streams(static_cast<std::size_t>(matrix.cols()));
   for (Eigen::Index c = 0; c < matrix.cols(); ++c) {
@@ -158,7 +158,7 @@ FeatureMatrix resample(const FeatureMatrix& matrix, double rate_hz) {
   return resample(streams, rate_hz);
 }
 
-bool normalize_min_max(Eigen::Ref<Eigen::VectorXd> x, double eps) {
+bool normalizeMinMax(Eigen::Ref<Eigen::VectorXd> x, double eps) {
   if (x.size() == 0) return true;
   const double lo = x.minCoeff(), hi = x.maxCoeff();
   const double range = hi - lo;
@@ -170,12 +170,12 @@ bool normalize_min_max(Eigen::Ref<Eigen::VectorXd> x, double eps) {
   return false;
 }
 
-NormalizationInfo normalize_min_max(Eigen::MatrixXd& data, double eps) {
+NormalizationInfo normalizeMinMax(Eigen::MatrixXd& data, double eps) {
   NormalizationInfo info;
   for (Eigen::Index c = 0; c < data.cols(); ++c) {
     const double lo = data.rows() ? data.col(c).minCoeff() : 0.0;
     const double hi = data.rows() ? data.col(c).maxCoeff() : 0.0;
-    const bool constant = normalize_min_max(data.col(c), eps);
+    const bool constant = normalizeMinMax(data.col(c), eps);
     info.offset.push_back(lo);
     info.scale.push_back(constant ? 1.0 : hi - lo);
     info.constant.push_back(constant);
@@ -183,7 +183,7 @@ NormalizationInfo normalize_min_max(Eigen::MatrixXd& data, double eps) {
   return info;
 }
 
-NormalizationInfo z_normalize(Eigen::MatrixXd& data, double eps) {
+NormalizationInfo zNormalize(Eigen::MatrixXd& data, double eps) {
   NormalizationInfo info;
   for (Eigen::Index c = 0; c < data.cols(); ++c) {
     auto col = data.col(c);
@@ -203,8 +203,8 @@ NormalizationInfo z_normalize(Eigen::MatrixXd& data, double eps) {
   return info;
 }
 
-void check_finite(const FeatureMatrix& m, const std::string& context) {
-  m.validate_shape();
+void checkFinite(const FeatureMatrix& m, const std::string& context) {
+  m.validateShape();
   const std::string prefix = context.empty() ? "" : context + ": ";
   for (Eigen::Index c = 0; c < m.cols(); ++c) {
     for (Eigen::Index r = 0; r < m.rows(); ++r) {
@@ -212,7 +212,7 @@ void check_finite(const FeatureMatrix& m, const std::string& context) {
       if (!std::isfinite(v)) {
         std::ostringstream msg;
         msg << prefix << "feature '" << m.names[c] << "' has " << (std::isnan(v) ? "NaN" : "Inf")
-            << " at sample " << r << " (t=" << m.time_at(r) << " s)";
+            << " at sample " << r << " (t=" << m.timeAt(r) << " s)";
         throw std::invalid_argument(msg.str());
       }
     }

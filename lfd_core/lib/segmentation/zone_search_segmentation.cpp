@@ -10,8 +10,8 @@ namespace {
 // ClaSP searches only the zones, which depend on its min_s (eq. 1). The anchors place each
 // changepoint on a sensory event: the sensors time an interaction to a few samples, while the
 // smooth kinematics ClaSP segments peak up to a window away from it.
-void search_in_zones(const DemoEvidence& evidence, bool anchor_to_events,
-                     MultivariateSegmentationConfig* clasp) {
+void searchInZones(const DemoEvidence& evidence, bool anchor_to_events,
+                   MultivariateSegmentationConfig* clasp) {
   clasp->candidate_zones_for = [&evidence](std::size_t min_s) { return evidence.zones(min_s); };
   if (!anchor_to_events) return;
   for (const SensoryEvent& e : evidence.events.details) {
@@ -20,14 +20,14 @@ void search_in_zones(const DemoEvidence& evidence, bool anchor_to_events,
   }
 }
 
-DemoSegmentationResult segment_demo(const FeatureMatrix& demo, const DemoSettings& settings,
-                                    const PerDemoRun& run) {
-  const DemoEvidence evidence = detect_demo_evidence(demo, settings, run);
-  MultivariateSegmentationConfig clasp = clasp_settings(settings, run.result);
-  if (run.validate) search_in_zones(evidence, settings.config.anchor_to_events, &clasp);
-  DemoSegmentationResult out = run_demo_clasp(demo, settings, run.result, clasp);
-  validate_changepoints(evidence, run.validate, &out);
-  add_changepoint_times(demo, &out);
+DemoSegmentationResult segmentDemo(const FeatureMatrix& demo, const DemoSettings& settings,
+                                   const PerDemoRun& run) {
+  const DemoEvidence evidence = detectDemoEvidence(demo, settings, run);
+  MultivariateSegmentationConfig clasp = claspSettings(settings, run.result);
+  if (run.validate) searchInZones(evidence, settings.config.anchor_to_events, &clasp);
+  DemoSegmentationResult out = runDemoClasp(demo, settings, run.result, clasp);
+  validateChangepoints(evidence, run.validate, &out);
+  addChangepointTimes(demo, &out);
   return out;
 }
 
@@ -36,13 +36,13 @@ DemoSegmentationResult segment_demo(const FeatureMatrix& demo, const DemoSetting
 SegmentationPipelineResult ZoneSearchSegmentation::segment(
     const PreparedSegmentation& prepared, const std::vector<FeatureMatrix>& demos,
     const SegmentationPipelineConfig& config) const {
-  PerDemoRun run = begin_per_demo_run(prepared, demos, config);
-  for_each_demo(demos.size(), config.threads, [&](std::size_t d) {
-    run.result.demos[d] = segment_demo(demos[d], run.settings[d], run);
+  PerDemoRun run = beginPerDemoRun(prepared, demos, config);
+  forEachDemo(demos.size(), config.threads, [&](std::size_t d) {
+    run.result.demos[d] = segmentDemo(demos[d], run.settings[d], run);
   });
   if (config.consensus_count)
-    agree_on_changepoint_count(demos, run.validate, config.consensus_fill_p_value, &run.result);
-  return finish_per_demo_run(demos, &run);
+    agreeOnChangepointCount(demos, run.validate, config.consensus_fill_p_value, &run.result);
+  return finishPerDemoRun(demos, &run);
 }
 
 }  // namespace lfd

@@ -40,15 +40,15 @@ struct DemoBagOptions {
 };
 
 /// Grasp time (bag time, s) of a demo written with `o`.
-inline double grasp_time(const DemoBagOptions& o) {
+inline double graspTime(const DemoBagOptions& o) {
   return o.start_time + o.grasp_fraction * o.duration;
 }
 
-inline void write_demo_bag(const std::string& path, const DemoBagOptions& o = {}) {
+inline void writeDemoBag(const std::string& path, const DemoBagOptions& o = {}) {
   rosbag::Bag bag(path, rosbag::bagmode::Write);
   std::mt19937 rng(o.seed);
   std::normal_distribution<double> noise(0.0, 1.0);
-  const double grasp = grasp_time(o);
+  const double grasp = graspTime(o);
   const int samples = static_cast<int>(o.duration * o.pose_rate);
   for (int i = 0; i < samples; ++i) {
     const double t = o.start_time + i / o.pose_rate;

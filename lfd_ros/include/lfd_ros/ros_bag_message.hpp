@@ -34,14 +34,14 @@ boost::shared_ptr<M> instantiateChecked(const rosbag::MessageInstance& m, std::s
                                         const std::string& file) {
   const std::string md5 = ros::message_traits::md5sum<M>();
   if (md5 != "*" && m.getMD5Sum() != "*" && m.getMD5Sum() != md5) return nullptr;
-  static const rosmsg::MessageSchema schema = rosmsg::MessageSchema::parse(
+  static const rosmsg::MessageSchema kSchema = rosmsg::MessageSchema::parse(
       ros::message_traits::datatype<M>(), ros::message_traits::definition<M>());
   std::vector<std::uint8_t> bytes(m.size());
   ros::serialization::OStream out(bytes.data(), static_cast<std::uint32_t>(bytes.size()));
   m.write(out);
   auto msg = boost::make_shared<M>();
   try {
-    rosmsg::check_message_bytes(schema, bytes.data(), bytes.size());
+    rosmsg::checkMessageBytes(kSchema, bytes.data(), bytes.size());
     ros::serialization::IStream in(bytes.data(), static_cast<std::uint32_t>(bytes.size()));
     ros::serialization::deserialize(in, *msg);
   } catch (const std::exception& e) {

@@ -18,13 +18,13 @@ namespace lfd {
 template <typename M>
 void checkRequestStrings(const M& request, const StringBudget& budget) {
   // The schema of M, parsed once per type from the definition generated with it.
-  static const rosmsg::MessageSchema schema = rosmsg::MessageSchema::parse(
+  static const rosmsg::MessageSchema kSchema = rosmsg::MessageSchema::parse(
       ros::message_traits::datatype<M>(), ros::message_traits::definition<M>());
   const std::uint32_t size = ros::serialization::serializationLength(request);
   std::vector<std::uint8_t> bytes(size);
   ros::serialization::OStream out(bytes.data(), size);
   ros::serialization::serialize(out, request);
-  checkMessageStrings(schema, bytes.data(), bytes.size(), budget);
+  checkMessageStrings(kSchema, bytes.data(), bytes.size(), budget);
 }
 
 }  // namespace lfd

@@ -28,27 +28,27 @@ struct DemoFeatures {
 
 /// The bag files of one demonstration: `path` itself, or its comma-separated parts (unless a file
 /// of that very name exists).
-std::vector<std::string> demo_parts(const std::string& path);
+std::vector<std::string> demoParts(const std::string& path);
 
 /// One demonstration's bag files, each opened once by the file-access layer: the reader reads
 /// these descriptors, and their identities (lfd::FileIdentity) key the service's cache, so a key
 /// always describes the very files that were read.
 struct DemoFiles {
   std::string path;                ///< as the request gave it
-  std::vector<std::string> names;  ///< demo_parts(path), for messages
+  std::vector<std::string> names;  ///< demoParts(path), for messages
   std::vector<lfd::InputFile> parts;
 };
 
 /// Opens the parts of `path` under `policy`. Throws std::runtime_error "cannot open bag ...: why".
-DemoFiles open_demo_files(const std::string& path, const lfd::PathPolicy& policy = {});
+DemoFiles openDemoFiles(const std::string& path, const lfd::PathPolicy& policy = {});
 
 /// The request budget of the segmentation (service and CLI), checked before anything is read:
 /// `entries` (bag paths or CSV files) within limits/max_bags, the files they expand to (demo
 /// parts) within limits/max_bag_files, their total size within limits/max_total_bytes, and each
 /// one a regular file inside `paths`' roots. Throws std::invalid_argument naming the key, or for
 /// a file "cannot open <kind>: ..." and why.
-void check_request_budget(const std::vector<std::string>& entries, const RequestLimits& limits,
-                          const lfd::PathPolicy& paths, const std::string& kind = "bag");
+void checkRequestBudget(const std::vector<std::string>& entries, const RequestLimits& limits,
+                        const lfd::PathPolicy& paths, const std::string& kind = "bag");
 
 /// Raw (not resampled) streams of the configured fields of one bag. Throws std::runtime_error for
 /// unreadable/truncated bags or messages that do not match their definition (naming the file,
@@ -58,26 +58,26 @@ void check_request_budget(const std::vector<std::string>& entries, const Request
 /// counted as the first message of each topic expands its fields, before the rest is read). Each
 /// stream is in stamp order (lfd_core/io/stamp_order.hpp); `warnings` gets one line per topic whose
 /// stamps were out of order, duplicated or had a gap.
-std::vector<lfd::Stream> read_bag_streams(const DemoFiles& files,
-                                          const std::vector<TopicConfig>& topics,
-                                          std::vector<FeatureRole>* roles = nullptr,
-                                          std::vector<std::string>* warnings = nullptr,
-                                          std::size_t max_features = 0);
-std::vector<lfd::Stream> read_bag_streams(const std::string& path,
-                                          const std::vector<TopicConfig>& topics,
-                                          std::vector<FeatureRole>* roles = nullptr,
-                                          std::vector<std::string>* warnings = nullptr,
-                                          std::size_t max_features = 0);
+std::vector<lfd::Stream> readBagStreams(const DemoFiles& files,
+                                        const std::vector<TopicConfig>& topics,
+                                        std::vector<FeatureRole>* roles = nullptr,
+                                        std::vector<std::string>* warnings = nullptr,
+                                        std::size_t max_features = 0);
+std::vector<lfd::Stream> readBagStreams(const std::string& path,
+                                        const std::vector<TopicConfig>& topics,
+                                        std::vector<FeatureRole>* roles = nullptr,
+                                        std::vector<std::string>* warnings = nullptr,
+                                        std::size_t max_features = 0);
 
-/// read_bag_streams + resampling at `rate` Hz (errors name the bag). Streams over `limits`
-/// (features, time span, |value|) are refused before resampling (check_streams).
-DemoFeatures read_bag_features(const DemoFiles& files, const std::vector<TopicConfig>& topics,
-                               double rate, const RequestLimits& limits = RequestLimits());
-DemoFeatures read_bag_features(const std::string& path, const std::vector<TopicConfig>& topics,
-                               double rate, const RequestLimits& limits = RequestLimits());
+/// readBagStreams + resampling at `rate` Hz (errors name the bag). Streams over `limits`
+/// (features, time span, |value|) are refused before resampling (checkStreams).
+DemoFeatures readBagFeatures(const DemoFiles& files, const std::vector<TopicConfig>& topics,
+                             double rate, const RequestLimits& limits = RequestLimits());
+DemoFeatures readBagFeatures(const std::string& path, const std::vector<TopicConfig>& topics,
+                             double rate, const RequestLimits& limits = RequestLimits());
 
 /// Every topic of the bag(s) with its type, message count and numeric fields (paths as they are
 /// written in the configuration's `fields`). Throws std::runtime_error for unreadable bags.
-std::string describe_bag(const std::string& path);
+std::string describeBag(const std::string& path);
 
 }  // namespace lfd_segmentation

@@ -9,7 +9,7 @@
 namespace lfd_segmentation {
 
 /// "a,b,,c" -> {a, b, c}.
-inline std::vector<std::string> split_list(const std::string& s) {
+inline std::vector<std::string> splitList(const std::string& s) {
   std::vector<std::string> out;
   std::stringstream in(s);
   std::string item;
@@ -18,13 +18,13 @@ inline std::vector<std::string> split_list(const std::string& s) {
   return out;
 }
 
-inline bool ends_with(const std::string& s, const std::string& suffix) {
+inline bool endsWith(const std::string& s, const std::string& suffix) {
   return s.size() >= suffix.size() &&
          s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
 }
 
 /// The value after option argv[*k] (advancing *k); throws "<option> needs a value".
-inline std::string option_value(int argc, char** argv, int* k) {
+inline std::string optionValue(int argc, char** argv, int* k) {
   const std::string option = argv[*k];
   if (*k + 1 >= argc) throw std::invalid_argument(option + " needs a value");
   return argv[++*k];

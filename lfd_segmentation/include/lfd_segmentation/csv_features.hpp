@@ -17,14 +17,14 @@ namespace lfd_segmentation {
 /// columns, checked on the header; data rows; finite |values| whose squares would overflow the
 /// distances) the read stops at once with the limit's key, the line and the column. A UTF-8
 /// byte-order mark is skipped; a UTF-16 file is refused ("save it as UTF-8").
-lfd::FeatureMatrix read_csv_features(const std::string& path, const std::string& time_column = "",
-                                     double rate = 0.0,
-                                     const RequestLimits& limits = RequestLimits());
+lfd::FeatureMatrix readCsvFeatures(const std::string& path, const std::string& time_column = "",
+                                   double rate = 0.0,
+                                   const RequestLimits& limits = RequestLimits());
 
 /// "" for a clock without gaps; else a warning naming the largest gap: the segmentation takes the
 /// rows as evenly spaced (its windows and lags are counted in samples of the median step), so a
 /// gap of more than `max_missing` median steps shifts every time parameter across it.
-std::string clock_gap_warning(const lfd::FeatureMatrix& matrix, const std::string& path,
-                              double max_missing = 10.0);
+std::string clockGapWarning(const lfd::FeatureMatrix& matrix, const std::string& path,
+                            double max_missing = 10.0);
 
 }  // namespace lfd_segmentation

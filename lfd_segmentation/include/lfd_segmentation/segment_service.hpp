@@ -13,8 +13,8 @@ namespace lfd_segmentation {
 
 /// The node's parameters with the request's non-zero overrides applied (throws
 /// std::invalid_argument for an unknown combination or a threshold outside (0,1]).
-SegmentationParams apply_overrides(const SegmentationParams& params,
-                                   const lfd_msgs::Segment::Request& request);
+SegmentationParams applyOverrides(const SegmentationParams& params,
+                                  const lfd_msgs::Segment::Request& request);
 
 /// The last request's bags read and features selected (II-B), for the next request on the same
 /// bags: an evaluation asks for every combination method in turn, and neither the bags nor the
@@ -31,8 +31,8 @@ struct PreparedCache {
 /// Handles one request; always returns (success=false + error on failure). Before any work: every
 /// string within limits/max_request_string_bytes, every path absolute, the request budget. With a
 /// cache, a request on the bags of the previous one reuses their features and selection.
-void handle_segment_request(const SegmentationParams& params,
-                            const lfd_msgs::Segment::Request& request,
-                            lfd_msgs::Segment::Response& response, PreparedCache* cache = nullptr);
+void handleSegmentRequest(const SegmentationParams& params,
+                          const lfd_msgs::Segment::Request& request,
+                          lfd_msgs::Segment::Response& response, PreparedCache* cache = nullptr);
 
 }  // namespace lfd_segmentation

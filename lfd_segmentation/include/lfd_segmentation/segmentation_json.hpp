@@ -18,21 +18,21 @@ namespace lfd_segmentation {
 /// file); files written before the marker are recognised by their top-level "success" and "mode"
 /// or "error".
 constexpr const char* kSegmentationResultFormat = "lfd_segmentation_result";
-lfd::OutputKind segmentation_result_output();
+lfd::OutputKind segmentationResultOutput();
 
 struct JsonOptions {
   bool profiles = true;           ///< combined profile (raw and Kaiser-penalized) per demo
   bool feature_profiles = false;  ///< every selected feature's own profile (large)
 };
 
-nlohmann::json to_json(const lfd::SegmentationPipelineResult& result,
-                       const std::vector<lfd::FeatureMatrix>& demos,
-                       const std::vector<std::string>& sources, const JsonOptions& options = {});
+nlohmann::json toJson(const lfd::SegmentationPipelineResult& result,
+                      const std::vector<lfd::FeatureMatrix>& demos,
+                      const std::vector<std::string>& sources, const JsonOptions& options = {});
 
 /// Plain multivariate ClaSP of one series (no relevance, no validation).
-nlohmann::json to_json(const lfd::MultivariateSegmentation& segmentation,
-                       const lfd::FeatureMatrix& demo, const std::string& source,
-                       const JsonOptions& options = {});
+nlohmann::json toJson(const lfd::MultivariateSegmentation& segmentation,
+                      const lfd::FeatureMatrix& demo, const std::string& source,
+                      const JsonOptions& options = {});
 
 /// What the segmentation read, one entry per demo in input order (`segment --features`, drawn by
 /// plot_segmentation.py): "time", the demo's clock (s, full precision, the clock of the
@@ -41,12 +41,12 @@ nlohmann::json to_json(const lfd::MultivariateSegmentation& segmentation,
 /// kFeatureResolution of its feature's range (of its magnitude when constant): far below a
 /// figure's pixel, and half the bytes of full doubles.
 constexpr double kFeatureResolution = 1e-6;
-nlohmann::json feature_matrices_json(const std::vector<lfd::FeatureMatrix>& demos,
-                                     const std::vector<std::string>& states,
-                                     const std::vector<std::string>& sensors);
+nlohmann::json featureMatricesJson(const std::vector<lfd::FeatureMatrix>& demos,
+                                   const std::vector<std::string>& states,
+                                   const std::vector<std::string>& sensors);
 
 /// The JSON as text, indented one space per level, except that arrays of numbers or strings stay
 /// on one line: profiles and feature values would otherwise take a line per number.
-std::string dump_json(const nlohmann::json& json);
+std::string dumpJson(const nlohmann::json& json);
 
 }  // namespace lfd_segmentation

@@ -60,29 +60,29 @@ struct SegmentationParams {
   lfd::SegmentationPipelineConfig pipeline;
   /// The pipeline configuration with the seconds attached (and, for callers that work in samples
   /// of the nominal clock, the sample counts filled at `rate`).
-  lfd::SegmentationPipelineConfig pipeline_config() const;
+  lfd::SegmentationPipelineConfig pipelineConfig() const;
 };
 
 /// Parses the YAML layout of config/segmentation.yaml; missing keys keep the defaults. Throws
 /// std::invalid_argument with the offending key on bad values (and for the ground-truth topic).
-SegmentationParams params_from_yaml(const YAML::Node& root);
-SegmentationParams load_params_file(const std::string& path);
+SegmentationParams paramsFromYaml(const YAML::Node& root);
+SegmentationParams loadParamsFile(const std::string& path);
 
 /// Refuses a request-level time override that is not a finite positive number of seconds within
 /// limits/max_demo_seconds (NaN, inf, 1e300). `key` names the field in the message.
-void check_seconds_override(double value, const std::string& key, const RequestLimits& limits);
+void checkSecondsOverride(double value, const std::string& key, const RequestLimits& limits);
 
 /// Refuses demos the parameters cannot segment: a window as long as the demo (the answer would be
 /// "0 changepoints" for a reason that is not in the data; the pipeline refuses a minimum segment
 /// over half a demo itself), and demos over the sample limits.
-void check_demos_fit(const SegmentationParams& params, const std::vector<lfd::FeatureMatrix>& demos,
-                     const std::vector<std::string>& sources);
+void checkDemosFit(const SegmentationParams& params, const std::vector<lfd::FeatureMatrix>& demos,
+                   const std::vector<std::string>& sources);
 
 /// Refuses raw streams whose stamps span more than limits/max_demo_seconds (one message stamped
 /// hours late would otherwise be resampled into millions of rows) or hold |values| above
 /// limits/max_abs_value. Fast: one pass, before anything is allocated.
-void check_streams(const std::vector<lfd::Stream>& streams, const std::string& source,
-                   const RequestLimits& limits);
+void checkStreams(const std::vector<lfd::Stream>& streams, const std::string& source,
+                  const RequestLimits& limits);
 
 /// The topic that must never be read by the segmenter (ground truth for evaluation only).
 constexpr const char* kGroundTruthTopic = "/lfd/phase";

@@ -222,6 +222,9 @@ class WorkcellSim {
   void checkTrajectoryVelocities(const JointTrajectory& trajectory,
                                  const std::vector<int>& index) const;
   struct Actuated;
+  void loadModel(const std::string& mjcf_path);  // m_ and d_, or throws with nothing held
+  void releaseModel();
+  void configureFromModel();
   void configureActuators();
   void configureGains(Actuated& a);   // kp and kd of a's joint
   void configureLimits(Actuated& a);  // a's position, velocity and effort limits

@@ -36,7 +36,7 @@ struct SignatureOptions {
 
 /// Throws std::invalid_argument naming the option that is out of range (phase_bins in [2, 1000],
 /// the others finite and >= 0, threshold_margin and min_threshold > 0).
-void check_signature_options(const SignatureOptions& options);
+void checkSignatureOptions(const SignatureOptions& options);
 
 /// One channel's expectation along one segment.
 struct ChannelSignature {
@@ -70,20 +70,20 @@ struct SegmentedRecording {
 /// Learns the signature of `channels` from >= 2 demonstrations with the same number of boundaries.
 /// Throws std::invalid_argument for fewer demos, a differing boundary count, boundaries out of
 /// order or outside the recording, a missing channel, or a recording without a clock.
-SensorySignature learn_signature(const std::vector<SegmentedRecording>& demos,
-                                 const std::vector<std::string>& channels,
-                                 const SignatureOptions& options = {});
+SensorySignature learnSignature(const std::vector<SegmentedRecording>& demos,
+                                const std::vector<std::string>& channels,
+                                const SignatureOptions& options = {});
 
 /// The phase slack of one segment: options.phase_slack, at least options.time_slack over the
 /// segment's mean duration (a boundary placed 0.3 s off shifts every event near it by 0.3 s).
-double segment_slack(const SignatureOptions& options, const SegmentSignature& segment);
+double segmentSlack(const SignatureOptions& options, const SegmentSignature& segment);
 
 /// How far one channel's reading at `phase` of `segment` is from what the demonstrations showed
 /// within the slack around it, in spreads. The slack reaches into the neighbouring segments: a
 /// boundary sits at a sensory event, so an event a little late in a run shows the previous
 /// segment's level just after the boundary.
-double deviation_at(const std::vector<SegmentSignature>& segments, const SignatureOptions& options,
-                    std::size_t segment, std::size_t channel, double phase, double value);
+double deviationAt(const std::vector<SegmentSignature>& segments, const SignatureOptions& options,
+                   std::size_t segment, std::size_t channel, double phase, double value);
 
 /// A deviation that lasted: which segment and channel, when, expected versus measured.
 struct Deviation {
@@ -135,8 +135,8 @@ class SignatureMonitor {
 /// Per segment and channel, the highest sustained deviation of a whole segmented run (offline
 /// scoring with the live monitor's rule). scores[s][c] / threshold = the anomaly score; the
 /// Deviation of each segment's worst channel is in `worst` when given.
-std::vector<std::vector<double>> score_recording(const SensorySignature& signature,
-                                                 const SegmentedRecording& run,
-                                                 std::vector<Deviation>* worst = nullptr);
+std::vector<std::vector<double>> scoreRecording(const SensorySignature& signature,
+                                                const SegmentedRecording& run,
+                                                std::vector<Deviation>* worst = nullptr);
 
 }  // namespace lfd

@@ -14,7 +14,7 @@
 //                                    JointTrajectoryControllerState actual/positions/<joint>
 //   twist/linear/norm                sqrt(x^2 + y^2 + z^2) of a message with numeric x, y, z and no
 //                                    field of its own called norm
-// expand_fields() also accepts "*" in place of an index or a name: every element of the array in
+// expandFields() also accepts "*" in place of an index or a name: every element of the array in
 // a sample message (every name of its key array, when it has one).
 //
 // Every read is bounds-checked: bytes that do not match the definition throw MessageError, never
@@ -42,7 +42,7 @@ struct UnknownField : std::invalid_argument {
 
 /// Splits "a/b/3" into {"a", "b", "3"} (a leading '/' is ignored); throws UnknownField on an
 /// empty component.
-std::vector<std::string> split_path(const std::string& path);
+std::vector<std::string> splitPath(const std::string& path);
 
 /// Reads a fixed list of numeric fields from one message after another of the same schema.
 class FieldReader {
@@ -64,7 +64,7 @@ class FieldReader {
   double value(std::size_t k) const;
   /// header.stamp of the last message (seconds), or 0 when the top-level message has no
   /// std_msgs/Header called header or its stamp is zero.
-  double header_stamp() const;
+  double headerStamp() const;
 
  private:
   struct Impl;
@@ -74,23 +74,22 @@ class FieldReader {
 /// Replaces every "*" of the patterns by the indices (or key names) of that array in `sample`,
 /// and checks every resulting path. Throws UnknownField (listing the message's numeric fields)
 /// or MessageError (sample does not match the schema).
-std::vector<std::string> expand_fields(const MessageSchema& schema, const std::uint8_t* sample,
-                                       std::size_t size, const std::vector<std::string>& patterns);
+std::vector<std::string> expandFields(const MessageSchema& schema, const std::uint8_t* sample,
+                                      std::size_t size, const std::vector<std::string>& patterns);
 
 /// Every numeric field path of `sample`, compactly: arrays as "error/positions/<0..6>" plus
 /// "<name: a, b, ...>" when indexed by name (at most `max_names` names shown), arrays of messages
 /// through their first element ("objects/<0..1>/pose/..."), empty arrays as "<empty>".
-std::vector<std::string> list_numeric_fields(const MessageSchema& schema,
-                                             const std::uint8_t* sample, std::size_t size,
-                                             std::size_t max_names = 8);
+std::vector<std::string> listNumericFields(const MessageSchema& schema, const std::uint8_t* sample,
+                                           std::size_t size, std::size_t max_names = 8);
 
 /// The length of the array at `path` in `sample` (fixed arrays: their length).
-std::size_t array_length(const MessageSchema& schema, const std::uint8_t* sample, std::size_t size,
-                         const std::string& path);
+std::size_t arrayLength(const MessageSchema& schema, const std::uint8_t* sample, std::size_t size,
+                        const std::string& path);
 
 /// The string (one element) or string[] at `path` in `sample`.
-std::vector<std::string> string_values(const MessageSchema& schema, const std::uint8_t* sample,
-                                       std::size_t size, const std::string& path);
+std::vector<std::string> stringValues(const MessageSchema& schema, const std::uint8_t* sample,
+                                      std::size_t size, const std::string& path);
 
 /// Gets each string of a message with its field path: "task", "bag_paths[2]",
 /// "metadata.header.frame_id", "segmentations[0].source". `value` points into the message bytes.
@@ -99,11 +98,11 @@ using StringVisitor = std::function<void(const std::string& path, std::string_vi
 /// Walks every field of one serialized message (any depth, every array element) and calls
 /// `visit` for each string. Throws MessageError, naming the field, when the bytes do not match
 /// the schema (a length past the end, bytes left over).
-void for_each_string(const MessageSchema& schema, const std::uint8_t* data, std::size_t size,
-                     const StringVisitor& visit);
+void forEachString(const MessageSchema& schema, const std::uint8_t* data, std::size_t size,
+                   const StringVisitor& visit);
 
 /// Whether the bytes are a message of the schema at all: every length within the buffer and
-/// nothing left over (for_each_string without a visitor). Throws MessageError naming the field.
-void check_message_bytes(const MessageSchema& schema, const std::uint8_t* data, std::size_t size);
+/// nothing left over (forEachString without a visitor). Throws MessageError naming the field.
+void checkMessageBytes(const MessageSchema& schema, const std::uint8_t* data, std::size_t size);
 
 }  // namespace lfd::rosmsg

@@ -37,9 +37,9 @@ enum class Kind {
 };
 
 /// Serialized size of a fixed-size builtin (0 for kString and kMessage).
-std::size_t builtin_size(Kind kind);
+std::size_t builtinSize(Kind kind);
 /// Numbers, time and duration: what a field path may end on.
-bool is_numeric(Kind kind);
+bool isNumeric(Kind kind);
 
 constexpr int kScalar = -1;          ///< FieldDefinition::array_length of a plain field
 constexpr int kVariableLength = -2;  ///< T[]: uint32 count, then the elements
@@ -51,7 +51,7 @@ struct FieldDefinition {
   int array_length = kScalar;  ///< kScalar, kVariableLength or the fixed length N of T[N]
   std::size_t message = 0;     ///< index in MessageSchema::types() when kind == kMessage
 
-  bool is_array() const { return array_length != kScalar; }
+  bool isArray() const { return array_length != kScalar; }
 };
 
 struct MessageType {
@@ -65,7 +65,7 @@ struct MessageType {
   std::size_t min_size = 0;
 
   /// Index of the field called `name`, or -1.
-  int field_index(const std::string& name) const;
+  int fieldIndex(const std::string& name) const;
 };
 
 /// A message type and every type it uses. types()[0] is the top-level type.

@@ -23,7 +23,7 @@ enum class EvidenceKind {
   kClasp,        ///< a changepoint of ClaSP's recursive segmentation (shape change)
 };
 
-std::string to_string(EvidenceKind kind);
+std::string toString(EvidenceKind kind);
 
 struct BoundaryEvidence {
   std::size_t index = 0;  ///< sample of the demonstration
@@ -74,43 +74,43 @@ struct Pause {
 };
 
 /// The pauses of a speed profile (speed >= 0, on the demo's clock `time`).
-std::vector<Pause> find_pauses(const Eigen::VectorXd& speed, const std::vector<double>& time,
-                               const PauseConfig& config);
+std::vector<Pause> findPauses(const Eigen::VectorXd& speed, const std::vector<double>& time,
+                              const PauseConfig& config);
 
 /// Speed profile of the state features (rows = samples, cols = features already divided by their
 /// task-wide range) on the demo's clock `time` (s). Throws std::invalid_argument on a size
 /// mismatch.
-Eigen::VectorXd state_speed(const Eigen::MatrixXd& scaled_states, const std::vector<double>& time,
-                            double smoothing_seconds);
+Eigen::VectorXd stateSpeed(const Eigen::MatrixXd& scaled_states, const std::vector<double>& time,
+                           double smoothing_seconds);
 
 /// Evidence of motion onsets after the pauses (not the first motion of the demo: it starts at
 /// rest).
-std::vector<BoundaryEvidence> motion_onset_evidence(const Eigen::VectorXd& speed,
-                                                    const std::vector<double>& time,
-                                                    const std::vector<Pause>& pauses,
-                                                    const PauseConfig& config, double weight);
+std::vector<BoundaryEvidence> motionOnsetEvidence(const Eigen::VectorXd& speed,
+                                                  const std::vector<double>& time,
+                                                  const std::vector<Pause>& pauses,
+                                                  const PauseConfig& config, double weight);
 
 /// Evidence of the instants of rest shorter than a pause between two motions (at the speed's
 /// minimum).
-std::vector<BoundaryEvidence> motion_stop_evidence(const Eigen::VectorXd& speed,
-                                                   const std::vector<double>& time,
-                                                   const PauseConfig& config, double weight);
+std::vector<BoundaryEvidence> motionStopEvidence(const Eigen::VectorXd& speed,
+                                                 const std::vector<double>& time,
+                                                 const PauseConfig& config, double weight);
 
 /// A pause between two motions is one transition: evidence inside it (the gripper closing while
 /// the arm waits) moves to the pause's end, where the next motion starts. Evidence within
 /// `start_samples` of the pause's beginning stays: a contact made as the hand stops (a press
 /// held still) begins a phase. Evidence in the first rest or the last one stays where it is.
-void gather_into_pauses(const std::vector<Pause>& pauses, std::size_t samples,
-                        std::size_t start_samples, std::vector<BoundaryEvidence>* evidence);
+void gatherIntoPauses(const std::vector<Pause>& pauses, std::size_t samples,
+                      std::size_t start_samples, std::vector<BoundaryEvidence>* evidence);
 
 /// Evidence of the sensory events: rest edges as contact, the others as level steps. A level
 /// event within `fold_samples` of a rest edge is that contact's own force building up or fading
 /// (the ramp reaching its plateau), so it joins the rest edge instead of standing alone.
-std::vector<BoundaryEvidence> sensory_evidence(const SensorEvents& events,
-                                               const EvidenceWeights& weights,
-                                               std::size_t fold_samples);
+std::vector<BoundaryEvidence> sensoryEvidence(const SensorEvents& events,
+                                              const EvidenceWeights& weights,
+                                              std::size_t fold_samples);
 
 /// Evidence of ClaSP's accepted changepoints.
-std::vector<BoundaryEvidence> clasp_evidence(const MultivariateSegmentation& clasp, double weight);
+std::vector<BoundaryEvidence> claspEvidence(const MultivariateSegmentation& clasp, double weight);
 
 }  // namespace lfd

@@ -36,12 +36,12 @@ enum class ClaspScore {
   kMacroF1,  ///< mean of the F1 scores of both classes (the original ClaSP paper)
 };
 
-WindowSelection parse_window_selection(const std::string& name);  ///< "suss","fft","acf"
-ClaspDistance parse_clasp_distance(const std::string& name);      ///< "znorm_euclidean","euclidean"
-ClaspScore parse_clasp_score(const std::string& name);            ///< "roc_auc","f1"
-std::string to_string(WindowSelection selection);
-std::string to_string(ClaspDistance distance);
-std::string to_string(ClaspScore score);
+WindowSelection parseWindowSelection(const std::string& name);  ///< "suss","fft","acf"
+ClaspDistance parseClaspDistance(const std::string& name);      ///< "znorm_euclidean","euclidean"
+ClaspScore parseClaspScore(const std::string& name);            ///< "roc_auc","f1"
+std::string toString(WindowSelection selection);
+std::string toString(ClaspDistance distance);
+std::string toString(ClaspScore score);
 
 struct ClaspConfig {
   std::size_t window_size = 0;  ///< w in samples; 0 = automatic (window_selection)
@@ -81,50 +81,50 @@ struct KnnResult {
 
 /// SuSS: smallest w whose rolling mean/std/range summarise the whole series within `threshold`
 /// (score = 1 - mean distance between window and global statistics). Result in [lbound, n/2].
-std::size_t suss_window_size(const Eigen::Ref<const Eigen::VectorXd>& series,
-                             std::size_t lbound = 10, double threshold = 0.89);
+std::size_t sussWindowSize(const Eigen::Ref<const Eigen::VectorXd>& series, std::size_t lbound = 10,
+                           double threshold = 0.89);
 /// Period (samples) of the strongest Fourier component with period in [lbound, n/4].
-std::size_t dominant_fourier_window_size(const Eigen::Ref<const Eigen::VectorXd>& series,
-                                         std::size_t lbound = 10);
+std::size_t dominantFourierWindowSize(const Eigen::Ref<const Eigen::VectorXd>& series,
+                                      std::size_t lbound = 10);
 /// Lag of the highest local maximum of the autocorrelation in [lbound, n/4].
-std::size_t autocorrelation_window_size(const Eigen::Ref<const Eigen::VectorXd>& series,
-                                        std::size_t lbound = 10);
+std::size_t autocorrelationWindowSize(const Eigen::Ref<const Eigen::VectorXd>& series,
+                                      std::size_t lbound = 10);
 /// Dispatches on `selection`; always returns a w with 2 <= w and 3 * w <= n, throws if n is
 /// too short for any window.
-std::size_t select_window_size(const Eigen::Ref<const Eigen::VectorXd>& series,
-                               WindowSelection selection, std::size_t lbound = 10);
+std::size_t selectWindowSize(const Eigen::Ref<const Eigen::VectorXd>& series,
+                             WindowSelection selection, std::size_t lbound = 10);
 
 // ---------------------------------------------------------------- k-NN
 
 /// Exact self-join k-NN of all length-w subsequences in O(n^2) time and O(n) memory (sliding dot
 /// products along diagonals, each pair visited once). |i - j| <= exclusion_zone is excluded.
-KnnResult self_join_knn(const Eigen::Ref<const Eigen::VectorXd>& series, std::size_t window,
-                        std::size_t k, std::size_t exclusion_zone,
-                        ClaspDistance distance = ClaspDistance::kZNormalizedEuclidean);
+KnnResult selfJoinKnn(const Eigen::Ref<const Eigen::VectorXd>& series, std::size_t window,
+                      std::size_t k, std::size_t exclusion_zone,
+                      ClaspDistance distance = ClaspDistance::kZNormalizedEuclidean);
 /// Multivariate k-NN by distance averaging (ClaSP authors' multivariate method, as claspy does):
 /// rows = samples, columns = channels; each channel's distance profile of a query is z-normalized
 /// (trivial matches set to its maximum first), the profiles are averaged with `weights` (empty =
 /// equal), and the k smallest averages are the neighbours. `distances` then hold the averaged
 /// z-scores, not Euclidean distances. O(d n^2) time, O(d n) memory.
-KnnResult distance_average_knn(const Eigen::MatrixXd& series, const std::vector<double>& weights,
-                               std::size_t window, std::size_t k, std::size_t exclusion_zone,
-                               ClaspDistance distance = ClaspDistance::kZNormalizedEuclidean);
+KnnResult distanceAverageKnn(const Eigen::MatrixXd& series, const std::vector<double>& weights,
+                             std::size_t window, std::size_t k, std::size_t exclusion_zone,
+                             ClaspDistance distance = ClaspDistance::kZNormalizedEuclidean);
 /// O(n^2 w) reference implementation (tests).
-KnnResult brute_force_knn(const Eigen::Ref<const Eigen::VectorXd>& series, std::size_t window,
-                          std::size_t k, std::size_t exclusion_zone,
-                          ClaspDistance distance = ClaspDistance::kZNormalizedEuclidean);
+KnnResult bruteForceKnn(const Eigen::Ref<const Eigen::VectorXd>& series, std::size_t window,
+                        std::size_t k, std::size_t exclusion_zone,
+                        ClaspDistance distance = ClaspDistance::kZNormalizedEuclidean);
 
 // ---------------------------------------------------------------- profile and significance
 
 /// Classification score for every split s in [min_split, n - min_split] (n = series length =
 /// m + w - 1); NaN elsewhere. Computed incrementally: moving the split by one relabels one
 /// subsequence and updates only those that have it as a neighbour, O(m k) in total.
-Eigen::VectorXd classification_score_profile(const KnnResult& knn, std::size_t min_split,
-                                             ClaspScore score = ClaspScore::kRocAuc);
+Eigen::VectorXd classificationScoreProfile(const KnnResult& knn, std::size_t min_split,
+                                           ClaspScore score = ClaspScore::kRocAuc);
 
 /// Two-sided Wilcoxon rank-sum p-value of the k-NN predicted labels left vs right of `split`
 /// (as claspy's significance test). Returned as log10(p) so that tiny p-values stay exact.
-double split_log10_p_value(const KnnResult& knn, std::size_t split);
+double splitLog10PValue(const KnnResult& knn, std::size_t split);
 
 /// Everything ClaSP computes on one series.
 struct ClaspProfile {
@@ -136,8 +136,8 @@ struct ClaspProfile {
 
 /// Selects w (unless fixed), computes the k-NN and the profile. Throws std::invalid_argument for
 /// non-finite input or a series too short for the window (n < 2 * min_segment_size + 1 etc.).
-ClaspProfile compute_clasp_profile(const Eigen::Ref<const Eigen::VectorXd>& series,
-                                   const ClaspConfig& config);
+ClaspProfile computeClaspProfile(const Eigen::Ref<const Eigen::VectorXd>& series,
+                                 const ClaspConfig& config);
 
 /// Result of a univariate segmentation.
 struct ClaspSegmentation {
@@ -153,7 +153,7 @@ struct ClaspSegmentation {
 /// num_changepoints < 0 the significance test decides when to stop; otherwise exactly that many
 /// changepoints are returned when the series allows it (ranges shorter than 2 * min segment size
 /// are not split).
-ClaspSegmentation clasp_segment(const Eigen::Ref<const Eigen::VectorXd>& series,
-                                const ClaspConfig& config, int num_changepoints = -1);
+ClaspSegmentation claspSegment(const Eigen::Ref<const Eigen::VectorXd>& series,
+                               const ClaspConfig& config, int num_changepoints = -1);
 
 }  // namespace lfd

@@ -13,17 +13,17 @@ namespace lfd {
 /// One demonstration's features (rows = samples, already scaled alike across demos) on a grid of
 /// `step` seconds from its first sample: row k holds the features at time[0] + k * step
 /// (linear interpolation). Throws std::invalid_argument on a size mismatch or step <= 0.
-Eigen::MatrixXd on_uniform_grid(const Eigen::MatrixXd& features, const std::vector<double>& time,
-                                double step);
+Eigen::MatrixXd onUniformGrid(const Eigen::MatrixXd& features, const std::vector<double>& time,
+                              double step);
 
 /// Summed squared Euclidean distance along the best monotone warping path. `band` (< 1): the
 /// path stays within band x the longer length of the diagonal joining the corners (a slanted
 /// Sakoe-Chiba band); >= 1 = unconstrained.
-double multivariate_dtw_cost(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b, double band = 1.0);
+double multivariateDtwCost(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b, double band = 1.0);
 
 /// For every row of `a`, the mean row of `b` it is warped to by multivariate DTW (fractional).
-std::vector<double> multivariate_dtw_map(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b,
-                                         double band = 1.0);
+std::vector<double> multivariateDtwMap(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b,
+                                       double band = 1.0);
 
 struct DemoAlignment {
   std::size_t reference = 0;  ///< the medoid demonstration
@@ -34,21 +34,21 @@ struct DemoAlignment {
   std::vector<double> mean_cost;  ///< per demo, DTW cost to the reference per aligned row
 };
 
-/// Aligns gridded demos (on_uniform_grid) to their medoid; `threads` <= 0 = all cores; `band`
-/// as for multivariate_dtw_cost.
+/// Aligns gridded demos (onUniformGrid) to their medoid; `threads` <= 0 = all cores; `band`
+/// as for multivariateDtwCost.
 /// Throws std::invalid_argument on no demos, an empty one or differing feature counts.
-DemoAlignment align_to_medoid(const std::vector<Eigen::MatrixXd>& gridded, int threads,
-                              double band = 1.0);
+DemoAlignment alignToMedoid(const std::vector<Eigen::MatrixXd>& gridded, int threads,
+                            double band = 1.0);
 
 /// The same map, with the alignment held at anchor pairs: row a_anchors[k] of `a` is matched to
 /// row b_anchors[k] of `b` and DTW runs between consecutive anchors only (both increasing, inside
 /// the series). Agreed boundaries hold a long alignment on track where the features alone are
 /// ambiguous (a pause matches any other pause).
-std::vector<double> anchored_dtw_map(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b,
-                                     const std::vector<std::size_t>& a_anchors,
-                                     const std::vector<std::size_t>& b_anchors, double band = 1.0);
+std::vector<double> anchoredDtwMap(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b,
+                                   const std::vector<std::size_t>& a_anchors,
+                                   const std::vector<std::size_t>& b_anchors, double band = 1.0);
 
 /// Linear interpolation of a per-row map at a fractional row (clamped to its ends).
-double map_row(const std::vector<double>& map, double row);
+double mapRow(const std::vector<double>& map, double row);
 
 }  // namespace lfd

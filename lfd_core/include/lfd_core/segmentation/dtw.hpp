@@ -47,13 +47,13 @@ struct DtwPairView {
 };
 
 /// True when cell (i,j) lies in the band for series of lengths n and m.
-bool dtw_in_band(long i, long j, long n, long m, int band);
+bool dtwInBand(long i, long j, long n, long m, int band);
 
 /// Scalar DTW cost with memory linear in min(n,m) (two rows). Throws on empty input.
-double dtw_cost(const double* a, std::size_t n, const double* b, std::size_t m,
-                const DtwOptions& options = {});
-double dtw_cost(const std::vector<double>& a, const std::vector<double>& b,
-                const DtwOptions& options = {});
+double dtwCost(const double* a, std::size_t n, const double* b, std::size_t m,
+               const DtwOptions& options = {});
+double dtwCost(const std::vector<double>& a, const std::vector<double>& b,
+               const DtwOptions& options = {});
 
 /// Scalar DTW with the warping path (direction matrix of n*m bytes).
 DtwResult dtw(const double* a, std::size_t n, const double* b, std::size_t m,
@@ -63,18 +63,17 @@ DtwResult dtw(const std::vector<double>& a, const std::vector<double>& b,
 
 /// Batched SIMD DTW over many independent pairs (lengths may differ; pairs of similar sizes are
 /// grouped per vector). `threads` <= 0 uses the hardware concurrency. Results keep input order.
-std::vector<double> dtw_cost_batch(const std::vector<DtwPairView>& pairs,
-                                   const DtwOptions& options = {}, int threads = 1);
-std::vector<DtwResult> dtw_batch(const std::vector<DtwPairView>& pairs,
+std::vector<double> dtwCostBatch(const std::vector<DtwPairView>& pairs,
                                  const DtwOptions& options = {}, int threads = 1);
+std::vector<DtwResult> dtwBatch(const std::vector<DtwPairView>& pairs,
+                                const DtwOptions& options = {}, int threads = 1);
 
 /// The two signals resampled along a path: out.first[k] = a[path[k].first], and so on.
-std::pair<std::vector<double>, std::vector<double>> dtw_aligned_pair(const double* a,
-                                                                     const double* b,
-                                                                     const WarpingPath& path);
+std::pair<std::vector<double>, std::vector<double>> dtwAlignedPair(const double* a, const double* b,
+                                                                   const WarpingPath& path);
 
 /// Summed local cost along a path (to check a path against its reported cost).
-double dtw_path_cost(const double* a, const double* b, const WarpingPath& path);
+double dtwPathCost(const double* a, const double* b, const WarpingPath& path);
 
 /// Number of lanes of the batched kernel (8 floats per vector).
 constexpr int kDtwLanes = 8;

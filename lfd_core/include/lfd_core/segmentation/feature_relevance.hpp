@@ -60,22 +60,22 @@ struct FeatureRelevanceResult {
 
   const FeatureRelevance& feature(const std::string& name) const;  ///< throws if unknown
   /// Scores of the selected features in `selected` order (weights for the profile combination).
-  std::vector<double> selected_scores() const;
+  std::vector<double> selectedScores() const;
 };
 
 /// Computes the relevance of `features` (all columns when empty) across `demos`. Throws
 /// std::invalid_argument with fewer than 2 demonstrations, a feature missing from a
 /// demonstration, non-finite samples, or empty demonstrations.
-FeatureRelevanceResult compute_feature_relevance(const std::vector<FeatureMatrix>& demos,
-                                                 std::vector<std::string> features = {},
-                                                 const FeatureRelevanceConfig& config = {});
+FeatureRelevanceResult computeFeatureRelevance(const std::vector<FeatureMatrix>& demos,
+                                               std::vector<std::string> features = {},
+                                               const FeatureRelevanceConfig& config = {});
 
 /// Indices of the entries with score >= threshold * max score (best first); entries flagged in
 /// `excluded` are skipped. If the best score is <= 0, only the best is returned.
-std::vector<std::size_t> select_by_threshold(const std::vector<double>& scores,
-                                             const std::vector<bool>& excluded, double threshold);
+std::vector<std::size_t> selectByThreshold(const std::vector<double>& scores,
+                                           const std::vector<bool>& excluded, double threshold);
 
 /// Pearson correlation; 0 when either signal has (numerically) no variance.
-double pearson_correlation(const std::vector<double>& x, const std::vector<double>& y);
+double pearsonCorrelation(const std::vector<double>& x, const std::vector<double>& y);
 
 }  // namespace lfd

@@ -15,8 +15,8 @@ namespace lfd {
 
 /// Segments prepared demos jointly (the pipeline's kJoint). Needs clocks (config.seconds set);
 /// throws std::invalid_argument otherwise or on the pipeline's own input errors.
-SegmentationPipelineResult segment_jointly(const PreparedSegmentation& prepared,
-                                           const std::vector<FeatureMatrix>& demos,
-                                           const SegmentationPipelineConfig& config);
+SegmentationPipelineResult segmentJointly(const PreparedSegmentation& prepared,
+                                          const std::vector<FeatureMatrix>& demos,
+                                          const SegmentationPipelineConfig& config);
 
 }  // namespace lfd

@@ -1,4 +1,4 @@
-// One range of multivariate ClaSP's recursion (segment_multivariate, paper II-C): the per-feature
+// One range of multivariate ClaSP's recursion (segmentMultivariate, paper II-C): the per-feature
 // ClaSP profiles of the sub-series, combined and penalized by a Kaiser window spanning it. The
 // profiles are computed on the sub-series only (k-NN restricted to it), as claspy's binary
 // segmentation does: a slice of the whole-series profile would keep neighbours from outside the
@@ -39,14 +39,14 @@ struct ProfileInputs {
 /// The range [begin, begin + len)'s combined profile times a Kaiser window spanning it (a split
 /// near a range end would leave a short, uninterpretable segment); nothing when no feature's
 /// window fits the range.
-std::optional<RangeProfile> range_profile(const ProfileInputs& in, std::size_t begin,
-                                          std::size_t len);
+std::optional<RangeProfile> rangeProfile(const ProfileInputs& in, std::size_t begin,
+                                         std::size_t len);
 
 /// Keeps the whole series' profiles for plots (paper Fig. 5, 8).
-void record_first_profile(const RangeProfile& r, MultivariateSegmentation* out);
+void recordFirstProfile(const RangeProfile& r, MultivariateSegmentation* out);
 
 /// Weighted mean of the profiles' log10 p-values (ClaSP's rank-sum test) of a split at t,
 /// relative to the range.
-double split_log10_p(const RangeProfile& r, std::size_t t);
+double splitLog10P(const RangeProfile& r, std::size_t t);
 
 }  // namespace lfd

@@ -25,28 +25,27 @@ enum class ProfileCombination {
   kWeightedProduct,  ///< prod_f p_f^(w_f / sum w) = exp(sum_f w_f log p_f / sum_f w_f)
   /// Not a profile combination: one k-NN on the per-channel distance profiles, each z-normalized
   /// and averaged before the neighbours are taken (the ClaSP authors' multivariate method,
-  /// distance_average_knn), one window for all features (the largest of theirs), one profile.
+  /// distanceAverageKnn), one window for all features (the largest of theirs), one profile.
   kDistanceAverage,
   kWeightedDistanceAverage,  ///< the same with the profiles weighted by feature relevance
 };
 
 /// "average", "product", "weighted_average", "weighted_product", "distance_average",
 /// "weighted_distance_average" (throws std::invalid_argument).
-ProfileCombination parse_profile_combination(const std::string& name);
-std::string to_string(ProfileCombination combination);
+ProfileCombination parseProfileCombination(const std::string& name);
+std::string toString(ProfileCombination combination);
 
 /// Combines equally long profiles. NaN in any profile makes that sample NaN. Weights must be
 /// >= 0 with a positive sum (ignored by the unweighted methods; empty = all ones). Product
 /// methods work in log space and return the (weighted) geometric mean, so the result keeps the
 /// scale of a single ClaSP score whatever the number of features, and never underflows; a score
 /// <= 0 is clamped to 1e-12 before the log.
-Eigen::VectorXd combine_profiles(const std::vector<Eigen::VectorXd>& profiles,
-                                 const std::vector<double>& weights,
-                                 ProfileCombination combination);
+Eigen::VectorXd combineProfiles(const std::vector<Eigen::VectorXd>& profiles,
+                                const std::vector<double>& weights, ProfileCombination combination);
 
 /// Kaiser window of length n with shape beta (I0-Bessel), peak 1 in the middle, fading toward
 /// both ends (w(0) = w(n-1) = 1 / I0(beta)).
-Eigen::VectorXd kaiser_window(std::size_t n, double beta);
+Eigen::VectorXd kaiserWindow(std::size_t n, double beta);
 
 struct MultivariateSegmentationConfig {
   ProfileCombination combination = ProfileCombination::kWeightedProduct;
@@ -135,8 +134,8 @@ struct MultivariateSegmentation {
 /// column carries no information and is left out of the combination, with a zero profile).
 /// `weights`: one relevance score per column (empty = all ones). Throws std::invalid_argument on
 /// shape mismatch, non-finite values, negative weights or a series too short for min_s.
-MultivariateSegmentation segment_multivariate(const Eigen::MatrixXd& features,
-                                              const std::vector<double>& weights,
-                                              const MultivariateSegmentationConfig& config);
+MultivariateSegmentation segmentMultivariate(const Eigen::MatrixXd& features,
+                                             const std::vector<double>& weights,
+                                             const MultivariateSegmentationConfig& config);
 
 }  // namespace lfd

@@ -20,6 +20,6 @@ struct RampFit {
 /// Best flat-ramp-flat fit of y[begin, end) (absolute indices, end - begin >= 2; clipped to y).
 /// O(m^2) for a window of m samples (prefix sums make each candidate O(1)). Ties keep the
 /// shortest ramp. Throws std::invalid_argument for a window of fewer than 2 samples.
-RampFit fit_ramp(const std::vector<double>& y, std::size_t begin, std::size_t end);
+RampFit fitRamp(const std::vector<double>& y, std::size_t begin, std::size_t end);
 
 }  // namespace lfd

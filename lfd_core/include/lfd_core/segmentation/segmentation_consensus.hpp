@@ -17,7 +17,7 @@ namespace lfd {
 /// Applies the agreement to `result` (changepoints, pruned, added, their times, a warning per demo
 /// changed). fill_p_value 0 = never add; without validation, or without a sensory event of its
 /// own, a demo is never filled (it has no zone).
-void agree_on_changepoint_count(const std::vector<FeatureMatrix>& demos, bool validated,
-                                double fill_p_value, SegmentationPipelineResult* result);
+void agreeOnChangepointCount(const std::vector<FeatureMatrix>& demos, bool validated,
+                             double fill_p_value, SegmentationPipelineResult* result);
 
 }  // namespace lfd

@@ -1,7 +1,7 @@
 // The plug-in point of II-C: every way of segmenting prepared demonstrations is one
 // SegmentationMethod, chosen by name from the configuration (SegmentationPipelineConfig::procedure,
 // the `procedure` parameter). A new method is one class and one line in the registry
-// (segmentation_method.cpp); the pipeline (segment_prepared) only looks it up and calls it.
+// (segmentation_method.cpp); the pipeline (segmentPrepared) only looks it up and calls it.
 #pragma once
 
 #include <memory>
@@ -17,16 +17,16 @@ class SegmentationMethod {
   virtual ~SegmentationMethod();
   /// The name the configuration chooses it by ("zone_search", "paper", "joint").
   virtual std::string name() const = 0;
-  /// II-C on prepared demos (segment_prepared's contract: `demos` are the prepared ones).
+  /// II-C on prepared demos (segmentPrepared's contract: `demos` are the prepared ones).
   virtual SegmentationPipelineResult segment(const PreparedSegmentation& prepared,
                                              const std::vector<FeatureMatrix>& demos,
                                              const SegmentationPipelineConfig& config) const = 0;
 };
 
 /// Every registered method's name, in registration order.
-std::vector<std::string> segmentation_method_names();
+std::vector<std::string> segmentationMethodNames();
 
 /// The method of that name; throws std::invalid_argument naming the known ones otherwise.
-std::unique_ptr<SegmentationMethod> make_segmentation_method(const std::string& name);
+std::unique_ptr<SegmentationMethod> makeSegmentationMethod(const std::string& name);
 
 }  // namespace lfd

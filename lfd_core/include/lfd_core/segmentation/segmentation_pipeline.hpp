@@ -39,7 +39,7 @@ struct TimeParameters {
 };
 
 /// How ClaSP's candidates meet the sensory zones: the name of the SegmentationMethod that
-/// segment_prepared runs (segmentation_method.hpp; to_string gives the registry name).
+/// segmentPrepared runs (segmentation_method.hpp; toString gives the registry name).
 enum class SegmentationProcedure {
   /// Ours: the zones first, each recursion step takes its argmax inside them, the changepoint
   /// sits on a sensory event of its zone (anchor_to_events), the demos agree on their count
@@ -55,8 +55,8 @@ enum class SegmentationProcedure {
 };
 
 /// "zone_search", "paper" or "joint" (throws std::invalid_argument otherwise).
-SegmentationProcedure parse_segmentation_procedure(const std::string& name);
-std::string to_string(SegmentationProcedure procedure);
+SegmentationProcedure parseSegmentationProcedure(const std::string& name);
+std::string toString(SegmentationProcedure procedure);
 
 struct SegmentationPipelineConfig {
   /// Time parameters in seconds (see TimeParameters); when unset, the sample counts of
@@ -101,15 +101,15 @@ struct SegmentationPipelineConfig {
 /// Each sensor column's sensor: the channels of one sensor share their name up to the last '/'
 /// (a topic's array or vector: /touch/values/0 and /touch/values/1); names without '/' (CSV
 /// columns) are one sensor.
-std::vector<std::size_t> sensor_channel_groups(const std::vector<std::string>& names);
+std::vector<std::size_t> sensorChannelGroups(const std::vector<std::string>& names);
 
 /// The configuration with its seconds (if any) converted to sample counts at `rate` (Hz) and
 /// `seconds` cleared; unchanged without seconds. Throws std::invalid_argument for rate <= 0.
-SegmentationPipelineConfig in_samples(const SegmentationPipelineConfig& config, double rate);
+SegmentationPipelineConfig inSamples(const SegmentationPipelineConfig& config, double rate);
 
 /// Sample rate (Hz) of a demonstration's clock: 1 / median step. Throws std::invalid_argument when
 /// the demonstration has no clock (no timestamps) or a non-increasing one.
-double sample_rate_of(const FeatureMatrix& demo);
+double sampleRateOf(const FeatureMatrix& demo);
 
 struct DemoSegmentationResult {
   std::vector<std::size_t> changepoints;  ///< validated changepoints (row indices, sorted)
@@ -153,26 +153,26 @@ struct PreparedSegmentation {
   SegmentationPipelineResult base;
 };
 
-/// Checks and II-B of run_segmentation_pipeline (same arguments, same errors).
-PreparedSegmentation prepare_segmentation(const std::vector<FeatureMatrix>& demos,
-                                          const std::vector<std::string>& sensor_features,
-                                          const SegmentationPipelineConfig& config = {},
-                                          const std::vector<std::string>& state_features = {});
+/// Checks and II-B of runSegmentationPipeline (same arguments, same errors).
+PreparedSegmentation prepareSegmentation(const std::vector<FeatureMatrix>& demos,
+                                         const std::vector<std::string>& sensor_features,
+                                         const SegmentationPipelineConfig& config = {},
+                                         const std::vector<std::string>& state_features = {});
 
-/// II-C on prepared demos by the method config.procedure names (make_segmentation_method):
+/// II-C on prepared demos by the method config.procedure names (makeSegmentationMethod):
 /// `config` may differ from the one prepared with in its II-C settings only (combination, ClaSP,
 /// events, procedure), e.g. to compare the combinations on one feature selection. `demos` must be
 /// the prepared ones.
-SegmentationPipelineResult segment_prepared(const PreparedSegmentation& prepared,
-                                            const std::vector<FeatureMatrix>& demos,
-                                            const SegmentationPipelineConfig& config = {});
+SegmentationPipelineResult segmentPrepared(const PreparedSegmentation& prepared,
+                                           const std::vector<FeatureMatrix>& demos,
+                                           const SegmentationPipelineConfig& config = {});
 
 /// Warns, per demo, of each constant (dead) sensor and of a demo without a sensory event
 /// (nothing when the sensors were not used).
-void add_sensor_warnings(const std::vector<FeatureMatrix>& demos, bool validated,
-                         SegmentationPipelineResult* result);
+void addSensorWarnings(const std::vector<FeatureMatrix>& demos, bool validated,
+                       SegmentationPipelineResult* result);
 
-/// Runs the pipeline (prepare_segmentation, then segment_prepared). `sensor_features` name the
+/// Runs the pipeline (prepareSegmentation, then segmentPrepared). `sensor_features` name the
 /// sensor columns; `state_features` name the candidates for segmentation (empty = every column that
 /// is not a sensor). Every demonstration must have the same set of features (any column order).
 /// Throws std::invalid_argument (with the demonstration and feature named) for: no
@@ -180,7 +180,7 @@ void add_sensor_warnings(const std::vector<FeatureMatrix>& demos, bool validated
 /// samples, empty demonstrations, demonstrations shorter than 2 * min_s, no state feature, or
 /// only constant state features. A single demonstration falls back to every non-constant state
 /// feature with equal weights (warning); constant features are left out (warning).
-SegmentationPipelineResult run_segmentation_pipeline(
+SegmentationPipelineResult runSegmentationPipeline(
     const std::vector<FeatureMatrix>& demos, const std::vector<std::string>& sensor_features,
     const SegmentationPipelineConfig& config = {},
     const std::vector<std::string>& state_features = {});

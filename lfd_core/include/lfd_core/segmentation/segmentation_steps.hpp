@@ -1,12 +1,12 @@
 // The steps of the per-demo methods (zone_search, paper), in the order they run:
-//   begin_per_demo_run        the prepared result, each demo's sample-count settings
-//   per demo:  detect_demo_evidence   sensory events and their eq. (1) zones
-//              clasp_settings + the method's own search setup
-//              run_demo_clasp         multivariate ClaSP (multivariate_segmentation.hpp)
-//              validate_changepoints  the zone filter (eq. 1)
-//              add_changepoint_times
-//   agree_on_changepoint_count        the consensus (segmentation_consensus.hpp), zone_search only
-//   finish_per_demo_run               timing, sensor warnings
+//   beginPerDemoRun        the prepared result, each demo's sample-count settings
+//   per demo:  detectDemoEvidence   sensory events and their eq. (1) zones
+//              claspSettings + the method's own search setup
+//              runDemoClasp         multivariate ClaSP (multivariate_segmentation.hpp)
+//              validateChangepoints  the zone filter (eq. 1)
+//              addChangepointTimes
+//   agreeOnChangepointCount        the consensus (segmentation_consensus.hpp), zone_search only
+//   finishPerDemoRun               timing, sensor warnings
 // Each method calls them in sequence, so what differs between methods is visible in its own file.
 #pragma once
 
@@ -21,7 +21,7 @@
 namespace lfd {
 
 /// "demonstration d", the prefix of every per-demo error and warning.
-std::string demo_label(std::size_t d);
+std::string demoLabel(std::size_t d);
 
 /// The sample-count settings of one demonstration: the config's own counts, or its seconds
 /// converted at the demonstration's rate (0 = index-only series).
@@ -32,30 +32,30 @@ struct DemoSettings {
 
 /// Every demo's settings; checks its clock and that it holds 2 min_s (std::invalid_argument with
 /// the demonstration named).
-std::vector<DemoSettings> demo_settings(const std::vector<FeatureMatrix>& demos,
-                                        const SegmentationPipelineConfig& config);
+std::vector<DemoSettings> demoSettings(const std::vector<FeatureMatrix>& demos,
+                                       const SegmentationPipelineConfig& config);
 
 /// Runs job(d) for every demonstration (parallel_for); rethrows the first failure (by
 /// demonstration index) with the demonstration named.
-void for_each_demo(std::size_t count, int threads, const std::function<void(std::size_t)>& job);
+void forEachDemo(std::size_t count, int threads, const std::function<void(std::size_t)>& job);
 
 /// What every demo of a per-demo method shares.
 struct PerDemoRun {
   SegmentationPipelineResult result;  ///< the prepared result; `demos` sized, to be filled
   std::vector<DemoSettings> settings;
-  std::vector<std::size_t> sensor_groups;  ///< sensor_channel_groups of the sensor features
+  std::vector<std::size_t> sensor_groups;  ///< sensorChannelGroups of the sensor features
   bool validate = false;                   ///< sensors validate ClaSP's changepoints
   std::chrono::steady_clock::time_point start;
 };
 
 /// Settings, the validation switch and its warning (no sensors or validation disabled).
-PerDemoRun begin_per_demo_run(const PreparedSegmentation& prepared,
-                              const std::vector<FeatureMatrix>& demos,
-                              const SegmentationPipelineConfig& config);
+PerDemoRun beginPerDemoRun(const PreparedSegmentation& prepared,
+                           const std::vector<FeatureMatrix>& demos,
+                           const SegmentationPipelineConfig& config);
 
 /// The segmentation time and the sensor warnings; returns the result.
-SegmentationPipelineResult finish_per_demo_run(const std::vector<FeatureMatrix>& demos,
-                                               PerDemoRun* run);
+SegmentationPipelineResult finishPerDemoRun(const std::vector<FeatureMatrix>& demos,
+                                            PerDemoRun* run);
 
 /// One demo's sensory evidence: its events and the events its confidence zones surround.
 struct DemoEvidence {
@@ -67,26 +67,25 @@ struct DemoEvidence {
 };
 
 /// Detects the demo's sensory events (once: they do not depend on min_s); none without validation.
-DemoEvidence detect_demo_evidence(const FeatureMatrix& demo, const DemoSettings& settings,
-                                  const PerDemoRun& run);
+DemoEvidence detectDemoEvidence(const FeatureMatrix& demo, const DemoSettings& settings,
+                                const PerDemoRun& run);
 
 /// ClaSP's settings for one demo before the method's own search setup (the fixed window, if any,
 /// for every selected feature).
-MultivariateSegmentationConfig clasp_settings(const DemoSettings& settings,
-                                              const SegmentationPipelineResult& prepared);
+MultivariateSegmentationConfig claspSettings(const DemoSettings& settings,
+                                             const SegmentationPipelineResult& prepared);
 
 /// Multivariate ClaSP on the demo's selected features; fills clasp, min_segment_length,
 /// num_samples and sample_rate, not the changepoints.
-DemoSegmentationResult run_demo_clasp(const FeatureMatrix& demo, const DemoSettings& settings,
-                                      const SegmentationPipelineResult& prepared,
-                                      const MultivariateSegmentationConfig& clasp);
+DemoSegmentationResult runDemoClasp(const FeatureMatrix& demo, const DemoSettings& settings,
+                                    const SegmentationPipelineResult& prepared,
+                                    const MultivariateSegmentationConfig& clasp);
 
 /// The zone filter (eq. 1): ClaSP's changepoints inside a zone are the changepoints, the others
 /// are rejected; records the zones and events. Without validation every changepoint is kept.
-void validate_changepoints(const DemoEvidence& evidence, bool validate,
-                           DemoSegmentationResult* out);
+void validateChangepoints(const DemoEvidence& evidence, bool validate, DemoSegmentationResult* out);
 
 /// The times of the changepoints and of the rejected ones.
-void add_changepoint_times(const FeatureMatrix& demo, DemoSegmentationResult* out);
+void addChangepointTimes(const FeatureMatrix& demo, DemoSegmentationResult* out);
 
 }  // namespace lfd

@@ -60,12 +60,12 @@ enum class EventPlacement {
 };
 
 /// "threshold", "shift", "fit" (throws std::invalid_argument otherwise).
-EventPlacement parse_event_placement(const std::string& name);
-std::string to_string(EventPlacement placement);
+EventPlacement parseEventPlacement(const std::string& name);
+std::string toString(EventPlacement placement);
 
 /// "ratio_of_max" (the paper's 0.4 x max) or "noise" (throws std::invalid_argument otherwise).
-EventThreshold parse_event_threshold(const std::string& name);
-std::string to_string(EventThreshold threshold);
+EventThreshold parseEventThreshold(const std::string& name);
+std::string toString(EventThreshold threshold);
 
 struct SensoryEventConfig {
   EventThreshold threshold = EventThreshold::kRatioOfMax;
@@ -130,18 +130,18 @@ struct Interval {
 
 /// Event sample indices of one sensor signal (sorted, unique). Index t refers to the sample where
 /// the difference x[t] - x[t-1] switches the activity on (or the first quiet sample after it).
-std::vector<std::size_t> detect_sensory_events(const Eigen::Ref<const Eigen::VectorXd>& signal,
-                                               const SensoryEventConfig& config = {});
+std::vector<std::size_t> detectSensoryEvents(const Eigen::Ref<const Eigen::VectorXd>& signal,
+                                             const SensoryEventConfig& config = {});
 
 /// The same events with their rest-edge flag and strength (sorted by index, unique).
-std::vector<SensoryEvent> detect_sensory_event_details(
-    const Eigen::Ref<const Eigen::VectorXd>& signal, const SensoryEventConfig& config = {});
+std::vector<SensoryEvent> detectSensoryEventDetails(const Eigen::Ref<const Eigen::VectorXd>& signal,
+                                                    const SensoryEventConfig& config = {});
 
 /// Eq. (1): union over events s of [max(0, s - min_s/2), min(s + min_s/2, length)], merged into
 /// disjoint sorted intervals (touching or overlapping intervals merge). min_s/2 uses integer
 /// division. Note the paper's upper clip is len(T), not len(T) - 1; we keep it literally.
-std::vector<Interval> confidence_zones(const std::vector<std::size_t>& events, std::size_t min_s,
-                                       std::size_t length);
+std::vector<Interval> confidenceZones(const std::vector<std::size_t>& events, std::size_t min_s,
+                                      std::size_t length);
 
 struct ChangepointValidation {
   std::vector<std::size_t> accepted;  ///< candidates inside a zone (sorted)
@@ -164,19 +164,19 @@ struct SensorEvents {
 /// each column's sensor (empty = every column its own): the channels of one sensor are at rest
 /// only together, so a rest edge is where the whole sensor leaves or regains rest. Throws
 /// std::invalid_argument on non-finite sensor values, bad config or a wrong number of groups.
-SensorEvents detect_sensor_events(const Eigen::MatrixXd& sensors,
-                                  const SensoryEventConfig& config = {},
-                                  const std::vector<std::size_t>& groups = {});
+SensorEvents detectSensorEvents(const Eigen::MatrixXd& sensors,
+                                const SensoryEventConfig& config = {},
+                                const std::vector<std::size_t>& groups = {});
 
 /// Keeps the candidates that lie in a zone. Candidates are a sample index each.
-ChangepointValidation validate_with_zones(const std::vector<std::size_t>& candidates,
-                                          const std::vector<Interval>& zones);
+ChangepointValidation validateWithZones(const std::vector<std::size_t>& candidates,
+                                        const std::vector<Interval>& zones);
 
 /// Full paper step: events of every sensor column (rows = samples), zones with min_s, validation.
 /// A matrix with zero columns yields no zones, hence every candidate rejected. Throws
 /// std::invalid_argument on non-finite sensor values or bad config.
-ChangepointValidation validate_changepoints(const std::vector<std::size_t>& candidates,
-                                            const Eigen::MatrixXd& sensors, std::size_t min_s,
-                                            const SensoryEventConfig& config = {});
+ChangepointValidation validateChangepoints(const std::vector<std::size_t>& candidates,
+                                           const Eigen::MatrixXd& sensors, std::size_t min_s,
+                                           const SensoryEventConfig& config = {});
 
 }  // namespace lfd

@@ -21,7 +21,7 @@ struct SampleSpan {
 /// The stretches of at least `min_samples` rows (>= 2) where every column of `channels` (rows =
 /// samples, one sensor's channels) holds one value exactly. Throws std::invalid_argument for
 /// min_samples < 2.
-std::vector<SampleSpan> repeated_readings(const Eigen::MatrixXd& channels, std::size_t min_samples);
+std::vector<SampleSpan> repeatedReadings(const Eigen::MatrixXd& channels, std::size_t min_samples);
 
 }  // namespace lfd
 
@@ -32,7 +32,7 @@ namespace lfd {
 /// (`channels`: the sensor's columns per demo) repeat no reading that long, demos where it holds
 /// one reading throughout (dead) not counted. Otherwise (a noise-free sensor) none. Throws
 /// std::invalid_argument on a size mismatch.
-std::vector<std::vector<SampleSpan>> stale_readings(const std::vector<Eigen::MatrixXd>& channels,
-                                                    const std::vector<std::size_t>& min_samples);
+std::vector<std::vector<SampleSpan>> staleReadings(const std::vector<Eigen::MatrixXd>& channels,
+                                                   const std::vector<std::size_t>& min_samples);
 
 }  // namespace lfd

@@ -32,15 +32,15 @@ struct FeatureMatrix {
   Eigen::Index rows() const { return data.rows(); }
   Eigen::Index cols() const { return data.cols(); }
   /// Column index of a feature, or -1.
-  int index_of(const std::string& name) const;
+  int indexOf(const std::string& name) const;
   /// Column index of a feature; throws std::invalid_argument naming the missing feature.
   int require(const std::string& name) const;
   /// Time of a row: the stored timestamp, or the row index when no clock is stored.
-  double time_at(Eigen::Index row) const;
+  double timeAt(Eigen::Index row) const;
   /// The sub-matrix of the listed features (in that order); throws if one is missing.
   FeatureMatrix select(const std::vector<std::string>& features) const;
   /// Throws std::invalid_argument if the shape is inconsistent (names/time vs data).
-  void validate_shape() const;
+  void validateShape() const;
 };
 
 /// Resamples streams onto one uniform clock at `rate_hz`, spanning the interval where every
@@ -67,14 +67,14 @@ struct NormalizationInfo {
 
 /// Max-min normalization of each column to [0,1]. A constant column (range <= eps * (1+|max|))
 /// becomes all zeros and is flagged rather than producing NaN.
-NormalizationInfo normalize_min_max(Eigen::MatrixXd& data, double eps = 1e-12);
+NormalizationInfo normalizeMinMax(Eigen::MatrixXd& data, double eps = 1e-12);
 /// Zero mean, unit standard deviation per column; constant columns become 0 and are flagged.
-NormalizationInfo z_normalize(Eigen::MatrixXd& data, double eps = 1e-12);
+NormalizationInfo zNormalize(Eigen::MatrixXd& data, double eps = 1e-12);
 
 /// Same as above on a single signal; returns true when the signal was constant.
-bool normalize_min_max(Eigen::Ref<Eigen::VectorXd> signal, double eps = 1e-12);
+bool normalizeMinMax(Eigen::Ref<Eigen::VectorXd> signal, double eps = 1e-12);
 
 /// Throws std::invalid_argument naming the first NaN/Inf sample (feature, row and time).
-void check_finite(const FeatureMatrix& matrix, const std::string& context = "");
+void checkFinite(const FeatureMatrix& matrix, const std::string& context = "");
 
 }  // namespace lfd

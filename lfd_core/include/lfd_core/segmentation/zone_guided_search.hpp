@@ -1,4 +1,4 @@
-// The zone-guided search of multivariate ClaSP (segment_multivariate with candidate_zones or
+// The zone-guided search of multivariate ClaSP (segmentMultivariate with candidate_zones or
 // candidate_zones_for, and zone_anchors): which samples may be candidates, where a candidate is
 // placed, and what significance it needs. Without zones every sample may be a candidate and
 // ClaSP's own test (with significance_per_sample) decides.
@@ -27,7 +27,7 @@ class ZoneGuide {
   bool restricted() const { return restricted_; }
 
   /// The zone holding sample t; -1 = none.
-  int zone_of(std::size_t t) const;
+  int zoneOf(std::size_t t) const;
 
   /// May t be a candidate: anywhere without zones, else in a zone still open.
   bool open(std::size_t t) const;
@@ -35,23 +35,23 @@ class ZoneGuide {
   /// Zones the range [begin, end) cannot split in: with anchors a zone is searched only while it
   /// holds an event ClaSP may split at (inside the range and its min_s margins, i.e. where
   /// `penalized` is defined); its others sit on changepoints already.
-  std::vector<bool> closed_zones(std::size_t begin, std::size_t end,
-                                 const Eigen::VectorXd& penalized) const;
+  std::vector<bool> closedZones(std::size_t begin, std::size_t end,
+                                const Eigen::VectorXd& penalized) const;
 
   /// The anchor (sensory event) of t's zone nearest to t, preferred anchors (rest edges) first,
   /// relative to `begin` as t is; -1 = none.
-  Eigen::Index anchor_for(const Eigen::VectorXd& profile, std::size_t begin, Eigen::Index t) const;
+  Eigen::Index anchorFor(const Eigen::VectorXd& profile, std::size_t begin, Eigen::Index t) const;
 
   /// The log10 p a candidate with its profile argmax at `argmax` needs.
-  double needed_log10_p(std::size_t argmax) const;
+  double neededLog10P(std::size_t argmax) const;
 
   /// Takes the zone of an accepted changepoint; false when one per zone and it was taken
   /// meanwhile (by a better candidate of another range).
   bool claim(std::size_t index);
 
  private:
-  bool is_preferred(std::size_t anchor) const;
-  void init_needed_log10_p();
+  bool isPreferred(std::size_t anchor) const;
+  void initNeededLog10P();
 
   const MultivariateSegmentationConfig& config_;
   const std::vector<Interval> zones_;

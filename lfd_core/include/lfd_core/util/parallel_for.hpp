@@ -17,7 +17,7 @@ namespace lfd {
 /// passes it to every job(i, scratch) it runs, so buffers are reused across jobs instead of
 /// reallocated (DTW's cost matrices). A scratch is never shared by two threads.
 template <typename Scratch, typename Job>
-void parallel_for_with_scratch(std::size_t count, int threads, Job job) {
+void parallelForWithScratch(std::size_t count, int threads, Job job) {
   std::vector<std::exception_ptr> errors(count);
   std::atomic<std::size_t> next{0};
   auto worker = [&]() {
@@ -46,10 +46,9 @@ void parallel_for_with_scratch(std::size_t count, int threads, Job job) {
 }
 
 template <typename Job>
-void parallel_for(std::size_t count, int threads, Job job) {
+void parallelFor(std::size_t count, int threads, Job job) {
   struct NoScratch {};
-  parallel_for_with_scratch<NoScratch>(count, threads,
-                                       [&job](std::size_t i, NoScratch&) { job(i); });
+  parallelForWithScratch<NoScratch>(count, threads, [&job](std::size_t i, NoScratch&) { job(i); });
 }
 
 }  // namespace lfd
