@@ -31,6 +31,40 @@ def manifests():
     return out
 
 
+ROS_INCLUDE = re.compile(
+    r'#include\s*[<"](ros/|rosbag/|topic_tools/|actionlib|tf2|[a-z_]+_msgs/|lfd_msgs/|lfd_ros/)')
+LOCAL_INCLUDE = re.compile(r'#include\s*"([^"]+)"')
+
+
+def repository_header(name, including_file):
+    """The repository file an #include "name" resolves to (next to the including file, or in a
+    package's include/ folder), or None for a system header."""
+    candidates = [os.path.join(os.path.dirname(including_file), name)]
+    package = name.split("/")[0]
+    candidates.append(os.path.join(ROOT, package, "include", name))
+    for c in candidates:
+        if os.path.isfile(c):
+            return os.path.realpath(c)
+    return None
+
+
+def ros_includes(path, seen):
+    """["file: #include ..."] for every ROS header path includes, directly or through the
+    repository's own headers."""
+    path = os.path.realpath(path)
+    if path in seen:
+        return []
+    seen.add(path)
+    text = open(path, errors="replace").read()
+    found = ["%s: %s" % (os.path.relpath(path, ROOT), m.group(0))
+             for m in ROS_INCLUDE.finditer(text)]
+    for m in LOCAL_INCLUDE.finditer(text):
+        header = repository_header(m.group(1), path)
+        if header:
+            found += ros_includes(header, seen)
+    return found
+
+
 def is_robot(name):
     return name.endswith(ROBOTS)
 
@@ -60,12 +94,23 @@ class PackageRules(unittest.TestCase):
 
     def test_the_core_sources_include_no_ros_header(self):
         folder = os.path.join(ROOT, self.packages["lfd_core"][0])
-        ros = re.compile(r'#include\s*[<"](ros/|rosbag/|tf2|[a-z_]+_msgs/|lfd_msgs/|lfd_ros/)')
         found = []
         for sub in ("include", "lib"):
             for path in glob.glob(os.path.join(folder, sub, "**", "*.[ch]pp"), recursive=True):
-                found += ["%s: %s" % (os.path.relpath(path, ROOT), m.group(0))
-                          for m in ros.finditer(open(path).read())]
+                found += ros_includes(path, set())
+        self.assertEqual(found, [])
+
+    def test_every_lib_folder_is_ros_free(self):
+        """DESIGN.md's layout: a package's lib/ holds no ROS code (that is ros/), neither in its
+        sources nor in the repository headers they include, at any depth."""
+        folders = [self.packages[p][0] for p in sorted(self.packages)]
+        checked, found = 0, []
+        for folder in folders:
+            for path in glob.glob(os.path.join(ROOT, folder, "lib", "**", "*.*"), recursive=True):
+                if path.endswith((".cpp", ".hpp", ".h", ".inc")):
+                    checked += 1
+                    found += ros_includes(path, set())
+        self.assertGreater(checked, 50, "no lib/ sources found under %s" % ROOT)
         self.assertEqual(found, [])
 
     def test_algorithms_know_no_simulator_and_no_robot(self):
