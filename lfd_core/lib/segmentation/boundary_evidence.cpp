@@ -95,7 +95,7 @@ Eigen::VectorXd stateSpeed(const Eigen::MatrixXd& scaled_states, const std::vect
                            double smoothing_seconds) {
   const Eigen::Index n = scaled_states.rows();
   if (static_cast<std::size_t>(n) != time.size())
-    throw std::invalid_argument("state_speed: " + std::to_string(n) + " samples but " +
+    throw std::invalid_argument("stateSpeed: " + std::to_string(n) + " samples but " +
                                 std::to_string(time.size()) + " timestamps");
   Eigen::VectorXd speed = Eigen::VectorXd::Zero(n);
   if (n < 3 || scaled_states.cols() == 0) return speed;

@@ -21,7 +21,7 @@ void checkPair(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
 Eigen::MatrixXd onUniformGrid(const Eigen::MatrixXd& features, const std::vector<double>& time,
                               double step) {
   if (time.size() != static_cast<std::size_t>(features.rows()) || time.empty() || !(step > 0))
-    throw std::invalid_argument("on_uniform_grid: a timestamp per row and a positive step needed");
+    throw std::invalid_argument("onUniformGrid: a timestamp per row and a positive step needed");
   const double span = time.back() - time.front();
   const Eigen::Index rows = static_cast<Eigen::Index>(std::floor(span / step)) + 1;
   Eigen::MatrixXd out(rows, features.cols());

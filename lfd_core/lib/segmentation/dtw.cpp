@@ -113,7 +113,7 @@ DtwResult dtw(const double* a, std::size_t n, const double* b, std::size_t m,
   checkPair(a, n, b, m);
   if (n * m > kMaxDirectionBytes) {
     throw std::invalid_argument("DTW path of " + std::to_string(n) + "x" + std::to_string(m) +
-                                " cells needs too much memory; use a band or dtw_cost");
+                                " cells needs too much memory; use a band or dtwCost");
   }
   std::vector<std::uint8_t> steps(n * m, kDiag);
   std::vector<double> prev(m, kInf), cur(m, kInf);

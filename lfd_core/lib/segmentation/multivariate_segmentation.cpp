@@ -44,22 +44,22 @@ bool isWeighted(ProfileCombination c) {
 void checkInputs(const Eigen::MatrixXd& features, const std::vector<double>& weights,
                  const MultivariateSegmentationConfig& config) {
   const std::size_t num_features = static_cast<std::size_t>(features.cols());
-  if (num_features == 0) throw std::invalid_argument("segment_multivariate: no feature columns");
+  if (num_features == 0) throw std::invalid_argument("segmentMultivariate: no feature columns");
   if (!features.allFinite())
-    throw std::invalid_argument("segment_multivariate: features contain NaN/Inf values");
+    throw std::invalid_argument("segmentMultivariate: features contain NaN/Inf values");
   if (!weights.empty() && weights.size() != num_features)
-    throw std::invalid_argument("segment_multivariate: " + std::to_string(weights.size()) +
+    throw std::invalid_argument("segmentMultivariate: " + std::to_string(weights.size()) +
                                 " weights for " + std::to_string(num_features) + " features");
   if (!config.window_sizes.empty() && config.window_sizes.size() != num_features)
     throw std::invalid_argument(
-        "segment_multivariate: window_sizes must have one entry per feature");
+        "segmentMultivariate: window_sizes must have one entry per feature");
   for (double v : weights)
     if (!(v >= 0.0) || !std::isfinite(v))
-      throw std::invalid_argument("segment_multivariate: weights must be finite and >= 0");
+      throw std::invalid_argument("segmentMultivariate: weights must be finite and >= 0");
   if (!(config.clasp.p_value_threshold > 0.0))
-    throw std::invalid_argument("segment_multivariate: p_value_threshold must be > 0");
+    throw std::invalid_argument("segmentMultivariate: p_value_threshold must be > 0");
   if (!(config.zone_p_value_threshold >= 0.0 && config.zone_p_value_threshold < 1.0))
-    throw std::invalid_argument("segment_multivariate: zone_p_value_threshold must be in [0, 1)");
+    throw std::invalid_argument("segmentMultivariate: zone_p_value_threshold must be in [0, 1)");
 }
 
 // The window of one feature: fixed by the config, or chosen on the whole demonstration.
@@ -89,7 +89,7 @@ std::vector<std::size_t> activeFeatures(const Eigen::MatrixXd& features,
     if (n < 6 || !(range > 1e-12 * (1.0 + col.cwiseAbs().maxCoeff())) || w[f] <= 0.0) continue;
     out->window_sizes[f] = windowOf(col, f, config);
     if (out->window_sizes[f] < 2)
-      throw std::invalid_argument("segment_multivariate: window size of feature " +
+      throw std::invalid_argument("segmentMultivariate: window size of feature " +
                                   std::to_string(f) + " must be >= 2");
     active.push_back(f);
   }

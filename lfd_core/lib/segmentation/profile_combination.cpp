@@ -54,24 +54,24 @@ std::string toString(ProfileCombination combination) {
 Eigen::VectorXd combineProfiles(const std::vector<Eigen::VectorXd>& profiles,
                                 const std::vector<double>& weights,
                                 ProfileCombination combination) {
-  if (profiles.empty()) throw std::invalid_argument("combine_profiles: no profiles");
+  if (profiles.empty()) throw std::invalid_argument("combineProfiles: no profiles");
   const Eigen::Index n = profiles.front().size();
   for (const auto& p : profiles)
-    if (p.size() != n) throw std::invalid_argument("combine_profiles: profiles differ in length");
+    if (p.size() != n) throw std::invalid_argument("combineProfiles: profiles differ in length");
   std::vector<double> w(profiles.size(), 1.0);
   if (isWeighted(combination) && !weights.empty()) {
     if (weights.size() != profiles.size())
-      throw std::invalid_argument("combine_profiles: " + std::to_string(weights.size()) +
+      throw std::invalid_argument("combineProfiles: " + std::to_string(weights.size()) +
                                   " weights for " + std::to_string(profiles.size()) + " profiles");
     w = weights;
   }
   double total = 0.0;
   for (double v : w) {
     if (!(v >= 0.0) || !std::isfinite(v))
-      throw std::invalid_argument("combine_profiles: weights must be finite and >= 0");
+      throw std::invalid_argument("combineProfiles: weights must be finite and >= 0");
     total += v;
   }
-  if (!(total > 0.0)) throw std::invalid_argument("combine_profiles: weights sum to zero");
+  if (!(total > 0.0)) throw std::invalid_argument("combineProfiles: weights sum to zero");
   const bool product = combination == ProfileCombination::kProduct ||
                        combination == ProfileCombination::kWeightedProduct;
 
@@ -94,7 +94,7 @@ Eigen::VectorXd combineProfiles(const std::vector<Eigen::VectorXd>& profiles,
 
 Eigen::VectorXd kaiserWindow(std::size_t n, double beta) {
   if (!(beta >= 0.0) || !std::isfinite(beta))
-    throw std::invalid_argument("kaiser_window: beta must be finite and >= 0");
+    throw std::invalid_argument("kaiserWindow: beta must be finite and >= 0");
   Eigen::VectorXd win(static_cast<Eigen::Index>(n));
   if (n == 1) {
     win[0] = 1.0;

@@ -12,7 +12,7 @@ namespace lfd {
 RampFit fitRamp(const std::vector<double>& y, std::size_t begin, std::size_t end) {
   end = std::min(end, y.size());
   if (begin >= end || end - begin < 2)
-    throw std::invalid_argument("fit_ramp: the window needs at least 2 samples");
+    throw std::invalid_argument("fitRamp: the window needs at least 2 samples");
   const std::size_t m = end - begin;
   std::vector<double> py(m + 1, 0.0), pty(m + 1, 0.0);  // prefix sums of y and t * y
   for (std::size_t t = 0; t < m; ++t) {
