@@ -4,7 +4,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <random>
+#include <string>
 #include <vector>
 
 #include "lfd_core/segmentation/sensory_events.hpp"
@@ -223,6 +225,18 @@ TEST(SensoryEvents, RejectsBadConfigAndInput) {
   Eigen::VectorXd x = Eigen::VectorXd::Zero(5);
   x[2] = std::nan("");
   EXPECT_THROW(lfd::detectSensoryEvents(x), std::invalid_argument);
+}
+
+TEST(SensoryEvents, ABadValueIsNamedByItsSensorColumn) {
+  Eigen::MatrixXd sensors = Eigen::MatrixXd::Zero(20, 3);
+  sensors(7, 2) = std::numeric_limits<double>::infinity();
+  try {
+    lfd::detectSensorEvents(sensors, SensoryEventConfig{});
+    FAIL() << "an infinite reading was accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("sensor column 2 has NaN/Inf"), std::string::npos)
+        << e.what();
+  }
 }
 
 TEST(ConfidenceZones, EquationOneWithClippingAndMerging) {

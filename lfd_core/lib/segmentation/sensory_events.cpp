@@ -527,12 +527,12 @@ SensorEvents detectSensorEvents(const Eigen::MatrixXd& sensors, const SensoryEve
                                 " group ids for " + std::to_string(cols) + " sensor columns");
   std::vector<Channel> channels;
   for (std::size_t c = 0; c < cols; ++c) {
-    try {
-      channels.push_back(analyseChannel(sensors.col(static_cast<Eigen::Index>(c)), config));
-    } catch (const std::invalid_argument&) {
+    // Only a bad value is named by its column here; any other error propagates as it is (a
+    // failure inside the detector was reported as NaN/Inf).
+    if (!sensors.col(static_cast<Eigen::Index>(c)).allFinite())
       throw std::invalid_argument("sensory events: sensor column " + std::to_string(c) +
                                   " has NaN/Inf values");
-    }
+    channels.push_back(analyseChannel(sensors.col(static_cast<Eigen::Index>(c)), config));
   }
   std::map<std::size_t, std::vector<std::size_t>> members;  // group id -> its columns
   for (std::size_t c = 0; c < cols; ++c) members[groups.empty() ? c : groups[c]].push_back(c);
