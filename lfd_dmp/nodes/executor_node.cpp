@@ -194,6 +194,9 @@ class Executor {
     max_silence_ = pnh.param("monitoring/max_silence", max_silence_);
     if (!(max_silence_ > 0.0))
       throw std::runtime_error("executor: ~monitoring/max_silence must be > 0");
+    min_wall_silence_ = pnh.param("monitoring/min_wall_silence", min_wall_silence_);
+    if (!(min_wall_silence_ >= 0.0))
+      throw std::runtime_error("executor: ~monitoring/min_wall_silence must be >= 0");
     settle_time_ = pnh.param("settle_time", settle_time_);
     clock_timeout_ = pnh.param("clock_timeout", clock_timeout_);
     motion_lead_ = pnh.param("motion_lead", motion_lead_);
@@ -526,7 +529,7 @@ class Executor {
     if (!monitoring_ || !library.sensory_signature) return;
     try {
       monitor_ = std::make_unique<lfd_dmp::ExecutionMonitor>(nh_, *library.sensory_signature,
-                                                             max_silence_);
+                                                             max_silence_, min_wall_silence_);
       result->monitored = true;
     } catch (const std::invalid_argument& e) {
       result->warnings.push_back(std::string("not monitored: ") + e.what());
@@ -697,7 +700,8 @@ class Executor {
   double trajectory_period_ = 0.01, feedback_period_ = 0.05;
   std::unique_ptr<lfd_dmp::TaskPlanner> planner_;
   bool monitoring_ = true, stop_on_alarm_ = false;
-  double max_silence_ = 2.0;                            // s (executor.yaml monitoring/max_silence)
+  double max_silence_ = 2.0;       // s (executor.yaml monitoring/max_silence)
+  double min_wall_silence_ = 0.5;  // wall s (executor.yaml monitoring/min_wall_silence)
   std::unique_ptr<lfd_dmp::ExecutionMonitor> monitor_;  // the current goal's
   tf2_ros::Buffer tf_buffer_;
   tf2_ros::TransformListener tf_listener_;

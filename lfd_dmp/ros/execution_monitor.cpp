@@ -40,10 +40,15 @@ std::string describeSilence(const Silence& s, const std::vector<PlannedSegment>&
 }
 
 ExecutionMonitor::ExecutionMonitor(ros::NodeHandle& nh, lfd::SensorySignature signature,
-                                   double max_silence)
-    : signature_(std::move(signature)), max_silence_(max_silence), monitor_(signature_) {
+                                   double max_silence, double min_wall_silence)
+    : signature_(std::move(signature)),
+      max_silence_(max_silence),
+      min_wall_silence_(min_wall_silence),
+      monitor_(signature_) {
   if (!(max_silence > 0) || !std::isfinite(max_silence))
     throw std::invalid_argument("max_silence must be finite and > 0");
+  if (!(min_wall_silence >= 0) || !std::isfinite(min_wall_silence))
+    throw std::invalid_argument("min_wall_silence must be finite and >= 0");
   channels_ = std::make_unique<SensorChannels>(
       nh, signature_,
       [this](const ros::Time& stamp, const Eigen::VectorXd& values) { onReading(stamp, values); });
@@ -97,7 +102,9 @@ std::optional<Silence> ExecutionMonitor::silence(const ros::Time& now) const {
   if (t >= spans_.back().second) return std::nullopt;
   const auto [segment, phase] = segmentAt(t);
   std::optional<Silence> worst;
+  const ros::WallTime wall_now = ros::WallTime::now();
   for (const SensorChannels::Activity& a : channels_->activity()) {
+    if (a.count > 0 && (wall_now - a.arrived).toSec() <= min_wall_silence_) continue;  // alive
     Silence s;
     s.topic = a.topic;
     s.period = a.count > 1 ? (a.last - a.first).toSec() / static_cast<double>(a.count - 1) : 0.0;

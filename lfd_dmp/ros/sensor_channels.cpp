@@ -58,7 +58,7 @@ std::vector<std::string> SensorChannels::unconnected() const {
 std::vector<SensorChannels::Activity> SensorChannels::activity() const {
   std::lock_guard<std::mutex> lock(mutex_);
   std::vector<Activity> out;
-  for (const auto& s : sources_) out.push_back({s->topic, s->first, s->last, s->count});
+  for (const auto& s : sources_) out.push_back({s->topic, s->first, s->last, s->count, s->arrived});
   return out;
 }
 
@@ -95,6 +95,7 @@ void SensorChannels::onMessage(Source* s, const topic_tools::ShapeShifter::Const
     const double header = s->reader->headerStamp();
     stamp = header > 0 ? ros::Time(header) : ros::Time::now();
     s->last = stamp;
+    s->arrived = ros::WallTime::now();
     if (s->count++ == 0) s->first = stamp;
     for (std::size_t k = 0; k < s->fields.size(); ++k) {
       if (!s->reader->present(k)) continue;

@@ -27,10 +27,11 @@ lfd::SensorySignature twoTopics() {
   return s;
 }
 
-// Publishes both topics at ~2 kHz each until destroyed.
+// Publishes both topics at ~2 kHz each until destroyed; the F/T stamped ft_lag s in the past.
 class Publishers {
  public:
-  std::atomic<bool> level_on{true};
+  std::atomic<bool> level_on{true}, ft_on{true};
+  std::atomic<double> ft_lag{0.0};
   Publishers() {
     ros::NodeHandle nh;
     ft_ = nh.advertise<geometry_msgs::WrenchStamped>("/channels_test/ft", 100);
@@ -41,8 +42,8 @@ class Publishers {
       std_msgs::Float64MultiArray a;
       a.data = {0.0, kLevel, 1.0};
       while (!stop_) {
-        w.header.stamp = ros::Time::now();
-        ft_.publish(w);
+        w.header.stamp = ros::Time::now() - ros::Duration(ft_lag);
+        if (ft_on) ft_.publish(w);
         if (level_on) level_.publish(a);
         std::this_thread::sleep_for(std::chrono::microseconds(500));
       }
@@ -140,7 +141,7 @@ lfd::SensorySignature quietSignature() {
 TEST(ExecutionMonitor, ATopicThatStopsDuringTheMotionIsNamedOnceSilentForMaxSilence) {
   Publishers publishers;
   ros::NodeHandle nh;
-  lfd_dmp::ExecutionMonitor monitor(nh, quietSignature(), 0.3);
+  lfd_dmp::ExecutionMonitor monitor(nh, quietSignature(), 0.3, 0.3);
   lfd_dmp::ExecutionPlan plan;
   plan.segments.resize(1);
   plan.segments[0].name = "press";
@@ -163,6 +164,36 @@ TEST(ExecutionMonitor, ATopicThatStopsDuringTheMotionIsNamedOnceSilentForMaxSile
   EXPECT_NE(text.find("/channels_test/level silent"), std::string::npos) << text;
   monitor.stop();
   EXPECT_FALSE(monitor.silence(ros::Time::now())) << "a stopped monitor judges nothing";
+}
+
+// A simulation stepped far faster than real time runs its clock ahead of a loaded subscriber's
+// callbacks: a topic whose messages keep arriving, stamped long before `now`, is late, not silent;
+// once nothing arrives for min_wall_silence, it is.
+TEST(ExecutionMonitor, ATopicThatKeepsArrivingLateIsNotSilentUntilItStops) {
+  Publishers publishers;
+  publishers.ft_lag = 2.0;  // s behind the clock, far beyond max_silence
+  ros::NodeHandle nh;
+  lfd_dmp::ExecutionMonitor monitor(nh, quietSignature(), 0.3, 0.3);
+  lfd_dmp::ExecutionPlan plan;
+  plan.segments.resize(1);
+  plan.segments[0].name = "press";
+  plan.segments[0].duration = 10.0;  // the motion still runs when the F/T stops
+  monitor.start(plan, ros::Time::now() - ros::Duration(2.5));
+  ros::WallDuration(0.5).sleep();
+  EXPECT_FALSE(monitor.silence(ros::Time::now())) << "the F/T arrives, 2 s late";
+  publishers.ft_on = false;
+  const ros::WallTime stopped = ros::WallTime::now();
+  std::optional<lfd_dmp::Silence> silent;
+  ASSERT_TRUE(
+      waitFor([&] { return (silent = monitor.silence(ros::Time::now())).has_value(); }, 2.0));
+  EXPECT_EQ(silent->topic, "/channels_test/ft");
+  EXPECT_GE((ros::WallTime::now() - stopped).toSec(), 0.3 - 0.05) << "not before min_wall_silence";
+  monitor.stop();
+}
+
+TEST(ExecutionMonitor, RefusesANegativeWallSilence) {
+  ros::NodeHandle nh;
+  EXPECT_THROW(lfd_dmp::ExecutionMonitor(nh, quietSignature(), 0.3, -1.0), std::invalid_argument);
 }
 
 }  // namespace

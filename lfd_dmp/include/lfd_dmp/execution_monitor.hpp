@@ -40,7 +40,12 @@ class ExecutionMonitor {
   /// Subscribes to the signature's sources. Throws std::invalid_argument when the signature cannot
   /// be read live (no topic per channel).
   /// max_silence: s a source topic may go without a message (at least 10 of its periods).
-  ExecutionMonitor(ros::NodeHandle& nh, lfd::SensorySignature signature, double max_silence);
+  /// min_wall_silence: wall s without any message arriving before a source counts as silent. A
+  /// simulation stepped many times faster than real time advances its clock by seconds while a
+  /// loaded machine delays one subscriber's callbacks by a fraction of a wall second; a stream
+  /// that keeps arriving, late, is alive. On a robot (sim time = wall time) max_silence decides.
+  ExecutionMonitor(ros::NodeHandle& nh, lfd::SensorySignature signature, double max_silence,
+                   double min_wall_silence);
 
   /// Judges the readings of the motion of `plan` that starts at `t0` (segments in plan order,
   /// as many as the signature's: else std::invalid_argument).
@@ -65,7 +70,7 @@ class ExecutionMonitor {
   std::pair<std::size_t, double> segmentAt(double t) const;
 
   lfd::SensorySignature signature_;
-  double max_silence_;
+  double max_silence_, min_wall_silence_;
   lfd::SignatureMonitor monitor_;
   std::vector<std::pair<double, double>> spans_;  ///< each segment's [start, end) s of the motion
   ros::Time t0_;

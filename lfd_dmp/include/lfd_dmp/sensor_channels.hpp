@@ -48,6 +48,7 @@ class SensorChannels {
     std::string topic;
     ros::Time first, last;  ///< zero before the first message
     std::size_t count = 0;
+    ros::WallTime arrived;  ///< wall time of the last message's arrival (zero before the first)
   };
   std::vector<Activity> activity() const;
 
@@ -64,6 +65,7 @@ class SensorChannels {
     std::vector<std::uint8_t> bytes;  ///< the last message, serialized (reused: 200 Hz each)
     ros::Time first, last;            ///< stamps (Activity)
     std::size_t count = 0;
+    ros::WallTime arrived;
     ros::Subscriber subscriber;
   };
   void onMessage(Source* source, const topic_tools::ShapeShifter::ConstPtr& msg);
