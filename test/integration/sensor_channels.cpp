@@ -138,14 +138,20 @@ lfd::SensorySignature quietSignature() {
   return s;
 }
 
+// A motion of one segment, 'press', lasting `duration` s.
+lfd_dmp::ExecutionPlan pressPlan(double duration) {
+  lfd_dmp::ExecutionPlan plan;
+  plan.segments.resize(1);
+  plan.segments[0].name = "press";
+  plan.segments[0].duration = duration;
+  return plan;
+}
+
 TEST(ExecutionMonitor, ATopicThatStopsDuringTheMotionIsNamedOnceSilentForMaxSilence) {
   Publishers publishers;
   ros::NodeHandle nh;
   lfd_dmp::ExecutionMonitor monitor(nh, quietSignature(), 0.3, 0.3);
-  lfd_dmp::ExecutionPlan plan;
-  plan.segments.resize(1);
-  plan.segments[0].name = "press";
-  plan.segments[0].duration = 3.0;
+  const lfd_dmp::ExecutionPlan plan = pressPlan(3.0);
   const ros::Time t0 = ros::Time::now();
   monitor.start(plan, t0);
   ros::WallDuration(0.5).sleep();
@@ -174,10 +180,7 @@ TEST(ExecutionMonitor, ATopicThatKeepsArrivingLateIsNotSilentUntilItStops) {
   publishers.ft_lag = 2.0;  // s behind the clock, far beyond max_silence
   ros::NodeHandle nh;
   lfd_dmp::ExecutionMonitor monitor(nh, quietSignature(), 0.3, 0.3);
-  lfd_dmp::ExecutionPlan plan;
-  plan.segments.resize(1);
-  plan.segments[0].name = "press";
-  plan.segments[0].duration = 10.0;  // the motion still runs when the F/T stops
+  const lfd_dmp::ExecutionPlan plan = pressPlan(10.0);  // still running when the F/T stops
   monitor.start(plan, ros::Time::now() - ros::Duration(2.5));
   ros::WallDuration(0.5).sleep();
   EXPECT_FALSE(monitor.silence(ros::Time::now())) << "the F/T arrives, 2 s late";
