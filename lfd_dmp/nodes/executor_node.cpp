@@ -34,9 +34,12 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <deque>
 #include <map>
 #include <memory>
 #include <mutex>
+#include <string>
+#include <vector>
 
 namespace {
 
@@ -90,6 +93,12 @@ void ignore(const boost::shared_ptr<const M>&) {}
 // Handles on the action's topics (the names and types ActionServer uses) while its server is
 // replaced: roscpp keeps a topic and its connections as long as one handle on it lives, so the
 // clients stay connected to the new server.
+// One joint state of the running plan's joints, as it arrived.
+struct JointSample {
+  ros::Time stamp;
+  Eigen::VectorXd q;
+};
+
 struct ActionTopics {
   explicit ActionTopics(ros::NodeHandle& pnh)
       : goal(pnh.subscribe("execute/goal", 1, &ignore<lfd_msgs::ExecuteTaskActionGoal>)),
@@ -411,7 +420,15 @@ class Executor {
     executed_ = nav_msgs::Path();
     feedback_ = lfd_msgs::ExecuteTaskFeedback();
     tracked_stamp_ = ros::Time();
+    trackJoints({});
     monitor_.reset();  // its subscriptions end with the goal
+  }
+
+  // From now on, each joint state of `names` is kept for track() (none: no longer kept).
+  void trackJoints(const std::vector<std::string>& names) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    tracked_joints_ = names;
+    unread_joint_states_.clear();
   }
 
   void finish(lfd_msgs::ExecuteTaskResult* result, const std::string& error, bool preempted) {
@@ -470,6 +487,7 @@ class Executor {
                                                    t0 + ros::Duration(plan.times[e.sample])));
     result->motion_start = t0;
     if (monitor_) monitor_->start(plan, t0);
+    trackJoints(plan.joint_names);
     executed_ = nav_msgs::Path();
     feedback_.motion_start = t0;
     feedback_.planned_duration = plan.duration();
@@ -482,15 +500,11 @@ class Executor {
       if (clock_reset_) throw std::runtime_error(clockResetText());
       if (goal_server_->isPreemptRequested() || !ros::ok()) stop(plan, t0, now);
       watch.check(now);
-      const ros::Time measured = track(plan, t0);
+      const ros::Time measured = track(plan, t0, t_end, &reached);
       checkMonitor(plan, t0, now, measured, result);
       if (now >= t_end) {
         if (feedback_.state != lfd_msgs::ExecuteTaskFeedback::SETTLING)
           setState(lfd_msgs::ExecuteTaskFeedback::SETTLING, plan);
-        if (reached.isZero() && measured >= t_end &&
-            feedback_.tcp_position_error <= robot_.ik_tolerance.position &&
-            feedback_.tcp_orientation_error <= robot_.ik_tolerance.orientation)
-          reached = measured;
         if (now >= t_end + ros::Duration(settle_time_)) break;
       }
       ros::WallDuration(0.001).sleep();
@@ -617,37 +631,48 @@ class Executor {
     return plan.segments.back();
   }
 
-  // The measured TCP against the plan at the latest joint state (into feedback_, published every
-  // ~feedback_period and at each new segment); returns that joint state's stamp.
-  ros::Time track(const lfd_dmp::ExecutionPlan& plan, const ros::Time& t0) {
-    Eigen::VectorXd q(plan.joint_names.size());
-    ros::Time stamp;
+  // Every joint state that arrived since the last call, in order, against the plan (into feedback_,
+  // published every ~feedback_period and at each new segment); returns the latest one's stamp.
+  // `reached` gets the stamp of the first state at or after `t_end` within the IK tolerance: taken
+  // from the states themselves, not from whichever is latest when this loop next runs, so a stall
+  // of this thread (while a lockstep client steps the clock on) does not lengthen the measurement.
+  ros::Time track(const lfd_dmp::ExecutionPlan& plan, const ros::Time& t0, const ros::Time& t_end,
+                  ros::Time* reached) {
+    std::deque<JointSample> arrived;
     {
       std::lock_guard<std::mutex> lock(mutex_);
-      for (size_t i = 0; i < plan.joint_names.size(); ++i)
-        q[static_cast<Eigen::Index>(i)] = joints_.at(plan.joint_names[i]);
-      stamp = last_joint_stamp_;
+      arrived.swap(unread_joint_states_);
     }
-    if (stamp != tracked_stamp_) {
-      tracked_stamp_ = stamp;
-      const size_t k = sampleAt(plan, t0, stamp);
-      const lfd::Pose tcp = planner().forward(q);
-      feedback_.tcp_position_error = (tcp.position - plan.poses[k].position).norm();
-      feedback_.tcp_orientation_error = tcp.orientation.angularDistance(plan.poses[k].orientation);
-      feedback_.progress =
-          plan.duration() > 0 ? std::min(1.0, (stamp - t0).toSec() / plan.duration()) : 1.0;
-      feedback_.progress = std::max(0.0, feedback_.progress);
-      const auto& seg = segmentAt(plan, k);
-      feedback_.segment_index = static_cast<uint32_t>(&seg - plan.segments.data());
-      recordExecuted(tcp, stamp);
-      if (feedback_.segment != seg.name) {
-        feedback_.segment = seg.name;
-        publishFeedback();
-      }
+    for (const JointSample& sample : arrived) {
+      if (sample.stamp == tracked_stamp_) continue;
+      tracked_stamp_ = sample.stamp;
+      compareWithPlan(plan, t0, sample);
+      if (reached->isZero() && sample.stamp >= t_end &&
+          feedback_.tcp_position_error <= robot_.ik_tolerance.position &&
+          feedback_.tcp_orientation_error <= robot_.ik_tolerance.orientation)
+        *reached = sample.stamp;
     }
     // Also while nothing changes (a paused clock): a client that missed one still learns the state.
     if (wallSince(last_feedback_) > feedback_period_) publishFeedback();
-    return stamp;
+    return tracked_stamp_;
+  }
+
+  void compareWithPlan(const lfd_dmp::ExecutionPlan& plan, const ros::Time& t0,
+                       const JointSample& sample) {
+    const size_t k = sampleAt(plan, t0, sample.stamp);
+    const lfd::Pose tcp = planner().forward(sample.q);
+    feedback_.tcp_position_error = (tcp.position - plan.poses[k].position).norm();
+    feedback_.tcp_orientation_error = tcp.orientation.angularDistance(plan.poses[k].orientation);
+    feedback_.progress =
+        plan.duration() > 0 ? std::min(1.0, (sample.stamp - t0).toSec() / plan.duration()) : 1.0;
+    feedback_.progress = std::max(0.0, feedback_.progress);
+    const auto& seg = segmentAt(plan, k);
+    feedback_.segment_index = static_cast<uint32_t>(&seg - plan.segments.data());
+    recordExecuted(tcp, sample.stamp);
+    if (feedback_.segment != seg.name) {
+      feedback_.segment = seg.name;
+      publishFeedback();
+    }
   }
 
   void setState(uint8_t state, const lfd_dmp::ExecutionPlan& plan) {
@@ -677,7 +702,16 @@ class Executor {
     std::lock_guard<std::mutex> lock(mutex_);
     for (size_t i = 0; i < msg->name.size() && i < msg->position.size(); ++i)
       if (std::isfinite(msg->position[i])) joints_[msg->name[i]] = msg->position[i];
-    last_joint_stamp_ = msg->header.stamp;
+    if (tracked_joints_.empty()) return;
+    JointSample sample{msg->header.stamp, Eigen::VectorXd(tracked_joints_.size())};
+    for (size_t i = 0; i < tracked_joints_.size(); ++i) {
+      const auto it = joints_.find(tracked_joints_[i]);
+      if (it == joints_.end()) return;
+      sample.q[static_cast<Eigen::Index>(i)] = it->second;
+    }
+    unread_joint_states_.push_back(std::move(sample));
+    // Bounded: a goal thread that stopped reading (it is planning) keeps the newest states only.
+    if (unread_joint_states_.size() > kMaxUnreadJointStates) unread_joint_states_.pop_front();
   }
 
   void onGripper(const sensor_msgs::JointState::ConstPtr& msg) {
@@ -720,7 +754,9 @@ class Executor {
   nav_msgs::Path executed_;
   std::mutex mutex_;
   std::map<std::string, double> joints_;
-  ros::Time last_joint_stamp_;
+  std::vector<std::string> tracked_joints_;      // the running plan's joints (none: not tracked)
+  std::deque<JointSample> unread_joint_states_;  // of tracked_joints_, not yet read by track()
+  static constexpr size_t kMaxUnreadJointStates = 4096;
   std::optional<double> gripper_;
 };
 

@@ -107,9 +107,10 @@ class Cell(object):
         from lfd_tools import master
         self.rospy, self.lockstep = rospy, lockstep
         master.wait_for_param("/use_sim_time", 120)  # rospy reads it once, at init
+        # Persistent: a reproduction steps the bridge thousands of times (profile-reproduction).
         self.srv = master.service_proxies(node_name, {
             "/bridge/reset": ResetSim, "/bridge/set_scene": SetScene, "/bridge/pause": SetBool,
-            "/bridge/step": StepSim})
+            "/bridge/step": StepSim}, persistent=True)
         # The plain client: SimpleActionClient drops a result that arrives before send_goal has
         # returned (a refusal answered within the caller's time slice), and its timeouts run on
         # sim time, which stands still while paused.

@@ -147,9 +147,14 @@ def wait_for_param(name, timeout):
         time.sleep(0.2)
 
 
-def service_proxies(node_name, services, timeout=120.0):
+def service_proxies(node_name, services, timeout=120.0, persistent=False):
     """Starts this process's rospy node and returns {name: ServiceProxy} once every service of
-    {name: type} answers. Ctrl-C raises KeyboardInterrupt (signals stay Python's)."""
+    {name: type} answers. Ctrl-C raises KeyboardInterrupt (signals stay Python's).
+    persistent: keep one connection per service (for a service called thousands of times: a
+    plain proxy asks the master where the service is and opens a new connection on every call,
+    0.9 ms more per call here, and the master's CPU with it). A persistent proxy whose server went
+    away raises rospy.ServiceException on its next call; it is not reconnected (a retried call
+    could act twice)."""
     import rospy
     rospy.init_node(node_name, anonymous=True, disable_signals=True)
     proxies = {}
@@ -158,7 +163,7 @@ def service_proxies(node_name, services, timeout=120.0):
             rospy.wait_for_service(name, timeout=timeout)
         except rospy.ROSException:
             raise RuntimeError("service %s did not come up within %.0f s" % (name, timeout))
-        proxies[name] = rospy.ServiceProxy(name, typ)
+        proxies[name] = rospy.ServiceProxy(name, typ, persistent=persistent)
     return proxies
 
 
