@@ -207,6 +207,36 @@ TEST(PositionDmp, MovingGoalStaysSmooth) {
   }
 }
 
+// A rollout with a goal switch is the plain rollout up to the switch, then the runner's moved-goal
+// motion: the executor relies on this to replan a running segment without moving what is done.
+TEST(SegmentDmp, RolloutGoalSwitchKeepsThePastAndReachesTheNewGoal) {
+  const Eigen::VectorXd t = demoTimes();
+  lfd::SegmentDemo seg;
+  seg.times = t;
+  seg.positions = lfd_test::curve3d(t, kDuration);
+  const lfd::SegmentDmp dmp = lfd::SegmentDmp::learn(seg);
+  lfd::SegmentRolloutOptions plain;
+  plain.dt = 0.002;
+  plain.goal_filter = 20.0;
+  const lfd::SegmentTrajectory before = dmp.rollout(plain);
+  const Eigen::Vector3d new_goal =
+      seg.positions.bottomRows(1).transpose() + Eigen::Vector3d(0.05, -0.04, 0.02);
+  lfd::SegmentRolloutOptions switched = plain;
+  switched.duration = 1.5 * kDuration;
+  switched.goal_switches.push_back({0.8, {Eigen::VectorXd(new_goal), std::nullopt, std::nullopt}});
+  const lfd::SegmentTrajectory after = dmp.rollout(switched);
+  const int at = static_cast<int>(std::lround(0.8 / plain.dt));
+  EXPECT_EQ(after.positions.topRows(at + 1), before.positions.topRows(at + 1));
+  EXPECT_GT((after.positions.row(at + 1) - before.positions.row(at + 1)).norm(), 0.0);
+  EXPECT_LT((after.positions.bottomRows(1).transpose() - new_goal).norm(), 1e-3);
+  double max_dv = 0.0;
+  for (Eigen::Index k = 1; k < after.velocities.rows(); ++k)
+    max_dv = std::max(max_dv, (after.velocities.row(k) - after.velocities.row(k - 1)).norm());
+  EXPECT_LT(max_dv, 0.02);  // acceleration < 10 m/s^2: the filtered goal moves smoothly
+  switched.goal_switches.front().time = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_THROW(dmp.rollout(switched), std::invalid_argument);
+}
+
 TEST(PositionDmp, ExactDiscretizationIsDtIndependent) {
   const Eigen::VectorXd t = demoTimes();
   const Eigen::MatrixXd demo = lfd_test::curve2d(t, kDuration);

@@ -323,13 +323,16 @@ lfd::SegmentRolloutOptions rolloutOptions(const lfd::SegmentDmp& dmp, const Segm
   return ro;
 }
 
-// Reachability of the WHOLE path before anything moves, in pieces (a cancel is seen between).
-void solveIk(lfd::CartesianToJoints& ik, const Eigen::VectorXd& q_start,
+// Reachability of the WHOLE path before anything moves, in pieces (a cancel is seen between):
+// from sample `from` on (the joints before it are the plan's already, `seed` the last of them or
+// the start).
+void solveIk(lfd::CartesianToJoints& ik, const Eigen::VectorXd& seed_joints, size_t from,
              const std::function<void(const std::string&)>& poll, ExecutionPlan& plan) {
-  Eigen::VectorXd seed = q_start;
+  Eigen::VectorXd seed = seed_joints;
+  plan.joints.resize(from);
   plan.joints.reserve(plan.poses.size());
   for (const PlannedSegment& ps : plan.segments) {
-    for (size_t a = ps.begin; a < ps.end; a += kIkChunk) {
+    for (size_t a = std::max(ps.begin, from); a < ps.end; a += kIkChunk) {
       poll("IK of segment " + ps.name);
       std::vector<lfd::TimedPose> samples;
       for (size_t k = a; k < std::min(ps.end, a + kIkChunk); ++k)
@@ -348,6 +351,43 @@ void solveIk(lfd::CartesianToJoints& ik, const Eigen::VectorXd& q_start,
       for (Eigen::VectorXd& q : path.positions) plan.joints.push_back(std::move(q));
       seed = plan.joints.back();
     }
+  }
+}
+
+// The targets in force at `t` s into the plan: the last update at or before it, else `targets`.
+const std::vector<SegmentTarget>& targetsAt(const std::vector<SegmentTarget>& targets,
+                                            const std::vector<TargetUpdate>& updates, double t) {
+  const std::vector<SegmentTarget>* in_force = &targets;
+  for (const TargetUpdate& u : updates)
+    if (u.time <= t) in_force = &u.targets;
+  return *in_force;
+}
+
+// The goal switches of a segment running from `begin` for `duration` s: the updates that fall
+// inside it, at their times into it.
+std::vector<lfd::GoalSwitch> switchesDuring(const std::vector<TargetUpdate>& updates, size_t s,
+                                            double begin, double duration, bool orientation) {
+  std::vector<lfd::GoalSwitch> out;
+  for (const TargetUpdate& u : updates) {
+    if (u.time <= begin || u.time >= begin + duration) continue;
+    lfd::GoalSwitch g;
+    g.time = u.time - begin;
+    g.goal.position = Eigen::VectorXd(u.targets[s].goal.position);
+    if (orientation) g.goal.orientation = u.targets[s].goal.orientation;
+    out.push_back(g);
+  }
+  return out;
+}
+
+void checkUpdates(const std::vector<TargetUpdate>& updates, size_t segments) {
+  double previous = 0.0;
+  for (const TargetUpdate& u : updates) {
+    if (!(u.time > previous) || !std::isfinite(u.time))
+      throw std::invalid_argument("target updates must come at increasing times after 0 s");
+    if (u.targets.size() != segments)
+      throw std::invalid_argument("a target update has " + std::to_string(u.targets.size()) +
+                                  " segment goals, the library " + std::to_string(segments));
+    previous = u.time;
   }
 }
 
@@ -415,14 +455,25 @@ ExecutionPlan TaskPlanner::plan(const SkillLibrary& library,
                                 const Eigen::VectorXd& q_start, std::optional<double> gripper_start,
                                 const ExecutorOptions& options,
                                 const std::function<bool()>& cancelled) {
+  return replan(library, targets, {}, ExecutionPlan(), q_start, gripper_start, options, cancelled);
+}
+
+ExecutionPlan TaskPlanner::replan(const SkillLibrary& library,
+                                  const std::vector<SegmentTarget>& targets,
+                                  const std::vector<TargetUpdate>& updates,
+                                  const ExecutionPlan& current, const Eigen::VectorXd& q_start,
+                                  std::optional<double> gripper_start,
+                                  const ExecutorOptions& options,
+                                  const std::function<bool()>& cancelled) {
   const auto poll = [&](const std::string& where) {
     if (cancelled && cancelled())
       throw PlanningCancelled("cancelled while planning (" + where + ")");
   };
   checkPlanRequest(library, targets, q_start, chain().dof(), options);
+  checkUpdates(updates, library.segments.size());
   ExecutionPlan plan;
   checkRange(targets, options.allow_extrapolation, &plan);
-  const GoalQuery goals = goalQuery(library, targets, options.all_segment_goals);
+  for (const TargetUpdate& u : updates) checkRange(u.targets, options.allow_extrapolation, &plan);
   plan.joint_names = chain().jointNames();
   plan.dt = options.dt;
   const TcpPose start = forward(q_start);
@@ -430,16 +481,25 @@ ExecutionPlan TaskPlanner::plan(const SkillLibrary& library,
   state.gripper = gripper_start;
   for (size_t s = 0; s < library.segments.size(); ++s) {
     poll("segment " + library.segments[s].name);
-    const SegmentTarget& target = targets[s];
+    // A segment is generalized toward the targets in force when it starts; an update while it
+    // runs moves its DMP's goal (the goal filter keeps the motion smooth).
+    const std::vector<SegmentTarget>& in_force = targetsAt(targets, updates, state.t_offset);
+    const SegmentTarget& target = in_force[s];
     PlannedSegment planned;
     planned.name = library.segments[s].name;
     planned.frames = target.frames;
+    const GoalQuery goals = goalQuery(library, in_force, options.all_segment_goals);
     const lfd::GeneralizationResult gen =
         generalizeForTarget(library.segments[s], target, goals, options, planned, plan);
-    const lfd::SegmentTrajectory traj =
-        gen.dmp.rollout(rolloutOptions(gen.dmp, target, options, state));
+    lfd::SegmentRolloutOptions ro = rolloutOptions(gen.dmp, target, options, state);
+    ro.goal_filter = options.goal_filter;
+    ro.goal_switches =
+        switchesDuring(updates, s, state.t_offset, *ro.tau, gen.dmp.orientation.has_value());
+    const lfd::SegmentTrajectory traj = gen.dmp.rollout(ro);
     planned.begin = plan.times.size();
-    planned.goal = target.goal;
+    planned.goal = ro.goal_switches.empty()
+                       ? target.goal
+                       : targetsAt(targets, updates, state.t_offset + *ro.tau)[s].goal;
     appendRollout(traj, s == 0, state.t_offset, state.orientation, state.gripper, &plan);
     planned.end = plan.times.size();
     // as sampled: the durations sum to the plan's
@@ -451,7 +511,18 @@ ExecutionPlan TaskPlanner::plan(const SkillLibrary& library,
     if (traj.gripper.size()) state.gripper = traj.gripper[traj.gripper.size() - 1];
     plan.segments.push_back(planned);
   }
-  solveIk(ik_, q_start, poll, plan);
+  // What the robot did before the last update stays as it was planned: IK only from there.
+  size_t keep = 0;
+  if (!updates.empty() && current.joint_names == plan.joint_names) {
+    while (keep < current.joints.size() && keep < plan.times.size() &&
+           plan.times[keep] < updates.back().time)
+      ++keep;
+    plan.joints.assign(current.joints.begin(), current.joints.begin() + static_cast<long>(keep));
+    plan.max_ik_position_error = current.max_ik_position_error;
+    plan.max_ik_orientation_error = current.max_ik_orientation_error;
+    plan.max_speed_ratio = current.max_speed_ratio;
+  }
+  solveIk(ik_, keep > 0 ? plan.joints[keep - 1] : q_start, keep, poll, plan);
   plan.gripper_events = gripperEvents(plan.gripper, options.gripper_threshold_fraction,
                                       options.gripper_hysteresis, options.gripper_min_range);
   return plan;

@@ -186,6 +186,52 @@ TEST_F(PlannerTest, SegmentsRunInSequenceFromTheCurrentPoseToEachNewGoal) {
   EXPECT_NEAR(planner_.plan(lib_, targets(grasp, goal), q0_, 0.04, opt).duration(), 6.75, 0.05);
 }
 
+// An object moved while the robot approaches it: the replanned path is the old one up to the
+// update (the robot already followed it), then bends smoothly into the moved goals: the running
+// segment's DMP goal moves, the later segment is generalized toward its new goal.
+TEST_F(PlannerTest, AGoalMovedWhileItsSegmentRunsIsFollowedSmoothly) {
+  const Eigen::Vector3d grasp = home_.position + Eigen::Vector3d(0.02, 0.0, -0.045);
+  const Eigen::Vector3d goal = grasp + Eigen::Vector3d(-0.03, 0.05, 0.12);
+  lfd_dmp::ExecutorOptions opt;
+  opt.dt = 0.004;
+  const lfd_dmp::ExecutionPlan before = planner_.plan(lib_, targets(grasp, goal), q0_, 0.04, opt);
+  const Eigen::Vector3d shift(0.03, -0.02, 0.0);
+  const double at = 0.8;  // s: within the approach (2.0 s)
+  const std::vector<lfd_dmp::TargetUpdate> updates{{at, targets(grasp + shift, goal + shift)}};
+  const lfd_dmp::ExecutionPlan after =
+      planner_.replan(lib_, targets(grasp, goal), updates, before, q0_, 0.04, opt);
+  ASSERT_EQ(after.segments.size(), 2u);
+  ASSERT_EQ(after.joints.size(), after.times.size());
+  const size_t k_at = static_cast<size_t>(std::lround(at / opt.dt));
+  for (size_t k = 0; k <= k_at; ++k) {
+    ASSERT_LT((after.poses[k].position - before.poses[k].position).norm(), 1e-12) << k;
+    ASSERT_EQ(after.joints[k], before.joints[k]) << k;  // kept, not solved again
+  }
+  EXPECT_LT((after.poses[after.segments[0].end - 1].position - (grasp + shift)).norm(), 0.004);
+  EXPECT_LT((after.poses.back().position - (goal + shift)).norm(), 0.004);
+  EXPECT_LT((after.segments[0].goal.position - (grasp + shift)).norm(), 1e-12);
+  // Smooth: the TCP's acceleration changes by less than 0.05 m/s^2 from one sample to the next
+  // around the update (a goal that jumped there, unfiltered, steps it by 0.65 m/s^2).
+  double max_da = 0.0;
+  const auto acceleration = [&](size_t k) {
+    return Eigen::Vector3d(
+        (after.poses[k + 1].position - 2 * after.poses[k].position + after.poses[k - 1].position) /
+        (opt.dt * opt.dt));
+  };
+  for (size_t k = k_at - 10; k < k_at + 10; ++k)
+    max_da = std::max(max_da, (acceleration(k + 1) - acceleration(k)).norm());
+  EXPECT_LT(max_da, 0.05);
+  for (size_t k = 0; k < after.poses.size(); k += 97)
+    EXPECT_LT((planner_.forward(after.joints[k]).position - after.poses[k].position).norm(), 0.002);
+  // Updates out of order, or of the wrong size, are refused.
+  EXPECT_THROW(planner_.replan(lib_, targets(grasp, goal), {{0.0, targets(grasp, goal)}}, before,
+                               q0_, 0.04, opt),
+               std::invalid_argument);
+  EXPECT_THROW(planner_.replan(lib_, targets(grasp, goal), {{at, {target("approach", grasp)}}},
+                               before, q0_, 0.04, opt),
+               std::invalid_argument);
+}
+
 // Regression: the driver refuses a trajectory whose velocity is beyond a joint's limit; the
 // executor checks the trajectory it would send first, so the goal fails naming the joint. A
 // normal plan is within the limits.

@@ -1,8 +1,10 @@
 #include "lfd_core/dmp/segment_dmp.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 namespace lfd {
 namespace {
@@ -169,8 +171,20 @@ SegmentTrajectory SegmentDmp::rollout(const SegmentRolloutOptions& o) const {
   traj.quaternions.resize(steps, orientation ? 4 : 0);
   traj.angular_velocities.resize(steps, orientation ? 3 : 0);
   if (gripper) traj.gripper.resize(steps);
+  std::vector<GoalSwitch> switches = o.goal_switches;
+  for (const GoalSwitch& g : switches)
+    if (!std::isfinite(g.time)) throw std::invalid_argument("rollout: a goal switch time is NaN");
+  std::stable_sort(switches.begin(), switches.end(),
+                   [](const GoalSwitch& a, const GoalSwitch& b) { return a.time < b.time; });
+  auto next_switch = switches.begin();
   for (int k = 0; k < steps; ++k) {
-    if (k > 0) runner.step(o.dt);
+    if (k > 0) {
+      // A switch at or before the step's start: the step already drives toward the new goal.
+      const double now = (k - 1) * o.dt;
+      for (; next_switch != switches.end() && next_switch->time <= now + 1e-9 * o.dt; ++next_switch)
+        runner.setGoal(next_switch->goal);
+      runner.step(o.dt);
+    }
     traj.phases[k] = runner.phase();
     if (position) {
       traj.positions.row(k) = runner.position().transpose();

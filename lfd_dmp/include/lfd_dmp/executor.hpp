@@ -91,6 +91,16 @@ struct ExecutorOptions {
   double gripper_threshold_fraction = 0.5;
   double gripper_hysteresis = 0.05;
   double gripper_min_range = 0.005;
+  /// 1/normalized time: a goal that moves while its segment runs (TargetUpdate) is followed with
+  /// the time constant tau / goal_filter (lfd::SegmentRolloutOptions::goal_filter)
+  double goal_filter = 10.0;
+};
+
+/// Segment targets that take effect `time` s into a plan (an object moved): a segment starting
+/// later is generalized toward them, a segment running then moves its DMP's goal to them.
+struct TargetUpdate {
+  double time = 0.0;
+  std::vector<SegmentTarget> targets;
 };
 
 /// A goal outside the demonstrated range when extrapolation is not allowed.
@@ -165,6 +175,19 @@ class TaskPlanner {
                      const Eigen::VectorXd& q_start, std::optional<double> gripper_start,
                      const ExecutorOptions& options,
                      const std::function<bool()>& cancelled = nullptr);
+
+  /// The plan of `plan(targets)` as it becomes when `updates` (increasing times) take effect:
+  /// identical up to each update's time; a segment running then keeps its DMP and follows its
+  /// moved goal through options.goal_filter (position, velocity and acceleration continuous);
+  /// every later segment is generalized toward the updated targets. IK is solved only from the
+  /// last update on: the joints before it are `current`'s (the plan the robot is following).
+  /// Throws as plan() does, and std::invalid_argument on updates out of order or of the wrong
+  /// size.
+  ExecutionPlan replan(const SkillLibrary& library, const std::vector<SegmentTarget>& targets,
+                       const std::vector<TargetUpdate>& updates, const ExecutionPlan& current,
+                       const Eigen::VectorXd& q_start, std::optional<double> gripper_start,
+                       const ExecutorOptions& options,
+                       const std::function<bool()>& cancelled = nullptr);
 
  private:
   lfd::CartesianToJoints ik_;

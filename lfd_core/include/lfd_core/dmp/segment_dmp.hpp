@@ -34,6 +34,19 @@ struct SegmentTrajectory {
   Eigen::VectorXd gripper;             ///< steps, or empty
 };
 
+/// Goal update for a running segment (moving goals); unset parts keep their current goal.
+struct SegmentGoal {
+  std::optional<Eigen::VectorXd> position;
+  std::optional<Eigen::Quaterniond> orientation;
+  std::optional<double> gripper;
+};
+
+/// A goal change `time` s into a rollout (an object moved while the segment ran).
+struct GoalSwitch {
+  double time = 0.0;
+  SegmentGoal goal;
+};
+
 /// New start / goal / timing for a rollout. Unset fields keep the learned demo values.
 struct SegmentRolloutOptions {
   double dt = 0.01;
@@ -46,6 +59,9 @@ struct SegmentRolloutOptions {
   /// Goal filter rate in 1/normalized time (0 = off): the attractor follows goal changes by
   /// dg/dsigma = goal_filter * (g_target - g), making goal switches acceleration-continuous.
   double goal_filter = 0.0;
+  /// Goal changes while the rollout runs, each applied (SegmentDmpRunner::setGoal) at the first
+  /// step at or after its time, in time order; with goal_filter > 0 the motion stays smooth.
+  std::vector<GoalSwitch> goal_switches;
 };
 
 struct SegmentDmp {
@@ -72,13 +88,6 @@ struct SegmentDmp {
   /// the rotated rollout. This lets demos of different headings be compared in a task frame.
   /// Throws std::invalid_argument if r is not a rotation or the position part is not 3-D.
   SegmentDmp rotated(const Eigen::Matrix3d& r) const;
-};
-
-/// Goal update for a running segment (moving goals); unset parts keep their current goal.
-struct SegmentGoal {
-  std::optional<Eigen::VectorXd> position;
-  std::optional<Eigen::Quaterniond> orientation;
-  std::optional<double> gripper;
 };
 
 /// Steps a SegmentDmp online with any dt, accepting goal changes while it runs (the executor's
