@@ -15,6 +15,13 @@ derived from the skill library and the task file.
   sensors_silenced  every sensor row of the signature stops publishing at 30% of the first segment
                   (a dead driver).
   joint_locked    each scene joint of the task (the drawer's slide) is stuck from the start.
+And two cases of goals that follow a moving object (executor.yaml follow_objects/*: the goal gives
+each object's pose in the object's own tf frame), counted apart from the faults ("following"):
+  nominal_followed  the nominal goal, its objects followed: nothing moves, nothing may be replanned.
+  object_moved    the object of the first segment's goal frame is shoved 3-8 cm (horizontally,
+                  distance and direction drawn per goal, seeded by its id) at 30% of that segment,
+                  while the hand approaches it: the task should still succeed. Not for a fixed
+                  object (scene.yaml: the drawer's cabinet), whose place defines the task's goal.
 Detection counts the sensor faults and the faulty runs whose task failed (judged by the task file's
 success rules, as a demonstration is); a fault of the world the task survived (a weak grip while
 pushing) is counted apart. Delay: sim s from the fault to the alarm (the alarm's "s into the
@@ -22,13 +29,15 @@ motion"), for the faults with a moment (not sensors_frozen, which is wrong only 
 should have changed).
 
   bench_faults.py --library-dir DIR [--mode sim] [--tasks grasp,drawer] [--goals N]
-                  [--attach] [--out result.json] [--update-docs]
+                  [--cases none,object_moved,...] [--attach] [--out result.json] [--update-docs]
 
 --update-docs: after the run, rewrite docs/results.md's section bench-faults from its summary
 (lfd_tools.results_doc).
 """
 import json
+import math
 import os
+import random
 import re
 import statistics
 import sys
@@ -39,6 +48,9 @@ from lfd_tools import bags, lockstep, master, report, reproduction, results_doc,
 FROZEN_AT_S = 0.3
 # faults of the monitoring itself: always counted
 SENSOR_FAULTS = ("sensors_frozen", "sensors_silenced")
+# goals sent with their objects followed; counted apart (summary "following")
+FOLLOWED_CASES = ("nominal_followed", "object_moved")
+SHOVE_M = (0.03, 0.08)
 ALARM_TIME = re.compile(r"\(([-\d.]+) s into the motion\)")
 
 
@@ -56,6 +68,16 @@ def held_segment(signature):
         if s > 0 and top > 0 and level > 0.5 * top:
             return s
     return None
+
+
+def shoved(pose, seed):
+    """geometry_msgs/Pose of `pose` (lfd_tools.tasks) moved horizontally by SHOVE_M, its distance
+    and direction drawn from `seed`."""
+    rng = random.Random(seed)
+    distance, angle = rng.uniform(*SHOVE_M), rng.uniform(0.0, 2.0 * math.pi)
+    x, y, z = pose["position"]
+    return lockstep.pose_msg(dict(pose, position=[x + distance * math.cos(angle),
+                                                  y + distance * math.sin(angle), z]))
 
 
 def faults_for(task, library, scene, durations):
@@ -77,6 +99,14 @@ def faults_for(task, library, scene, durations):
     if obj in tasks.scene()["objects"]:
         park = lockstep.pose_msg(tasks.pose(tasks.scene()["objects"][obj]["park"]))
         out.append(("object_removed", [request("move_object", obj, at(0, 0.5), park)], at(0, 0.5)))
+        # Not a fixed object (the drawer's cabinet): the task's goal is defined where it stands
+        # (the drawer open by so much), and the judge, given the scene's goal, would hold the
+        # moved cabinet's drawer to the old place.
+        if obj in scene["objects"] and not tasks.scene()["objects"][obj].get("fixed"):
+            out.append(("object_moved", [request("move_object", obj, at(0, 0.3),
+                                                 shoved(scene["objects"][obj], scene["id"]))],
+                        at(0, 0.3)))
+    out.append(("nominal_followed", [], None))
     held = held_segment(library["sensory_signature"])
     if held is not None:
         out.append(("grip_lost", [request("weaken_grip", at=at(held, 0.3), value=0.0)],
@@ -91,9 +121,9 @@ def faults_for(task, library, scene, durations):
     return out
 
 
-def run_goal(cell, inject, task, scene, library_path, faults, offset):
+def run_goal(cell, inject, task, scene, library_path, faults, offset, follow=False):
     """One goal with `faults` (requests with at_time relative to the motion start), judged by the
-    task's success rules: its record."""
+    task's success rules: its record. follow: the goal's objects are followed."""
     def schedule(feedback):
         t0 = feedback.motion_start.to_sec()
         for f in faults:
@@ -104,7 +134,7 @@ def run_goal(cell, inject, task, scene, library_path, faults, offset):
 
     try:
         res, _, outcome = reproduction.execute_and_judge(cell, task, scene, library_path,
-                                                         on_moving=schedule)
+                                                         on_moving=schedule, follow=follow)
     except reproduction.NotJudged as exc:  # a silenced sensor the task's judge reads: a failed task
         res, outcome = exc.result, {"success": False, "reason": str(exc)}
     alarm = ALARM_TIME.search(res.monitor_alarm or "")
@@ -115,7 +145,7 @@ def run_goal(cell, inject, task, scene, library_path, faults, offset):
                         else None),
             "goal_succeeded": res.success,
             "task_succeeded": bool(res.success and outcome["success"]), "judged": outcome["reason"],
-            "error": res.error}
+            "error": res.error, "replans": list(res.replans)}
 
 
 def auc(negatives, positives):
@@ -130,6 +160,8 @@ def summarize(runs):
     """Detection over the sensor faults and the faults that made the task fail (one the task
     survived, e.g. a weak grip while pushing, is counted apart); false alarms over the nominal
     runs."""
+    following = {c: [r for r in runs if r["fault"] == c] for c in FOLLOWED_CASES}
+    runs = [r for r in runs if r["fault"] not in FOLLOWED_CASES]
     nominal = [r["score"] for r in runs if r["fault"] == "none"]
     faulty = [r for r in runs if r["fault"] != "none"
               and (not r["task_succeeded"] or r["fault"] in SENSOR_FAULTS)]
@@ -156,12 +188,20 @@ def summarize(runs):
                                                                if r["delay_s"] is not None])
                           if any(r["delay_s"] is not None for r in rs) else None}
                       for f, rs in sorted(by_fault.items())},
+        "following": {c: {"runs": len(rs), "task_succeeded": sum(r["task_succeeded"] for r in rs),
+                          "replanned_runs": sum(bool(r.get("replans")) for r in rs),
+                          "alarms": sum(bool(r["alarm"]) for r in rs),
+                          "failed_tasks": sorted({r["task"] for r in rs
+                                                  if not r["task_succeeded"]})}
+                      for c, rs in following.items() if rs},
     }
 
 
 def main():
     ap = reproduction.goal_bench_parser(__doc__, goals=5)
     ap.add_argument("--out", default=None)
+    ap.add_argument("--cases", default=None,
+                    help="comma-separated: none and the fault names (default: all)")
     ap.add_argument("--update-docs", action="store_true",
                     help="rewrite docs/results.md's section bench-faults from the result")
     args = ap.parse_args()
@@ -190,22 +230,27 @@ def main():
                     plan, _ = cell.execute(lockstep.execute_goal(path, scene, dry_run=True))
                     cases = [("none", [], None)] + faults_for(task, library, scene,
                                                               list(plan.segment_durations))
+                    if args.cases:
+                        cases = [c for c in cases if c[0] in args.cases.split(",")]
                     for name, faults, offset in cases:
                         started = time.time()
                         try:
-                            r = run_goal(cell, inject, task, scene, path, faults, offset)
+                            r = run_goal(cell, inject, task, scene, path, faults, offset,
+                                         follow=name in FOLLOWED_CASES)
                         except RuntimeError as exc:
                             r = {"monitored": False, "score": 0.0, "alarm": "",
                                  "alarm_time_s": None, "fault_time_s": offset, "delay_s": None,
                                  "goal_succeeded": False, "task_succeeded": False, "judged": "",
-                                 "error": str(exc)}
+                                 "error": str(exc), "replans": []}
                         r.update(task=task, goal=scene["id"], fault=name)
                         results["runs"].append(r)
                         print("%-6s goal %3d %-16s %-7s score %6.2f %-6s delay %s  %.1f s  %s" % (
                             task, scene["id"], name, "ok" if r["task_succeeded"] else "FAILED",
                             r["score"], "ALARM" if r["alarm"] else "-",
                             "-" if r["delay_s"] is None else "%.3f s" % r["delay_s"],
-                            time.time() - started, (r["alarm"] or r["error"])[:90]), flush=True)
+                            time.time() - started,
+                            (r["alarm"] or r["error"] or "; ".join(r["replans"]))[:90]),
+                            flush=True)
             results["summary"] = summarize(results["runs"])
             print(json.dumps(results["summary"], indent=1))
     if args.update_docs:

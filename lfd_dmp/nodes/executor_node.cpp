@@ -14,6 +14,7 @@
 #include "lfd_dmp/execution_monitor.hpp"
 #include "lfd_dmp/execution_request.hpp"
 #include "lfd_dmp/executor.hpp"
+#include "lfd_dmp/object_following.hpp"
 #include "lfd_dmp/plan_messages.hpp"
 
 #include <lfd_msgs/ExecuteTaskAction.h>
@@ -38,6 +39,7 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -206,6 +208,7 @@ class Executor {
     min_wall_silence_ = pnh.param("monitoring/min_wall_silence", min_wall_silence_);
     if (!(min_wall_silence_ >= 0.0))
       throw std::runtime_error("executor: ~monitoring/min_wall_silence must be >= 0");
+    loadFollowOptions(pnh);
     settle_time_ = pnh.param("settle_time", settle_time_);
     clock_timeout_ = pnh.param("clock_timeout", clock_timeout_);
     motion_lead_ = pnh.param("motion_lead", motion_lead_);
@@ -354,6 +357,26 @@ class Executor {
     }
   }
 
+  void loadFollowOptions(ros::NodeHandle& pnh) {
+    lfd_dmp::FollowOptions& f = follow_options_;
+    f.enabled = pnh.param("follow_objects/enabled", f.enabled);
+    f.check_period = pnh.param("follow_objects/check_period", f.check_period);
+    f.min_shift = pnh.param("follow_objects/min_shift", f.min_shift);
+    f.min_turn = pnh.param("follow_objects/min_turn", f.min_turn);
+    f.lead = pnh.param("follow_objects/lead", f.lead);
+    f.until_fraction = pnh.param("follow_objects/until_fraction", f.until_fraction);
+    f.max_replans = static_cast<size_t>(
+        std::max(0, pnh.param("follow_objects/max_replans", static_cast<int>(f.max_replans))));
+    options_.goal_filter = pnh.param("follow_objects/goal_filter", options_.goal_filter);
+    try {
+      lfd_dmp::checkFollowOptions(f);
+    } catch (const std::invalid_argument& e) {
+      throw std::runtime_error(std::string("executor: ~") + e.what());
+    }
+    if (!(options_.goal_filter > 0.0))
+      throw std::runtime_error("executor: ~follow_objects/goal_filter must be > 0");
+  }
+
   // ---- the action ------------------------------------------------------------------------------
   void execute(ActionServer& server, const lfd_msgs::ExecuteTaskGoal& goal) {
     const lfd::TrimHeapOnExit trim;  // the goal's library and plan go back to the system
@@ -396,7 +419,12 @@ class Executor {
       ROS_INFO("executor: planned %s: %zu segments, %.2f s, IK residual %.2f mm, %.2f s wall",
                library.task.c_str(), plan.segments.size(), plan.duration(),
                plan.max_ik_position_error * 1e3, result.planning_time);
-      if (!goal.dry_run) run(plan, &result);
+      if (!goal.dry_run) {
+        startFollowing({&library, targets, s, planner().forward(q), q, gripper, opt,
+                        goal.object_names, goal.object_poses},
+                       plan);
+        run(std::move(plan), &result);
+      }
       result.success = true;
       goal_server_->setSucceeded(result);
     } catch (const lfd_dmp::PlanningCancelled& e) {
@@ -421,6 +449,7 @@ class Executor {
     feedback_ = lfd_msgs::ExecuteTaskFeedback();
     tracked_stamp_ = ros::Time();
     trackJoints({});
+    following_.reset();
     monitor_.reset();  // its subscriptions end with the goal
   }
 
@@ -474,7 +503,7 @@ class Executor {
     }
   }
 
-  void run(const lfd_dmp::ExecutionPlan& plan, lfd_msgs::ExecuteTaskResult* result) {
+  void run(lfd_dmp::ExecutionPlan plan, lfd_msgs::ExecuteTaskResult* result) {
     waitForDriver(trajectory_pub_);
     if (!plan.gripper_events.empty()) waitForDriver(gripper_pub_);
     waitForSensors(result);
@@ -492,7 +521,7 @@ class Executor {
     feedback_.motion_start = t0;
     feedback_.planned_duration = plan.duration();
     setState(lfd_msgs::ExecuteTaskFeedback::MOVING, plan);
-    const ros::Time t_end = t0 + ros::Duration(plan.duration());
+    ros::Time t_end = t0 + ros::Duration(plan.duration());
     ClockWatch watch(clock_timeout_);
     ros::Time reached;
     for (;;) {
@@ -502,6 +531,9 @@ class Executor {
       watch.check(now);
       const ros::Time measured = track(plan, t0, t_end, &reached);
       checkMonitor(plan, t0, now, measured, result);
+      if (following_ && now < t_end && now >= following_->next_look &&
+          followObjects(t0, now, &plan, result))
+        t_end = t0 + ros::Duration(plan.duration());
       if (now >= t_end) {
         if (feedback_.state != lfd_msgs::ExecuteTaskFeedback::SETTLING)
           setState(lfd_msgs::ExecuteTaskFeedback::SETTLING, plan);
@@ -533,6 +565,129 @@ class Executor {
     throw Preempted("preempted at t=" + std::to_string((now - t0).toSec()) +
                     " s of the motion, in segment '" + segmentAt(plan, k).name +
                     "'; the arm holds there");
+  }
+
+  // ---- goals that follow a moving object (lfd_dmp/object_following.hpp) -----------------------
+  // What a replan needs: the goal's library and first targets, the scene as the plan has it now,
+  // where the task started, and the objects' poses as the goal gave them (a pose in a frame that
+  // moves with the object is looked up on tf again: that object is followed).
+  struct FollowRequest {
+    const lfd_dmp::SkillLibrary* library = nullptr;
+    std::vector<lfd_dmp::SegmentTarget> targets;
+    lfd::Scene scene;
+    lfd_dmp::TcpPose start;
+    Eigen::VectorXd q_start;
+    std::optional<double> gripper_start;
+    lfd_dmp::ExecutorOptions options;
+    std::vector<std::string> names;
+    std::vector<geometry_msgs::PoseStamped> poses;
+  };
+  struct Following {
+    FollowRequest request;
+    std::vector<lfd_dmp::TargetUpdate> updates;
+    std::map<std::string, double> windows;  // s into the plan each object is followed until
+    ros::Time next_look;
+  };
+
+  void startFollowing(FollowRequest request, const lfd_dmp::ExecutionPlan& plan) {
+    following_.reset();
+    if (!follow_options_.enabled) return;
+    auto windows = lfd_dmp::followWindows(*request.library, plan, follow_options_);
+    if (windows.empty()) return;
+    following_ = Following{std::move(request), {}, std::move(windows), ros::Time()};
+  }
+
+  // Looks at the followed objects; when one moved, plans the rest of the motion toward it from
+  // ~follow_objects/lead ahead, sends it (it replaces the running trajectory from then on) and
+  // returns true. A moved goal that cannot be planned (out of reach, outside the demonstrated
+  // range) holds the arm and fails the goal.
+  bool followObjects(const ros::Time& t0, const ros::Time& now, lfd_dmp::ExecutionPlan* plan,
+                     lfd_msgs::ExecuteTaskResult* result) {
+    Following& f = *following_;
+    f.next_look = now + ros::Duration(follow_options_.check_period);
+    const double elapsed = (now - t0).toSec();
+    const std::map<std::string, lfd::Pose> seen = objectsNow(f);
+    const auto moves =
+        lfd_dmp::movedObjects(f.request.scene, seen, f.windows, elapsed, follow_options_);
+    if (moves.empty()) return false;
+    const double at = elapsed + follow_options_.lead;
+    if (f.updates.size() >= follow_options_.max_replans || at >= plan->duration()) {
+      result->warnings.push_back(
+          "not followed (" + std::to_string(f.updates.size()) +
+          " replans already, ~follow_objects/max_replans): " + lfd_dmp::describeMoves(moves));
+      following_.reset();
+      return false;
+    }
+    setState(lfd_msgs::ExecuteTaskFeedback::REPLANNING, *plan);
+    lfd::Scene scene = f.request.scene;
+    // Only the moved ones: an object the robot holds or pushes by now keeps its planned pose.
+    for (const lfd_dmp::ObjectMove& m : moves) scene.objects[m.object] = seen.at(m.object);
+    lfd_dmp::ExecutionPlan next;
+    try {
+      std::vector<std::string> warnings;
+      f.updates.push_back({at, lfd_dmp::segmentTargets(*f.request.library, scene, f.request.start,
+                                                       f.request.options, &warnings)});
+      next = planner().replan(*f.request.library, f.request.targets, f.updates, *plan,
+                              f.request.q_start, f.request.gripper_start, f.request.options);
+    } catch (const std::exception& e) {
+      hold(*plan, t0, ros::Time::now());
+      throw std::runtime_error("the goal moved (" + lfd_dmp::describeMoves(moves) +
+                               ") and cannot be followed: " + e.what() + "; the arm holds there");
+    }
+    if (ros::Time::now() + ros::Duration(0.5 * follow_options_.check_period) >
+        t0 + ros::Duration(at)) {  // planned too slowly: the next look plans again, further ahead
+      f.updates.pop_back();
+      setState(lfd_msgs::ExecuteTaskFeedback::MOVING, *plan);
+      return false;
+    }
+    sendFrom(next, t0, at);
+    f.request.scene = scene;
+    *plan = std::move(next);
+    if (monitor_) monitor_->retime(*plan);
+    std::ostringstream line;
+    line.precision(3);
+    line << "at " << elapsed << " s into the motion: " << lfd_dmp::describeMoves(moves)
+         << "; the motion follows it from " << at << " s";
+    result->replans.push_back(line.str());
+    ROS_INFO("executor: %s", result->replans.back().c_str());
+    feedback_.planned_duration = plan->duration();
+    setState(lfd_msgs::ExecuteTaskFeedback::MOVING, *plan);
+    return true;
+  }
+
+  // Where the followed objects are now, each looked up on tf without waiting (an object not seen
+  // now is not moved).
+  std::map<std::string, lfd::Pose> objectsNow(const Following& f) {
+    std::map<std::string, lfd::Pose> out;
+    for (size_t i = 0; i < f.request.names.size(); ++i) {
+      const geometry_msgs::PoseStamped& ps = f.request.poses[i];
+      if (!f.windows.count(f.request.names[i]) || ps.header.frame_id == cartesianFrame() ||
+          !tf_buffer_.canTransform(cartesianFrame(), ps.header.frame_id, ros::Time(0)))
+        continue;
+      try {
+        out[f.request.names[i]] = scenePose(ps, "object '" + f.request.names[i] + "'");
+      } catch (const std::exception&) {  // gone from tf between the two calls: not seen
+      }
+    }
+    return out;
+  }
+
+  // The plan from `at` s on replaces what the driver runs from then, gripper included: a command
+  // stamped then drops the later ones pending (bridge and driver), then the plan's later events.
+  void sendFrom(const lfd_dmp::ExecutionPlan& plan, const ros::Time& t0, double at) {
+    size_t k = 0;
+    while (k + 1 < plan.times.size() && plan.times[k] < at) ++k;
+    trajectory_pub_.publish(lfd_dmp::toJointTrajectory(plan, t0, trajectory_period_, k));
+    const lfd_dmp::GripperEvent* last = nullptr;
+    for (const lfd_dmp::GripperEvent& e : plan.gripper_events)
+      if (e.sample <= k) last = &e;
+    if (last)
+      gripper_pub_.publish(
+          lfd_dmp::gripperCommand(last->close, robot_.gripper, t0 + ros::Duration(plan.times[k])));
+    for (const lfd_dmp::GripperEvent& e : plan.gripper_events)
+      if (e.sample > k)
+        gripper_pub_.publish(lfd_dmp::gripperCommand(e.close, robot_.gripper,
+                                                     t0 + ros::Duration(plan.times[e.sample])));
   }
 
   // ---- execution monitoring (lfd_dmp/execution_monitor.hpp) -----------------------------------
@@ -737,6 +892,8 @@ class Executor {
   double max_silence_ = 2.0;       // s (executor.yaml monitoring/max_silence)
   double min_wall_silence_ = 0.5;  // wall s (executor.yaml monitoring/min_wall_silence)
   std::unique_ptr<lfd_dmp::ExecutionMonitor> monitor_;  // the current goal's
+  lfd_dmp::FollowOptions follow_options_;               // executor.yaml follow_objects/*
+  std::optional<Following> following_;                  // the current goal's
   tf2_ros::Buffer tf_buffer_;
   tf2_ros::TransformListener tf_listener_;
   ros::Publisher trajectory_pub_, gripper_pub_, planned_pub_, executed_pub_, marker_pub_;

@@ -55,22 +55,34 @@ ExecutionMonitor::ExecutionMonitor(ros::NodeHandle& nh, lfd::SensorySignature si
 }
 
 void ExecutionMonitor::start(const ExecutionPlan& plan, const ros::Time& t0) {
-  if (plan.segments.size() != signature_.segments.size())
-    throw std::invalid_argument("the plan has " + std::to_string(plan.segments.size()) +
-                                " segments, the sensory signature " +
-                                std::to_string(signature_.segments.size()));
+  auto spans = spansOf(plan);
   std::lock_guard<std::mutex> lock(mutex_);
-  spans_.clear();
-  double start = 0.0;
-  for (const PlannedSegment& s : plan.segments) {
-    spans_.emplace_back(start, start + s.duration);
-    start += s.duration;
-  }
+  spans_ = std::move(spans);
   t0_ = t0;
   worst_ = lfd::Deviation();
   alarm_.reset();
   monitor_.reset();
   active_ = true;
+}
+
+void ExecutionMonitor::retime(const ExecutionPlan& plan) {
+  auto spans = spansOf(plan);
+  std::lock_guard<std::mutex> lock(mutex_);
+  spans_ = std::move(spans);
+}
+
+std::vector<std::pair<double, double>> ExecutionMonitor::spansOf(const ExecutionPlan& plan) const {
+  if (plan.segments.size() != signature_.segments.size())
+    throw std::invalid_argument("the plan has " + std::to_string(plan.segments.size()) +
+                                " segments, the sensory signature " +
+                                std::to_string(signature_.segments.size()));
+  std::vector<std::pair<double, double>> spans;
+  double start = 0.0;
+  for (const PlannedSegment& s : plan.segments) {
+    spans.emplace_back(start, start + s.duration);
+    start += s.duration;
+  }
+  return spans;
 }
 
 void ExecutionMonitor::stop() {

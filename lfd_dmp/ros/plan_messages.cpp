@@ -8,18 +8,21 @@
 namespace lfd_dmp {
 
 trajectory_msgs::JointTrajectory toJointTrajectory(const ExecutionPlan& plan,
-                                                   const ros::Time& start, double period) {
+                                                   const ros::Time& start, double period,
+                                                   size_t from) {
   trajectory_msgs::JointTrajectory msg;
-  msg.header.stamp = start;
-  msg.joint_names = plan.joint_names;
   const size_t n = plan.times.size();
+  if (from >= n && n > 0) throw std::invalid_argument("toJointTrajectory: no sample from there");
+  const double offset = n > 0 ? plan.times[from] : 0.0;
+  msg.header.stamp = start + ros::Duration(offset);
+  msg.joint_names = plan.joint_names;
   const size_t every = std::max<size_t>(1, static_cast<size_t>(std::lround(period / plan.dt)));
   std::vector<size_t> knots;
-  for (size_t k = 0; k < n; k += every) knots.push_back(k);
+  for (size_t k = from; k < n; k += every) knots.push_back(k);
   if (n > 0 && knots.back() != n - 1) knots.push_back(n - 1);
   for (size_t k : knots) {
     trajectory_msgs::JointTrajectoryPoint p;
-    p.time_from_start = ros::Duration(plan.times[k]);
+    p.time_from_start = ros::Duration(plan.times[k] - offset);
     const Eigen::VectorXd& q = plan.joints[k];
     p.positions.assign(q.data(), q.data() + q.size());
     // Central differences (one-sided at the start; zero at the last sample: the arm stops there).

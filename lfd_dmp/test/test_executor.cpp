@@ -1,6 +1,7 @@
 // Executor logic without ROS: segment goal rules, gripper thresholding, segment sequencing of the
 // planned path, and refusal of unreachable goals / mismatched libraries before anything moves.
 #include "lfd_dmp/executor.hpp"
+#include "lfd_dmp/object_following.hpp"
 #include "lfd_dmp/plan_messages.hpp"
 #include "lfd_dmp/skill_learner.hpp"
 #include "strokes.hpp"
@@ -223,6 +224,19 @@ TEST_F(PlannerTest, AGoalMovedWhileItsSegmentRunsIsFollowedSmoothly) {
   EXPECT_LT(max_da, 0.05);
   for (size_t k = 0; k < after.poses.size(); k += 97)
     EXPECT_LT((planner_.forward(after.joints[k]).position - after.poses[k].position).norm(), 0.002);
+  // What is sent: the rest from the update, stamped when it starts, its first knot the old plan's
+  // (the driver's targets go on without a jump).
+  const trajectory_msgs::JointTrajectory tail =
+      lfd_dmp::toJointTrajectory(after, ros::Time(100.0), 0.01, k_at);
+  EXPECT_NEAR(tail.header.stamp.toSec(), 100.0 + after.times[k_at], 1e-9);
+  ASSERT_FALSE(tail.points.empty());
+  EXPECT_EQ(tail.points.front().time_from_start.toSec(), 0.0);
+  for (size_t j = 0; j < tail.joint_names.size(); ++j)
+    EXPECT_EQ(tail.points.front().positions[j], before.joints[k_at][static_cast<Eigen::Index>(j)]);
+  EXPECT_NEAR(tail.points.back().time_from_start.toSec(), after.duration() - after.times[k_at],
+              1e-9);
+  EXPECT_THROW(lfd_dmp::toJointTrajectory(after, ros::Time(0), 0.01, after.times.size()),
+               std::invalid_argument);
   // Updates out of order, or of the wrong size, are refused.
   EXPECT_THROW(planner_.replan(lib_, targets(grasp, goal), {{0.0, targets(grasp, goal)}}, before,
                                q0_, 0.04, opt),
@@ -230,6 +244,53 @@ TEST_F(PlannerTest, AGoalMovedWhileItsSegmentRunsIsFollowedSmoothly) {
   EXPECT_THROW(planner_.replan(lib_, targets(grasp, goal), {{at, {target("approach", grasp)}}},
                                before, q0_, 0.04, opt),
                std::invalid_argument);
+}
+
+// Which objects a plan follows and until when: each through 60% of the first segment whose goal
+// frames name it (then the robot is at it; later the robot moves it). A move under both
+// thresholds, an object not seen and a window that is over change nothing.
+TEST_F(PlannerTest, ObjectsAreFollowedUntilTheRobotReachesThem) {
+  lfd_dmp::ExecutorOptions opt;
+  opt.dt = 0.004;
+  const Eigen::Vector3d grasp = home_.position + Eigen::Vector3d(0.02, 0.0, -0.045);
+  const lfd_dmp::ExecutionPlan plan =
+      planner_.plan(lib_, targets(grasp, grasp + Eigen::Vector3d(0, 0.05, 0.1)), q0_, 0.04, opt);
+  lfd_dmp::SkillLibrary lib = lib_;
+  lib.segments[0].goal.emplace();
+  lib.segments[0].goal->position_frame = lfd::SceneFrame::parse("object:block");
+  lib.segments[1].goal.emplace();
+  lib.segments[1].goal->position_frame = lfd::SceneFrame::parse("goal");
+  lib.segments[1].goal->motion_frame = lfd::SceneFrame::parse("heading:block");
+  lib.segments[1].goal->orientation_frame = lfd::SceneFrame::parse("object:tray");
+  const lfd_dmp::FollowOptions follow;
+  const auto windows = lfd_dmp::followWindows(lib, plan, follow);
+  ASSERT_EQ(windows.size(), 2u);
+  EXPECT_NEAR(windows.at("block"), 0.6 * plan.segments[0].duration, 1e-9);
+  EXPECT_NEAR(windows.at("tray"), plan.segments[0].duration + 0.6 * plan.segments[1].duration,
+              1e-9);
+
+  lfd::Scene planned;
+  planned.objects["block"] = {Eigen::Vector3d(0.4, 0.0, 0.8), Eigen::Quaterniond::Identity()};
+  planned.objects["tray"] = {Eigen::Vector3d(0.4, 0.3, 0.8), Eigen::Quaterniond::Identity()};
+  std::map<std::string, lfd::Pose> now = planned.objects;
+  EXPECT_TRUE(lfd_dmp::movedObjects(planned, now, windows, 0.5, follow).empty());
+  now["block"].position.x() += 0.004;  // under 5 mm
+  EXPECT_TRUE(lfd_dmp::movedObjects(planned, now, windows, 0.5, follow).empty());
+  now["block"].position.x() += 0.04;
+  const auto moved = lfd_dmp::movedObjects(planned, now, windows, 0.5, follow);
+  ASSERT_EQ(moved.size(), 1u);
+  EXPECT_EQ(moved[0].object, "block");
+  EXPECT_NEAR(moved[0].shift, 0.044, 1e-9);
+  EXPECT_EQ(lfd_dmp::describeMoves(moved), "object 'block' moved 4.40 cm and turned 0.00 deg");
+  // Reached: the block rides with the robot now.
+  EXPECT_TRUE(lfd_dmp::movedObjects(planned, now, windows, windows.at("block"), follow).empty());
+  now["tray"].orientation = Eigen::AngleAxisd(0.1, Eigen::Vector3d::UnitZ());
+  EXPECT_EQ(lfd_dmp::movedObjects(planned, now, windows, 3.0, follow).size(), 1u);
+  now.erase("tray");  // not seen: not moved
+  EXPECT_TRUE(lfd_dmp::movedObjects(planned, now, windows, 3.0, follow).empty());
+  lfd_dmp::FollowOptions bad;
+  bad.lead = 0.0;
+  EXPECT_THROW(lfd_dmp::checkFollowOptions(bad), std::invalid_argument);
 }
 
 // Regression: the driver refuses a trajectory whose velocity is beyond a joint's limit; the

@@ -18,7 +18,7 @@ from actionlib_msgs.msg import GoalStatus
 from lfd_msgs.msg import DemoSegmentation, ExecuteTaskFeedback
 from lfd_msgs.srv import LearnSkills
 from lfd_tools import bags
-from lfd_tools import config, judge, lockstep, tasks
+from lfd_tools import config, judge, lockstep, reproduction, tasks
 
 TASK = "grasp"
 FUZZ_GOALS = 150      # seeded random goals of test_7 (~10 s on the 2-core machine)
@@ -147,6 +147,38 @@ class ExecutorAction(unittest.TestCase):
                                                             tasks.base_in_world()),
                                     self.scene, tasks.table_top())
         self.assertTrue(outcome["success"], outcome["reason"])
+
+    def test_8_follows_the_stick_moved_during_the_approach(self):
+        """The stick is moved 5 cm while the hand approaches it (/bridge/inject_fault
+        move_object, a third into the approach). Given the stick's pose in its own tf frame, the
+        executor follows it: the rest of the motion is planned anew toward where it is, and the
+        grasp still succeeds. Given it in the world frame (fixed), the same move is not followed,
+        and the task fails: what following is for."""
+        from lfd_msgs.srv import InjectFault, InjectFaultRequest
+        inject = rospy.ServiceProxy("/bridge/inject_fault", InjectFault)
+        dry, _ = self.answer(self.goal(dry_run=True))
+        at = 0.35 * dry.segment_durations[0]
+        shifted = lockstep.pose_msg(moved(self.scene["objects"]["stick"], dx=0.04, dy=-0.03))
+
+        def move_stick(feedback):
+            r = inject(InjectFaultRequest(kind="move_object", target="stick", pose=shifted,
+                                          at_time=feedback.motion_start.to_sec() + at))
+            self.assertTrue(r.success, r.message)
+        outcomes = {}
+        for follow in (True, False):
+            res, _, outcome = reproduction.execute_and_judge(
+                self.cell, TASK, self.scene, self.library, on_moving=move_stick, follow=follow)
+            self.assertTrue(res.success, res.error)
+            outcomes[follow] = (res, outcome, [f.state for f in self.cell.feedback])
+        followed, judged, states = outcomes[True]
+        self.assertEqual(len(followed.replans), 1, followed.replans)
+        self.assertIn("object 'stick' moved 5.00 cm", followed.replans[0])
+        self.assertIn(ExecuteTaskFeedback.REPLANNING, states)
+        self.assertTrue(judged["success"], judged["reason"])
+        self.assertLess(followed.final_position_error, 0.005)
+        fixed, judged, _ = outcomes[False]
+        self.assertEqual(list(fixed.replans), [])
+        self.assertFalse(judged["success"], "the stick moved 5 cm and the grasp still held")
 
     def test_2_preempted_while_moving_then_answers(self):
         self.place()

@@ -50,6 +50,9 @@ class ExecutionMonitor {
   /// Judges the readings of the motion of `plan` that starts at `t0` (segments in plan order,
   /// as many as the signature's: else std::invalid_argument).
   void start(const ExecutionPlan& plan, const ros::Time& t0);
+  /// The running motion was replanned (an object moved): its segments' times from `plan`, what
+  /// was judged so far kept.
+  void retime(const ExecutionPlan& plan);
   void stop();
 
   /// The worst reading so far (score: sustained deviation / threshold) and the first alarm.
@@ -66,6 +69,8 @@ class ExecutionMonitor {
 
  private:
   void onReading(const ros::Time& stamp, const Eigen::VectorXd& values);
+  /// Each segment's [start, end) s into the motion; checks the count against the signature's.
+  std::vector<std::pair<double, double>> spansOf(const ExecutionPlan& plan) const;
   /// The segment of the motion at `t` s from its start and the phase in it (mutex_ held).
   std::pair<std::size_t, double> segmentAt(double t) const;
 

@@ -22,10 +22,13 @@ namespace lfd_dmp {
 /// A TCP pose as its message: the suite's one conversion (the demonstrator's too).
 using lfd_msgs::toPoseMsg;
 
-/// The planned joints every `period` s (and the last sample), velocities by central differences,
-/// header.stamp = `start`: the driver interpolates them on its clock from then on.
+/// The planned joints from sample `from` on, every `period` s (and the last sample), velocities
+/// by central differences; header.stamp = `start` + the time of sample `from` (the plan starts at
+/// `start`): the driver interpolates them on its clock from then on, and a trajectory sent while
+/// another runs replaces it from its stamp (a replanned rest of the motion).
 trajectory_msgs::JointTrajectory toJointTrajectory(const ExecutionPlan& plan,
-                                                   const ros::Time& start, double period);
+                                                   const ros::Time& start, double period,
+                                                   size_t from = 0);
 
 /// Refuses a trajectory that moves a joint faster than its limit (`limits` by `joint_names`;
 /// a joint without a positive finite limit is not checked): the driver refuses it whole (a

@@ -84,11 +84,18 @@ class LiveRecording(object):
                     yield topic, m, m.header.stamp
 
 
-def execute_goal(library, scene, duration_scale=1.0, allow_extrapolation=False, dry_run=False):
-    """An lfd_msgs/ExecuteTaskGoal for a scene {"objects": {name: pose}, "goal": pose} (world)."""
+def execute_goal(library, scene, duration_scale=1.0, allow_extrapolation=False, dry_run=False,
+                 follow=False):
+    """An lfd_msgs/ExecuteTaskGoal for a scene {"objects": {name: pose}, "goal": pose} (world).
+    follow: each object's pose is given as the origin of its own tf frame (the bridge publishes
+    one per object, as a tracker would), so the executor follows an object that moves while the
+    robot approaches it; else in the world frame (fixed)."""
     from lfd_msgs.msg import ExecuteTaskGoal
+    origin = {"position": [0.0, 0.0, 0.0], "orientation": [1.0, 0.0, 0.0, 0.0]}
+    poses = [stamped(origin, name) if follow else stamped(p)
+             for name, p in scene["objects"].items()]
     return ExecuteTaskGoal(library=library, object_names=list(scene["objects"]),
-                           object_poses=[stamped(p) for p in scene["objects"].values()],
+                           object_poses=poses,
                            goal=stamped(scene["goal"]), duration_scale=duration_scale,
                            allow_extrapolation=allow_extrapolation, dry_run=dry_run)
 
@@ -216,6 +223,14 @@ class Cell(object):
         from lfd_msgs.msg import ExecuteTaskFeedback
         return any(f.state != ExecuteTaskFeedback.PLANNING for f in self.feedback)
 
+    def replanning(self):
+        """The executor plans the rest of the motion anew (an object moved). In lockstep the clock
+        is held meanwhile: the new motion starts ~follow_objects/lead (sim s) after the look that
+        saw the move, which covers the planning on a robot's clock, but a client stepping ~9x
+        faster than real time would run past it while the plan is computed."""
+        from lfd_msgs.msg import ExecuteTaskFeedback
+        return bool(self.feedback) and self.feedback[-1].state == ExecuteTaskFeedback.REPLANNING
+
     def done(self):
         from actionlib import CommState
         return self.goal_handle.get_comm_state() == CommState.DONE
@@ -228,7 +243,7 @@ class Cell(object):
             wall = time.time() - started
             if wall > timeout or (not self.moving() and wall > PLANNING_TIMEOUT_S):
                 return False
-            if self.lockstep and self.moving():
+            if self.lockstep and self.moving() and not self.replanning():
                 self.step(STEP_CHUNK)
             else:
                 time.sleep(0.002)

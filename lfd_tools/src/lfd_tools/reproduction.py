@@ -26,9 +26,10 @@ def place_scene(cell, task, scene):
 
 
 def execute_and_judge(cell, task, scene, library, duration_scale=1.0, allow_extrapolation=False,
-                      after_scene=None, on_moving=None):
+                      after_scene=None, on_moving=None, follow=False):
     """(result, wall s, judged outcome). after_scene(): once the scene is placed (e.g. start a bag);
-    on_moving(feedback): once the motion is sent (lockstep.Cell.execute)."""
+    on_moving(feedback): once the motion is sent (lockstep.Cell.execute); follow: the objects'
+    poses in their own tf frames, followed if they move (lockstep.execute_goal)."""
     criterion = tasks.success_criterion(task)
     place_scene(cell, task, scene)
     if after_scene:
@@ -36,7 +37,7 @@ def execute_and_judge(cell, task, scene, library, duration_scale=1.0, allow_extr
     measured = cell.record(bags.topics_for(criterion))
     try:
         res, wall = cell.execute(lockstep.execute_goal(library, scene, duration_scale,
-                                                       allow_extrapolation),
+                                                       allow_extrapolation, follow=follow),
                                  on_moving=on_moving)
         if res is None:
             raise RuntimeError("the executor gave no result")

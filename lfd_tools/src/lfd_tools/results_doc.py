@@ -214,7 +214,20 @@ def faults_sections(result, made_by):
                "%d, alarmed %d. ROC AUC of the anomaly score, faulty vs nominal: %s."
                % (s["nominal_runs"], s["false_alarms"], s["nominal_task_failures"],
                   s["harmless_faults"], s["harmless_faults_alarmed"], num("%.2f", s["roc_auc"]))]
+            + following_table(s.get("following") or {})
             + ([] if result.get("complete", True) else ["", "(interrupted: incomplete run)"])}
+
+
+def following_table(following):
+    """Goals whose objects the executor followed (bench_faults.py FOLLOWED_CASES)."""
+    if not following:
+        return []
+    rows = [(case, "%d" % v["runs"], "%d" % v["task_succeeded"], "%d" % v["replanned_runs"],
+             "%d" % v["alarms"], ", ".join(v["failed_tasks"]) or "-")
+            for case, v in sorted(following.items())]
+    return ["", "Goals whose objects are followed (the goal gives each object's pose in its own tf "
+            "frame):", ""] + tables.markdown_table(
+                ["case", "runs", "task succeeded", "replanned", "alarms", "failed tasks"], rows)
 
 
 def pr2_case_cells(row):
