@@ -640,7 +640,10 @@ class Executor {
       setState(lfd_msgs::ExecuteTaskFeedback::MOVING, *plan);
       return false;
     }
-    sendFrom(next, t0, at);
+    // Sent from ~motion_lead ahead, not from `at`: the driver replaces the running trajectory
+    // when the new one arrives and holds its first point until its stamp, so the new one carries
+    // the unchanged plan up to `at` and the targets go on without a jump.
+    sendFrom(next, t0, std::min(at, (ros::Time::now() - t0).toSec() + motion_lead_));
     f.request.scene = scene;
     *plan = std::move(next);
     if (monitor_) monitor_->retime(*plan);
@@ -672,11 +675,11 @@ class Executor {
     return out;
   }
 
-  // The plan from `at` s on replaces what the driver runs from then, gripper included: a command
-  // stamped then drops the later ones pending (bridge and driver), then the plan's later events.
-  void sendFrom(const lfd_dmp::ExecutionPlan& plan, const ros::Time& t0, double at) {
+  // The plan from `from` s on replaces what the driver runs, gripper included: a command stamped
+  // then drops the later ones pending (bridge and driver), then the plan's later events.
+  void sendFrom(const lfd_dmp::ExecutionPlan& plan, const ros::Time& t0, double from) {
     size_t k = 0;
-    while (k + 1 < plan.times.size() && plan.times[k] < at) ++k;
+    while (k + 1 < plan.times.size() && plan.times[k] < from) ++k;
     trajectory_pub_.publish(lfd_dmp::toJointTrajectory(plan, t0, trajectory_period_, k));
     const lfd_dmp::GripperEvent* last = nullptr;
     for (const lfd_dmp::GripperEvent& e : plan.gripper_events)

