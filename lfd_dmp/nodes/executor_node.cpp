@@ -640,10 +640,11 @@ class Executor {
       setState(lfd_msgs::ExecuteTaskFeedback::MOVING, *plan);
       return false;
     }
-    // Sent from ~motion_lead ahead, not from `at`: the driver replaces the running trajectory
-    // when the new one arrives and holds its first point until its stamp, so the new one carries
-    // the unchanged plan up to `at` and the targets go on without a jump.
-    sendFrom(next, t0, std::min(at, (ros::Time::now() - t0).toSec() + motion_lead_));
+    // Sent from now, not from `at`: the bridge replaces the running trajectory when the new one
+    // arrives and holds its first point until its stamp (a ros_control driver would splice them
+    // at the stamp instead); carrying the unchanged plan up to `at`, the targets go on without a
+    // jump either way.
+    sendFrom(next, t0, std::min(at, (ros::Time::now() - t0).toSec()));
     f.request.scene = scene;
     *plan = std::move(next);
     if (monitor_) monitor_->retime(*plan);
