@@ -354,13 +354,13 @@ void solveIk(lfd::CartesianToJoints& ik, const Eigen::VectorXd& seed_joints, siz
   }
 }
 
-// The targets in force at `t` s into the plan: the last update at or before it, else `targets`.
-const std::vector<SegmentTarget>& targetsAt(const std::vector<SegmentTarget>& targets,
-                                            const std::vector<TargetUpdate>& updates, double t) {
-  const std::vector<SegmentTarget>* in_force = &targets;
-  for (const TargetUpdate& u : updates)
-    if (u.time <= t) in_force = &u.targets;
-  return *in_force;
+// Which targets are in force at `t` s into the plan: 1 + the last update at or before it, 0 for
+// the plan's own targets (the index into a list of every target set, those first).
+size_t targetSetAt(const std::vector<TargetUpdate>& updates, double t) {
+  size_t in_force = 0;
+  for (size_t u = 0; u < updates.size(); ++u)
+    if (updates[u].time <= t) in_force = u + 1;
+  return in_force;
 }
 
 // The goal switches of a segment running from `begin` for `duration` s: the updates that fall
@@ -479,18 +479,23 @@ ExecutionPlan TaskPlanner::replan(const SkillLibrary& library,
   const TcpPose start = forward(q_start);
   RolloutState state{start.position, start.orientation};
   state.gripper = gripper_start;
+  // Every target set, the plan's own first, and what each generalizes over (once per set).
+  std::vector<const std::vector<SegmentTarget>*> sets{&targets};
+  for (const TargetUpdate& u : updates) sets.push_back(&u.targets);
+  std::vector<GoalQuery> queries;
+  for (const auto* set : sets)
+    queries.push_back(goalQuery(library, *set, options.all_segment_goals));
   for (size_t s = 0; s < library.segments.size(); ++s) {
     poll("segment " + library.segments[s].name);
     // A segment is generalized toward the targets in force when it starts; an update while it
     // runs moves its DMP's goal (the goal filter keeps the motion smooth).
-    const std::vector<SegmentTarget>& in_force = targetsAt(targets, updates, state.t_offset);
-    const SegmentTarget& target = in_force[s];
+    const size_t in_force = targetSetAt(updates, state.t_offset);
+    const SegmentTarget& target = (*sets[in_force])[s];
     PlannedSegment planned;
     planned.name = library.segments[s].name;
     planned.frames = target.frames;
-    const GoalQuery goals = goalQuery(library, in_force, options.all_segment_goals);
     const lfd::GeneralizationResult gen =
-        generalizeForTarget(library.segments[s], target, goals, options, planned, plan);
+        generalizeForTarget(library.segments[s], target, queries[in_force], options, planned, plan);
     lfd::SegmentRolloutOptions ro = rolloutOptions(gen.dmp, target, options, state);
     ro.goal_filter = options.goal_filter;
     ro.goal_switches =
@@ -499,7 +504,7 @@ ExecutionPlan TaskPlanner::replan(const SkillLibrary& library,
     planned.begin = plan.times.size();
     planned.goal = ro.goal_switches.empty()
                        ? target.goal
-                       : targetsAt(targets, updates, state.t_offset + *ro.tau)[s].goal;
+                       : (*sets[targetSetAt(updates, state.t_offset + *ro.tau)])[s].goal;
     appendRollout(traj, s == 0, state.t_offset, state.orientation, state.gripper, &plan);
     planned.end = plan.times.size();
     // as sampled: the durations sum to the plan's

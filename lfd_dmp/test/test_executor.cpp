@@ -148,6 +148,14 @@ class PlannerTest : public ::testing::Test {
                                               const Eigen::Vector3d& goal) const {
     return {target("approach", grasp), target("move", goal)};
   }
+  // The reach-then-carry goals most tests plan toward, and their options (dt 4 ms).
+  Eigen::Vector3d grasp() const { return home_.position + Eigen::Vector3d(0.02, 0.0, -0.045); }
+  Eigen::Vector3d goal() const { return grasp() + Eigen::Vector3d(-0.03, 0.05, 0.12); }
+  static lfd_dmp::ExecutorOptions coarse() {
+    lfd_dmp::ExecutorOptions opt;
+    opt.dt = 0.004;
+    return opt;
+  }
   lfd::KinematicChain chain_;
   Eigen::VectorXd q0_;
   lfd_dmp::TaskPlanner planner_;
@@ -156,10 +164,8 @@ class PlannerTest : public ::testing::Test {
 };
 
 TEST_F(PlannerTest, SegmentsRunInSequenceFromTheCurrentPoseToEachNewGoal) {
-  const Eigen::Vector3d grasp = home_.position + Eigen::Vector3d(0.02, 0.0, -0.045);
-  const Eigen::Vector3d goal = grasp + Eigen::Vector3d(-0.03, 0.05, 0.12);
-  lfd_dmp::ExecutorOptions opt;
-  opt.dt = 0.004;
+  const Eigen::Vector3d grasp = this->grasp(), goal = this->goal();
+  lfd_dmp::ExecutorOptions opt = coarse();
   const lfd_dmp::ExecutionPlan plan = planner_.plan(lib_, targets(grasp, goal), q0_, 0.04, opt);
   ASSERT_EQ(plan.segments.size(), 2u);
   EXPECT_EQ(plan.segments[0].begin, 0u);
@@ -191,10 +197,8 @@ TEST_F(PlannerTest, SegmentsRunInSequenceFromTheCurrentPoseToEachNewGoal) {
 // update (the robot already followed it), then bends smoothly into the moved goals: the running
 // segment's DMP goal moves, the later segment is generalized toward its new goal.
 TEST_F(PlannerTest, AGoalMovedWhileItsSegmentRunsIsFollowedSmoothly) {
-  const Eigen::Vector3d grasp = home_.position + Eigen::Vector3d(0.02, 0.0, -0.045);
-  const Eigen::Vector3d goal = grasp + Eigen::Vector3d(-0.03, 0.05, 0.12);
-  lfd_dmp::ExecutorOptions opt;
-  opt.dt = 0.004;
+  const Eigen::Vector3d grasp = this->grasp(), goal = this->goal();
+  lfd_dmp::ExecutorOptions opt = coarse();
   const lfd_dmp::ExecutionPlan before = planner_.plan(lib_, targets(grasp, goal), q0_, 0.04, opt);
   const Eigen::Vector3d shift(0.03, -0.02, 0.0);
   const double at = 0.8;  // s: within the approach (2.0 s)
@@ -297,10 +301,8 @@ TEST_F(PlannerTest, ObjectsAreFollowedUntilTheRobotReachesThem) {
 // executor checks the trajectory it would send first, so the goal fails naming the joint. A
 // normal plan is within the limits.
 TEST_F(PlannerTest, ATrajectoryFasterThanAJointsLimitIsRefusedBeforeItIsSent) {
-  const Eigen::Vector3d grasp = home_.position + Eigen::Vector3d(0.02, 0.0, -0.045);
-  const Eigen::Vector3d goal = grasp + Eigen::Vector3d(-0.03, 0.05, 0.12);
-  lfd_dmp::ExecutorOptions opt;
-  opt.dt = 0.004;
+  const Eigen::Vector3d grasp = this->grasp(), goal = this->goal();
+  lfd_dmp::ExecutorOptions opt = coarse();
   const lfd_dmp::ExecutionPlan plan = planner_.plan(lib_, targets(grasp, goal), q0_, 0.04, opt);
   trajectory_msgs::JointTrajectory msg = lfd_dmp::toJointTrajectory(plan, ros::Time(0), 0.01);
   const Eigen::VectorXd& limits = chain_.velocityLimits();
