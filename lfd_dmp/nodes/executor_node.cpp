@@ -640,11 +640,12 @@ class Executor {
       setState(lfd_msgs::ExecuteTaskFeedback::MOVING, *plan);
       return false;
     }
-    // Sent from now, not from `at`: the bridge replaces the running trajectory when the new one
-    // arrives and holds its first point until its stamp (a ros_control driver would splice them
-    // at the stamp instead); carrying the unchanged plan up to `at`, the targets go on without a
-    // jump either way.
-    sendFrom(next, t0, std::min(at, (ros::Time::now() - t0).toSec()));
+    // Sent from ~motion_lead ahead, carrying the unchanged plan up to `at`. The bridge replaces
+    // the running trajectory when the new one arrives (holding its first point until its stamp),
+    // and one arriving after its stamp starts late, the whole rest shifted: stamped at "now", a
+    // lockstep client's next step (50 ms) served before the message left the arm 2.5 cm behind
+    // its plan in one fresh-root run. The lead absorbs that; its cost is a target 0.1 s ahead.
+    sendFrom(next, t0, std::min(at, (ros::Time::now() - t0).toSec() + motion_lead_));
     f.request.scene = scene;
     *plan = std::move(next);
     if (monitor_) monitor_->retime(*plan);
