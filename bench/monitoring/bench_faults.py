@@ -22,6 +22,15 @@ each object's pose in the object's own tf frame), counted apart from the faults 
                   distance and direction drawn per goal, seeded by its id) at 30% of that segment,
                   while the hand approaches it: the task should still succeed. Not for a fixed
                   object (scene.yaml: the drawer's cabinet), whose place defines the task's goal.
+And two cases of recovery after a lost grasp (executor.yaml recovery/*: the executor opens the
+gripper, goes back to the start of the segment that reached for the object, looks again and
+retries), their objects followed, counted apart too ("recovery"):
+  grasp_dropped   the grip's force drops to 0 at 30% of the held segment (as grip_lost) and comes
+                  back 0.5 s later: the object falls, the hand must pick it up again.
+  grasp_missed    the object of the first segment's goal frame is shoved 3-8 cm across itself
+                  (along its narrower horizontal side, scene.yaml half_size) at 75% of that
+                  segment, after it is followed: the gripper closes on nothing (shoved along a
+                  stick, the hand would still grasp it, further along).
 Detection counts the sensor faults and the faulty runs whose task failed (judged by the task file's
 success rules, as a demonstration is); a fault of the world the task survived (a weak grip while
 pushing) is counted apart. Delay: sim s from the fault to the alarm (the alarm's "s into the
@@ -50,6 +59,9 @@ FROZEN_AT_S = 0.3
 SENSOR_FAULTS = ("sensors_frozen", "sensors_silenced")
 # goals sent with their objects followed; counted apart (summary "following")
 FOLLOWED_CASES = ("nominal_followed", "object_moved")
+# recovery after a lost grasp, objects followed too; counted apart (summary "recovery")
+RECOVERY_CASES = ("grasp_dropped", "grasp_missed")
+DROP_FOR_S = 0.5
 SHOVE_M = (0.03, 0.08)
 ALARM_TIME = re.compile(r"\(([-\d.]+) s into the motion\)")
 
@@ -80,6 +92,20 @@ def shoved(pose, seed):
                                                   y + distance * math.sin(angle), z]))
 
 
+def shoved_across(pose, half_size, seed):
+    """geometry_msgs/Pose of `pose` moved by SHOVE_M along the object's narrower horizontal axis
+    (its yaw from the pose's quaternion), to a side drawn from `seed`."""
+    rng = random.Random(seed)
+    distance, side = rng.uniform(*SHOVE_M), rng.choice((-1.0, 1.0))
+    w, qx, qy, qz = pose["orientation"]
+    yaw = math.atan2(2.0 * (w * qz + qx * qy), 1.0 - 2.0 * (qy * qy + qz * qz))
+    if half_size[1] > half_size[0]:  # across = the object's x axis
+        yaw -= 0.5 * math.pi
+    x, y, z = pose["position"]
+    return lockstep.pose_msg(dict(pose, position=[x - side * distance * math.sin(yaw),
+                                                  y + side * distance * math.cos(yaw), z]))
+
+
 def faults_for(task, library, scene, durations):
     """[(name, [InjectFault requests], offset s into the motion or None)] that apply to the task."""
     from geometry_msgs.msg import Pose
@@ -106,10 +132,18 @@ def faults_for(task, library, scene, durations):
             out.append(("object_moved", [request("move_object", obj, at(0, 0.3),
                                                  shoved(scene["objects"][obj], scene["id"]))],
                         at(0, 0.3)))
+            across = shoved_across(scene["objects"][obj],
+                                   tasks.scene()["objects"][obj]["half_size"], scene["id"])
+            out.append(("grasp_missed", [request("move_object", obj, at(0, 0.75), across)],
+                        at(0, 0.75)))
     out.append(("nominal_followed", [], None))
     held = held_segment(library["sensory_signature"])
     if held is not None:
         out.append(("grip_lost", [request("weaken_grip", at=at(held, 0.3), value=0.0)],
+                    at(held, 0.3)))
+        out.append(("grasp_dropped", [request("weaken_grip", at=at(held, 0.3), value=0.0),
+                                      request("weaken_grip", at=at(held, 0.3) + DROP_FOR_S,
+                                              value=1.0)],
                     at(held, 0.3)))
     rows = sorted(set(library["sensory_signature"]["sources"]))
     out.append(("sensors_frozen", [request("freeze_sensor", r, FROZEN_AT_S) for r in rows], None))
@@ -145,7 +179,8 @@ def run_goal(cell, inject, task, scene, library_path, faults, offset, follow=Fal
                         else None),
             "goal_succeeded": res.success,
             "task_succeeded": bool(res.success and outcome["success"]), "judged": outcome["reason"],
-            "error": res.error, "replans": list(res.replans)}
+            "error": res.error, "replans": list(res.replans),
+            "recoveries": list(res.recoveries)}
 
 
 def auc(negatives, positives):
@@ -161,7 +196,8 @@ def summarize(runs):
     survived, e.g. a weak grip while pushing, is counted apart); false alarms over the nominal
     runs."""
     following = {c: [r for r in runs if r["fault"] == c] for c in FOLLOWED_CASES}
-    runs = [r for r in runs if r["fault"] not in FOLLOWED_CASES]
+    recovery = {c: [r for r in runs if r["fault"] == c] for c in RECOVERY_CASES}
+    runs = [r for r in runs if r["fault"] not in FOLLOWED_CASES + RECOVERY_CASES]
     nominal = [r["score"] for r in runs if r["fault"] == "none"]
     faulty = [r for r in runs if r["fault"] != "none"
               and (not r["task_succeeded"] or r["fault"] in SENSOR_FAULTS)]
@@ -194,6 +230,12 @@ def summarize(runs):
                           "failed_tasks": sorted({r["task"] for r in rs
                                                   if not r["task_succeeded"]})}
                       for c, rs in following.items() if rs},
+        "recovery": {c: {"runs": len(rs), "task_succeeded": sum(r["task_succeeded"] for r in rs),
+                         "recovered_runs": sum(bool(r.get("recoveries")) for r in rs),
+                         "recoveries": sum(len(r.get("recoveries", [])) for r in rs),
+                         "failed_tasks": sorted({r["task"] for r in rs
+                                                 if not r["task_succeeded"]})}
+                     for c, rs in recovery.items() if rs},
     }
 
 
@@ -236,12 +278,12 @@ def main():
                         started = time.time()
                         try:
                             r = run_goal(cell, inject, task, scene, path, faults, offset,
-                                         follow=name in FOLLOWED_CASES)
+                                         follow=name in FOLLOWED_CASES + RECOVERY_CASES)
                         except RuntimeError as exc:
                             r = {"monitored": False, "score": 0.0, "alarm": "",
                                  "alarm_time_s": None, "fault_time_s": offset, "delay_s": None,
                                  "goal_succeeded": False, "task_succeeded": False, "judged": "",
-                                 "error": str(exc), "replans": []}
+                                 "error": str(exc), "replans": [], "recoveries": []}
                         r.update(task=task, goal=scene["id"], fault=name)
                         results["runs"].append(r)
                         print("%-6s goal %3d %-16s %-7s score %6.2f %-6s delay %s  %.1f s  %s" % (
@@ -249,7 +291,8 @@ def main():
                             r["score"], "ALARM" if r["alarm"] else "-",
                             "-" if r["delay_s"] is None else "%.3f s" % r["delay_s"],
                             time.time() - started,
-                            (r["alarm"] or r["error"] or "; ".join(r["replans"]))[:90]),
+                            (r["error"] or "; ".join(r["recoveries"] + r["replans"])
+                             or r["alarm"])[:160]),
                             flush=True)
             results["summary"] = summarize(results["runs"])
             print(json.dumps(results["summary"], indent=1))

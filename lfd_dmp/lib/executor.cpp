@@ -160,8 +160,12 @@ void checkLibrary(const SkillLibrary& library) {
 }
 
 // Refuses a goal outside the demonstrated range unless extrapolation is allowed.
-void checkRange(const std::vector<SegmentTarget>& targets, bool allow, ExecutionPlan* plan) {
+// `first`: the segments before it are not planned (ExecutorOptions::first_segment).
+void checkRange(const std::vector<SegmentTarget>& all, size_t first, bool allow,
+                ExecutionPlan* plan) {
   const SegmentTarget* worst = nullptr;
+  const std::vector<SegmentTarget> targets(
+      all.begin() + static_cast<long>(std::min(first, all.size())), all.end());
   for (const SegmentTarget& t : targets) {
     plan->extrapolation_distance = std::max(plan->extrapolation_distance, t.range.distance);
     plan->extrapolation_angle = std::max(plan->extrapolation_angle, t.range.angle);
@@ -220,6 +224,10 @@ void checkPlanRequest(const SkillLibrary& library, const std::vector<SegmentTarg
   if (!(options.dt > 0.0) || !(options.duration_scale > 0.0) ||
       !std::isfinite(options.duration_scale))
     throw std::invalid_argument("dt and duration_scale must be finite and > 0");
+  if (options.first_segment >= library.segments.size())
+    throw std::invalid_argument("first_segment " + std::to_string(options.first_segment) +
+                                " is past the library's " +
+                                std::to_string(library.segments.size()) + " segments");
 }
 
 // What each segment generalizes over: its own goal, or every segment's goal together
@@ -472,8 +480,10 @@ ExecutionPlan TaskPlanner::replan(const SkillLibrary& library,
   checkPlanRequest(library, targets, q_start, chain().dof(), options);
   checkUpdates(updates, library.segments.size());
   ExecutionPlan plan;
-  checkRange(targets, options.allow_extrapolation, &plan);
-  for (const TargetUpdate& u : updates) checkRange(u.targets, options.allow_extrapolation, &plan);
+  const size_t first = options.first_segment;
+  checkRange(targets, first, options.allow_extrapolation, &plan);
+  for (const TargetUpdate& u : updates)
+    checkRange(u.targets, first, options.allow_extrapolation, &plan);
   plan.joint_names = chain().jointNames();
   plan.dt = options.dt;
   const TcpPose start = forward(q_start);
@@ -494,6 +504,11 @@ ExecutionPlan TaskPlanner::replan(const SkillLibrary& library,
     PlannedSegment planned;
     planned.name = library.segments[s].name;
     planned.frames = target.frames;
+    if (s < first) {  // done before this plan: kept empty, indices as the library's
+      planned.goal = target.goal;
+      plan.segments.push_back(planned);
+      continue;
+    }
     const lfd::GeneralizationResult gen =
         generalizeForTarget(library.segments[s], target, queries[in_force], options, planned, plan);
     lfd::SegmentRolloutOptions ro = rolloutOptions(gen.dmp, target, options, state);
@@ -505,7 +520,8 @@ ExecutionPlan TaskPlanner::replan(const SkillLibrary& library,
     planned.goal = ro.goal_switches.empty()
                        ? target.goal
                        : (*sets[targetSetAt(updates, state.t_offset + *ro.tau)])[s].goal;
-    appendRollout(traj, s == 0, state.t_offset, state.orientation, state.gripper, &plan);
+    appendRollout(traj, plan.times.empty(), state.t_offset, state.orientation, state.gripper,
+                  &plan);
     planned.end = plan.times.size();
     // as sampled: the durations sum to the plan's
     planned.duration = plan.times.back() - state.t_offset;

@@ -24,7 +24,8 @@ std::map<std::string, double> followWindows(const SkillLibrary& library, const E
                                             const FollowOptions& options) {
   std::map<std::string, double> windows;
   for (std::size_t s = 0; s < library.segments.size() && s < plan.segments.size(); ++s) {
-    if (!library.segments[s].goal) continue;
+    // An empty segment was done before the plan (a retry after a recovery): not followed there.
+    if (!library.segments[s].goal || plan.segments[s].end == plan.segments[s].begin) continue;
     const lfd::SegmentGoalModel& g = *library.segments[s].goal;
     std::vector<const lfd::SceneFrame*> frames{&g.position_frame, &g.orientation_frame};
     if (g.motion_frame) frames.push_back(&*g.motion_frame);

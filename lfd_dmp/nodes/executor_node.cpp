@@ -16,6 +16,7 @@
 #include "lfd_dmp/executor.hpp"
 #include "lfd_dmp/object_following.hpp"
 #include "lfd_dmp/plan_messages.hpp"
+#include "lfd_dmp/recovery.hpp"
 
 #include <lfd_msgs/ExecuteTaskAction.h>
 #include <lfd_core/io/safe_paths.hpp>
@@ -209,6 +210,7 @@ class Executor {
     if (!(min_wall_silence_ >= 0.0))
       throw std::runtime_error("executor: ~monitoring/min_wall_silence must be >= 0");
     loadFollowOptions(pnh);
+    loadRecoveryOptions(pnh);
     settle_time_ = pnh.param("settle_time", settle_time_);
     clock_timeout_ = pnh.param("clock_timeout", clock_timeout_);
     motion_lead_ = pnh.param("motion_lead", motion_lead_);
@@ -377,6 +379,24 @@ class Executor {
       throw std::runtime_error("executor: ~follow_objects/goal_filter must be > 0");
   }
 
+  void loadRecoveryOptions(ros::NodeHandle& pnh) {
+    lfd_dmp::RecoveryOptions& r = recovery_;
+    r.enabled = pnh.param("recovery/enabled", r.enabled);
+    r.max_attempts = static_cast<size_t>(
+        std::max(0, pnh.param("recovery/max_attempts", static_cast<int>(r.max_attempts))));
+    r.retreat_speed_fraction =
+        pnh.param("recovery/retreat_speed_fraction", r.retreat_speed_fraction);
+    r.min_retreat_duration = pnh.param("recovery/min_retreat_duration", r.min_retreat_duration);
+    r.release_time = pnh.param("recovery/release_time", r.release_time);
+    r.settle_time = pnh.param("recovery/settle_time", r.settle_time);
+    r.min_hold_time = pnh.param("recovery/min_hold_time", r.min_hold_time);
+    try {
+      lfd_dmp::checkRecoveryOptions(r);
+    } catch (const std::invalid_argument& e) {
+      throw std::runtime_error(std::string("executor: ~") + e.what());
+    }
+  }
+
   // ---- the action ------------------------------------------------------------------------------
   void execute(ActionServer& server, const lfd_msgs::ExecuteTaskGoal& goal) {
     const lfd::TrimHeapOnExit trim;  // the goal's library and plan go back to the system
@@ -420,9 +440,8 @@ class Executor {
                library.task.c_str(), plan.segments.size(), plan.duration(),
                plan.max_ik_position_error * 1e3, result.planning_time);
       if (!goal.dry_run) {
-        startFollowing({&library, targets, s, planner().forward(q), q, gripper, opt,
-                        goal.object_names, goal.object_poses},
-                       plan);
+        context_ = GoalContext{&library, targets, s, planner().forward(q), q, gripper, opt, goal};
+        startFollowing(plan);
         run(std::move(plan), &result);
       }
       result.success = true;
@@ -450,6 +469,7 @@ class Executor {
     tracked_stamp_ = ros::Time();
     trackJoints({});
     following_.reset();
+    context_.reset();
     monitor_.reset();  // its subscriptions end with the goal
   }
 
@@ -503,10 +523,24 @@ class Executor {
     }
   }
 
+  // A grasp the monitor found lost (recover() retries it).
+  struct LostGrasp {
+    lfd::Deviation alarm;
+    ros::Time t0, now;  // the motion's start, and when the alarm was seen
+  };
+
   void run(lfd_dmp::ExecutionPlan plan, lfd_msgs::ExecuteTaskResult* result) {
     waitForDriver(trajectory_pub_);
     if (!plan.gripper_events.empty()) waitForDriver(gripper_pub_);
     waitForSensors(result);
+    while (std::optional<LostGrasp> lost = runMotion(plan, result))
+      plan = recover(*lost, plan, result);
+  }
+
+  // One motion: the plan sent and followed to its end (and settled); or, when the monitor finds
+  // the grasp lost and a retry is left, the arm held and what recover() needs.
+  std::optional<LostGrasp> runMotion(lfd_dmp::ExecutionPlan& plan,
+                                     lfd_msgs::ExecuteTaskResult* result) {
     // The whole motion is sent ahead, stamped on the driver's clock: it runs at sim time whatever
     // the load, and a lockstep client only has to step.
     const ros::Time t0 = ros::Time::now() + ros::Duration(motion_lead_);
@@ -514,8 +548,9 @@ class Executor {
     for (const lfd_dmp::GripperEvent& e : plan.gripper_events)
       gripper_pub_.publish(lfd_dmp::gripperCommand(e.close, robot_.gripper,
                                                    t0 + ros::Duration(plan.times[e.sample])));
-    result->motion_start = t0;
+    if (result->motion_start.isZero()) result->motion_start = t0;
     if (monitor_) monitor_->start(plan, t0);
+    feedback_.monitor_alarm.clear();  // this motion's first alarm (the result keeps the goal's)
     trackJoints(plan.joint_names);
     executed_ = nav_msgs::Path();
     feedback_.motion_start = t0;
@@ -530,7 +565,8 @@ class Executor {
       if (goal_server_->isPreemptRequested() || !ros::ok()) stop(plan, t0, now);
       watch.check(now);
       const ros::Time measured = track(plan, t0, t_end, &reached);
-      checkMonitor(plan, t0, now, measured, result);
+      if (const auto lost = checkMonitor(plan, t0, now, measured, result))
+        return LostGrasp{*lost, t0, now};
       if (following_ && now < t_end && now >= following_->next_look &&
           followObjects(t0, now, &plan, result))
         t_end = t0 + ros::Duration(plan.duration());
@@ -548,13 +584,14 @@ class Executor {
           "in ~settle_time");
     }
     endMonitor(result);
-    result->execution_time = (reached - t0).toSec();
+    result->execution_time = (reached - result->motion_start).toSec();
     result->final_position_error = feedback_.tcp_position_error;
     result->final_orientation_error = feedback_.tcp_orientation_error;
     executed_pub_.publish(executed_);
     ROS_INFO("executor: done in %.2f s sim (planned %.2f s), final TCP error %.1f mm / %.3f rad",
              result->execution_time, plan.duration(), result->final_position_error * 1e3,
              result->final_orientation_error);
+    return std::nullopt;
   }
 
   // Holds the arm where the plan is now and keeps the gripper as the plan has it now (a later
@@ -568,10 +605,10 @@ class Executor {
   }
 
   // ---- goals that follow a moving object (lfd_dmp/object_following.hpp) -----------------------
-  // What a replan needs: the goal's library and first targets, the scene as the plan has it now,
-  // where the task started, and the objects' poses as the goal gave them (a pose in a frame that
-  // moves with the object is looked up on tf again: that object is followed).
-  struct FollowRequest {
+  // What a replan or a retry needs: the goal's library and the targets of the running plan, the
+  // scene as it has it, where the task started, where this plan started, and the goal itself (an
+  // object pose in a frame that moves with the object is looked up on tf again: followed).
+  struct GoalContext {
     const lfd_dmp::SkillLibrary* library = nullptr;
     std::vector<lfd_dmp::SegmentTarget> targets;
     lfd::Scene scene;
@@ -579,22 +616,20 @@ class Executor {
     Eigen::VectorXd q_start;
     std::optional<double> gripper_start;
     lfd_dmp::ExecutorOptions options;
-    std::vector<std::string> names;
-    std::vector<geometry_msgs::PoseStamped> poses;
+    lfd_msgs::ExecuteTaskGoal goal;
   };
   struct Following {
-    FollowRequest request;
     std::vector<lfd_dmp::TargetUpdate> updates;
     std::map<std::string, double> windows;  // s into the plan each object is followed until
     ros::Time next_look;
   };
 
-  void startFollowing(FollowRequest request, const lfd_dmp::ExecutionPlan& plan) {
+  void startFollowing(const lfd_dmp::ExecutionPlan& plan) {
     following_.reset();
     if (!follow_options_.enabled) return;
-    auto windows = lfd_dmp::followWindows(*request.library, plan, follow_options_);
+    auto windows = lfd_dmp::followWindows(*context_->library, plan, follow_options_);
     if (windows.empty()) return;
-    following_ = Following{std::move(request), {}, std::move(windows), ros::Time()};
+    following_ = Following{{}, std::move(windows), ros::Time()};
   }
 
   // Looks at the followed objects; when one moved, plans the rest of the motion toward it from
@@ -608,7 +643,7 @@ class Executor {
     const double elapsed = (now - t0).toSec();
     const std::map<std::string, lfd::Pose> seen = objectsNow(f);
     const auto moves =
-        lfd_dmp::movedObjects(f.request.scene, seen, f.windows, elapsed, follow_options_);
+        lfd_dmp::movedObjects(context_->scene, seen, f.windows, elapsed, follow_options_);
     if (moves.empty()) return false;
     const double at = elapsed + follow_options_.lead;
     if (f.updates.size() >= follow_options_.max_replans || at >= plan->duration()) {
@@ -619,16 +654,16 @@ class Executor {
       return false;
     }
     setState(lfd_msgs::ExecuteTaskFeedback::REPLANNING, *plan);
-    lfd::Scene scene = f.request.scene;
+    lfd::Scene scene = context_->scene;
     // Only the moved ones: an object the robot holds or pushes by now keeps its planned pose.
     for (const lfd_dmp::ObjectMove& m : moves) scene.objects[m.object] = seen.at(m.object);
     lfd_dmp::ExecutionPlan next;
     try {
       std::vector<std::string> warnings;
-      f.updates.push_back({at, lfd_dmp::segmentTargets(*f.request.library, scene, f.request.start,
-                                                       f.request.options, &warnings)});
-      next = planner().replan(*f.request.library, f.request.targets, f.updates, *plan,
-                              f.request.q_start, f.request.gripper_start, f.request.options);
+      f.updates.push_back({at, lfd_dmp::segmentTargets(*context_->library, scene, context_->start,
+                                                       context_->options, &warnings)});
+      next = planner().replan(*context_->library, context_->targets, f.updates, *plan,
+                              context_->q_start, context_->gripper_start, context_->options);
     } catch (const std::exception& e) {
       hold(*plan, t0, ros::Time::now());
       throw std::runtime_error("the goal moved (" + lfd_dmp::describeMoves(moves) +
@@ -646,7 +681,7 @@ class Executor {
     // lockstep client's next step (50 ms) served before the message left the arm 2.5 cm behind
     // its plan in one fresh-root run. The lead absorbs that; its cost is a target 0.1 s ahead.
     sendFrom(next, t0, std::min(at, (ros::Time::now() - t0).toSec() + motion_lead_));
-    f.request.scene = scene;
+    context_->scene = scene;
     *plan = std::move(next);
     if (monitor_) monitor_->retime(*plan);
     std::ostringstream line;
@@ -664,13 +699,14 @@ class Executor {
   // now is not moved).
   std::map<std::string, lfd::Pose> objectsNow(const Following& f) {
     std::map<std::string, lfd::Pose> out;
-    for (size_t i = 0; i < f.request.names.size(); ++i) {
-      const geometry_msgs::PoseStamped& ps = f.request.poses[i];
-      if (!f.windows.count(f.request.names[i]) || ps.header.frame_id == cartesianFrame() ||
+    const std::vector<std::string>& names = context_->goal.object_names;
+    for (size_t i = 0; i < names.size(); ++i) {
+      const geometry_msgs::PoseStamped& ps = context_->goal.object_poses[i];
+      if (!f.windows.count(names[i]) || ps.header.frame_id == cartesianFrame() ||
           !tf_buffer_.canTransform(cartesianFrame(), ps.header.frame_id, ros::Time(0)))
         continue;
       try {
-        out[f.request.names[i]] = scenePose(ps, "object '" + f.request.names[i] + "'");
+        out[names[i]] = scenePose(ps, "object '" + names[i] + "'");
       } catch (const std::exception&) {  // gone from tf between the two calls: not seen
       }
     }
@@ -729,31 +765,138 @@ class Executor {
     }
   }
 
-  void checkMonitor(const lfd_dmp::ExecutionPlan& plan, const ros::Time& t0, const ros::Time& now,
-                    const ros::Time& measured, lfd_msgs::ExecuteTaskResult* result) {
-    if (!monitor_) return;
+  // Returns the lost grasp that recover() retries (~recovery/*: enabled, an attempt left); a lost
+  // grasp is looked for even after an earlier alarm (a yank) was reported. A lost grasp with no
+  // attempt left fails the goal; any other alarm is reported, or stops the motion
+  // (~monitoring/stop_on_alarm).
+  std::optional<lfd::Deviation> checkMonitor(const lfd_dmp::ExecutionPlan& plan,
+                                             const ros::Time& t0, const ros::Time& now,
+                                             const ros::Time& measured,
+                                             lfd_msgs::ExecuteTaskResult* result) {
+    if (!monitor_) return std::nullopt;
     feedback_.anomaly_score = std::max(feedback_.anomaly_score, monitor_->worst().score);
-    if (!feedback_.monitor_alarm.empty()) return;
+    std::optional<lfd::Deviation> lost = monitor_->latestAlarm();
+    if (!recovery_.enabled || (lost && !lfd_dmp::lostGrasp(*lost, plan, recovery_))) lost.reset();
+    if (!lost && !feedback_.monitor_alarm.empty()) return std::nullopt;
     std::string text;
-    if (const std::optional<lfd::Deviation> alarm = monitor_->alarm()) {
+    if (lost) {
+      text = lfd_dmp::describeAlarm(*lost, plan.segments);
+    } else if (const std::optional<lfd::Deviation> alarm = monitor_->alarm()) {
       text = lfd_dmp::describeAlarm(*alarm, plan.segments);
     } else if (const std::optional<lfd_dmp::Silence> silent = monitor_->silence(measured)) {
       text = lfd_dmp::describeSilence(*silent, plan.segments);
       feedback_.anomaly_score = std::max(feedback_.anomaly_score, silent->gap / silent->allowed);
     } else {
-      return;
+      return std::nullopt;
     }
-    feedback_.monitor_alarm = result->monitor_alarm = text;
+    feedback_.monitor_alarm = text;
+    if (result->monitor_alarm.empty()) result->monitor_alarm = text;  // the goal's first
     result->max_anomaly_score = feedback_.anomaly_score;
     publishFeedback();
-    if (!stop_on_alarm_) {
-      ROS_WARN("executor: monitor: %s", result->monitor_alarm.c_str());
-      return;
+    if (lost && result->recoveries.size() < recovery_.max_attempts) return lost;
+    if (!lost && !stop_on_alarm_) {
+      ROS_WARN("executor: monitor: %s", text.c_str());
+      return std::nullopt;
     }
     hold(plan, t0, now);
     monitor_->stop();
-    throw std::runtime_error("stopped by the execution monitor: " + result->monitor_alarm +
-                             "; the arm holds there");
+    if (lost)
+      throw std::runtime_error(
+          "the grasp was lost after " + std::to_string(result->recoveries.size()) +
+          " recoveries (~recovery/max_attempts): " + text + "; the arm holds there");
+    throw std::runtime_error("stopped by the execution monitor: " + text + "; the arm holds there");
+  }
+
+  // ---- recovery after a lost grasp (lfd_dmp/recovery.hpp) -------------------------------------
+  // Holds the arm and opens the gripper, goes back to the last boundary that held, looks at the
+  // objects again (a pose given in a frame that moves with its object is looked up on tf) and
+  // plans the task from there. Returns that plan; throws, the arm holding, when it cannot be
+  // planned (the object out of reach or outside the demonstrated range now).
+  lfd_dmp::ExecutionPlan recover(const LostGrasp& lost, const lfd_dmp::ExecutionPlan& plan,
+                                 lfd_msgs::ExecuteTaskResult* result) {
+    setState(lfd_msgs::ExecuteTaskFeedback::RECOVERING, plan);
+    const size_t k = hold(plan, lost.t0, lost.now);
+    gripper_pub_.publish(lfd_dmp::gripperCommand(false, robot_.gripper, lost.now));
+    monitor_->stop();
+    following_.reset();
+    const size_t retry = lfd_dmp::retrySegment(*context_->library, plan, k);
+    const std::string boundary = "the start of segment '" + plan.segments[retry].name + "'";
+    retreat(plan.joints[plan.segments[retry].begin]);
+    lfd_dmp::ExecutorOptions opt = context_->options;
+    opt.first_segment = retry;
+    std::optional<double> gripper;
+    const Eigen::VectorXd q = currentJoints(&gripper);
+    lfd_dmp::ExecutionPlan next;
+    try {
+      const lfd::Scene seen = scene(context_->goal);
+      std::vector<std::string> warnings;
+      auto targets =
+          lfd_dmp::segmentTargets(*context_->library, seen, context_->start, opt, &warnings);
+      next = planner().plan(*context_->library, targets, q, gripper, opt, [this] {
+        return goal_server_->isPreemptRequested() || !ros::ok() || clock_reset_;
+      });
+      lfd_dmp::checkTrajectoryVelocities(
+          lfd_dmp::toJointTrajectory(next, ros::Time(0), trajectory_period_),
+          planner().chain().jointNames(), planner().chain().velocityLimits());
+      *context_ =
+          GoalContext{context_->library, std::move(targets), seen, context_->start, q, gripper, opt,
+                      context_->goal};
+    } catch (const lfd_dmp::PlanningCancelled&) {
+      throw;
+    } catch (const std::exception& e) {
+      throw std::runtime_error("the grasp was lost (" + feedback_.monitor_alarm +
+                               ") and the retry cannot be planned: " + e.what() +
+                               "; the arm holds at " + boundary);
+    }
+    // A gripper that does not open (broken, or holding on to something) would reach for the object
+    // closed: no retry.
+    if (!next.gripper_events.empty() && next.gripper_events.front().close &&
+        !lfd_dmp::gripperClosedAt(plan, plan.segments[retry].begin)) {
+      std::ostringstream m;
+      m << "the grasp was lost (" << feedback_.monitor_alarm << ") and the gripper does not open "
+        << "(it reads " << gripper.value_or(NAN) << " after ~recovery/release_time): no retry; "
+        << "the arm holds at " << boundary;
+      throw std::runtime_error(m.str());
+    }
+    std::ostringstream line;
+    line.precision(3);
+    line << "at " << lost.alarm.time << " s into the motion the grasp was lost ("
+         << lost.alarm.channel_name << " measured " << lost.alarm.measured
+         << ", the demonstrations showed " << lost.alarm.expected << "): the gripper opened, the "
+         << "arm went back to " << boundary << " and the task was planned again from there "
+         << "(attempt " << result->recoveries.size() + 1 << " of " << recovery_.max_attempts << ")";
+    result->recoveries.push_back(line.str());
+    ROS_WARN("executor: %s", result->recoveries.back().c_str());
+    const ros::Time now = ros::Time::now();
+    planned_pub_.publish(lfd_dmp::plannedPath(next, cartesianFrame(), now));
+    marker_pub_.publish(lfd_dmp::segmentMarkers(next, cartesianFrame(), now));
+    startFollowing(next);
+    feedback_.planned_duration = next.duration();
+    return next;
+  }
+
+  // A slow joint-space move to `q_back` once the gripper had ~recovery/release_time to open;
+  // returns when the arm has had ~recovery/settle_time of sim time there.
+  void retreat(const Eigen::VectorXd& q_back) {
+    std::optional<double> gripper;
+    const lfd_dmp::ExecutionPlan back =
+        lfd_dmp::retreatPlan(planner(), currentJoints(&gripper), q_back, options_.dt, recovery_);
+    const ros::Time start =
+        ros::Time::now() + ros::Duration(std::max(motion_lead_, recovery_.release_time));
+    trajectory_pub_.publish(lfd_dmp::toJointTrajectory(back, start, trajectory_period_));
+    trackJoints(back.joint_names);
+    const ros::Time arrived = start + ros::Duration(back.duration());
+    ClockWatch watch(clock_timeout_);
+    ros::Time reached;
+    for (;;) {
+      const ros::Time now = ros::Time::now();
+      if (clock_reset_) throw std::runtime_error(clockResetText());
+      if (goal_server_->isPreemptRequested() || !ros::ok()) stop(back, start, now);
+      watch.check(now);
+      track(back, start, arrived, &reached);
+      if (now >= arrived + ros::Duration(recovery_.settle_time)) return;
+      ros::WallDuration(0.001).sleep();
+    }
   }
 
   void endMonitor(lfd_msgs::ExecuteTaskResult* result) {
@@ -898,7 +1041,9 @@ class Executor {
   double min_wall_silence_ = 0.5;  // wall s (executor.yaml monitoring/min_wall_silence)
   std::unique_ptr<lfd_dmp::ExecutionMonitor> monitor_;  // the current goal's
   lfd_dmp::FollowOptions follow_options_;               // executor.yaml follow_objects/*
+  std::optional<GoalContext> context_;                  // the current goal's
   std::optional<Following> following_;                  // the current goal's
+  lfd_dmp::RecoveryOptions recovery_;                   // executor.yaml recovery/*
   tf2_ros::Buffer tf_buffer_;
   tf2_ros::TransformListener tf_listener_;
   ros::Publisher trajectory_pub_, gripper_pub_, planned_pub_, executed_pub_, marker_pub_;

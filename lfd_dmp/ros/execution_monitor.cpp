@@ -61,6 +61,7 @@ void ExecutionMonitor::start(const ExecutionPlan& plan, const ros::Time& t0) {
   t0_ = t0;
   worst_ = lfd::Deviation();
   alarm_.reset();
+  latest_alarm_.reset();
   monitor_.reset();
   active_ = true;
 }
@@ -98,6 +99,11 @@ lfd::Deviation ExecutionMonitor::worst() const {
 std::optional<lfd::Deviation> ExecutionMonitor::alarm() const {
   std::lock_guard<std::mutex> lock(mutex_);
   return alarm_;
+}
+
+std::optional<lfd::Deviation> ExecutionMonitor::latestAlarm() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return latest_alarm_;
 }
 
 std::pair<std::size_t, double> ExecutionMonitor::segmentAt(double t) const {
@@ -143,6 +149,10 @@ void ExecutionMonitor::onReading(const ros::Time& stamp, const Eigen::VectorXd& 
   const lfd::Deviation d = monitor_.observe(s, phase, t, values);
   if (d.score > worst_.score) worst_ = d;
   if (d.score > 1.0 && !alarm_) alarm_ = d;
+  if (d.score > 1.0)
+    latest_alarm_ = d;
+  else
+    latest_alarm_.reset();
 }
 
 }  // namespace lfd_dmp

@@ -182,6 +182,67 @@ class ExecutorAction(unittest.TestCase):
         self.assertEqual(list(fixed.replans), [])
         self.assertFalse(judged["success"], "the stick moved 5 cm and the grasp still held")
 
+    def drop_stick(self, for_s, grip=0.0):
+        """on_moving callback: the grip's force drops to `grip` (a fraction) a third into the carry
+        ('move'), and comes back `for_s` s later (None: never)."""
+        from lfd_msgs.srv import InjectFault, InjectFaultRequest
+        inject = rospy.ServiceProxy("/bridge/inject_fault", InjectFault)
+        dry, _ = self.answer(self.goal(dry_run=True))
+        at = dry.segment_durations[0] + 0.3 * dry.segment_durations[1]
+        self.assertTrue(dry.monitored, "the library has no sensory signature")
+
+        def drop(feedback):
+            faults = [(at, grip)] + ([(at + for_s, 1.0)] if for_s is not None else [])
+            for t, value in faults:
+                r = inject(InjectFaultRequest(kind="weaken_grip", value=value,
+                                              at_time=feedback.motion_start.to_sec() + t))
+                self.assertTrue(r.success, r.message)
+        return drop
+
+    def test_9_picks_the_dropped_stick_up_again(self):
+        """The stick slips out of the hand during the carry (the grip's force gone for 0.5 s).
+        The monitor finds the pads unloaded; the executor opens the gripper, goes back to the start
+        of the approach, looks at the stick where it fell (its own tf frame) and grasps it again:
+        the task succeeds, and the result says how it recovered."""
+        res, _, outcome = reproduction.execute_and_judge(
+            self.cell, TASK, self.scene, self.library, on_moving=self.drop_stick(0.5),
+            follow=True)
+        self.assertTrue(res.success, res.error)
+        self.assertEqual(len(res.recoveries), 1, res.recoveries)
+        self.assertIn("the grasp was lost", res.recoveries[0])
+        self.assertIn("went back to the start of segment 'approach'", res.recoveries[0])
+        self.assertIn("segment 'move'", res.monitor_alarm)
+        self.assertIn(ExecuteTaskFeedback.RECOVERING, [f.state for f in self.cell.feedback])
+        self.assertTrue(outcome["success"], outcome["reason"])
+
+    def lost_for_good(self, grip):
+        """The goal with the grip weakened to `grip` from a third into the carry on, for good:
+        its result (the grip restored after)."""
+        from lfd_msgs.srv import InjectFault, InjectFaultRequest
+        drop = self.drop_stick(None, grip)
+        self.place()
+        res, _ = self.cell.execute(self.goal(follow=True), on_moving=drop)
+        restored = rospy.ServiceProxy("/bridge/inject_fault", InjectFault)(
+            InjectFaultRequest(kind="weaken_grip", value=1.0, at_time=0.0))
+        self.assertTrue(restored.success, restored.message)
+        self.assertFalse(res.success)
+        self.assertIn("the arm holds", res.error)
+        return res
+
+    def test_10_a_grasp_lost_for_good_fails_explained(self):
+        """A grip too weak to hold the stick, for good: every retry drops it again. After
+        recovery/max_attempts retries the goal fails, saying so, the arm holding. A grip with no
+        force at all cannot even open the gripper: no retry, and the goal says why. The node then
+        answers the next goal."""
+        attempts = rospy.get_param("/executor/recovery/max_attempts")
+        weak = self.lost_for_good(0.1)
+        self.assertEqual(len(weak.recoveries), attempts, weak.recoveries)
+        self.assertIn("the grasp was lost after %d recoveries" % attempts, weak.error)
+        dead = self.lost_for_good(0.0)
+        self.assertEqual(list(dead.recoveries), [])
+        self.assertIn("the gripper does not open", dead.error)
+        self.assert_alive()
+
     def test_2_preempted_while_moving_then_answers(self):
         self.place()
         self.cell.send(self.goal(duration_scale=2.0))

@@ -185,8 +185,12 @@ class Benchmarks(unittest.TestCase):
                    "harmless_faults": 1, "harmless_faults_alarmed": 0, "faulty_runs": 4,
                    "detected": 3, "detection_rate": 0.75, "median_delay_s": 0.5, "roc_auc": 0.9,
                    "per_fault": {"grip_lost": {"runs": 4, "detected": 3,
-                                               "median_delay_s": 0.5}}}
+                                               "median_delay_s": 0.5}},
+                   "recovery": {"grasp_dropped": {"runs": 5, "task_succeeded": 4,
+                                                  "recovered_runs": 5, "recoveries": 6,
+                                                  "failed_tasks": ["drawer"]}}}
         text = self.render("faults", {"runs": [], "summary": summary, "complete": True})
+        self.assertIn("| grasp_dropped | 5 | 4 | 5 | 6 | drawer |", text)
         self.assertIn("| grip_lost | 4 | 3 | 0.50 s |", text)
         self.assertIn("| **all** | **4** | **3 (75%)** | 0.50 s |", text)
         self.assertIn("ROC AUC of the anomaly score, faulty vs nominal: 0.90.", text)

@@ -58,6 +58,9 @@ class ExecutionMonitor {
   /// The worst reading so far (score: sustained deviation / threshold) and the first alarm.
   lfd::Deviation worst() const;
   std::optional<lfd::Deviation> alarm() const;
+  /// The latest reading over its threshold, if the newest readings are: an alarm raised after
+  /// the first (a grasp lost after a reported yank) is not hidden by it.
+  std::optional<lfd::Deviation> latestAlarm() const;
   /// The source that has been silent the longest beyond what it may be, at `now` during the
   /// motion; none before the start, after the end or while stopped. `now` is best the stamp of
   /// the latest joint state: a loaded machine then delays both alike (the clock would run ahead).
@@ -81,7 +84,7 @@ class ExecutionMonitor {
   ros::Time t0_;
   bool active_ = false;
   lfd::Deviation worst_;
-  std::optional<lfd::Deviation> alarm_;
+  std::optional<lfd::Deviation> alarm_, latest_alarm_;
   mutable std::mutex mutex_;
   std::unique_ptr<SensorChannels> channels_;  // last: its callbacks use the members above
 };

@@ -94,6 +94,10 @@ struct ExecutorOptions {
   /// 1/normalized time: a goal that moves while its segment runs (TargetUpdate) is followed with
   /// the time constant tau / goal_filter (lfd::SegmentRolloutOptions::goal_filter)
   double goal_filter = 10.0;
+  /// Plan from this segment on (a retry after a recovery, lfd_dmp/recovery.hpp): the earlier
+  /// segments were done before; they stay in the plan, empty (no samples, 0 s), so that segment
+  /// indices still match the library's and its sensory signature's.
+  size_t first_segment = 0;
 };
 
 /// Segment targets that take effect `time` s into a plan (an object moved): a segment starting

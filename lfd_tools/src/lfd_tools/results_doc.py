@@ -215,6 +215,7 @@ def faults_sections(result, made_by):
                % (s["nominal_runs"], s["false_alarms"], s["nominal_task_failures"],
                   s["harmless_faults"], s["harmless_faults_alarmed"], num("%.2f", s["roc_auc"]))]
             + following_table(s.get("following") or {})
+            + recovery_table(s.get("recovery") or {})
             + ([] if result.get("complete", True) else ["", "(interrupted: incomplete run)"])}
 
 
@@ -228,6 +229,18 @@ def following_table(following):
     return ["", "Goals whose objects are followed (the goal gives each object's pose in its own tf "
             "frame):", ""] + tables.markdown_table(
                 ["case", "runs", "task succeeded", "replanned", "alarms", "failed tasks"], rows)
+
+
+def recovery_table(recovery):
+    """Goals whose grasp was lost (bench_faults.py RECOVERY_CASES)."""
+    if not recovery:
+        return []
+    rows = [(case, "%d" % v["runs"], "%d" % v["task_succeeded"], "%d" % v["recovered_runs"],
+             "%d" % v["recoveries"], ", ".join(v["failed_tasks"]) or "-")
+            for case, v in sorted(recovery.items())]
+    return ["", "Recovery after a lost grasp (objects followed; executor.yaml recovery/*):", ""] \
+        + tables.markdown_table(["case", "runs", "task succeeded", "recovered runs", "recoveries",
+                                 "failed tasks"], rows)
 
 
 def pr2_case_cells(row):
