@@ -24,7 +24,8 @@ each object's pose in the object's own tf frame), counted apart from the faults 
                   object (scene.yaml: the drawer's cabinet), whose place defines the task's goal.
 And two cases of recovery after a lost grasp (executor.yaml recovery/*: the executor opens the
 gripper, goes back to the start of the segment that reached for the object, looks again and
-retries), their objects followed, counted apart too ("recovery"):
+retries), their objects followed, counted apart too ("recovery"), for the tasks that grasp something
+(tasks.grasps: not a fist that pushes or wipes):
   grasp_dropped   the grip's force drops to 0 at 30% of the held segment (as grip_lost) and comes
                   back 0.5 s later: the object falls, the hand must pick it up again.
   grasp_missed    the object of the first segment's goal frame is shoved 3-8 cm across itself
@@ -132,19 +133,21 @@ def faults_for(task, library, scene, durations):
             out.append(("object_moved", [request("move_object", obj, at(0, 0.3),
                                                  shoved(scene["objects"][obj], scene["id"]))],
                         at(0, 0.3)))
-            across = shoved_across(scene["objects"][obj],
-                                   tasks.scene()["objects"][obj]["half_size"], scene["id"])
-            out.append(("grasp_missed", [request("move_object", obj, at(0, 0.75), across)],
-                        at(0, 0.75)))
+            if tasks.grasps(task):
+                across = shoved_across(scene["objects"][obj],
+                                       tasks.scene()["objects"][obj]["half_size"], scene["id"])
+                out.append(("grasp_missed", [request("move_object", obj, at(0, 0.75), across)],
+                            at(0, 0.75)))
     out.append(("nominal_followed", [], None))
     held = held_segment(library["sensory_signature"])
     if held is not None:
         out.append(("grip_lost", [request("weaken_grip", at=at(held, 0.3), value=0.0)],
                     at(held, 0.3)))
-        out.append(("grasp_dropped", [request("weaken_grip", at=at(held, 0.3), value=0.0),
-                                      request("weaken_grip", at=at(held, 0.3) + DROP_FOR_S,
-                                              value=1.0)],
-                    at(held, 0.3)))
+        if tasks.grasps(task):
+            out.append(("grasp_dropped", [request("weaken_grip", at=at(held, 0.3), value=0.0),
+                                          request("weaken_grip", at=at(held, 0.3) + DROP_FOR_S,
+                                                  value=1.0)],
+                        at(held, 0.3)))
     rows = sorted(set(library["sensory_signature"]["sources"]))
     out.append(("sensors_frozen", [request("freeze_sensor", r, FROZEN_AT_S) for r in rows], None))
     out.append(("sensors_silenced",

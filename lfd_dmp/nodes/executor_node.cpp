@@ -15,6 +15,7 @@
 #include "lfd_dmp/execution_request.hpp"
 #include "lfd_dmp/executor.hpp"
 #include "lfd_dmp/object_following.hpp"
+#include "lfd_dmp/object_symmetry.hpp"
 #include "lfd_dmp/plan_messages.hpp"
 #include "lfd_dmp/recovery.hpp"
 
@@ -207,10 +208,14 @@ class Executor {
     if (!(max_silence_ > 0.0))
       throw std::runtime_error("executor: ~monitoring/max_silence must be > 0");
     min_wall_silence_ = pnh.param("monitoring/min_wall_silence", min_wall_silence_);
+    max_frozen_ = pnh.param("monitoring/max_frozen", max_frozen_);
+    if (!(max_frozen_ > 0.0))
+      throw std::runtime_error("executor: ~monitoring/max_frozen must be > 0");
     if (!(min_wall_silence_ >= 0.0))
       throw std::runtime_error("executor: ~monitoring/min_wall_silence must be >= 0");
     loadFollowOptions(pnh);
     loadRecoveryOptions(pnh);
+    loadSymmetries(pnh);
     settle_time_ = pnh.param("settle_time", settle_time_);
     clock_timeout_ = pnh.param("clock_timeout", clock_timeout_);
     motion_lead_ = pnh.param("motion_lead", motion_lead_);
@@ -379,6 +384,29 @@ class Executor {
       throw std::runtime_error("executor: ~follow_objects/goal_filter must be > 0");
   }
 
+  // ~object_symmetry: {<object>: {x: <order>, y: <order>, z: <order>}} (orders absent = 1).
+  void loadSymmetries(ros::NodeHandle& pnh) {
+    XmlRpc::XmlRpcValue all;
+    if (!pnh.getParam("object_symmetry", all)) return;
+    if (all.getType() != XmlRpc::XmlRpcValue::TypeStruct)
+      throw std::runtime_error("executor: ~object_symmetry must map object names to {x, y, z}");
+    for (auto& [name, orders] : all) {
+      const auto order = [&, &name = name, &orders = orders](const char* axis) {
+        if (orders.getType() != XmlRpc::XmlRpcValue::TypeStruct || !orders.hasMember(axis))
+          return 1;
+        if (orders[axis].getType() != XmlRpc::XmlRpcValue::TypeInt)
+          throw std::runtime_error("executor: ~object_symmetry/" + name + "/" + axis +
+                                   " must be an integer");
+        return static_cast<int>(orders[axis]);
+      };
+      try {
+        symmetries_[name] = lfd_dmp::symmetryOfOrders(order("x"), order("y"), order("z"));
+      } catch (const std::invalid_argument& e) {
+        throw std::runtime_error("executor: ~object_symmetry/" + name + ": " + e.what());
+      }
+    }
+  }
+
   void loadRecoveryOptions(ros::NodeHandle& pnh) {
     lfd_dmp::RecoveryOptions& r = recovery_;
     r.enabled = pnh.param("recovery/enabled", r.enabled);
@@ -416,7 +444,7 @@ class Executor {
       if (library.cartesian_frame != cartesianFrame())
         throw std::invalid_argument("the library's poses are in '" + library.cartesian_frame +
                                     "', the robot's Cartesian frame is '" + cartesianFrame() + "'");
-      const lfd::Scene s = scene(goal);
+      const lfd::Scene s = lfd_dmp::canonicalScene(library, scene(goal), symmetries_);
       std::optional<double> gripper;
       const Eigen::VectorXd q = currentJoints(&gripper);
       std::vector<std::string> warnings;
@@ -707,6 +735,10 @@ class Executor {
         continue;
       try {
         out[names[i]] = scenePose(ps, "object '" + names[i] + "'");
+        const auto symmetric = symmetries_.find(names[i]);
+        if (symmetric != symmetries_.end())
+          out[names[i]] = lfd_dmp::canonicalPose(*context_->library, names[i], out[names[i]],
+                                                 symmetric->second);
       } catch (const std::exception&) {  // gone from tf between the two calls: not seen
       }
     }
@@ -738,8 +770,8 @@ class Executor {
     monitor_.reset();
     if (!monitoring_ || !library.sensory_signature) return;
     try {
-      monitor_ = std::make_unique<lfd_dmp::ExecutionMonitor>(nh_, *library.sensory_signature,
-                                                             max_silence_, min_wall_silence_);
+      monitor_ = std::make_unique<lfd_dmp::ExecutionMonitor>(
+          nh_, *library.sensory_signature, max_silence_, min_wall_silence_, max_frozen_);
       result->monitored = true;
     } catch (const std::invalid_argument& e) {
       result->warnings.push_back(std::string("not monitored: ") + e.what());
@@ -776,7 +808,9 @@ class Executor {
     if (!monitor_) return std::nullopt;
     feedback_.anomaly_score = std::max(feedback_.anomaly_score, monitor_->worst().score);
     std::optional<lfd::Deviation> lost = monitor_->latestAlarm();
-    if (!recovery_.enabled || (lost && !lfd_dmp::lostGrasp(*lost, plan, recovery_))) lost.reset();
+    const std::optional<lfd_dmp::Frozen> frozen = monitor_->frozen(measured);
+    if (!recovery_.enabled || frozen || (lost && !lfd_dmp::lostGrasp(*lost, plan, recovery_)))
+      lost.reset();
     if (!lost && !feedback_.monitor_alarm.empty()) return std::nullopt;
     std::string text;
     if (lost) {
@@ -786,6 +820,10 @@ class Executor {
     } else if (const std::optional<lfd_dmp::Silence> silent = monitor_->silence(measured)) {
       text = lfd_dmp::describeSilence(*silent, plan.segments);
       feedback_.anomaly_score = std::max(feedback_.anomaly_score, silent->gap / silent->allowed);
+    } else if (frozen) {
+      text = lfd_dmp::describeFrozen(*frozen, plan.segments);
+      feedback_.anomaly_score =
+          std::max(feedback_.anomaly_score, frozen->unchanged / frozen->allowed);
     } else {
       return std::nullopt;
     }
@@ -828,7 +866,8 @@ class Executor {
     const Eigen::VectorXd q = currentJoints(&gripper);
     lfd_dmp::ExecutionPlan next;
     try {
-      const lfd::Scene seen = scene(context_->goal);
+      const lfd::Scene seen =
+          lfd_dmp::canonicalScene(*context_->library, scene(context_->goal), symmetries_);
       std::vector<std::string> warnings;
       auto targets =
           lfd_dmp::segmentTargets(*context_->library, seen, context_->start, opt, &warnings);
@@ -1039,11 +1078,13 @@ class Executor {
   bool monitoring_ = true, stop_on_alarm_ = false;
   double max_silence_ = 2.0;       // s (executor.yaml monitoring/max_silence)
   double min_wall_silence_ = 0.5;  // wall s (executor.yaml monitoring/min_wall_silence)
-  std::unique_ptr<lfd_dmp::ExecutionMonitor> monitor_;  // the current goal's
-  lfd_dmp::FollowOptions follow_options_;               // executor.yaml follow_objects/*
-  std::optional<GoalContext> context_;                  // the current goal's
-  std::optional<Following> following_;                  // the current goal's
-  lfd_dmp::RecoveryOptions recovery_;                   // executor.yaml recovery/*
+  double max_frozen_ = 0.5;        // s (executor.yaml monitoring/max_frozen)
+  std::unique_ptr<lfd_dmp::ExecutionMonitor> monitor_;         // the current goal's
+  lfd_dmp::FollowOptions follow_options_;                      // executor.yaml follow_objects/*
+  std::optional<GoalContext> context_;                         // the current goal's
+  std::optional<Following> following_;                         // the current goal's
+  lfd_dmp::RecoveryOptions recovery_;                          // executor.yaml recovery/*
+  std::map<std::string, lfd_dmp::ObjectSymmetry> symmetries_;  // executor.yaml object_symmetry
   tf2_ros::Buffer tf_buffer_;
   tf2_ros::TransformListener tf_listener_;
   ros::Publisher trajectory_pub_, gripper_pub_, planned_pub_, executed_pub_, marker_pub_;

@@ -39,12 +39,24 @@ std::string describeSilence(const Silence& s, const std::vector<PlannedSegment>&
   return where(s.segment, s.phase, s.time, segments) + text;
 }
 
+std::string describeFrozen(const Frozen& f, const std::vector<PlannedSegment>& segments) {
+  char text[384];
+  std::snprintf(text, sizeof(text),
+                "%s frozen: the same readings for %.3f s (allowed %.3f s): its sensors say nothing "
+                "about the world",
+                f.topic.c_str(), f.unchanged, f.allowed);
+  return where(f.segment, f.phase, f.time, segments) + text;
+}
+
 ExecutionMonitor::ExecutionMonitor(ros::NodeHandle& nh, lfd::SensorySignature signature,
-                                   double max_silence, double min_wall_silence)
+                                   double max_silence, double min_wall_silence, double max_frozen)
     : signature_(std::move(signature)),
       max_silence_(max_silence),
       min_wall_silence_(min_wall_silence),
+      max_frozen_(max_frozen),
       monitor_(signature_) {
+  if (!(max_frozen > 0) || !std::isfinite(max_frozen))
+    throw std::invalid_argument("max_frozen must be finite and > 0");
   if (!(max_silence > 0) || !std::isfinite(max_silence))
     throw std::invalid_argument("max_silence must be finite and > 0");
   if (!(min_wall_silence >= 0) || !std::isfinite(min_wall_silence))
@@ -136,6 +148,22 @@ std::optional<Silence> ExecutionMonitor::silence(const ros::Time& now) const {
     s.segment = segment;
     s.phase = phase;
     worst = s;
+  }
+  return worst;
+}
+
+std::optional<Frozen> ExecutionMonitor::frozen(const ros::Time& now) const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (!active_ || now < t0_ || spans_.empty()) return std::nullopt;
+  const double t = (now - t0_).toSec();
+  if (t >= spans_.back().second) return std::nullopt;
+  std::optional<Frozen> worst;
+  for (const SensorChannels::Activity& a : channels_->activity()) {
+    if (a.count < 2 || a.last <= t0_) continue;  // silence() speaks for a stream that stopped
+    const double unchanged = (a.last - std::max(a.changed, t0_)).toSec();
+    if (unchanged <= max_frozen_ || (worst && unchanged <= worst->unchanged)) continue;
+    const auto [segment, phase] = segmentAt(t);
+    worst = Frozen{a.topic, unchanged, max_frozen_, segment, phase, t};
   }
   return worst;
 }

@@ -58,7 +58,8 @@ std::vector<std::string> SensorChannels::unconnected() const {
 std::vector<SensorChannels::Activity> SensorChannels::activity() const {
   std::lock_guard<std::mutex> lock(mutex_);
   std::vector<Activity> out;
-  for (const auto& s : sources_) out.push_back({s->topic, s->first, s->last, s->count, s->arrived});
+  for (const auto& s : sources_)
+    out.push_back({s->topic, s->first, s->last, s->count, s->arrived, s->changed});
   return out;
 }
 
@@ -97,11 +98,16 @@ void SensorChannels::onMessage(Source* s, const topic_tools::ShapeShifter::Const
     s->last = stamp;
     s->arrived = ros::WallTime::now();
     if (s->count++ == 0) s->first = stamp;
+    std::vector<double> fields(s->fields.size(), 0.0);
     for (std::size_t k = 0; k < s->fields.size(); ++k) {
       if (!s->reader->present(k)) continue;
-      latest_[static_cast<Eigen::Index>(s->channels[k])] = s->reader->value(k);
+      fields[k] = s->reader->value(k);
+      latest_[static_cast<Eigen::Index>(s->channels[k])] = fields[k];
       seen_[s->channels[k]] = true;
     }
+    const bool idle = std::all_of(fields.begin(), fields.end(), [](double v) { return v == 0.0; });
+    if (idle || fields != s->previous) s->changed = stamp;
+    s->previous = std::move(fields);
     if (std::find(seen_.begin(), seen_.end(), false) != seen_.end()) return;
     values = latest_;
   }

@@ -27,11 +27,12 @@ lfd::SensorySignature twoTopics() {
   return s;
 }
 
-// Publishes both topics at ~2 kHz each until destroyed; the F/T stamped ft_lag s in the past.
+// Publishes both topics at ~2 kHz each until destroyed; the F/T stamped ft_lag s in the past, with
+// a noise of 1 mN when ft_noise (else exactly kForceZ), the level at level_value.
 class Publishers {
  public:
-  std::atomic<bool> level_on{true}, ft_on{true};
-  std::atomic<double> ft_lag{0.0};
+  std::atomic<bool> level_on{true}, ft_on{true}, ft_noise{false};
+  std::atomic<double> ft_lag{0.0}, level_value{kLevel};
   Publishers() {
     ros::NodeHandle nh;
     ft_ = nh.advertise<geometry_msgs::WrenchStamped>("/channels_test/ft", 100);
@@ -41,8 +42,10 @@ class Publishers {
       w.wrench.force.z = kForceZ;
       std_msgs::Float64MultiArray a;
       a.data = {0.0, kLevel, 1.0};
-      while (!stop_) {
+      for (int k = 0; !stop_; ++k) {
         w.header.stamp = ros::Time::now() - ros::Duration(ft_lag);
+        w.wrench.force.z = kForceZ + (ft_noise ? 1e-3 * (k % 3) : 0.0);
+        a.data[1] = level_value;
         if (ft_on) ft_.publish(w);
         if (level_on) level_.publish(a);
         std::this_thread::sleep_for(std::chrono::microseconds(500));
@@ -150,7 +153,7 @@ lfd_dmp::ExecutionPlan pressPlan(double duration) {
 TEST(ExecutionMonitor, ATopicThatStopsDuringTheMotionIsNamedOnceSilentForMaxSilence) {
   Publishers publishers;
   ros::NodeHandle nh;
-  lfd_dmp::ExecutionMonitor monitor(nh, quietSignature(), 0.3, 0.3);
+  lfd_dmp::ExecutionMonitor monitor(nh, quietSignature(), 0.3, 0.3, 10.0);
   const lfd_dmp::ExecutionPlan plan = pressPlan(3.0);
   const ros::Time t0 = ros::Time::now();
   monitor.start(plan, t0);
@@ -179,7 +182,7 @@ TEST(ExecutionMonitor, ATopicThatKeepsArrivingLateIsNotSilentUntilItStops) {
   Publishers publishers;
   publishers.ft_lag = 2.0;  // s behind the clock, far beyond max_silence
   ros::NodeHandle nh;
-  lfd_dmp::ExecutionMonitor monitor(nh, quietSignature(), 0.3, 0.3);
+  lfd_dmp::ExecutionMonitor monitor(nh, quietSignature(), 0.3, 0.3, 10.0);
   const lfd_dmp::ExecutionPlan plan = pressPlan(10.0);  // still running when the F/T stops
   monitor.start(plan, ros::Time::now() - ros::Duration(2.5));
   ros::WallDuration(0.5).sleep();
@@ -194,9 +197,35 @@ TEST(ExecutionMonitor, ATopicThatKeepsArrivingLateIsNotSilentUntilItStops) {
   monitor.stop();
 }
 
-TEST(ExecutionMonitor, RefusesANegativeWallSilence) {
+// A stale driver repeats its last reading: a stream whose values stop changing is frozen after
+// max_frozen; a noisy live sensor never repeats, and an idle contact sensor's exact zeros are no
+// frozen stream.
+TEST(ExecutionMonitor, AStreamThatRepeatsItsReadingsIsFrozenAnIdleOneIsNot) {
+  Publishers publishers;
+  publishers.ft_noise = true;
   ros::NodeHandle nh;
-  EXPECT_THROW(lfd_dmp::ExecutionMonitor(nh, quietSignature(), 0.3, -1.0), std::invalid_argument);
+  lfd_dmp::ExecutionMonitor monitor(nh, quietSignature(), 5.0, 0.3, 0.2);
+  const lfd_dmp::ExecutionPlan plan = pressPlan(10.0);
+  monitor.start(plan, ros::Time::now());
+  std::optional<lfd_dmp::Frozen> frozen;
+  ASSERT_TRUE(
+      waitFor([&] { return (frozen = monitor.frozen(ros::Time::now())).has_value(); }, 2.0));
+  EXPECT_EQ(frozen->topic, "/channels_test/level");  // -2.25 in every message
+  EXPECT_GT(frozen->unchanged, 0.2);
+  const std::string text = lfd_dmp::describeFrozen(*frozen, plan.segments);
+  EXPECT_NE(text.find("/channels_test/level frozen"), std::string::npos) << text;
+  publishers.level_value = 0.0;
+  ros::WallDuration(0.3).sleep();
+  EXPECT_FALSE(monitor.frozen(ros::Time::now())) << "idle zeros and a noisy F/T";
+  monitor.stop();
+}
+
+TEST(ExecutionMonitor, RefusesANegativeWallSilenceOrNoFrozenTime) {
+  ros::NodeHandle nh;
+  EXPECT_THROW(lfd_dmp::ExecutionMonitor(nh, quietSignature(), 0.3, -1.0, 0.5),
+               std::invalid_argument);
+  EXPECT_THROW(lfd_dmp::ExecutionMonitor(nh, quietSignature(), 0.3, 0.3, 0.0),
+               std::invalid_argument);
 }
 
 }  // namespace

@@ -35,6 +35,17 @@ struct Silence {
 };
 std::string describeSilence(const Silence& s, const std::vector<PlannedSegment>& segments);
 
+/// A source topic whose readings stopped changing: the same non-zero values in every message for
+/// longer than it may be (a stale driver).
+struct Frozen {
+  std::string topic;
+  double unchanged = 0.0;  ///< s since its readings last changed (since the motion start at most)
+  double allowed = 0.0;    ///< s
+  std::size_t segment = 0;
+  double phase = 0.0, time = 0.0;  ///< where the motion is (s since its start)
+};
+std::string describeFrozen(const Frozen& f, const std::vector<PlannedSegment>& segments);
+
 class ExecutionMonitor {
  public:
   /// Subscribes to the signature's sources. Throws std::invalid_argument when the signature cannot
@@ -44,8 +55,9 @@ class ExecutionMonitor {
   /// simulation stepped many times faster than real time advances its clock by seconds while a
   /// loaded machine delays one subscriber's callbacks by a fraction of a wall second; a stream
   /// that keeps arriving, late, is alive. On a robot (sim time = wall time) max_silence decides.
+  /// max_frozen: s a source's readings may repeat exactly (Frozen).
   ExecutionMonitor(ros::NodeHandle& nh, lfd::SensorySignature signature, double max_silence,
-                   double min_wall_silence);
+                   double min_wall_silence, double max_frozen);
 
   /// Judges the readings of the motion of `plan` that starts at `t0` (segments in plan order,
   /// as many as the signature's: else std::invalid_argument).
@@ -65,6 +77,10 @@ class ExecutionMonitor {
   /// motion; none before the start, after the end or while stopped. `now` is best the stamp of
   /// the latest joint state: a loaded machine then delays both alike (the clock would run ahead).
   std::optional<Silence> silence(const ros::Time& now) const;
+  /// The source whose readings have repeated exactly the longest beyond max_frozen at `now` (as
+  /// silence()). Its sensors then say nothing about the world: an empty hand read on a frozen
+  /// sensor is no lost grasp.
+  std::optional<Frozen> frozen(const ros::Time& now) const;
   /// The sensor topics not connected yet (SensorChannels::unconnected).
   std::vector<std::string> unconnected() const { return channels_->unconnected(); }
   /// Sensor data that could not be read ("" = none).
@@ -78,7 +94,7 @@ class ExecutionMonitor {
   std::pair<std::size_t, double> segmentAt(double t) const;
 
   lfd::SensorySignature signature_;
-  double max_silence_, min_wall_silence_;
+  double max_silence_, min_wall_silence_, max_frozen_;
   lfd::SignatureMonitor monitor_;
   std::vector<std::pair<double, double>> spans_;  ///< each segment's [start, end) s of the motion
   ros::Time t0_;

@@ -49,6 +49,10 @@ class SensorChannels {
     ros::Time first, last;  ///< zero before the first message
     std::size_t count = 0;
     ros::WallTime arrived;  ///< wall time of the last message's arrival (zero before the first)
+    /// The stamp of the last message whose fields differed from the one before it, or were all
+    /// zero (an idle contact sensor): a live sensor's noise changes its readings every message, a
+    /// frozen driver repeats one.
+    ros::Time changed;
   };
   std::vector<Activity> activity() const;
 
@@ -66,6 +70,8 @@ class SensorChannels {
     ros::Time first, last;            ///< stamps (Activity)
     std::size_t count = 0;
     ros::WallTime arrived;
+    std::vector<double> previous;  ///< the last message's fields (Activity::changed)
+    ros::Time changed;
     ros::Subscriber subscriber;
   };
   void onMessage(Source* source, const topic_tools::ShapeShifter::ConstPtr& msg);

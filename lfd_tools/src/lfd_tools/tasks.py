@@ -154,6 +154,16 @@ def phases(task):
             for p in _task(task)["phases"]]
 
 
+def grasps(task):
+    """Whether the robot grasps something in the task: its hand starts open (gripper_at_start) and
+    a step closes it (a fist that pushes or wipes holds nothing)."""
+    t = _task(task)
+    if str(t.get("gripper_at_start", "open")) == "closed":
+        return False
+    return any(isinstance(step, dict) and step.get("gripper") == "close"
+               for p in t["phases"] for step in p.get("steps", []))
+
+
 def segment_names(task):
     """A task's skills in order (grasp: approach, move): its phases that are not windows."""
     return [p["name"] for p in phases(task) if not p["window"]]
