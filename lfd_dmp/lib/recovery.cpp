@@ -50,6 +50,9 @@ double minJerk(double tau) {
   return tau * tau * tau * (10.0 + tau * (-15.0 + 6.0 * tau));
 }
 constexpr double kMinJerkPeak = 1.875;
+// Of the expected reading: below it a reading of either sign is "nothing" (a sensor's noise
+// around rest).
+constexpr double kNearlyNothing = 0.25;
 
 }  // namespace
 
@@ -76,9 +79,13 @@ bool lostGrasp(const lfd::Deviation& alarm, const ExecutionPlan& plan,
   const std::size_t sample =
       std::min(plan.times.size() - 1, static_cast<std::size_t>(std::lround(samples)));
   const GripperEvent* closed = lastEvent(plan, sample);
+  // Less on the same side of rest, or nearly nothing: an empty hand. A reading of the other sign
+  // (the wrist pressed up where it carried a weight) is something else.
+  const bool less = std::abs(alarm.measured) < std::abs(alarm.expected) &&
+                    (alarm.measured * alarm.expected >= 0.0 ||
+                     std::abs(alarm.measured) < kNearlyNothing * std::abs(alarm.expected));
   return closed && closed->close &&
-         alarm.time - plan.times[closed->sample] >= options.min_hold_time &&
-         std::abs(alarm.measured) < std::abs(alarm.expected);
+         alarm.time - plan.times[closed->sample] >= options.min_hold_time && less;
 }
 
 std::size_t retrySegment(const SkillLibrary& library, const ExecutionPlan& plan,

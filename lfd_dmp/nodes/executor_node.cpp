@@ -498,6 +498,7 @@ class Executor {
     trackJoints({});
     following_.reset();
     context_.reset();
+    untrusted_sensors_ = false;
     monitor_.reset();  // its subscriptions end with the goal
   }
 
@@ -807,9 +808,13 @@ class Executor {
                                              lfd_msgs::ExecuteTaskResult* result) {
     if (!monitor_) return std::nullopt;
     feedback_.anomaly_score = std::max(feedback_.anomaly_score, monitor_->worst().score);
-    std::optional<lfd::Deviation> lost = monitor_->latestAlarm();
+    std::optional<lfd::Deviation> lost = monitor_->takeLatestAlarm();
     const std::optional<lfd_dmp::Frozen> frozen = monitor_->frozen(measured);
-    if (!recovery_.enabled || frozen || (lost && !lfd_dmp::lostGrasp(*lost, plan, recovery_)))
+    // A sensor that froze once is not trusted again during the goal (it may freeze again; a retry
+    // restarts the monitor's clock, and its last readings before the end are no longer judged).
+    untrusted_sensors_ = untrusted_sensors_ || frozen.has_value();
+    if (!recovery_.enabled || untrusted_sensors_ ||
+        (lost && !lfd_dmp::lostGrasp(*lost, plan, recovery_)))
       lost.reset();
     if (!lost && !feedback_.monitor_alarm.empty()) return std::nullopt;
     std::string text;
@@ -1076,9 +1081,10 @@ class Executor {
   double trajectory_period_ = 0.01, feedback_period_ = 0.05;
   std::unique_ptr<lfd_dmp::TaskPlanner> planner_;
   bool monitoring_ = true, stop_on_alarm_ = false;
-  double max_silence_ = 2.0;       // s (executor.yaml monitoring/max_silence)
-  double min_wall_silence_ = 0.5;  // wall s (executor.yaml monitoring/min_wall_silence)
-  double max_frozen_ = 0.5;        // s (executor.yaml monitoring/max_frozen)
+  double max_silence_ = 2.0;        // s (executor.yaml monitoring/max_silence)
+  double min_wall_silence_ = 0.5;   // wall s (executor.yaml monitoring/min_wall_silence)
+  double max_frozen_ = 0.5;         // s (executor.yaml monitoring/max_frozen)
+  bool untrusted_sensors_ = false;  // the current goal's: a monitored sensor froze
   std::unique_ptr<lfd_dmp::ExecutionMonitor> monitor_;         // the current goal's
   lfd_dmp::FollowOptions follow_options_;                      // executor.yaml follow_objects/*
   std::optional<GoalContext> context_;                         // the current goal's

@@ -113,9 +113,11 @@ std::optional<lfd::Deviation> ExecutionMonitor::alarm() const {
   return alarm_;
 }
 
-std::optional<lfd::Deviation> ExecutionMonitor::latestAlarm() const {
+std::optional<lfd::Deviation> ExecutionMonitor::takeLatestAlarm() {
   std::lock_guard<std::mutex> lock(mutex_);
-  return latest_alarm_;
+  std::optional<lfd::Deviation> out;
+  out.swap(latest_alarm_);
+  return out;
 }
 
 std::pair<std::size_t, double> ExecutionMonitor::segmentAt(double t) const {
@@ -177,10 +179,7 @@ void ExecutionMonitor::onReading(const ros::Time& stamp, const Eigen::VectorXd& 
   const lfd::Deviation d = monitor_.observe(s, phase, t, values);
   if (d.score > worst_.score) worst_ = d;
   if (d.score > 1.0 && !alarm_) alarm_ = d;
-  if (d.score > 1.0)
-    latest_alarm_ = d;
-  else
-    latest_alarm_.reset();
+  if (d.score > 1.0) latest_alarm_ = d;
 }
 
 }  // namespace lfd_dmp

@@ -73,6 +73,8 @@ TEST_F(RecoveryTest, AnAlarmIsALostGraspOnlyWhileHoldingAndWhenTheSensorReadsLes
   EXPECT_TRUE(lfd_dmp::lostGrasp(deviation(carrying, -4.0, -0.5), plan, {}));  // the weight gone
   EXPECT_FALSE(lfd_dmp::lostGrasp(deviation(carrying, 9.6, 15.0), plan, {}));  // squeezed harder
   EXPECT_FALSE(lfd_dmp::lostGrasp(deviation(carrying, -4.0, 8.0), plan, {}));  // a yank
+  EXPECT_FALSE(lfd_dmp::lostGrasp(deviation(carrying, 5.5, -5.4), plan, {}));  // pressed instead
+  EXPECT_TRUE(lfd_dmp::lostGrasp(deviation(carrying, -4.0, 0.3), plan, {}));   // noise around 0
   EXPECT_FALSE(lfd_dmp::lostGrasp(deviation(closed_at - 0.1, 9.6, 0.2), plan, {}));  // still open
   // Closing: the fingers load the pads within min_hold_time of the command.
   lfd_dmp::RecoveryOptions options;

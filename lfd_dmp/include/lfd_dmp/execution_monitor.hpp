@@ -70,9 +70,10 @@ class ExecutionMonitor {
   /// The worst reading so far (score: sustained deviation / threshold) and the first alarm.
   lfd::Deviation worst() const;
   std::optional<lfd::Deviation> alarm() const;
-  /// The latest reading over its threshold, if the newest readings are: an alarm raised after
-  /// the first (a grasp lost after a reported yank) is not hidden by it.
-  std::optional<lfd::Deviation> latestAlarm() const;
+  /// The latest reading over its threshold since the previous call (none: every reading since
+  /// was within): an alarm raised after the first (a grasp lost after a reported yank) is not
+  /// hidden by it, and one that lasted only between two calls is not missed.
+  std::optional<lfd::Deviation> takeLatestAlarm();
   /// The source that has been silent the longest beyond what it may be, at `now` during the
   /// motion; none before the start, after the end or while stopped. `now` is best the stamp of
   /// the latest joint state: a loaded machine then delays both alike (the clock would run ahead).

@@ -41,8 +41,9 @@ bool gripperClosedAt(const ExecutionPlan& plan, std::size_t sample);
 /// Whether `alarm` (a deviation from the sensory signature, at alarm.time s into `plan`) means
 /// the hand lost, or never got, what it should hold: the plan holds the gripper closed then, for
 /// at least options.min_hold_time since its close command, and the sensor reads less than the
-/// demonstrations did (the pads unloaded, the weight gone from the wrist). More than expected (a
-/// yank, a collision) is no lost grasp: a retry would not help.
+/// demonstrations did, on the same side of zero or nearly nothing (the pads unloaded, the weight
+/// gone from the wrist). More than expected (a yank, a collision), or the other sign (pressed
+/// where it should carry), is no lost grasp: a retry would not help.
 bool lostGrasp(const lfd::Deviation& alarm, const ExecutionPlan& plan,
                const RecoveryOptions& options);
 
