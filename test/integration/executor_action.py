@@ -303,8 +303,13 @@ class ExecutorAction(unittest.TestCase):
             result, state, seconds = self.cancel_while_planning()
         self.assertEqual(state, GoalStatus.PREEMPTED,
                          result.error if result else "no result (status %d)" % state)
-        self.assertIn("cancelled while planning", result.error)
-        self.assertEqual(result.motion_start.to_sec(), 0.0)  # nothing was sent
+        if "cancelled while planning" in result.error:
+            self.assertEqual(result.motion_start.to_sec(), 0.0)  # nothing was sent
+        else:
+            # The plan takes ~0.15 s of wall time; on a loaded machine (a fresh-root CI run,
+            # 2026-11-30) the cancel arrived just after it: then it is served before the motion
+            # starts, the arm held where it stands.
+            self.assertIn("preempted at t=-", result.error)
         self.assertLess(seconds, 5.0)
         self.assert_alive()
 
