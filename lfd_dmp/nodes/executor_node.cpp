@@ -590,9 +590,7 @@ class Executor {
     ros::Time reached;
     for (;;) {
       const ros::Time now = ros::Time::now();
-      if (clock_reset_) throw std::runtime_error(clockResetText());
-      if (goal_server_->isPreemptRequested() || !ros::ok()) stop(plan, t0, now);
-      watch.check(now);
+      checkRunning(plan, t0, now, &watch);
       const ros::Time measured = track(plan, t0, t_end, &reached);
       if (const auto lost = checkMonitor(plan, t0, now, measured, result))
         return LostGrasp{*lost, t0, now};
@@ -621,6 +619,15 @@ class Executor {
              result->execution_time, plan.duration(), result->final_position_error * 1e3,
              result->final_orientation_error);
     return std::nullopt;
+  }
+
+  // What every cycle of a motion checks: the simulator restarted, a cancel (the arm holds where
+  // `plan` started at t0 is now), sim time standing still.
+  void checkRunning(const lfd_dmp::ExecutionPlan& plan, const ros::Time& t0, const ros::Time& now,
+                    ClockWatch* watch) {
+    if (clock_reset_) throw std::runtime_error(clockResetText());
+    if (goal_server_->isPreemptRequested() || !ros::ok()) stop(plan, t0, now);
+    watch->check(now);
   }
 
   // Holds the arm where the plan is now and keeps the gripper as the plan has it now (a later
@@ -934,9 +941,7 @@ class Executor {
     ros::Time reached;
     for (;;) {
       const ros::Time now = ros::Time::now();
-      if (clock_reset_) throw std::runtime_error(clockResetText());
-      if (goal_server_->isPreemptRequested() || !ros::ok()) stop(back, start, now);
-      watch.check(now);
+      checkRunning(back, start, now, &watch);
       track(back, start, arrived, &reached);
       if (now >= arrived + ros::Duration(recovery_.settle_time)) return;
       ros::WallDuration(0.001).sleep();

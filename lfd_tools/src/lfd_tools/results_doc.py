@@ -219,28 +219,30 @@ def faults_sections(result, made_by):
             + ([] if result.get("complete", True) else ["", "(interrupted: incomplete run)"])}
 
 
+def case_table(title, columns, cases, cells):
+    """A bench_faults.py summary of cases ({case: counts}) as a titled table, a row per case."""
+    if not cases:
+        return []
+    rows = [(case,) + cells(v) for case, v in sorted(cases.items())]
+    return ["", title, ""] + tables.markdown_table(["case"] + columns, rows)
+
+
 def following_table(following):
     """Goals whose objects the executor followed (bench_faults.py FOLLOWED_CASES)."""
-    if not following:
-        return []
-    rows = [(case, "%d" % v["runs"], "%d" % v["task_succeeded"], "%d" % v["replanned_runs"],
-             "%d" % v["alarms"], ", ".join(v["failed_tasks"]) or "-")
-            for case, v in sorted(following.items())]
-    return ["", "Goals whose objects are followed (the goal gives each object's pose in its own tf "
-            "frame):", ""] + tables.markdown_table(
-                ["case", "runs", "task succeeded", "replanned", "alarms", "failed tasks"], rows)
+    return case_table(
+        "Goals whose objects are followed (the goal gives each object's pose in its own tf "
+        "frame):", ["runs", "task succeeded", "replanned", "alarms", "failed tasks"], following,
+        lambda v: ("%d" % v["runs"], "%d" % v["task_succeeded"], "%d" % v["replanned_runs"],
+                   "%d" % v["alarms"], ", ".join(v["failed_tasks"]) or "-"))
 
 
 def recovery_table(recovery):
     """Goals whose grasp was lost (bench_faults.py RECOVERY_CASES)."""
-    if not recovery:
-        return []
-    rows = [(case, "%d" % v["runs"], "%d" % v["task_succeeded"], "%d" % v["recovered_runs"],
-             "%d" % v["recoveries"], ", ".join(v["failed_tasks"]) or "-")
-            for case, v in sorted(recovery.items())]
-    return ["", "Recovery after a lost grasp (objects followed; executor.yaml recovery/*):", ""] \
-        + tables.markdown_table(["case", "runs", "task succeeded", "recovered runs", "recoveries",
-                                 "failed tasks"], rows)
+    return case_table(
+        "Recovery after a lost grasp (objects followed; executor.yaml recovery/*):",
+        ["runs", "task succeeded", "recovered runs", "recoveries", "failed tasks"], recovery,
+        lambda v: ("%d" % v["runs"], "%d" % v["task_succeeded"], "%d" % v["recovered_runs"],
+                   "%d" % v["recoveries"], ", ".join(v["failed_tasks"]) or "-"))
 
 
 def pr2_case_cells(row):
