@@ -181,8 +181,13 @@ class ExecutorAction(unittest.TestCase):
         self.assertEqual(len(followed.replans), 1, followed.replans)
         self.assertIn("object 'stick' moved 5.00 cm", followed.replans[0])
         self.assertIn(ExecuteTaskFeedback.REPLANNING, [f.state for f in feedback])
-        # The arm tracked the plan it was following throughout (0.3 mm measured).
-        self.assertLess(max(f.tcp_position_error for f in feedback), 0.01)
+        # The arm tracked the plan it was following throughout (0.3 mm measured), up to a recovery
+        # if the grasp of the moved stick slipped (then the arm leaves the plan on purpose: back
+        # to the approach's start, seen twice in 6 local runs).
+        recovering = [k for k, f in enumerate(feedback)
+                      if f.state == ExecuteTaskFeedback.RECOVERING]
+        tracked = feedback[:recovering[0]] if recovering else feedback
+        self.assertLess(max(f.tcp_position_error for f in tracked), 0.01)
         self.assertTrue(judged["success"], judged["reason"])
         self.assertLess(followed.final_position_error, 0.005)
         fixed, judged, _ = outcomes[False]
