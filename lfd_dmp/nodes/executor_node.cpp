@@ -600,7 +600,12 @@ class Executor {
       if (now >= t_end) {
         if (feedback_.state != lfd_msgs::ExecuteTaskFeedback::SETTLING)
           setState(lfd_msgs::ExecuteTaskFeedback::SETTLING, plan);
-        if (now >= t_end + ros::Duration(settle_time_)) break;
+        if (now >= t_end + ros::Duration(settle_time_)) {
+          // The final state as measured: SETTLING went out when the plan's time was over, with
+          // the progress of the last joint sample then, which lags on a loaded machine.
+          publishFeedback();
+          break;
+        }
       }
       ros::WallDuration(0.001).sleep();
     }

@@ -131,8 +131,10 @@ class ExecutorAction(unittest.TestCase):
         # Feedback and result travel on separate topics: the executor publishes SETTLING, then the
         # result once the settle is over, which a loaded machine may deliver first (the executor's
         # loop stalled while the client stepped past the settle: both within a millisecond).
+        # The last feedback, sent as the settle ends, holds the final measured progress.
         deadline = time.time() + 2.0
-        while (ExecuteTaskFeedback.SETTLING not in [f.state for f in self.cell.feedback]
+        while (not any(f.state == ExecuteTaskFeedback.SETTLING and f.progress > 0.99
+                       for f in self.cell.feedback)
                and time.time() < deadline):
             time.sleep(0.01)
         fb = self.cell.feedback
@@ -175,9 +177,9 @@ class ExecutorAction(unittest.TestCase):
         for follow in (True, False):
             res, _, outcome = reproduction.execute_and_judge(
                 self.cell, TASK, self.scene, self.library, on_moving=move_stick, follow=follow)
-            self.assertTrue(res.success, res.error)
             outcomes[follow] = (res, outcome, list(self.cell.feedback))
         followed, judged, feedback = outcomes[True]
+        self.assertTrue(followed.success, followed.error)
         self.assertEqual(len(followed.replans), 1, followed.replans)
         self.assertIn("object 'stick' moved 5.00 cm", followed.replans[0])
         self.assertIn(ExecuteTaskFeedback.REPLANNING, [f.state for f in feedback])
@@ -193,10 +195,17 @@ class ExecutorAction(unittest.TestCase):
         fixed, judged, _ = outcomes[False]
         self.assertEqual(list(fixed.replans), [])
         self.assertFalse(judged["success"], "the stick moved 5 cm and the grasp still held")
+        # Unfollowed, the hand closes where the stick was. Either it closes on nothing and the
+        # motion ends (the judge fails it), or the pads catch the stick's end, the grasp slips
+        # in the carry, and the retries (at the same fixed pose) fail the goal explained.
+        if not fixed.success:
+            self.assertIn("the grasp was lost", fixed.error)
+            self.assertGreater(len(fixed.recoveries), 0, fixed.error)
 
-    def drop_stick(self, for_s, grip=0.0):
+    def drop_stick(self, for_s, grip=0.0, lands_at=None):
         """on_moving callback: the grip's force drops to `grip` (a fraction) a third into the carry
-        ('move'), and comes back `for_s` s later (None: never)."""
+        ('move'), and comes back `for_s` s later (None: never). lands_at: the stick is then put
+        down at this pose (scene format), at rest, 0.4 s after the drop."""
         from lfd_msgs.srv import InjectFault, InjectFaultRequest
         inject = rospy.ServiceProxy("/bridge/inject_fault", InjectFault)
         dry, _ = self.answer(self.goal(dry_run=True))
@@ -204,25 +213,34 @@ class ExecutorAction(unittest.TestCase):
         self.assertTrue(dry.monitored, "the library has no sensory signature")
 
         def drop(feedback):
+            start = feedback.motion_start.to_sec()
             faults = [(at, grip)] + ([(at + for_s, 1.0)] if for_s is not None else [])
             for t, value in faults:
-                r = inject(InjectFaultRequest(kind="weaken_grip", value=value,
-                                              at_time=feedback.motion_start.to_sec() + t))
+                r = inject(InjectFaultRequest(kind="weaken_grip", value=value, at_time=start + t))
+                self.assertTrue(r.success, r.message)
+            if lands_at is not None:
+                r = inject(InjectFaultRequest(kind="move_object", target="stick",
+                                              pose=lockstep.pose_msg(lands_at),
+                                              at_time=start + at + 0.4))
                 self.assertTrue(r.success, r.message)
         return drop
 
     def test_9_picks_the_dropped_stick_up_again(self):
         """The stick slips out of the hand during the carry (the grip's force gone for 0.5 s).
         The monitor finds the pads unloaded; the executor opens the gripper, goes back to the start
-        of the approach, looks at the stick where it fell (its own tf frame) and grasps it again:
-        the task succeeds (within recovery/max_attempts retries), and the result says how it
-        recovered."""
+        of the approach, looks at the stick where it now lies (its own tf frame) and grasps it
+        again: the task succeeds (within recovery/max_attempts retries), and the result says how
+        it recovered. The fallen stick is put down flat 2 cm from where it was picked up: how a
+        falling stick bounces is chaotic (it landed on its end, out of the demonstrated range, or
+        against the table's edge in some runs), and this test is about the recovery, not the
+        fall; bench_faults.py's grasp_dropped lets it fall freely."""
+        stick = self.scene["objects"]["stick"]
+        lands_at = moved(stick, dy=0.02)
         res, _, outcome = reproduction.execute_and_judge(
-            self.cell, TASK, self.scene, self.library, on_moving=self.drop_stick(0.5),
-            follow=True)
+            self.cell, TASK, self.scene, self.library,
+            on_moving=self.drop_stick(0.5, lands_at=lands_at), follow=True)
         self.assertTrue(res.success, res.error)
-        # Where the stick falls decides whether the first retry holds it (a fallen stick grasped
-        # near its end slipped again in one fresh-root run): any retries up to the bound.
+        # Any retries up to the bound: a re-grasp may slip once more.
         attempts = rospy.get_param("/executor/recovery/max_attempts")
         self.assertTrue(1 <= len(res.recoveries) <= attempts, res.recoveries)
         self.assertIn("the grasp was lost", res.recoveries[0])
