@@ -261,6 +261,34 @@ TEST(JointSegmentation, BoundariesAreWhereMotionResumesAfterTheLongPauses) {
   for (std::size_t d = 0; d < demos.size(); ++d) expectBoundaries(result, demos[d], d, 0.3);
 }
 
+// Each demo's pauses are reported: the first rest, the last, and the 2 s waits, each ending where
+// its boundary is (the 0.3 s hesitations are short pauses, longer than min_pause).
+TEST(JointSegmentation, ReportsThePausesOfEachDemo) {
+  const auto demos = movesAndPauses(6, 5);
+  const auto result = lfd::runSegmentationPipeline(matrices(demos), {}, jointConfig());
+  for (std::size_t d = 0; d < demos.size(); ++d) {
+    const auto& r = result.demos[d];
+    const auto seconds = [&](std::size_t row) {
+      return demos[d].matrix.timeAt(static_cast<Eigen::Index>(row));
+    };
+    ASSERT_GE(r.pauses.size(), 2u + demos[d].truth.size()) << "demo " << d;
+    EXPECT_EQ(r.pauses.front().begin, 0u);
+    EXPECT_EQ(r.pauses.back().end, r.num_samples - 1);
+    std::size_t long_waits = 0;
+    for (std::size_t k = 1; k + 1 < r.pauses.size(); ++k) {
+      const double begin = seconds(r.pauses[k].begin), end = seconds(r.pauses[k].end);
+      if (end - begin < 1.0) {
+        EXPECT_LT(end - begin, 0.5) << "demo " << d << ": a hesitation is 0.3 s";
+        continue;
+      }
+      ASSERT_LT(long_waits, demos[d].truth.size()) << "demo " << d;
+      EXPECT_NEAR(end - begin, 2.0, 0.3) << "demo " << d << " pause " << k;
+      EXPECT_NEAR(end, demos[d].truth[long_waits++], 0.3) << "demo " << d << " pause " << k;
+    }
+    EXPECT_EQ(long_waits, demos[d].truth.size()) << "demo " << d;
+  }
+}
+
 // One demo skips the middle move: it is reported as lacking that boundary, not given one.
 TEST(JointSegmentation, ADemoLackingAPhaseIsReportedNotForced) {
   const std::size_t odd = 3;

@@ -96,6 +96,19 @@ json timesJson(const std::vector<std::size_t>& indices, const lfd::FeatureMatrix
   return out;
 }
 
+// Closed row intervals with their times (the end clipped to the demo).
+json intervalsJson(const std::vector<lfd::Interval>& intervals, const lfd::FeatureMatrix& demo) {
+  json out = json::array();
+  for (const lfd::Interval& z : intervals) {
+    const std::size_t end = std::min<std::size_t>(z.end, static_cast<std::size_t>(demo.rows()) - 1);
+    out.push_back({{"begin", z.begin},
+                   {"end", z.end},
+                   {"begin_time", demo.timeAt(static_cast<Eigen::Index>(z.begin))},
+                   {"end_time", demo.timeAt(static_cast<Eigen::Index>(end))}});
+  }
+  return out;
+}
+
 json claspJson(const lfd::MultivariateSegmentation& s, const lfd::FeatureMatrix& demo,
                const std::vector<std::string>& features, const JsonOptions& options) {
   json out;
@@ -168,14 +181,7 @@ json toJson(const lfd::SegmentationPipelineResult& r, const std::vector<lfd::Fea
   json demo_list = json::array();
   for (std::size_t d = 0; d < r.demos.size(); ++d) {
     const lfd::DemoSegmentationResult& s = r.demos[d];
-    json zones = json::array();
-    for (const lfd::Interval& z : s.zones) {
-      zones.push_back({{"begin", z.begin},
-                       {"end", z.end},
-                       {"begin_time", demos[d].timeAt(static_cast<Eigen::Index>(z.begin))},
-                       {"end_time", demos[d].timeAt(static_cast<Eigen::Index>(
-                                        std::min<std::size_t>(z.end, demos[d].rows() - 1)))}});
-    }
+    const json zones = intervalsJson(s.zones, demos[d]);
     json demo = claspJson(s.clasp, demos[d], r.selected_features, options);
     demo["source"] = d < sources.size() ? sources[d] : "";
     demo["num_samples"] = s.num_samples;
@@ -196,6 +202,7 @@ json toJson(const lfd::SegmentationPipelineResult& r, const std::vector<lfd::Fea
     demo["rest_edge_event_times"] = timesJson(rest_edges, demos[d]);
     demo["sample_rate"] = s.sample_rate;
     demo["zones"] = zones;
+    demo["pauses"] = intervalsJson(s.pauses, demos[d]);
     demo_list.push_back(demo);
   }
   out["demos"] = demo_list;

@@ -302,6 +302,7 @@ void gatherEvidence(const FeatureMatrix& demo, const Eigen::MatrixXd& scaled,
   }
   const std::vector<double> clock = clockOf(demo);
   const std::vector<Pause> pauses = findPauses(speed, clock, joint.pauses);
+  for (const Pause& p : pauses) out->pauses.push_back({p.begin, p.end - 1});
   const auto m =
       motionOnsetEvidence(speed, clock, pauses, joint.pauses, joint.weights.motion_onset);
   pieces.insert(pieces.end(), m.begin(), m.end());

@@ -124,7 +124,10 @@ struct DemoSegmentationResult {
   /// (consensus_fill_p_value); also in `changepoints`.
   std::vector<std::size_t> added;
   std::vector<double> added_times;
-  std::vector<Interval> zones;              ///< confidence zones (row indices, closed)
+  std::vector<Interval> zones;  ///< confidence zones (row indices, closed)
+  /// kJoint: where the state features rest ([first, last] row at rest, closed), the demo's
+  /// first and last rest included: a boundary between skills is often inside one.
+  std::vector<Interval> pauses;
   std::vector<std::size_t> events;          ///< sensory events (row indices)
   std::vector<SensoryEvent> event_details;  ///< the same with rest edges and strengths
   std::size_t min_segment_length = 0;       ///< the min_s used for ClaSP and the zones
