@@ -22,6 +22,9 @@ each object's pose in the object's own tf frame), counted apart from the faults 
                   distance and direction drawn per goal, seeded by its id) at 30% of that segment,
                   while the hand approaches it: the task should still succeed. Not for a fixed
                   object (scene.yaml: the drawer's cabinet), whose place defines the task's goal.
+  moved_from_start  the reference for object_moved: the object stands where that shove puts it
+                  from the start (nothing is injected, nothing followed). An object_moved failure
+                  that fails here too is the goal's generalization there, not the following.
 And two cases of recovery after a lost grasp (executor.yaml recovery/*: the executor opens the
 gripper, goes back to the start of the segment that reached for the object, looks again and
 retries), their objects followed, counted apart too ("recovery"), for the tasks that grasp something
@@ -60,6 +63,8 @@ FROZEN_AT_S = 0.3
 SENSOR_FAULTS = ("sensors_frozen", "sensors_silenced")
 # goals sent with their objects followed; counted apart (summary "following")
 FOLLOWED_CASES = ("nominal_followed", "object_moved")
+# object_moved's shoved pose from the start, nothing followed; counted with "following"
+REFERENCE_CASES = ("moved_from_start",)
 # recovery after a lost grasp, objects followed too; counted apart (summary "recovery")
 RECOVERY_CASES = ("grasp_dropped", "grasp_missed")
 DROP_FOR_S = 0.5
@@ -107,8 +112,17 @@ def shoved_across(pose, half_size, seed):
                                                   y + side * distance * math.cos(yaw), z]))
 
 
+def shoved_scene(scene, obj):
+    """The goal's scene with `obj` where object_moved shoves it (the same draw)."""
+    moved = shoved(scene["objects"][obj], scene["id"])
+    objects = dict(scene["objects"], **{obj: dict(scene["objects"][obj], position=[
+        moved.position.x, moved.position.y, moved.position.z])})
+    return dict(scene, objects=objects)
+
+
 def faults_for(task, library, scene, durations):
-    """[(name, [InjectFault requests], offset s into the motion or None)] that apply to the task."""
+    """[(name, [InjectFault requests], offset s into the motion or None, the scene placed or None
+    for the goal's)] that apply to the task."""
     from geometry_msgs.msg import Pose
     from lfd_msgs.srv import InjectFaultRequest
 
@@ -155,6 +169,9 @@ def faults_for(task, library, scene, durations):
     joints = list((scene.get("joints") or {}).keys())
     if joints:
         out.append(("joint_locked", [request("lock_joint", j, 0.0) for j in joints], 0.0))
+    out = [case + (None,) for case in out]
+    if any(case[0] == "object_moved" for case in out):
+        out.append(("moved_from_start", [], None, shoved_scene(scene, obj)))
     return out
 
 
@@ -198,9 +215,11 @@ def summarize(runs):
     """Detection over the sensor faults and the faults that made the task fail (one the task
     survived, e.g. a weak grip while pushing, is counted apart); false alarms over the nominal
     runs."""
-    following = {c: [r for r in runs if r["fault"] == c] for c in FOLLOWED_CASES}
+    following = {c: [r for r in runs if r["fault"] == c]
+                 for c in FOLLOWED_CASES + REFERENCE_CASES}
     recovery = {c: [r for r in runs if r["fault"] == c] for c in RECOVERY_CASES}
-    runs = [r for r in runs if r["fault"] not in FOLLOWED_CASES + RECOVERY_CASES]
+    runs = [r for r in runs
+            if r["fault"] not in FOLLOWED_CASES + REFERENCE_CASES + RECOVERY_CASES]
     nominal = [r["score"] for r in runs if r["fault"] == "none"]
     faulty = [r for r in runs if r["fault"] != "none"
               and (not r["task_succeeded"] or r["fault"] in SENSOR_FAULTS)]
@@ -273,15 +292,15 @@ def main():
                 for scene in tasks.unseen_scenes(task, args.mode)[:args.goals]:
                     reproduction.place_scene(cell, task, scene)
                     plan, _ = cell.execute(lockstep.execute_goal(path, scene, dry_run=True))
-                    cases = [("none", [], None)] + faults_for(task, library, scene,
-                                                              list(plan.segment_durations))
+                    cases = [("none", [], None, None)] + faults_for(
+                        task, library, scene, list(plan.segment_durations))
                     if args.cases:
                         cases = [c for c in cases if c[0] in args.cases.split(",")]
-                    for name, faults, offset in cases:
+                    for name, faults, offset, placed in cases:
                         started = time.time()
                         try:
-                            r = run_goal(cell, inject, task, scene, path, faults, offset,
-                                         follow=name in FOLLOWED_CASES + RECOVERY_CASES)
+                            r = run_goal(cell, inject, task, placed or scene, path, faults,
+                                         offset, follow=name in FOLLOWED_CASES + RECOVERY_CASES)
                         except RuntimeError as exc:
                             r = {"monitored": False, "score": 0.0, "alarm": "",
                                  "alarm_time_s": None, "fault_time_s": offset, "delay_s": None,

@@ -228,10 +228,13 @@ def case_table(title, columns, cases, cells):
 
 
 def following_table(following):
-    """Goals whose objects the executor followed (bench_faults.py FOLLOWED_CASES)."""
+    """Goals whose objects the executor followed (bench_faults.py FOLLOWED_CASES), and their
+    reference (REFERENCE_CASES)."""
     return case_table(
         "Goals whose objects are followed (the goal gives each object's pose in its own tf "
-        "frame):", ["runs", "task succeeded", "replanned", "alarms", "failed tasks"], following,
+        "frame); moved_from_start, not followed, has the object where object_moved shoves it "
+        "from the start:",
+        ["runs", "task succeeded", "replanned", "alarms", "failed tasks"], following,
         lambda v: ("%d" % v["runs"], "%d" % v["task_succeeded"], "%d" % v["replanned_runs"],
                    "%d" % v["alarms"], ", ".join(v["failed_tasks"]) or "-"))
 
