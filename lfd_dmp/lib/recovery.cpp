@@ -62,7 +62,8 @@ void checkRecoveryOptions(const RecoveryOptions& o) {
   for (const auto& [value, name] :
        {std::pair{o.min_retreat_duration, "min_retreat_duration"},
         std::pair{o.release_time, "release_time"}, std::pair{o.settle_time, "settle_time"},
-        std::pair{o.min_hold_time, "min_hold_time"}})
+        std::pair{o.min_hold_time, "min_hold_time"},
+        std::pair{o.min_held_opening, "min_held_opening"}})
     if (!(value >= 0.0) || !std::isfinite(value))
       throw std::invalid_argument(std::string("recovery/") + name + " must be finite and >= 0");
 }
@@ -73,7 +74,7 @@ bool gripperClosedAt(const ExecutionPlan& plan, std::size_t sample) {
 }
 
 bool lostGrasp(const lfd::Deviation& alarm, const ExecutionPlan& plan,
-               const RecoveryOptions& options) {
+               const RecoveryOptions& options, double closed_opening) {
   if (plan.times.empty() || !(plan.dt > 0.0) || !std::isfinite(alarm.time)) return false;
   const double samples = std::max(0.0, alarm.time / plan.dt);
   const std::size_t sample =
@@ -84,7 +85,9 @@ bool lostGrasp(const lfd::Deviation& alarm, const ExecutionPlan& plan,
   const bool less = std::abs(alarm.measured) < std::abs(alarm.expected) &&
                     (alarm.measured * alarm.expected >= 0.0 ||
                      std::abs(alarm.measured) < kNearlyNothing * std::abs(alarm.expected));
-  return closed && closed->close &&
+  const bool holds = sample < plan.gripper.size() &&
+                     plan.gripper[sample] - closed_opening >= options.min_held_opening;
+  return closed && closed->close && holds &&
          alarm.time - plan.times[closed->sample] >= options.min_hold_time && less;
 }
 

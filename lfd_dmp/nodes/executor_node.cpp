@@ -418,6 +418,7 @@ class Executor {
     r.release_time = pnh.param("recovery/release_time", r.release_time);
     r.settle_time = pnh.param("recovery/settle_time", r.settle_time);
     r.min_hold_time = pnh.param("recovery/min_hold_time", r.min_hold_time);
+    r.min_held_opening = pnh.param("recovery/min_held_opening", r.min_held_opening);
     try {
       lfd_dmp::checkRecoveryOptions(r);
     } catch (const std::invalid_argument& e) {
@@ -826,7 +827,7 @@ class Executor {
     // restarts the monitor's clock, and its last readings before the end are no longer judged).
     untrusted_sensors_ = untrusted_sensors_ || frozen.has_value();
     if (!recovery_.enabled || untrusted_sensors_ ||
-        (lost && !lfd_dmp::lostGrasp(*lost, plan, recovery_)))
+        (lost && !lfd_dmp::lostGrasp(*lost, plan, recovery_, robot_.gripper.close_opening)))
       lost.reset();
     if (!lost && !feedback_.monitor_alarm.empty()) return std::nullopt;
     std::string text;

@@ -27,6 +27,8 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
+#include <stdexcept>
 
 namespace {
 
@@ -60,6 +62,9 @@ class Learner {
               frames_.heading_tolerance);
     pnh.param("goal_frames/min_motion_length", frames_.min_motion_length,
               frames_.min_motion_length);
+    pnh.param("goal_frames/tie_z", frames_.tie_z, frames_.tie_z);
+    if (!(frames_.tie_z >= 0.0) || !std::isfinite(frames_.tie_z))
+      throw std::runtime_error("learner: ~goal_frames/tie_z must be finite and >= 0");
     pnh.param("tf_timeout", tf_timeout_, tf_timeout_);
     readSignature(pnh);
   }

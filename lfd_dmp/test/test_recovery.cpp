@@ -84,6 +84,22 @@ TEST_F(RecoveryTest, AnAlarmIsALostGraspOnlyWhileHoldingAndWhenTheSensorReadsLes
   EXPECT_FALSE(lfd_dmp::lostGrasp(deviation(NAN, 9.6, 0.2), plan, {}));
 }
 
+// A fist holds nothing: a plan whose fingers close fully (a push, a wipe) has no grasp to lose,
+// however light its pads; the same closing that stops on an object 1 cm wide does.
+TEST_F(RecoveryTest, AFistThatClosesOnNothingHasNoGraspToLose) {
+  const auto plan = planner_.plan(lib_, targets(grasp(), goal()), q0_, 0.04, coarse());
+  const std::size_t closed = plan.gripper_events.at(1).sample;
+  const double carrying = plan.times[plan.segments[1].begin] + 0.5;
+  auto fist = plan;
+  for (std::size_t i = closed; i < fist.gripper.size(); ++i) fist.gripper[i] = 0.0;
+  EXPECT_FALSE(lfd_dmp::lostGrasp(deviation(carrying, 9.6, 0.2), fist, {}));
+  auto held = fist;
+  for (std::size_t i = closed; i < held.gripper.size(); ++i) held.gripper[i] = 0.01;
+  EXPECT_TRUE(lfd_dmp::lostGrasp(deviation(carrying, 9.6, 0.2), held, {}));
+  // Measured from the robot's closing command: a gripper commanded to 8 mm holds nothing at 1 cm.
+  EXPECT_FALSE(lfd_dmp::lostGrasp(deviation(carrying, 9.6, 0.2), held, {}, 0.008));
+}
+
 // The last boundary that held: the start of the segment that reached for the object the gripper
 // closed on, wherever in the task the grasp was lost; never before the plan's first segment.
 TEST_F(RecoveryTest, ARetryStartsWhereTheHandReachedForTheObject) {

@@ -121,6 +121,30 @@ bool better(double spread, double distance, double best_spread, double best_dist
   return spread <= best_spread + tie && distance < best_distance - 1e-6;
 }
 
+// How much larger than the smallest a spread of `demos` demos may be by sampling noise alone: the
+// log of an RMS from d = demos - 1 degrees of freedom has a standard deviation of ~1 / sqrt(2 d)
+// (and the difference of two such logs ~1 / sqrt(d)), so exp(z / sqrt(d)). 1 for one demo or z 0.
+double noiseRatio(double z, std::size_t demos) {
+  return demos > 1 && z > 0 ? std::exp(z / std::sqrt(static_cast<double>(demos - 1))) : 1.0;
+}
+
+// The candidate with the smallest position spread, or, among those within `ratio` of it (and the
+// exact ties of better()), the one whose origin the segment end lies nearest to.
+const std::pair<SceneFrame, OffsetStats>& nearestOfTheBest(
+    const std::vector<std::pair<SceneFrame, OffsetStats>>& candidates, double ratio) {
+  const std::pair<SceneFrame, OffsetStats>* best = &candidates.front();
+  for (const auto& c : candidates)
+    if (better(c.second.position_rms, c.second.distance, best->second.position_rms,
+               best->second.distance))
+      best = &c;
+  const double within = best->second.position_rms * ratio;
+  const std::pair<SceneFrame, OffsetStats>* chosen = best;
+  for (const auto& c : candidates)
+    if (c.second.position_rms <= within && c.second.distance < chosen->second.distance - 1e-6)
+      chosen = &c;
+  return *chosen;
+}
+
 // RMS angle between each demo's horizontal motion and the x axis of `frame` (infinite when either
 // is undefined in some demo).
 double motionSpread(const SceneFrame& frame, const std::vector<SegmentDemoEnds>& demos,
@@ -254,15 +278,12 @@ SegmentGoalModel learnSegmentGoal(const std::vector<SegmentDemoEnds>& demos,
   Scene common;
   for (const std::string& name : commonObjects(demos)) common.objects[name] = Pose();
   SegmentGoalModel model;
-  OffsetStats best_position, best_orientation;
+  OffsetStats best_orientation;
+  std::vector<std::pair<SceneFrame, OffsetStats>> positions;
   for (const SceneFrame& frame : candidateFrames(common)) {
     const OffsetStats s = statistics(offsetsIn(frame, demos, options.frames));
     model.candidates.push_back({frame, s.position_rms, s.orientation_rms});
-    if (better(s.position_rms, s.distance, best_position.position_rms, best_position.distance)) {
-      best_position = s;
-      model.position_frame = frame;
-      model.position_offset = s.mean_position;
-    }
+    positions.emplace_back(frame, s);
     if (better(s.orientation_rms, s.distance, best_orientation.orientation_rms,
                best_orientation.distance)) {
       best_orientation = s;
@@ -270,7 +291,11 @@ SegmentGoalModel learnSegmentGoal(const std::vector<SegmentDemoEnds>& demos,
       model.orientation_offset = s.mean_orientation;
     }
   }
-  // `base` is always defined, so both were chosen.
+  // `base` is always defined, so both are chosen.
+  const auto& [position_frame, best_position] =
+      nearestOfTheBest(positions, noiseRatio(options.tie_z, demos.size()));
+  model.position_frame = position_frame;
+  model.position_offset = best_position.mean_position;
   model.position_spread = best_position.position_rms;
   model.orientation_spread = best_orientation.orientation_rms;
   // The frame whose x axis the motion follows best (the base frame's would change nothing).

@@ -28,6 +28,11 @@ struct RecoveryOptions {
   /// time to close and load the pads (a reproduction's pads loaded up to 0.47 s after the
   /// command where the demonstrations' had already; a retry then would undo a good grasp).
   double min_hold_time = 1.0;
+  /// m between the pads, beyond the closing command's opening, that the plan's closed gripper
+  /// (learned from the demonstrations' fingers) keeps where the hand should hold something: the
+  /// fingers stopped on an object. A plan that closes them fully (a fist that pushes or wipes)
+  /// holds nothing, and a light pad there is no lost grasp.
+  double min_held_opening = 0.005;
 };
 
 /// Throws std::invalid_argument naming the option out of range (fraction in (0, 1], the times
@@ -40,12 +45,13 @@ bool gripperClosedAt(const ExecutionPlan& plan, std::size_t sample);
 
 /// Whether `alarm` (a deviation from the sensory signature, at alarm.time s into `plan`) means
 /// the hand lost, or never got, what it should hold: the plan holds the gripper closed then, for
-/// at least options.min_hold_time since its close command, and the sensor reads less than the
-/// demonstrations did, on the same side of zero or nearly nothing (the pads unloaded, the weight
-/// gone from the wrist). More than expected (a yank, a collision), or the other sign (pressed
-/// where it should carry), is no lost grasp: a retry would not help.
+/// at least options.min_hold_time since its close command, on something (its opening at least
+/// options.min_held_opening beyond `closed_opening`, the robot's closing command, m), and the
+/// sensor reads less than the demonstrations did, on the same side of zero or nearly nothing (the
+/// pads unloaded, the weight gone from the wrist). More than expected (a yank, a collision), or
+/// the other sign (pressed where it should carry), is no lost grasp: a retry would not help.
 bool lostGrasp(const lfd::Deviation& alarm, const ExecutionPlan& plan,
-               const RecoveryOptions& options);
+               const RecoveryOptions& options, double closed_opening = 0.0);
 
 /// The segment to retry from after a grasp lost at `sample`: the last boundary that held is the
 /// start of the segment that reached for the object, i.e. of the run of segments whose goal frames

@@ -115,12 +115,18 @@ struct FrameSelectionOptions {
   double heading_tolerance = 0.25;
   /// m: a segment that moves less than this horizontally in some demo follows no frame.
   double min_motion_length = 0.02;
+  /// One-sided normal quantile: a frame whose position spread is within the sampling noise of
+  /// the smallest one (RMS ratio <= exp(z / sqrt(demos - 1)): 2.1 for 6 demos, 1.8 for 9) explains
+  /// the demos as well, and the frame whose origin the end lies nearest wins among those. A few
+  /// noisy demos cannot tell a push's box from its goal when every box stood ~11 cm from its goal;
+  /// the fist ends at the box. 0 = only equal spreads tie.
+  double tie_z = 1.645;
 };
 
 /// Learns a segment's goal from its demos (at least one; the frames are those of the objects
-/// every demo's scene names). Frames whose spreads are equal (within 10 um or urad + 0.1%) are
-/// told apart by the end's mean distance from their origin: the nearer one is kept (what the
-/// skill ends at).
+/// every demo's scene names). Frames whose spreads are equal (within 10 um or urad + 0.1%; for
+/// the position, within the sampling noise of options.tie_z) are told apart by the end's mean
+/// distance from their origin: the nearer one is kept (what the skill ends at).
 /// Throws std::invalid_argument on no demos or non-finite poses.
 SegmentGoalModel learnSegmentGoal(const std::vector<SegmentDemoEnds>& demos,
                                   const FrameSelectionOptions& options);
