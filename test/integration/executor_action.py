@@ -183,13 +183,15 @@ class ExecutorAction(unittest.TestCase):
         self.assertEqual(len(followed.replans), 1, followed.replans)
         self.assertIn("object 'stick' moved 5.00 cm", followed.replans[0])
         self.assertIn(ExecuteTaskFeedback.REPLANNING, [f.state for f in feedback])
-        # The arm tracked the plan it was following throughout (0.3 mm measured), up to a recovery
-        # if the grasp of the moved stick slipped (then the arm leaves the plan on purpose: back
-        # to the approach's start, seen twice in 6 local runs).
+        # The arm tracked the plan it was following throughout (0.3 mm measured; 11 mm once with
+        # two rostests and their simulations sharing the 2-core machine), up to a recovery if
+        # the grasp of the moved stick slipped (then the arm leaves the plan on purpose: back to
+        # the approach's start, seen twice in 6 local runs). A plan that jumped to the moved
+        # stick instead of following it smoothly would be 5 cm off.
         recovering = [k for k, f in enumerate(feedback)
                       if f.state == ExecuteTaskFeedback.RECOVERING]
         tracked = feedback[:recovering[0]] if recovering else feedback
-        self.assertLess(max(f.tcp_position_error for f in tracked), 0.01)
+        self.assertLess(max(f.tcp_position_error for f in tracked), 0.02)
         self.assertTrue(judged["success"], judged["reason"])
         self.assertLess(followed.final_position_error, 0.005)
         fixed, judged, _ = outcomes[False]
@@ -273,8 +275,9 @@ class ExecutorAction(unittest.TestCase):
         attempts = rospy.get_param("/executor/recovery/max_attempts")
         weak = self.lost_for_good(0.1)
         # A tenth of the grip opens the gripper within release_time in most runs, not in all: then
-        # the retry ends early, explained as a gripper that does not open.
-        self.assertTrue(1 <= len(weak.recoveries) <= attempts, weak.recoveries)
+        # the retries end early (at the first lost grasp in one local run of ten), explained as a
+        # gripper that does not open.
+        self.assertLessEqual(len(weak.recoveries), attempts, weak.recoveries)
         ended = ("the grasp was lost after %d recoveries" % attempts
                  if len(weak.recoveries) == attempts else "the gripper does not open")
         self.assertIn(ended, weak.error)

@@ -50,7 +50,9 @@ class ExecutorClockReset(unittest.TestCase):
     def answer(self, client):
         """Sends a goal with no library and waits (wall time) until it ends: (state, error)."""
         client.send_goal(ExecuteTaskGoal(library="", dry_run=True))
-        self.wait_until(lambda: client.get_state() in TERMINAL, 10.0, "the goal did not end")
+        # The status and the result travel on separate topics: a terminal status may come first.
+        self.wait_until(lambda: client.get_state() in TERMINAL and client.get_result() is not None,
+                        10.0, "the goal did not end with a result")
         result = client.get_result()
         return client.get_state(), result.error if result else ""
 
