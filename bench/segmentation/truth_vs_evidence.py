@@ -49,27 +49,26 @@ def segment(args, demos):
 
 
 def nearest(times, t):
-    """(signed error t - nearest, nearest) or (None, None) without any."""
-    if not times:
-        return None, None
-    best = min(times, key=lambda x: abs(t - x))
-    return t - best, best
+    """Signed error t - the nearest of `times`, or None without any."""
+    return t - min(times, key=lambda x: abs(t - x)) if times else None
 
 
 def boundary_rows(demo, truth, t0):
     """Per true boundary (s from t0, the first bag's start), where it lies against the
     evidence."""
     pauses = [(p["begin_time"] - t0, p["end_time"] - t0) for p in demo["pauses"]]
-    onsets = [end for _, end in pauses[:-1] if pauses and end > pauses[0][1] - 1e-9]
+    # Where motion resumes: not after the demo's first rest (the motion's start) nor its last.
+    onsets = [p["end_time"] - t0 for p in demo["pauses"]
+              if p["begin"] > 0 and p["end"] < demo["num_samples"] - 1]
     events = [t - t0 for t in demo["event_times"]]
     found = [t - t0 for t in demo["changepoint_times"]]
     rows = []
     for t in truth:
         inside = [p for p in pauses if p[0] <= t <= p[1]]
         rows.append({"truth_s": t, "pause_s": list(inside[0]) if inside else None,
-                     "onset_error_s": nearest(onsets, t)[0],
-                     "event_error_s": nearest(events, t)[0],
-                     "found_error_s": nearest(found, t)[0]})
+                     "onset_error_s": nearest(onsets, t),
+                     "event_error_s": nearest(events, t),
+                     "found_error_s": nearest(found, t)})
     return rows
 
 

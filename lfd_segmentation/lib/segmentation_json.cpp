@@ -181,7 +181,6 @@ json toJson(const lfd::SegmentationPipelineResult& r, const std::vector<lfd::Fea
   json demo_list = json::array();
   for (std::size_t d = 0; d < r.demos.size(); ++d) {
     const lfd::DemoSegmentationResult& s = r.demos[d];
-    const json zones = intervalsJson(s.zones, demos[d]);
     json demo = claspJson(s.clasp, demos[d], r.selected_features, options);
     demo["source"] = d < sources.size() ? sources[d] : "";
     demo["num_samples"] = s.num_samples;
@@ -201,7 +200,7 @@ json toJson(const lfd::SegmentationPipelineResult& r, const std::vector<lfd::Fea
       if (e.rest_edge) rest_edges.push_back(e.index);
     demo["rest_edge_event_times"] = timesJson(rest_edges, demos[d]);
     demo["sample_rate"] = s.sample_rate;
-    demo["zones"] = zones;
+    demo["zones"] = intervalsJson(s.zones, demos[d]);
     demo["pauses"] = intervalsJson(s.pauses, demos[d]);
     demo_list.push_back(demo);
   }
