@@ -169,9 +169,11 @@ def datasets_to_run(args, config):
             seg, demos, ms, tol))]
     if not args.datasets:
         raise RuntimeError("give --datasets, --truth or --labels")
-    return [(n, lambda seg, ms, tol, n=n: segmentation_scoring.evaluate_dataset_methods(
-        seg, os.path.join(args.datasets, n), ms, config, tol))
-            for n in (args.names.split(",") if args.names else tasks.datasets()) if n]
+    names = [n for n in (args.names.split(",") if args.names else tasks.datasets()) if n]
+    folders = [os.path.join(args.datasets, n) for n in names]
+    phases = segmentation_scoring.dataset_phases(folders)  # every bag's truth, all cores
+    return [(n, lambda seg, ms, tol, f=f: segmentation_scoring.evaluate_dataset_methods(
+        seg, f, ms, config, tol, phases[f])) for n, f in zip(names, folders)]
 
 
 def main():
@@ -210,8 +212,8 @@ def main():
         methods = [m for m in args.methods.split(",") if m] or config["segmentation"]["methods"]
         tol = (args.tolerance if args.tolerance is not None
                else float(config["segmentation"]["tolerance_s"]))
+        rows = datasets_to_run(args, config)  # first: it forks readers, rospy starts threads
         segment = make_segmenter(args)
-        rows = datasets_to_run(args, config)
     except (RuntimeError, OSError, KeyError, ValueError, yaml.YAMLError) as exc:
         print("error: %s" % exc, file=sys.stderr)
         return 2
