@@ -111,6 +111,80 @@ TEST(SensorySignature, APressWithoutForceIsFlaggedInThePressSegment) {
   EXPECT_LT(worst[1].time, p.approach + p.press);
 }
 
+// A wide spread floor (reproductions toward new goals press harder or softer than the demos) keeps
+// a missing press under the level's threshold: 10 N against a 5 N spread. Every demonstration held
+// the contact, so a reading at rest is a missing contact anyway; half the force is not.
+TEST(SensorySignature, AMissingContactIsAnAlarmWhateverTheLevelsSpread) {
+  std::vector<lfd::SegmentedRecording> demos;
+  for (unsigned k = 0; k < 5; ++k) demos.push_back(pressRun(varied(k), 1000 + k));
+  lfd::SignatureOptions wide;
+  wide.min_spread_fraction = 0.5;
+  const auto sig = lfd::learnSignature(demos, {"force_z", "gripper"}, wide);
+  wide.rest_band_fraction = 0.0;
+  const auto levels_only = lfd::learnSignature(demos, {"force_z", "gripper"}, wide);
+  for (unsigned k = 0; k < 10; ++k) {
+    Press missed = varied(70 + k), softer = varied(70 + k);
+    missed.level = 0.0;
+    softer.level *= 0.5;
+    const lfd::SegmentedRecording no_force = pressRun(missed, 7000 + k);
+    EXPECT_GT(lfd::scoreRecording(sig, no_force)[1][0], 1.0) << "run " << k;
+    EXPECT_LT(lfd::scoreRecording(levels_only, no_force)[1][0], 1.0) << "run " << k;
+    EXPECT_LT(worstScore(lfd::scoreRecording(sig, pressRun(softer, 7000 + k))), 1.0) << "run " << k;
+    EXPECT_LT(worstScore(lfd::scoreRecording(sig, pressRun(varied(90 + k), 9000 + k))), 1.0);
+  }
+  // Live: the rest is the run's first reading, whatever the sensor's offset.
+  Press missed = varied(99);
+  missed.level = 0.0;
+  lfd::SegmentedRecording offset = pressRun(missed, 99);
+  offset.features.data.col(0).array() += 3.0;
+  lfd::SignatureMonitor monitor(sig);
+  monitor.start();
+  double alarm = -1.0;
+  for (Eigen::Index i = 0; i < offset.features.rows() && alarm < 0; ++i) {
+    const double t = offset.features.timeAt(i) - offset.features.timeAt(0);
+    const std::size_t s = t < offset.boundaries[0] ? 0 : t < offset.boundaries[1] ? 1 : 2;
+    const double begin = s == 0 ? 0.0 : offset.boundaries[s - 1];
+    const double end =
+        s == 2 ? offset.features.timeAt(offset.features.rows() - 1) - 100.0 : offset.boundaries[s];
+    if (monitor.observe(s, (t - begin) / (end - begin), t, offset.features.data.row(i)).score > 1)
+      alarm = t;
+  }
+  EXPECT_GT(alarm, missed.approach);
+  EXPECT_LT(alarm, missed.approach + missed.press);
+}
+
+// Two pads of one sensor: every demonstration pressed on the left pad (some on both). A push toward
+// a new goal may meet the box with the right pad only: the sensor still feels the contact. Judged
+// pad by pad (no sources), the left pad at rest would be a missing contact; on neither pad it is.
+TEST(SensorySignature, AContactIsMissingOnlyWhenEveryChannelOfItsSensorIsAtRest) {
+  const auto twoPads = [](const lfd::SegmentedRecording& press, bool left, bool right) {
+    lfd::SegmentedRecording r = press;
+    r.features.names = {"pad_left", "pad_right"};
+    r.features.data.resize(press.features.rows(), 2);
+    r.features.data.col(0) = press.features.data.col(0) * (left ? 1.0 : 0.0);
+    r.features.data.col(1) = press.features.data.col(0) * (right ? 1.0 : 0.0);
+    return r;
+  };
+  std::vector<lfd::SegmentedRecording> demos;
+  for (unsigned k = 0; k < 6; ++k)
+    demos.push_back(twoPads(pressRun(varied(k), 1000 + k), true, k % 2 == 1));
+  const std::vector<std::string> pads = {"pad_left", "pad_right"};
+  lfd::SignatureOptions wide;
+  wide.min_spread_fraction = 0.5;  // the levels alone could not tell
+  const auto one_sensor = lfd::learnSignature(demos, pads, wide, {"/touch", "/touch"});
+  const auto two_sensors = lfd::learnSignature(demos, pads, wide);
+  EXPECT_EQ(lfd::sensorOf(one_sensor), (std::vector<std::size_t>{0, 0}));
+  EXPECT_EQ(lfd::sensorOf(two_sensors), (std::vector<std::size_t>{0, 1}));
+  for (unsigned k = 0; k < 6; ++k) {
+    const lfd::SegmentedRecording press = pressRun(varied(80 + k), 8000 + k);
+    EXPECT_LT(worstScore(lfd::scoreRecording(one_sensor, twoPads(press, true, false))), 1.0);
+    EXPECT_LT(worstScore(lfd::scoreRecording(one_sensor, twoPads(press, false, true))), 1.0);
+    EXPECT_GT(lfd::scoreRecording(two_sensors, twoPads(press, false, true))[1][0], 1.0);
+    EXPECT_GT(lfd::scoreRecording(one_sensor, twoPads(press, false, false))[1][0], 1.0);
+  }
+  EXPECT_THROW(lfd::learnSignature(demos, pads, wide, {"/touch"}), std::invalid_argument);
+}
+
 TEST(SensorySignature, TheLiveMonitorRaisesASlipWithinAFifthOfASecond) {
   const lfd::SensorySignature sig = learned(5);
   Press p = varied(91);

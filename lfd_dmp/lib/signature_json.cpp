@@ -16,7 +16,8 @@ json optionsJson(const lfd::SignatureOptions& o) {
           {"min_spread_fraction", o.min_spread_fraction},
           {"noise_sigmas", o.noise_sigmas},
           {"threshold_margin", o.threshold_margin},
-          {"min_threshold", o.min_threshold}};
+          {"min_threshold", o.min_threshold},
+          {"rest_band_fraction", o.rest_band_fraction}};
 }
 
 double nonNegative(const json& j, const char* key, const std::string& where) {
@@ -38,6 +39,10 @@ lfd::SignatureOptions optionsFromJson(const json& j, const std::string& w) {
   o.noise_sigmas = number(member(j, "noise_sigmas", w), w + ".noise_sigmas");
   o.threshold_margin = number(member(j, "threshold_margin", w), w + ".threshold_margin");
   o.min_threshold = number(member(j, "min_threshold", w), w + ".min_threshold");
+  // A library learned before the missing-contact check has none.
+  o.rest_band_fraction = j.contains("rest_band_fraction")
+                             ? number(j["rest_band_fraction"], w + ".rest_band_fraction")
+                             : 0.0;
   try {
     lfd::checkSignatureOptions(o);  // the learner's own rule, one place
   } catch (const std::invalid_argument& e) {
@@ -54,6 +59,10 @@ lfd::ChannelSignature channelFromJson(const json& j, std::size_t bins, const std
   c.threshold = number(member(j, "threshold", w), w + ".threshold");
   if (!(c.threshold > 0)) fail(w + ".threshold", "must be > 0");
   c.nominal_score = nonNegative(j, "nominal_score", w);
+  if (j.contains("held")) {
+    c.held = vector(j["held"], w + ".held", static_cast<long>(bins));
+    if (!(c.held.minCoeff() >= 0)) fail(w + ".held", "every distance must be >= 0");
+  }
   return c;
 }
 
@@ -63,11 +72,14 @@ json toJson(const lfd::SensorySignature& signature) {
   json segments = json::array();
   for (const lfd::SegmentSignature& s : signature.segments) {
     json channels = json::array();
-    for (const lfd::ChannelSignature& c : s.channels)
-      channels.push_back({{"mean", vectorJson(c.mean)},
-                          {"spread", vectorJson(c.spread)},
-                          {"threshold", c.threshold},
-                          {"nominal_score", c.nominal_score}});
+    for (const lfd::ChannelSignature& c : s.channels) {
+      json channel = {{"mean", vectorJson(c.mean)},
+                      {"spread", vectorJson(c.spread)},
+                      {"threshold", c.threshold},
+                      {"nominal_score", c.nominal_score}};
+      if (c.held.size() > 0) channel["held"] = vectorJson(c.held);
+      channels.push_back(channel);
+    }
     segments.push_back({{"duration_mean", s.duration_mean},
                         {"duration_spread", s.duration_spread},
                         {"channels", channels}});
@@ -76,6 +88,7 @@ json toJson(const lfd::SensorySignature& signature) {
           {"sources", signature.sources},
           {"demonstrations", signature.demonstrations},
           {"options", optionsJson(signature.options)},
+          {"rest_bands", signature.rest_bands},
           {"segments", segments}};
 }
 
@@ -88,6 +101,14 @@ lfd::SensorySignature signatureFromJson(const json& j, const std::string& where)
     fail(where + ".sources", "one source per channel (or none)");
   sig.demonstrations = static_cast<std::size_t>(nonNegative(j, "demonstrations", where));
   sig.options = optionsFromJson(member(j, "options", where), where + ".options");
+  if (j.contains("rest_bands")) {
+    const Eigen::VectorXd bands = vector(j["rest_bands"], where + ".rest_bands");
+    if (bands.size() != 0 && bands.size() != static_cast<Eigen::Index>(sig.channels.size()))
+      fail(where + ".rest_bands", "one band per channel (or none)");
+    if (bands.size() != 0 && !(bands.minCoeff() >= 0))
+      fail(where + ".rest_bands", "every band must be >= 0");
+    sig.rest_bands.assign(bands.data(), bands.data() + bands.size());
+  }
   const json& segments = member(j, "segments", where);
   if (!segments.is_array() || segments.empty())
     fail(where + ".segments", "expected a non-empty array");

@@ -190,10 +190,11 @@ void learnSignature(const std::vector<UsedDemo>& used, const lfd::SignatureOptio
     return;
   }
   try {
-    lfd::SensorySignature sig = lfd::learnSignature(recordings, first->sensors.names, options);
-    sig.sources = first->sensor_sources;
-    if (!sig.sources.empty() && sig.sources.size() != sig.channels.size()) sig.sources.clear();
-    out->library.sensory_signature = std::move(sig);
+    // The channels of one source are one sensor (its missing contact is judged on all of them).
+    const std::vector<std::string>& sources = first->sensor_sources;
+    out->library.sensory_signature = lfd::learnSignature(
+        recordings, first->sensors.names, options,
+        sources.size() == first->sensors.names.size() ? sources : std::vector<std::string>{});
   } catch (const std::invalid_argument& e) {
     out->warnings.push_back(std::string("no sensory signature: ") + e.what());
   }

@@ -263,6 +263,7 @@ class Learner {
     pnh.param("signature/noise_sigmas", o.noise_sigmas, o.noise_sigmas);
     pnh.param("signature/threshold_margin", o.threshold_margin, o.threshold_margin);
     pnh.param("signature/min_threshold", o.min_threshold, o.min_threshold);
+    pnh.param("signature/rest_band_fraction", o.rest_band_fraction, o.rest_band_fraction);
     try {
       lfd::checkSignatureOptions(o);
       sensors_ = lfd_dmp::loadMonitoredSensors(file);

@@ -74,7 +74,7 @@ void ExecutionMonitor::start(const ExecutionPlan& plan, const ros::Time& t0) {
   worst_ = lfd::Deviation();
   alarm_.reset();
   latest_alarm_.reset();
-  monitor_.reset();
+  monitor_.start();  // this run's first readings are its rest levels
   active_ = true;
 }
 

@@ -340,10 +340,13 @@ lfd::SensorySignature makeSignature() {
       ch.spread = Eigen::Vector4d(0.1, 0.2, 0.3, 0.4);
       ch.threshold = 3.0 + c;
       ch.nominal_score = 1.25;
+      ch.held = Eigen::Vector4d(0.0, 0.5 + s, 2.0, 0.0);
       seg.channels.push_back(ch);
     }
     sig.segments.push_back(seg);
   }
+  sig.rest_bands = {0.25, 0.5};
+  sig.options.rest_band_fraction = 0.05;
   return sig;
 }
 
@@ -360,6 +363,30 @@ TEST(SkillLibrary, TheSensorySignatureTravelsWithTheLibrary) {
   EXPECT_EQ(back.sensory_signature->segments[1].channels[1].mean,
             lib.sensory_signature->segments[1].channels[1].mean);
   EXPECT_EQ(back.sensory_signature->options.phase_bins, 4u);
+  EXPECT_EQ(back.sensory_signature->rest_bands, lib.sensory_signature->rest_bands);
+  EXPECT_EQ(back.sensory_signature->segments[1].channels[0].held,
+            lib.sensory_signature->segments[1].channels[0].held);
+}
+
+// A library learned before the missing-contact check (no held levels, rest bands or option)
+// loads with the check off: the levels alone judge its reproductions, as they did.
+TEST(SkillLibrary, ASignatureWithoutRestBandsLoadsWithTheMissingContactCheckOff) {
+  SkillLibrary lib = makeLibrary();
+  lib.sensory_signature = makeSignature();
+  nlohmann::json j = lfd_dmp::toJson(lib);
+  auto& sig = j["sensory_signature"];
+  sig.erase("rest_bands");
+  sig["options"].erase("rest_band_fraction");
+  for (auto& segment : sig["segments"])
+    for (auto& channel : segment["channels"]) channel.erase("held");
+  const std::string path = tempPath("old_sig.json");
+  std::ofstream(path) << j.dump();
+  const SkillLibrary back = lfd_dmp::loadSkillLibrary(path);
+  std::remove(path.c_str());
+  ASSERT_TRUE(back.sensory_signature.has_value());
+  EXPECT_TRUE(back.sensory_signature->rest_bands.empty());
+  EXPECT_EQ(back.sensory_signature->options.rest_band_fraction, 0.0);
+  EXPECT_EQ(back.sensory_signature->segments[0].channels[1].held.size(), 0);
 }
 
 TEST(SkillLibrary, ABrokenSignatureIsRefusedWithItsLocation) {
@@ -390,5 +417,16 @@ TEST(SkillLibrary, ABrokenSignatureIsRefusedWithItsLocation) {
   EXPECT_NE(broken([](auto& j) {
               j["sensory_signature"]["segments"][0]["channels"][0]["threshold"] = -1;
             }).find("threshold"),
+            std::string::npos);
+  EXPECT_NE(broken([](auto& j) {
+              j["sensory_signature"]["segments"][1]["channels"][1]["held"].erase(0);
+            }).find("segments[1].channels[1].held"),
+            std::string::npos);
+  EXPECT_NE(
+      broken([](auto& j) { j["sensory_signature"]["rest_bands"][1] = -0.5; }).find("rest_bands"),
+      std::string::npos);
+  EXPECT_NE(broken([](auto& j) {
+              j["sensory_signature"]["rest_bands"].erase(0);
+            }).find("one band per channel"),
             std::string::npos);
 }

@@ -124,6 +124,7 @@ ChannelSignature expectation(const std::vector<Eigen::VectorXd>& profiles, doubl
 struct ChannelFloors {
   std::vector<int> columns;
   std::vector<double> floors;
+  std::vector<double> rest_bands;  // SignatureOptions::rest_band_fraction
 };
 
 ChannelFloors channelFloors(const std::vector<SegmentedRecording>& demos,
@@ -132,10 +133,14 @@ ChannelFloors channelFloors(const std::vector<SegmentedRecording>& demos,
   for (const std::string& name : channels) {
     const int column = demos.front().features.require(name);
     f.columns.push_back(column);
-    const double floor = std::max(o.min_spread_fraction * taskRange(demos, column),
-                                  o.noise_sigmas * noiseSigma(demos, column));
+    const double range = taskRange(demos, column),
+                 noise = o.noise_sigmas * noiseSigma(demos, column);
+    const double floor = std::max(o.min_spread_fraction * range, noise);
     // A channel that never changed: any change is a deviation, measured against a tiny unit.
     f.floors.push_back(std::max(floor, 1e-9));
+    // (a constant channel: any change leaves rest)
+    f.rest_bands.push_back(
+        o.rest_band_fraction > 0 ? std::max({o.rest_band_fraction * range, noise, 1e-9}) : 0.0);
   }
   return f;
 }
@@ -166,14 +171,66 @@ std::vector<SegmentSignature> expectations(const std::vector<SegmentedRecording>
   return out;
 }
 
+// Each channel's `held`: per bin, the least contact any demonstration's sensor showed, in rest
+// bands: the largest distance of the sensor's channels from their first reading (which pad or axis
+// feels the contact may differ between demonstrations, that one does not).
+void setHeld(const std::vector<SegmentedRecording>& demos, const ChannelFloors& floors,
+             const std::vector<std::size_t>& sensor_of, const SignatureOptions& o,
+             std::vector<SegmentSignature>* segments) {
+  const std::size_t sensors = *std::max_element(sensor_of.begin(), sensor_of.end()) + 1;
+  const auto bins = static_cast<Eigen::Index>(o.phase_bins);
+  for (std::size_t s = 0; s < segments->size(); ++s) {
+    std::vector<Eigen::VectorXd> held(
+        sensors, Eigen::VectorXd::Constant(bins, std::numeric_limits<double>::infinity()));
+    for (const SegmentedRecording& r : demos) {
+      const std::vector<double> e = segmentEdges(r);
+      std::vector<Eigen::VectorXd> contact(sensors, Eigen::VectorXd::Zero(bins));
+      for (std::size_t c = 0; c < sensor_of.size(); ++c) {
+        const int column = floors.columns[c];
+        const Eigen::VectorXd p = phaseProfile(r, column, e[s], e[s + 1], o.phase_bins);
+        contact[sensor_of[c]] = contact[sensor_of[c]].cwiseMax(
+            ((p.array() - r.features.data(0, column)).abs() / floors.rest_bands[c]).matrix());
+      }
+      for (std::size_t g = 0; g < sensors; ++g) held[g] = held[g].cwiseMin(contact[g]);
+    }
+    for (std::size_t c = 0; c < sensor_of.size(); ++c)
+      (*segments)[s].channels[c].held = held[sensor_of[c]];
+  }
+}
+
+// Per sample of `run` and per sensor, whether every channel of the sensor is within its rest band
+// of the run's first reading (no sample has an entry without bands).
+std::vector<std::vector<bool>> sensorsAtRest(const SegmentedRecording& run,
+                                             const std::vector<std::string>& channels,
+                                             const std::vector<double>& rest_bands,
+                                             const std::vector<std::size_t>& sensor_of) {
+  std::vector<std::vector<bool>> out(static_cast<std::size_t>(run.features.rows()));
+  if (rest_bands.empty()) return out;
+  const std::size_t sensors = *std::max_element(sensor_of.begin(), sensor_of.end()) + 1;
+  for (Eigen::Index i = 0; i < run.features.rows(); ++i) {
+    std::vector<bool>& at_rest = out[static_cast<std::size_t>(i)];
+    at_rest.assign(sensors, true);
+    for (std::size_t c = 0; c < channels.size(); ++c) {
+      const int column = run.features.require(channels[c]);
+      if (!(std::abs(run.features.data(i, column) - run.features.data(0, column)) < rest_bands[c]))
+        at_rest[sensor_of[c]] = false;
+    }
+  }
+  return out;
+}
+
 struct RawScores {
   std::vector<std::vector<double>> scores;    // [segment][channel]
   std::vector<std::vector<Deviation>> worst;  // [segment][channel], at the highest score
 };
 
+// rest_bands and sensor_of: per channel (empty bands: the levels alone, as the thresholds are set).
 RawScores rawScores(const std::vector<SegmentSignature>& segments,
                     const std::vector<std::string>& channels, const SignatureOptions& o,
-                    const SegmentedRecording& run) {
+                    const SegmentedRecording& run, const std::vector<double>& rest_bands = {},
+                    const std::vector<std::size_t>& sensor_of = {}) {
+  const std::vector<std::vector<bool>> at_rest =
+      sensorsAtRest(run, channels, rest_bands, sensor_of);
   RawScores out;
   out.scores.assign(segments.size(), std::vector<double>(channels.size(), 0.0));
   out.worst.assign(segments.size(), std::vector<Deviation>(channels.size()));
@@ -189,7 +246,9 @@ RawScores rawScores(const std::vector<SegmentSignature>& segments,
         if (t < edges[s] || t > edges[s + 1]) continue;
         const double phase = (t - edges[s]) / (edges[s + 1] - edges[s]);
         const double value = run.features.data(i, column);
-        const double d = sustained.push(t, deviationAt(segments, o, s, c, phase, value));
+        const std::vector<bool>& rest = at_rest[static_cast<std::size_t>(i)];
+        const Reading reading{value, !rest.empty() && rest[sensor_of[c]]};
+        const double d = sustained.push(t, deviationAt(segments, o, s, c, phase, reading));
         if (d <= out.scores[s][c]) continue;
         out.scores[s][c] = d;
         const auto bin = std::min<Eigen::Index>(static_cast<Eigen::Index>(phase * o.phase_bins),
@@ -228,11 +287,9 @@ void checkSignatureOptions(const SignatureOptions& o) {
     throw std::invalid_argument("phase_bins must be in [2, 1000], got " +
                                 std::to_string(o.phase_bins));
   const std::pair<const char*, double> at_least_zero[] = {
-      {"phase_slack", o.phase_slack},
-      {"time_slack", o.time_slack},
-      {"persistence", o.persistence},
-      {"min_spread_fraction", o.min_spread_fraction},
-      {"noise_sigmas", o.noise_sigmas}};
+      {"phase_slack", o.phase_slack},   {"time_slack", o.time_slack},
+      {"persistence", o.persistence},   {"min_spread_fraction", o.min_spread_fraction},
+      {"noise_sigmas", o.noise_sigmas}, {"rest_band_fraction", o.rest_band_fraction}};
   for (const auto& [name, v] : at_least_zero)
     if (!(v >= 0) || !std::isfinite(v))
       throw std::invalid_argument(std::string(name) + " must be finite and >= 0");
@@ -241,9 +298,25 @@ void checkSignatureOptions(const SignatureOptions& o) {
     throw std::invalid_argument("threshold_margin and min_threshold must be finite and > 0");
 }
 
+std::vector<std::size_t> sensorOf(const SensorySignature& signature) {
+  std::vector<std::size_t> out;
+  std::vector<std::string> seen;
+  for (std::size_t c = 0; c < signature.channels.size(); ++c) {
+    if (signature.sources.size() != signature.channels.size()) {
+      out.push_back(c);
+      continue;
+    }
+    const auto it = std::find(seen.begin(), seen.end(), signature.sources[c]);
+    out.push_back(static_cast<std::size_t>(it - seen.begin()));
+    if (it == seen.end()) seen.push_back(signature.sources[c]);
+  }
+  return out;
+}
+
 SensorySignature learnSignature(const std::vector<SegmentedRecording>& demos,
                                 const std::vector<std::string>& channels,
-                                const SignatureOptions& options) {
+                                const SignatureOptions& options,
+                                const std::vector<std::string>& sources) {
   if (demos.size() < 2)
     throw std::invalid_argument("a sensory signature needs at least 2 demonstrations, got " +
                                 std::to_string(demos.size()));
@@ -252,12 +325,21 @@ SensorySignature learnSignature(const std::vector<SegmentedRecording>& demos,
   for (std::size_t d = 0; d < demos.size(); ++d)
     checkRecording(demos[d], demos.front().boundaries.size(), channels,
                    "demonstration " + std::to_string(d));
+  if (!sources.empty() && sources.size() != channels.size())
+    throw std::invalid_argument("a sensory signature needs one source per channel, got " +
+                                std::to_string(sources.size()) + " for " +
+                                std::to_string(channels.size()));
   SensorySignature signature;
   signature.channels = channels;
+  signature.sources = sources;
   signature.options = options;
   signature.demonstrations = demos.size();
   const ChannelFloors floors = channelFloors(demos, channels, options);
   signature.segments = expectations(demos, floors, options);
+  if (options.rest_band_fraction > 0) {
+    signature.rest_bands = floors.rest_bands;
+    setHeld(demos, floors, sensorOf(signature), options, &signature.segments);
+  }
   setThresholds(demos, floors, channels, &signature);
   return signature;
 }
@@ -270,41 +352,52 @@ double segmentSlack(const SignatureOptions& options, const SegmentSignature& seg
 
 namespace {
 
-// The smallest distance to the expected level over the phase bins [from, to] of one segment.
+// A missing contact: the sensor at rest where the demonstrations all held one (2 bands away:
+// their noise and the run's cannot meet).
+bool missingContact(const ChannelSignature& channel, long bin, const Reading& r) {
+  return r.sensor_at_rest && channel.held.size() > bin && channel.held[bin] >= 2.0;
+}
+
+// The smallest distance to the expected level over the phase bins [from, to] of one segment; a
+// missing contact counts twice the channel's threshold.
 double deviationOver(const ChannelSignature& channel, std::size_t phase_bins, double from,
-                     double to, double value) {
+                     double to, const Reading& reading) {
   const auto last = static_cast<long>(channel.mean.size()) - 1;
   const auto bin = [&](double p) {
     return std::clamp(static_cast<long>(std::floor(std::clamp(p, 0.0, 1.0) * phase_bins)), 0L,
                       last);
   };
   double best = std::numeric_limits<double>::infinity();
-  for (long b = bin(from); b <= bin(to); ++b)
-    best = std::min(best, std::abs(value - channel.mean[b]) / channel.spread[b]);
+  for (long b = bin(from); b <= bin(to); ++b) {
+    const double level = std::abs(reading.value - channel.mean[b]) / channel.spread[b];
+    best = std::min(best, missingContact(channel, b, reading)
+                              ? std::max(level, 2.0 * channel.threshold)
+                              : level);
+  }
   return best;
 }
 
 }  // namespace
 
 double deviationAt(const std::vector<SegmentSignature>& segments, const SignatureOptions& options,
-                   std::size_t segment, std::size_t channel, double phase, double value) {
+                   std::size_t segment, std::size_t channel, double phase, const Reading& reading) {
   const SegmentSignature& here = segments[segment];
   const double slack = segmentSlack(options, here);
   const double p = std::clamp(phase, 0.0, 1.0);
   double best =
-      deviationOver(here.channels[channel], options.phase_bins, p - slack, p + slack, value);
+      deviationOver(here.channels[channel], options.phase_bins, p - slack, p + slack, reading);
   // The part of the slack beyond this segment's edge, in seconds, then in the neighbour's phase.
   const double before = (slack - p) * here.duration_mean;
   if (before > 0 && segment > 0 && segments[segment - 1].duration_mean > 0) {
     const SegmentSignature& previous = segments[segment - 1];
     best = std::min(best, deviationOver(previous.channels[channel], options.phase_bins,
-                                        1.0 - before / previous.duration_mean, 1.0, value));
+                                        1.0 - before / previous.duration_mean, 1.0, reading));
   }
   const double after = (p + slack - 1.0) * here.duration_mean;
   if (after > 0 && segment + 1 < segments.size() && segments[segment + 1].duration_mean > 0) {
     const SegmentSignature& next = segments[segment + 1];
     best = std::min(best, deviationOver(next.channels[channel], options.phase_bins, 0.0,
-                                        after / next.duration_mean, value));
+                                        after / next.duration_mean, reading));
   }
   return best;
 }
@@ -325,10 +418,16 @@ void SustainedDeviation::reset() {
 
 SignatureMonitor::SignatureMonitor(const SensorySignature& signature)
     : signature_(signature),
-      recent_(signature.channels.size(), SustainedDeviation(signature.options.persistence)) {}
+      recent_(signature.channels.size(), SustainedDeviation(signature.options.persistence)),
+      sensor_of_(sensorOf(signature)) {}
 
 void SignatureMonitor::reset() {
   for (SustainedDeviation& r : recent_) r.reset();
+}
+
+void SignatureMonitor::start() {
+  reset();
+  rest_.resize(0);
 }
 
 Deviation SignatureMonitor::observe(std::size_t segment, double phase, double time,
@@ -341,11 +440,19 @@ Deviation SignatureMonitor::observe(std::size_t segment, double phase, double ti
                                 " channel values, got " + std::to_string(values.size()));
   if (segment != segment_) reset();
   segment_ = segment;
+  if (rest_.size() == 0) rest_ = values;
+  std::vector<bool> at_rest(recent_.size(), signature_.rest_bands.size() == recent_.size());
+  for (std::size_t c = 0; c < signature_.rest_bands.size() && c < recent_.size(); ++c) {
+    const auto i = static_cast<Eigen::Index>(c);
+    if (!(std::abs(values[i] - rest_[i]) < signature_.rest_bands[c]))
+      at_rest[sensor_of_[c]] = false;
+  }
   const SignatureOptions& o = signature_.options;
   Deviation worst;
   for (std::size_t c = 0; c < recent_.size(); ++c) {
     const ChannelSignature& sig = signature_.segments[segment].channels[c];
-    const double d = deviationAt(signature_.segments, o, segment, c, phase, values[c]);
+    const double d =
+        deviationAt(signature_.segments, o, segment, c, phase, {values[c], at_rest[sensor_of_[c]]});
     const double score = recent_[c].push(time, d) / sig.threshold;
     if (c > 0 && score <= worst.score) continue;
     const auto bin = std::min<Eigen::Index>(
@@ -359,7 +466,8 @@ std::vector<std::vector<double>> scoreRecording(const SensorySignature& signatur
                                                 const SegmentedRecording& run,
                                                 std::vector<Deviation>* worst) {
   checkRecording(run, signature.segments.size() - 1, signature.channels, "the run");
-  const RawScores raw = rawScores(signature.segments, signature.channels, signature.options, run);
+  const RawScores raw = rawScores(signature.segments, signature.channels, signature.options, run,
+                                  signature.rest_bands, sensorOf(signature));
   std::vector<std::vector<double>> scores = raw.scores;
   if (worst) worst->clear();
   for (std::size_t s = 0; s < scores.size(); ++s) {

@@ -32,6 +32,12 @@ struct SignatureOptions {
   double noise_sigmas = 3.0;          ///< spread >= this x the channel's measurement noise
   double threshold_margin = 1.5;      ///< alarm at margin x the worst leave-one-out score ...
   double min_threshold = 3.0;         ///< ... and never below this many spreads
+  /// A channel is at rest within this fraction of its range over the task (at least noise_sigmas
+  /// x its noise) of its first reading; a sensor (the channels of one source) when all its
+  /// channels are. Where every demonstration's sensor was beyond twice that band (a contact all of
+  /// them held, on whichever channel), a sensor at rest is a missing contact whatever the level's
+  /// spread: the object is not there. 0 = off.
+  double rest_band_fraction = 0.05;
 };
 
 /// Throws std::invalid_argument naming the option that is out of range (phase_bins in [2, 1000],
@@ -44,6 +50,10 @@ struct ChannelSignature {
   Eigen::VectorXd spread;      ///< its spread per bin (same units), floors applied
   double threshold = 0.0;      ///< alarm above this deviation (in spreads)
   double nominal_score = 0.0;  ///< the worst leave-one-out score of the demonstrations
+  /// Per phase bin, how far from rest the channel's sensor was in the demonstration that was
+  /// nearest to rest, in rest bands (its channel farthest from its first reading; empty: no
+  /// missing-contact check, e.g. a library learned before it existed).
+  Eigen::VectorXd held;
 };
 
 struct SegmentSignature {
@@ -56,6 +66,9 @@ struct SensorySignature {
   std::vector<std::string> channels;  ///< feature names, e.g. /wrench/wrench/force/z
   std::vector<std::string> sources;   ///< per channel, where it is read live (a topic); optional
   std::vector<SegmentSignature> segments;
+  /// Per channel, how near its first reading a reading is at rest (rest_band_fraction); empty or
+  /// 0: no missing-contact check.
+  std::vector<double> rest_bands;
   SignatureOptions options;
   std::size_t demonstrations = 0;
 };
@@ -68,22 +81,38 @@ struct SegmentedRecording {
 };
 
 /// Learns the signature of `channels` from >= 2 demonstrations with the same number of boundaries.
-/// Throws std::invalid_argument for fewer demos, a differing boundary count, boundaries out of
-/// order or outside the recording, a missing channel, or a recording without a clock.
+/// `sources`: per channel, where it is read (its sensor: the channels of one source are judged
+/// together for a missing contact); empty: every channel a sensor of its own. Throws
+/// std::invalid_argument for fewer demos, a differing boundary count, boundaries out of order or
+/// outside the recording, a missing channel, a recording without a clock, or sources that are not
+/// one per channel.
 SensorySignature learnSignature(const std::vector<SegmentedRecording>& demos,
                                 const std::vector<std::string>& channels,
-                                const SignatureOptions& options = {});
+                                const SignatureOptions& options = {},
+                                const std::vector<std::string>& sources = {});
+
+/// Per channel, the index of its sensor: channels with the same source share one (sources empty:
+/// one per channel).
+std::vector<std::size_t> sensorOf(const SensorySignature& signature);
 
 /// The phase slack of one segment: options.phase_slack, at least options.time_slack over the
 /// segment's mean duration (a boundary placed 0.3 s off shifts every event near it by 0.3 s).
 double segmentSlack(const SignatureOptions& options, const SegmentSignature& segment);
 
+/// A reading of one channel, and whether every channel of its sensor is at rest (within its rest
+/// band of the run's first reading; false when that is unknown or the check is off).
+struct Reading {
+  double value = 0.0;
+  bool sensor_at_rest = false;
+};
+
 /// How far one channel's reading at `phase` of `segment` is from what the demonstrations showed
 /// within the slack around it, in spreads. The slack reaches into the neighbouring segments: a
 /// boundary sits at a sensory event, so an event a little late in a run shows the previous
-/// segment's level just after the boundary.
+/// segment's level just after the boundary. A sensor at rest where every demonstration held a
+/// contact throughout the slack is twice the channel's threshold (a clear alarm once it lasts).
 double deviationAt(const std::vector<SegmentSignature>& segments, const SignatureOptions& options,
-                   std::size_t segment, std::size_t channel, double phase, double value);
+                   std::size_t segment, std::size_t channel, double phase, const Reading& reading);
 
 /// A deviation that lasted: which segment and channel, when, expected versus measured.
 struct Deviation {
@@ -123,12 +152,17 @@ class SignatureMonitor {
   /// of range or a wrong number of values.
   Deviation observe(std::size_t segment, double phase, double time, const Eigen::VectorXd& values);
 
-  /// Forgets the recent readings (a new segment or a restart after a recovery).
+  /// Forgets the recent readings (a new segment).
   void reset();
+  /// A new run (or a restart after a recovery): forgets the recent readings and the rest levels;
+  /// the next readings are the run's rest.
+  void start();
 
  private:
   const SensorySignature& signature_;
   std::vector<SustainedDeviation> recent_;
+  std::vector<std::size_t> sensor_of_;  ///< per channel, its sensor (sensorOf)
+  Eigen::VectorXd rest_;                ///< the run's first readings (empty until observed)
   std::size_t segment_ = 0;
 };
 
