@@ -119,6 +119,7 @@ TEST(SensorySignature, AMissingContactIsAnAlarmWhateverTheLevelsSpread) {
   for (unsigned k = 0; k < 5; ++k) demos.push_back(pressRun(varied(k), 1000 + k));
   lfd::SignatureOptions wide;
   wide.min_spread_fraction = 0.5;
+  wide.rest_band_fraction = 0.05;
   const auto sig = lfd::learnSignature(demos, {"force_z", "gripper"}, wide);
   wide.rest_band_fraction = 0.0;
   const auto levels_only = lfd::learnSignature(demos, {"force_z", "gripper"}, wide);
@@ -171,6 +172,7 @@ TEST(SensorySignature, AContactIsMissingOnlyWhenEveryChannelOfItsSensorIsAtRest)
   const std::vector<std::string> pads = {"pad_left", "pad_right"};
   lfd::SignatureOptions wide;
   wide.min_spread_fraction = 0.5;  // the levels alone could not tell
+  wide.rest_band_fraction = 0.05;
   const auto one_sensor = lfd::learnSignature(demos, pads, wide, {"/touch", "/touch"});
   const auto two_sensors = lfd::learnSignature(demos, pads, wide);
   EXPECT_EQ(lfd::sensorOf(one_sensor), (std::vector<std::size_t>{0, 0}));
@@ -183,6 +185,33 @@ TEST(SensorySignature, AContactIsMissingOnlyWhenEveryChannelOfItsSensorIsAtRest)
     EXPECT_GT(lfd::scoreRecording(one_sensor, twoPads(press, false, false))[1][0], 1.0);
   }
   EXPECT_THROW(lfd::learnSignature(demos, pads, wide, {"/touch"}), std::invalid_argument);
+}
+
+// A noisy pad (teleop-like: a reading at rest is |N(0, 0.45)| N, clipped at 0) strays beyond its
+// rest band in one reading of three, its mean over the persistence window does not: a press
+// without force is still a missing contact, a nominal press is not.
+TEST(SensorySignature, ANoisyPadAtRestIsJudgedOnItsMeanOverThePersistenceWindow) {
+  const auto noisyPad = [](Press p, unsigned seed) {
+    p.level *= 0.4;
+    lfd::SegmentedRecording r = pressRun(p, seed);
+    std::mt19937 rng(seed + 17);
+    std::normal_distribution<double> noise(0.0, 0.45);
+    for (Eigen::Index i = 0; i < r.features.rows(); ++i)
+      r.features.data(i, 0) = std::max(0.0, r.features.data(i, 0) + noise(rng));
+    return r;
+  };
+  std::vector<lfd::SegmentedRecording> demos;
+  for (unsigned k = 0; k < 6; ++k) demos.push_back(noisyPad(varied(k), 1000 + k));
+  lfd::SignatureOptions wide;
+  wide.min_spread_fraction = 0.5;
+  wide.rest_band_fraction = 0.05;
+  const auto sig = lfd::learnSignature(demos, {"force_z", "gripper"}, wide);
+  for (unsigned k = 0; k < 6; ++k) {
+    Press missed = varied(40 + k);
+    missed.level = 0.0;
+    EXPECT_GT(lfd::scoreRecording(sig, noisyPad(missed, 4000 + k))[1][0], 1.0) << "run " << k;
+    EXPECT_LT(worstScore(lfd::scoreRecording(sig, noisyPad(varied(50 + k), 5000 + k))), 1.0);
+  }
 }
 
 TEST(SensorySignature, TheLiveMonitorRaisesASlipWithinAFifthOfASecond) {

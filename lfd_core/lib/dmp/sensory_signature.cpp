@@ -171,8 +171,20 @@ std::vector<SegmentSignature> expectations(const std::vector<SegmentedRecording>
   return out;
 }
 
+// A channel's rest level: its mean over the recording's first `window` s (RestTracker's).
+double restLevel(const SegmentedRecording& r, int column, double window) {
+  double sum = 0.0;
+  int count = 0;
+  for (Eigen::Index i = 0; i < r.features.rows(); ++i) {
+    if (count > 0 && r.features.timeAt(i) - r.features.timeAt(0) > window) break;
+    sum += r.features.data(i, column);
+    ++count;
+  }
+  return sum / count;
+}
+
 // Each channel's `held`: per bin, the least contact any demonstration's sensor showed, in rest
-// bands: the largest distance of the sensor's channels from their first reading (which pad or axis
+// bands: the largest distance of the sensor's channels from their rest level (which pad or axis
 // feels the contact may differ between demonstrations, that one does not).
 void setHeld(const std::vector<SegmentedRecording>& demos, const ChannelFloors& floors,
              const std::vector<std::size_t>& sensor_of, const SignatureOptions& o,
@@ -189,7 +201,8 @@ void setHeld(const std::vector<SegmentedRecording>& demos, const ChannelFloors& 
         const int column = floors.columns[c];
         const Eigen::VectorXd p = phaseProfile(r, column, e[s], e[s + 1], o.phase_bins);
         contact[sensor_of[c]] = contact[sensor_of[c]].cwiseMax(
-            ((p.array() - r.features.data(0, column)).abs() / floors.rest_bands[c]).matrix());
+            ((p.array() - restLevel(r, column, o.persistence)).abs() / floors.rest_bands[c])
+                .matrix());
       }
       for (std::size_t g = 0; g < sensors; ++g) held[g] = held[g].cwiseMin(contact[g]);
     }
@@ -198,23 +211,22 @@ void setHeld(const std::vector<SegmentedRecording>& demos, const ChannelFloors& 
   }
 }
 
-// Per sample of `run` and per sensor, whether every channel of the sensor is within its rest band
-// of the run's first reading (no sample has an entry without bands).
+// Per sample of `run` and per sensor, whether it is at rest (RestTracker; no entry without bands).
 std::vector<std::vector<bool>> sensorsAtRest(const SegmentedRecording& run,
                                              const std::vector<std::string>& channels,
                                              const std::vector<double>& rest_bands,
-                                             const std::vector<std::size_t>& sensor_of) {
+                                             const std::vector<std::size_t>& sensor_of,
+                                             double window) {
   std::vector<std::vector<bool>> out(static_cast<std::size_t>(run.features.rows()));
   if (rest_bands.empty()) return out;
-  const std::size_t sensors = *std::max_element(sensor_of.begin(), sensor_of.end()) + 1;
+  std::vector<int> columns;
+  for (const std::string& c : channels) columns.push_back(run.features.require(c));
+  RestTracker tracker(rest_bands, sensor_of, window);
+  Eigen::VectorXd values(static_cast<Eigen::Index>(columns.size()));
   for (Eigen::Index i = 0; i < run.features.rows(); ++i) {
-    std::vector<bool>& at_rest = out[static_cast<std::size_t>(i)];
-    at_rest.assign(sensors, true);
-    for (std::size_t c = 0; c < channels.size(); ++c) {
-      const int column = run.features.require(channels[c]);
-      if (!(std::abs(run.features.data(i, column) - run.features.data(0, column)) < rest_bands[c]))
-        at_rest[sensor_of[c]] = false;
-    }
+    for (std::size_t c = 0; c < columns.size(); ++c)
+      values[static_cast<Eigen::Index>(c)] = run.features.data(i, columns[c]);
+    out[static_cast<std::size_t>(i)] = tracker.push(run.features.timeAt(i), values);
   }
   return out;
 }
@@ -230,7 +242,7 @@ RawScores rawScores(const std::vector<SegmentSignature>& segments,
                     const SegmentedRecording& run, const std::vector<double>& rest_bands = {},
                     const std::vector<std::size_t>& sensor_of = {}) {
   const std::vector<std::vector<bool>> at_rest =
-      sensorsAtRest(run, channels, rest_bands, sensor_of);
+      sensorsAtRest(run, channels, rest_bands, sensor_of, o.persistence);
   RawScores out;
   out.scores.assign(segments.size(), std::vector<double>(channels.size(), 0.0));
   out.worst.assign(segments.size(), std::vector<Deviation>(channels.size()));
@@ -411,6 +423,43 @@ double SustainedDeviation::push(double time, double deviation) {
   return time - first_time_ >= persistence_ ? window_.front().second : 0.0;
 }
 
+RestTracker::RestTracker(std::vector<double> rest_bands, std::vector<std::size_t> sensor_of,
+                         double window)
+    : rest_bands_(std::move(rest_bands)), sensor_of_(std::move(sensor_of)), window_(window) {
+  const std::size_t sensors =
+      sensor_of_.empty() ? 0 : *std::max_element(sensor_of_.begin(), sensor_of_.end()) + 1;
+  at_rest_.assign(sensors, false);
+}
+
+const std::vector<bool>& RestTracker::push(double time, const Eigen::VectorXd& values) {
+  if (rest_bands_.size() != static_cast<std::size_t>(values.size())) return at_rest_;  // off
+  if (recent_.empty() && rest_.size() == 0) {
+    first_time_ = time;
+    sum_ = Eigen::VectorXd::Zero(values.size());
+  }
+  recent_.emplace_back(time, values);
+  sum_ += values;
+  while (recent_.size() > 1 && recent_.front().first < time - window_) {
+    sum_ -= recent_.front().second;
+    recent_.pop_front();
+  }
+  if (time - first_time_ < window_) return at_rest_;
+  const Eigen::VectorXd mean = sum_ / static_cast<double>(recent_.size());
+  if (rest_.size() == 0) rest_ = mean;
+  std::fill(at_rest_.begin(), at_rest_.end(), true);
+  for (std::size_t c = 0; c < rest_bands_.size(); ++c) {
+    const auto i = static_cast<Eigen::Index>(c);
+    if (!(std::abs(mean[i] - rest_[i]) < rest_bands_[c])) at_rest_[sensor_of_[c]] = false;
+  }
+  return at_rest_;
+}
+
+void RestTracker::restart() {
+  recent_.clear();
+  rest_.resize(0);
+  std::fill(at_rest_.begin(), at_rest_.end(), false);
+}
+
 void SustainedDeviation::reset() {
   window_.clear();
   started_ = false;
@@ -419,7 +468,8 @@ void SustainedDeviation::reset() {
 SignatureMonitor::SignatureMonitor(const SensorySignature& signature)
     : signature_(signature),
       recent_(signature.channels.size(), SustainedDeviation(signature.options.persistence)),
-      sensor_of_(sensorOf(signature)) {}
+      sensor_of_(sensorOf(signature)),
+      rest_(signature.rest_bands, sensor_of_, signature.options.persistence) {}
 
 void SignatureMonitor::reset() {
   for (SustainedDeviation& r : recent_) r.reset();
@@ -427,7 +477,7 @@ void SignatureMonitor::reset() {
 
 void SignatureMonitor::start() {
   reset();
-  rest_.resize(0);
+  rest_.restart();
 }
 
 Deviation SignatureMonitor::observe(std::size_t segment, double phase, double time,
@@ -440,19 +490,13 @@ Deviation SignatureMonitor::observe(std::size_t segment, double phase, double ti
                                 " channel values, got " + std::to_string(values.size()));
   if (segment != segment_) reset();
   segment_ = segment;
-  if (rest_.size() == 0) rest_ = values;
-  std::vector<bool> at_rest(recent_.size(), signature_.rest_bands.size() == recent_.size());
-  for (std::size_t c = 0; c < signature_.rest_bands.size() && c < recent_.size(); ++c) {
-    const auto i = static_cast<Eigen::Index>(c);
-    if (!(std::abs(values[i] - rest_[i]) < signature_.rest_bands[c]))
-      at_rest[sensor_of_[c]] = false;
-  }
+  const std::vector<bool>& at_rest = rest_.push(time, values);
   const SignatureOptions& o = signature_.options;
   Deviation worst;
   for (std::size_t c = 0; c < recent_.size(); ++c) {
     const ChannelSignature& sig = signature_.segments[segment].channels[c];
-    const double d =
-        deviationAt(signature_.segments, o, segment, c, phase, {values[c], at_rest[sensor_of_[c]]});
+    const double d = deviationAt(signature_.segments, o, segment, c, phase,
+                                 {values[c], !at_rest.empty() && at_rest[sensor_of_[c]]});
     const double score = recent_[c].push(time, d) / sig.threshold;
     if (c > 0 && score <= worst.score) continue;
     const auto bin = std::min<Eigen::Index>(

@@ -33,11 +33,14 @@ struct SignatureOptions {
   double threshold_margin = 1.5;      ///< alarm at margin x the worst leave-one-out score ...
   double min_threshold = 3.0;         ///< ... and never below this many spreads
   /// A channel is at rest within this fraction of its range over the task (at least noise_sigmas
-  /// x its noise) of its first reading; a sensor (the channels of one source) when all its
-  /// channels are. Where every demonstration's sensor was beyond twice that band (a contact all of
-  /// them held, on whichever channel), a sensor at rest is a missing contact whatever the level's
-  /// spread: the object is not there. 0 = off.
-  double rest_band_fraction = 0.05;
+  /// x its noise) of its rest level, both means over `persistence` (the rest level: the run's
+  /// first such mean); a sensor (the channels of one source) when all its channels are. Where every
+  /// demonstration's sensor was beyond twice that band (a contact all of them held, on whichever
+  /// channel), a sensor at rest is a missing contact whatever the level's spread: the object is not
+  /// there. 0 = off: a contact sensor's check, which the learner turns on for its monitored
+  /// topics (learner.yaml signature/rest_band_fraction); off in the signature CLI, whose channels
+  /// may follow the motion (PR2's tracking errors: 6 -> 5 of 9 at 0.05).
+  double rest_band_fraction = 0.0;
 };
 
 /// Throws std::invalid_argument naming the option that is out of range (phase_bins in [2, 1000],
@@ -66,8 +69,8 @@ struct SensorySignature {
   std::vector<std::string> channels;  ///< feature names, e.g. /wrench/wrench/force/z
   std::vector<std::string> sources;   ///< per channel, where it is read live (a topic); optional
   std::vector<SegmentSignature> segments;
-  /// Per channel, how near its first reading a reading is at rest (rest_band_fraction); empty or
-  /// 0: no missing-contact check.
+  /// Per channel, how near its rest level a reading is at rest (rest_band_fraction); empty or 0:
+  /// no missing-contact check.
   std::vector<double> rest_bands;
   SignatureOptions options;
   std::size_t demonstrations = 0;
@@ -99,8 +102,8 @@ std::vector<std::size_t> sensorOf(const SensorySignature& signature);
 /// segment's mean duration (a boundary placed 0.3 s off shifts every event near it by 0.3 s).
 double segmentSlack(const SignatureOptions& options, const SegmentSignature& segment);
 
-/// A reading of one channel, and whether every channel of its sensor is at rest (within its rest
-/// band of the run's first reading; false when that is unknown or the check is off).
+/// A reading of one channel, and whether every channel of its sensor is at rest (RestTracker;
+/// false when that is unknown or the check is off).
 struct Reading {
   double value = 0.0;
   bool sensor_at_rest = false;
@@ -113,6 +116,27 @@ struct Reading {
 /// contact throughout the slack is twice the channel's threshold (a clear alarm once it lasts).
 double deviationAt(const std::vector<SegmentSignature>& segments, const SignatureOptions& options,
                    std::size_t segment, std::size_t channel, double phase, const Reading& reading);
+
+/// Which sensors are at rest: each channel's mean over the last `window` s within its rest band of
+/// the run's rest level, the first such mean (a noisy pad's single readings stray beyond the band,
+/// its mean over 0.1 s does not). Nothing is at rest until the first window is complete.
+class RestTracker {
+ public:
+  RestTracker(std::vector<double> rest_bands, std::vector<std::size_t> sensor_of, double window);
+  /// After a reading of every channel at `time` s: per sensor, whether it is at rest.
+  const std::vector<bool>& push(double time, const Eigen::VectorXd& values);
+  /// A new run: its next readings make its rest level.
+  void restart();
+
+ private:
+  std::vector<double> rest_bands_;
+  std::vector<std::size_t> sensor_of_;
+  double window_;
+  std::deque<std::pair<double, Eigen::VectorXd>> recent_;
+  Eigen::VectorXd sum_, rest_;  ///< rest_ empty until the first window is complete
+  double first_time_ = 0.0;
+  std::vector<bool> at_rest_;
+};
 
 /// A deviation that lasted: which segment and channel, when, expected versus measured.
 struct Deviation {
@@ -155,14 +179,14 @@ class SignatureMonitor {
   /// Forgets the recent readings (a new segment).
   void reset();
   /// A new run (or a restart after a recovery): forgets the recent readings and the rest levels;
-  /// the next readings are the run's rest.
+  /// the next readings make the run's rest (RestTracker).
   void start();
 
  private:
   const SensorySignature& signature_;
   std::vector<SustainedDeviation> recent_;
   std::vector<std::size_t> sensor_of_;  ///< per channel, its sensor (sensorOf)
-  Eigen::VectorXd rest_;                ///< the run's first readings (empty until observed)
+  RestTracker rest_;
   std::size_t segment_ = 0;
 };
 
