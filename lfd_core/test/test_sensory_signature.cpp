@@ -158,7 +158,7 @@ TEST(SensorySignature, AMissingContactIsAnAlarmWhateverTheLevelsSpread) {
 // a new goal may meet the box with the right pad only: the sensor still feels the contact. Judged
 // pad by pad (no sources), the left pad at rest would be a missing contact; on neither pad it is.
 TEST(SensorySignature, AContactIsMissingOnlyWhenEveryChannelOfItsSensorIsAtRest) {
-  const auto twoPads = [](const lfd::SegmentedRecording& press, bool left, bool right) {
+  const auto two_pads = [](const lfd::SegmentedRecording& press, bool left, bool right) {
     lfd::SegmentedRecording r = press;
     r.features.names = {"pad_left", "pad_right"};
     r.features.data.resize(press.features.rows(), 2);
@@ -168,7 +168,7 @@ TEST(SensorySignature, AContactIsMissingOnlyWhenEveryChannelOfItsSensorIsAtRest)
   };
   std::vector<lfd::SegmentedRecording> demos;
   for (unsigned k = 0; k < 6; ++k)
-    demos.push_back(twoPads(pressRun(varied(k), 1000 + k), true, k % 2 == 1));
+    demos.push_back(two_pads(pressRun(varied(k), 1000 + k), true, k % 2 == 1));
   const std::vector<std::string> pads = {"pad_left", "pad_right"};
   lfd::SignatureOptions wide;
   wide.min_spread_fraction = 0.5;  // the levels alone could not tell
@@ -179,10 +179,10 @@ TEST(SensorySignature, AContactIsMissingOnlyWhenEveryChannelOfItsSensorIsAtRest)
   EXPECT_EQ(lfd::sensorOf(two_sensors), (std::vector<std::size_t>{0, 1}));
   for (unsigned k = 0; k < 6; ++k) {
     const lfd::SegmentedRecording press = pressRun(varied(80 + k), 8000 + k);
-    EXPECT_LT(worstScore(lfd::scoreRecording(one_sensor, twoPads(press, true, false))), 1.0);
-    EXPECT_LT(worstScore(lfd::scoreRecording(one_sensor, twoPads(press, false, true))), 1.0);
-    EXPECT_GT(lfd::scoreRecording(two_sensors, twoPads(press, false, true))[1][0], 1.0);
-    EXPECT_GT(lfd::scoreRecording(one_sensor, twoPads(press, false, false))[1][0], 1.0);
+    EXPECT_LT(worstScore(lfd::scoreRecording(one_sensor, two_pads(press, true, false))), 1.0);
+    EXPECT_LT(worstScore(lfd::scoreRecording(one_sensor, two_pads(press, false, true))), 1.0);
+    EXPECT_GT(lfd::scoreRecording(two_sensors, two_pads(press, false, true))[1][0], 1.0);
+    EXPECT_GT(lfd::scoreRecording(one_sensor, two_pads(press, false, false))[1][0], 1.0);
   }
   EXPECT_THROW(lfd::learnSignature(demos, pads, wide, {"/touch"}), std::invalid_argument);
 }
@@ -191,7 +191,7 @@ TEST(SensorySignature, AContactIsMissingOnlyWhenEveryChannelOfItsSensorIsAtRest)
 // rest band in one reading of three, its mean over the persistence window does not: a press
 // without force is still a missing contact, a nominal press is not.
 TEST(SensorySignature, ANoisyPadAtRestIsJudgedOnItsMeanOverThePersistenceWindow) {
-  const auto noisyPad = [](Press p, unsigned seed) {
+  const auto noisy_pad = [](Press p, unsigned seed) {
     p.level *= 0.4;
     lfd::SegmentedRecording r = pressRun(p, seed);
     std::mt19937 rng(seed + 17);
@@ -201,7 +201,7 @@ TEST(SensorySignature, ANoisyPadAtRestIsJudgedOnItsMeanOverThePersistenceWindow)
     return r;
   };
   std::vector<lfd::SegmentedRecording> demos;
-  for (unsigned k = 0; k < 6; ++k) demos.push_back(noisyPad(varied(k), 1000 + k));
+  for (unsigned k = 0; k < 6; ++k) demos.push_back(noisy_pad(varied(k), 1000 + k));
   lfd::SignatureOptions wide;
   wide.min_spread_fraction = 0.5;
   wide.rest_band_fraction = 0.05;
@@ -209,8 +209,8 @@ TEST(SensorySignature, ANoisyPadAtRestIsJudgedOnItsMeanOverThePersistenceWindow)
   for (unsigned k = 0; k < 6; ++k) {
     Press missed = varied(40 + k);
     missed.level = 0.0;
-    EXPECT_GT(lfd::scoreRecording(sig, noisyPad(missed, 4000 + k))[1][0], 1.0) << "run " << k;
-    EXPECT_LT(worstScore(lfd::scoreRecording(sig, noisyPad(varied(50 + k), 5000 + k))), 1.0);
+    EXPECT_GT(lfd::scoreRecording(sig, noisy_pad(missed, 4000 + k))[1][0], 1.0) << "run " << k;
+    EXPECT_LT(worstScore(lfd::scoreRecording(sig, noisy_pad(varied(50 + k), 5000 + k))), 1.0);
   }
 }
 
