@@ -263,8 +263,19 @@ class Demonstrator {
     // A listener only for this lookup: kept, it would take in every /tf message of every demo.
     tf2_ros::Buffer tf_buffer;
     const tf2_ros::TransformListener tf_listener(tf_buffer);
+    // Waited for in wall time: tf's own timeout counts sim time, and 30 s of a simulation running
+    // free at ~12x was 2.5 s, too short on a loaded machine for the listener to connect ("world
+    // does not exist": a fresh root's recorder_topics test).
+    const ros::WallTime tf_deadline = ros::WallTime::now() + ros::WallDuration(30.0);
+    std::string why;
+    while (!tf_buffer.canTransform("world", robot_.poseFrame(), ros::Time(0), &why)) {
+      if (ros::WallTime::now() > tf_deadline || !ros::ok())
+        throw std::runtime_error("no transform from '" + robot_.poseFrame() +
+                                 "' to 'world' on tf in 30 s of wall time: " + why);
+      ros::WallDuration(0.01).sleep();
+    }
     const geometry_msgs::TransformStamped w =
-        tf_buffer.lookupTransform("world", robot_.poseFrame(), ros::Time(0), ros::Duration(30.0));
+        tf_buffer.lookupTransform("world", robot_.poseFrame(), ros::Time(0));
     world_from_base_ = Eigen::Isometry3d::Identity();
     world_from_base_.translation() = Eigen::Vector3d(
         w.transform.translation.x, w.transform.translation.y, w.transform.translation.z);
