@@ -276,11 +276,14 @@ class ExecutorAction(unittest.TestCase):
         weak = self.lost_for_good(0.1)
         # A tenth of the grip opens the gripper within release_time in most runs, not in all: then
         # the retries end early (at the first lost grasp in one local run of ten), explained as a
-        # gripper that does not open.
+        # gripper that does not open. Or the dropped stick lies where no retry can be planned
+        # (outside the demonstrated range: a fresh root, 1 run): explained as such.
         self.assertLessEqual(len(weak.recoveries), attempts, weak.recoveries)
-        ended = ("the grasp was lost after %d recoveries" % attempts
-                 if len(weak.recoveries) == attempts else "the gripper does not open")
-        self.assertIn(ended, weak.error)
+        if len(weak.recoveries) == attempts:
+            self.assertIn("the grasp was lost after %d recoveries" % attempts, weak.error)
+        else:
+            self.assertTrue(any(why in weak.error for why in (
+                "the gripper does not open", "the retry cannot be planned")), weak.error)
         dead = self.lost_for_good(0.0)
         self.assertEqual(list(dead.recoveries), [])
         self.assertIn("the gripper does not open", dead.error)
