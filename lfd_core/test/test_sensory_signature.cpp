@@ -57,6 +57,15 @@ lfd::SensorySignature learned(std::size_t demos) {
   return lfd::learnSignature(d, {"force_z", "gripper"});
 }
 
+// A spread floor of half the range (the levels alone cannot tell a missing press) with the
+// missing-contact check on, as the learner's configuration turns it on.
+lfd::SignatureOptions wideSpreadWithRestBands() {
+  lfd::SignatureOptions o;
+  o.min_spread_fraction = 0.5;
+  o.rest_band_fraction = 0.05;
+  return o;
+}
+
 double worstScore(const std::vector<std::vector<double>>& scores) {
   double worst = 0.0;
   for (const auto& s : scores)
@@ -117,9 +126,7 @@ TEST(SensorySignature, APressWithoutForceIsFlaggedInThePressSegment) {
 TEST(SensorySignature, AMissingContactIsAnAlarmWhateverTheLevelsSpread) {
   std::vector<lfd::SegmentedRecording> demos;
   for (unsigned k = 0; k < 5; ++k) demos.push_back(pressRun(varied(k), 1000 + k));
-  lfd::SignatureOptions wide;
-  wide.min_spread_fraction = 0.5;
-  wide.rest_band_fraction = 0.05;
+  lfd::SignatureOptions wide = wideSpreadWithRestBands();
   const auto sig = lfd::learnSignature(demos, {"force_z", "gripper"}, wide);
   wide.rest_band_fraction = 0.0;
   const auto levels_only = lfd::learnSignature(demos, {"force_z", "gripper"}, wide);
@@ -170,9 +177,7 @@ TEST(SensorySignature, AContactIsMissingOnlyWhenEveryChannelOfItsSensorIsAtRest)
   for (unsigned k = 0; k < 6; ++k)
     demos.push_back(two_pads(pressRun(varied(k), 1000 + k), true, k % 2 == 1));
   const std::vector<std::string> pads = {"pad_left", "pad_right"};
-  lfd::SignatureOptions wide;
-  wide.min_spread_fraction = 0.5;  // the levels alone could not tell
-  wide.rest_band_fraction = 0.05;
+  lfd::SignatureOptions wide = wideSpreadWithRestBands();  // the levels alone could not tell
   const auto one_sensor = lfd::learnSignature(demos, pads, wide, {"/touch", "/touch"});
   const auto two_sensors = lfd::learnSignature(demos, pads, wide);
   EXPECT_EQ(lfd::sensorOf(one_sensor), (std::vector<std::size_t>{0, 0}));
@@ -202,9 +207,7 @@ TEST(SensorySignature, ANoisyPadAtRestIsJudgedOnItsMeanOverThePersistenceWindow)
   };
   std::vector<lfd::SegmentedRecording> demos;
   for (unsigned k = 0; k < 6; ++k) demos.push_back(noisy_pad(varied(k), 1000 + k));
-  lfd::SignatureOptions wide;
-  wide.min_spread_fraction = 0.5;
-  wide.rest_band_fraction = 0.05;
+  lfd::SignatureOptions wide = wideSpreadWithRestBands();
   const auto sig = lfd::learnSignature(demos, {"force_z", "gripper"}, wide);
   for (unsigned k = 0; k < 6; ++k) {
     Press missed = varied(40 + k);
