@@ -361,6 +361,31 @@ TEST(SensoryEvents, FittedEventsAtTheStartAndEndOfSlowRamps) {
   EXPECT_NEAR(static_cast<double>(rest_edges[1]), 530.0, 5.0);  // back at rest
 }
 
+// A snap-fit in contact at 50 Hz: pressed at 13 N from 2 s, the force rises (quadratically, as the
+// hook deflects) from 6 s to 29 N at 6.9 s, and falls to a 9 N hold as it clicks over. The rise
+// and the fall are 0.9 s apart: the merge gap (0.5 s, the joint segmentation's) makes one burst of
+// them. Each end of it is fitted on its own change: the rise starts at 6 s (within 0.3 s; a fit
+// across the fall put it on the fall), the fall settles by 7 s.
+TEST(SensoryEvents, ARiseAndAFallInOneBurstAreTwoChanges) {
+  std::mt19937 rng(5);
+  std::normal_distribution<double> g(0.0, 0.3);
+  Eigen::VectorXd force(450);
+  for (Eigen::Index t = 0; t < force.size(); ++t) {
+    double f = 13.0 * std::clamp((t - 100.0) / 10.0, 0.0, 1.0);
+    if (t >= 300 && t < 345) f = 13.0 + 16.0 * std::pow((t - 300.0) / 45.0, 2.0);
+    if (t >= 345) f = 9.0 + 20.0 * std::exp(-(t - 345.0) / 2.5);
+    force[t] = f + g(rng);
+  }
+  SensoryEventConfig joint = yamlAt50hz();
+  joint.merge_gap = 25;
+  const Events events = lfd::detectSensoryEvents(force, joint);
+  ASSERT_EQ(events.size(), 3u) << ::testing::PrintToString(events);
+  EXPECT_NEAR(static_cast<double>(events[0]), 100.0, 3.0);  // the press
+  // The rise begins: a straight ramp fitted to a quadratic starts a third of the way in.
+  EXPECT_NEAR(static_cast<double>(events[1]), 300.0, 15.0);
+  EXPECT_NEAR(static_cast<double>(events[2]), 347.0, 10.0);  // the fall has settled
+}
+
 // Two pads of one sensor: pad A touches from 4 s to 7 s, pad B from 6.5 s to 10 s. As one sensor
 // the contact starts at 4 s and ends at 10 s: A letting go while B holds is no rest edge. As two
 // sensors every edge is one.

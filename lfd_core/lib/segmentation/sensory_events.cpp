@@ -222,23 +222,80 @@ std::vector<Burst> mergeBursts(const std::vector<Burst>& bursts, std::size_t gap
   return merged;
 }
 
+// y[t + ahead] - y[t - behind] of the smoothed y (laggedDifferences with its sign); 0 where it is
+// not defined.
+double signedDifference(const std::vector<double>& y, std::size_t lag, std::size_t t) {
+  const std::size_t ahead = lag / 2, behind = lag - ahead;
+  if (t < behind || t + ahead >= y.size()) return 0.0;
+  return y[t + ahead] - y[t - behind];
+}
+
+// Where the level's change turns round, scanning from `from` towards `to` (either way): having
+// gone one way by more than `off`, the signed lagged difference goes the other way by more than
+// `off`; the last sample before that which still went the first way (or had no sign). `to` when
+// the change never turns round.
+std::size_t turningPoint(const std::vector<double>& y, std::size_t lag, std::size_t from,
+                         std::size_t to, double off) {
+  const long step = to >= from ? 1 : -1;
+  double direction = 0.0;
+  std::size_t last_along = from;
+  for (std::size_t t = from; t != to; t = static_cast<std::size_t>(static_cast<long>(t) + step)) {
+    const double d = signedDifference(y, lag, t);
+    if (direction == 0.0 && std::abs(d) > off) direction = d > 0 ? 1.0 : -1.0;
+    if (direction * d >= 0.0) last_along = t;
+    if (direction * d < -off) return last_along;
+  }
+  return to;
+}
+
+// The windows [begin, end) fitRamp sees around a burst's start and its end. Each reaches a lag
+// beyond the burst's edge on the outside and two lags inside, but not past the point where the
+// level's change turns round (turningPoint): the merge gap can join two changes into one burst, a
+// force rising as a snap hook deflects and falling as it clicks over, and one flat-ramp-flat fit
+// across both put the rise's start on the fall (the insertion of the snap-fit class was lost). A
+// window keeps at least a lag inside the burst, where the new level shows, so that a wiping
+// force whose friction flips at every stroke is still fitted on its press.
+struct FitWindows {
+  std::size_t first_begin, first_end, last_begin, last_end;
+};
+
+FitWindows fitWindows(const Burst& b, const Channel& c, const SensoryEventConfig& config) {
+  const std::size_t n = c.y.size(), lag = config.difference_lag;
+  const double off = config.hysteresis * c.on;
+  FitWindows w;
+  w.first_begin = b.begin > lag ? b.begin - lag : 0;
+  const std::size_t first_reach = std::min(n, b.begin + 2 * lag + 1);
+  const std::size_t first_turn = turningPoint(c.y, lag, b.begin, first_reach, off) + 1;
+  w.first_end = std::max(std::min(first_reach, std::max(first_turn, b.begin + lag + 1)),
+                         std::min(n, w.first_begin + 2));
+  w.last_end = std::min(n, b.end + lag + 1);
+  const std::size_t last_reach = b.end > 2 * lag + w.first_begin ? b.end - 2 * lag : w.first_begin;
+  if (b.end == n) {
+    w.last_begin = last_reach;
+    return w;
+  }
+  const std::size_t last_turn = turningPoint(c.y, lag, b.end - 1, last_reach, off);
+  w.last_begin = std::min(std::max(last_reach, std::min(last_turn, b.end > lag ? b.end - lag : 0)),
+                          w.last_end - 2);
+  return w;
+}
+
 // EventPlacement::kFit: the burst's start where the level starts to change and its end where it
-// settles (fitRamp around each end); the ends of a short ramp or step are one event. An event
-// whose outer level is the rest level (the level at the demo's start, within the activity
-// threshold) leaves or regains rest on this channel.
+// settles (fitRamp in fitWindows); the ends of a short ramp or step are one event. An event whose
+// outer level is the rest level (the level at the demo's start, within the activity threshold)
+// leaves or regains rest on this channel.
 void placeByFit(const Burst& b, const Channel& c, const SensoryEventConfig& config,
                 std::vector<PlacedEvent>* events) {
   const std::size_t n = c.y.size(), lag = config.difference_lag;
   const double strength = b.peak / c.on;
-  const std::size_t lo = b.begin > lag ? b.begin - lag : 0;
-  const RampFit first = fitRamp(c.y, lo, std::min(n, b.begin + 2 * lag + 1));
+  const FitWindows w = fitWindows(b, c, config);
+  const RampFit first = fitRamp(c.y, w.first_begin, w.first_end);
   const bool from_rest = std::abs(first.before - c.rest) < c.on;
   if (b.end == n) {
     events->push_back({{first.start, from_rest, strength}, from_rest, false});
     return;
   }
-  const std::size_t hi = std::min(n, b.end + lag + 1);
-  const RampFit last = fitRamp(c.y, b.end > 2 * lag + lo ? b.end - 2 * lag : lo, hi);
+  const RampFit last = fitRamp(c.y, w.last_begin, w.last_end);
   const bool to_rest = std::abs(last.after - c.rest) < c.on;
   if (last.end <= first.start + lag / 2) {  // one step: the rest side says where
     const std::size_t at = !from_rest && to_rest ? last.end : first.start;
