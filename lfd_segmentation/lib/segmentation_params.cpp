@@ -136,6 +136,7 @@ void parseJoint(const YAML::Node& node, lfd::JointSegmentationConfig* joint) {
   section.readPositive("grid_step_seconds", joint->grid_step);
   section.readPositive("alignment_band", joint->alignment_band);
   section.readPositive("spread_seconds", joint->spread);
+  section.readPositive("agreement_spread_seconds", joint->agreement_spread);
   section.readFraction("min_support", joint->min_support);
   section.readFraction("short_phase_support", joint->short_phase_support);
   section.readPositive("match_window_seconds", joint->match_window);

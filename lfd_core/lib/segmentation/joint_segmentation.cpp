@@ -489,6 +489,7 @@ class JointAgreement {
         config_(config),
         min_segment_rows_(min_segment_seconds / config.grid_step),
         spread_rows_(config.spread / config.grid_step),
+        agreement_spread_rows_(config.agreement_spread / config.grid_step),
         window_rows_(config.match_window / config.grid_step),
         colocation_rows_(config.colocation / config.grid_step),
         threads_(threads) {
@@ -532,7 +533,7 @@ class JointAgreement {
     const Eigen::Index rows = grids_[reference_].rows();
     Eigen::VectorXd s = Eigen::VectorXd::Zero(rows);
     for (const DemoEvidence& e : evidence_)
-      s += demoSupport(e, rows, spread_rows_) / static_cast<double>(evidence_.size());
+      s += demoSupport(e, rows, agreement_spread_rows_) / static_cast<double>(evidence_.size());
     // Support above the background: evidence that is everywhere (a contact force varying all
     // along a wipe, in every demo at other times) supports every instant alike and so none.
     const double background = s.mean();
@@ -612,7 +613,7 @@ class JointAgreement {
   std::vector<DemoEvidence> evidence_;
   std::vector<Eigen::MatrixXd> grids_;
   const JointSegmentationConfig& config_;
-  double min_segment_rows_, spread_rows_, window_rows_, colocation_rows_;
+  double min_segment_rows_, spread_rows_, agreement_spread_rows_, window_rows_, colocation_rows_;
   int threads_;
   std::size_t reference_ = 0;
   std::vector<std::vector<double>> to_reference_, from_reference_;

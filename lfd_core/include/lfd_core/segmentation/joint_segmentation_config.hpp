@@ -15,9 +15,13 @@ struct JointSegmentationConfig {
   /// from start to end (>= 1: unconstrained): a periodic phase with a different number of
   /// strokes otherwise lets DTW fold whole phases onto one stroke.
   double alignment_band = 0.2;
-  /// Spread of a piece of evidence on the reference's axis (s, Gaussian sigma): the DTW
-  /// alignment's error between demos that move at different speeds.
+  /// Spread of a piece of evidence on the reference's axis (s, Gaussian sigma) when a demo's
+  /// boundary is placed: the DTW alignment's error between demos that move at different speeds.
   double spread = 0.5;
+  /// The same spread when the demos' evidence is added up into the support of a boundary (s).
+  /// Narrower than `spread`: two changes 0.8 s apart (a snap-fit's insertion and its snap) must
+  /// stay two peaks, not one plateau whose top lies between them and takes a piece of either.
+  double agreement_spread = 0.35;
   /// A boundary of the task needs this support: the mean over the demos of each demo's evidence
   /// near it (noisy-OR of its pieces). 0.5 = as if half the demos were sure of it.
   double min_support = 0.5;
