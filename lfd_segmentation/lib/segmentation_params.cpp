@@ -126,6 +126,7 @@ void parseJoint(const YAML::Node& node, lfd::JointSegmentationConfig* joint) {
   w.readFraction("motion_onset", weights.motion_onset);
   w.readFraction("motion_stop", weights.motion_stop);
   w.readFraction("clasp", weights.clasp);
+  w.readFraction("rhythm", weights.rhythm);
   const Section pause = section.child("pauses");
   auto& pc = joint->pauses;
   pause.readNonNegative("smoothing_seconds", pc.smoothing);

@@ -87,6 +87,8 @@ std::string toString(EvidenceKind kind) {
       return "motion_stop";
     case EvidenceKind::kClasp:
       return "clasp";
+    case EvidenceKind::kRhythm:
+      return "rhythm";
   }
   return "clasp";
 }
@@ -180,6 +182,28 @@ std::vector<BoundaryEvidence> sensoryEvidence(const SensorEvents& events,
       }
     }
     out.push_back({index, weights.sensor_level, EvidenceKind::kSensorLevel});
+  }
+  return out;
+}
+
+std::vector<BoundaryEvidence> rhythmEvidence(const std::vector<ReciprocatingRun>& runs,
+                                             const std::vector<BoundaryEvidence>& contacts,
+                                             double weight, std::size_t fold_samples) {
+  std::vector<BoundaryEvidence> out;
+  const auto onContact = [&](std::size_t index) {
+    std::size_t nearest = fold_samples + 1, at = index;
+    for (const BoundaryEvidence& c : contacts) {
+      const std::size_t distance = c.index > index ? c.index - index : index - c.index;
+      if (c.kind == EvidenceKind::kContact && distance <= fold_samples && distance < nearest) {
+        nearest = distance;
+        at = c.index;
+      }
+    }
+    return at;
+  };
+  for (const ReciprocatingRun& run : runs) {
+    out.push_back({onContact(run.begin), weight, EvidenceKind::kRhythm});
+    out.push_back({onContact(run.end), weight, EvidenceKind::kRhythm});
   }
   return out;
 }

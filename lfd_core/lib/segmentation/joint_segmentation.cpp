@@ -271,11 +271,35 @@ void dropStaleEvents(const std::vector<SampleSpan>& stale, std::size_t margin,
                     events->all.end());
 }
 
+// Each demo's periodic phases, found on the state features II-B selected (those the demos move
+// consistently: a wrist that turns a little at random in each demo adds its own drift to every
+// stroke and hides the reversals); on every moving state feature without II-B (one demo). At least
+// two: along a single feature every reversal goes straight back, and the test of direction says
+// nothing (PR2's one selected joint: its wiggles while the leg is screwed in were taken for a
+// periodic phase, 3/6 -> 2/6 at 1 s).
+std::vector<std::vector<ReciprocatingRun>> periodicPhases(const std::vector<FeatureMatrix>& demos,
+                                                          const std::vector<std::string>& moving,
+                                                          const std::vector<std::string>& selected,
+                                                          double smoothing, int threads) {
+  std::vector<std::string> names;
+  for (const std::string& name : moving)
+    if (selected.empty() || std::find(selected.begin(), selected.end(), name) != selected.end())
+      names.push_back(name);
+  std::vector<std::vector<ReciprocatingRun>> out(demos.size());
+  if (names.size() < 2) return out;
+  const std::vector<Eigen::MatrixXd> states = scaledStates(demos, names);
+  parallelFor(demos.size(), threads, [&](std::size_t d) {
+    out[d] = reciprocatingRuns(states[d], clockOf(demos[d]), smoothing);
+  });
+  return out;
+}
+
 // A demo's evidence of every kind, and its features and speed on the alignment grid.
 void gatherEvidence(const FeatureMatrix& demo, const Eigen::MatrixXd& scaled,
                     const Eigen::VectorXd& consistency, const Eigen::VectorXd& speed,
                     const Eigen::MatrixXd& scaled_sensors, const SegmentationPipelineResult& base,
                     const SensorSelection& contact, const std::vector<SampleSpan>& stale,
+                    const std::vector<ReciprocatingRun>& rhythm,
                     const SegmentationPipelineConfig& config, DemoSegmentationResult* out,
                     DemoEvidence* evidence, Eigen::MatrixXd* grid) {
   const JointSegmentationConfig& joint = config.joint;
@@ -300,6 +324,9 @@ void gatherEvidence(const FeatureMatrix& demo, const Eigen::MatrixXd& scaled,
                                    static_cast<std::size_t>(std::lround(joint.ramp_fold * rate)));
     pieces.insert(pieces.end(), s.begin(), s.end());
   }
+  const auto r = rhythmEvidence(rhythm, pieces, joint.weights.rhythm,
+                                static_cast<std::size_t>(std::lround(joint.ramp_fold * rate)));
+  pieces.insert(pieces.end(), r.begin(), r.end());
   const std::vector<double> clock = clockOf(demo);
   const std::vector<Pause> pauses = findPauses(speed, clock, joint.pauses);
   for (const Pause& p : pauses) out->pauses.push_back({p.begin, p.end - 1});
@@ -313,12 +340,21 @@ void gatherEvidence(const FeatureMatrix& demo, const Eigen::MatrixXd& scaled,
   for (const BoundaryEvidence& p : pieces)
     evidence->grid_rows.push_back((clock[p.index] - clock.front()) / joint.grid_step);
   evidence->claimed.assign(pieces.size(), false);
-  // The sensors align the demos too: contact begins and ends in the same order in each.
-  Eigen::MatrixXd aligned(scaled.rows(), scaled.cols() + 1 + scaled_sensors.cols());
+  // The sensors align the demos too: contact begins and ends in the same order in each. So does a
+  // periodic phase: its strokes, 3 in one demo and 6 in another, leave DTW free to match any
+  // stroke with any other, and its edges drift apart.
+  Eigen::MatrixXd aligned(scaled.rows(), scaled.cols() + 2 + scaled_sensors.cols());
   // A sensor weighs as much as the state features together, as the speed does: where contact
   // begins and ends is the surest landmark two demos share.
   const double weight = std::sqrt(static_cast<double>(std::max<Eigen::Index>(1, scaled.cols())));
-  aligned << withSpeed(ownShape(scaled) * consistency.asDiagonal(), speed), weight * scaled_sensors;
+  Eigen::VectorXd periodic = Eigen::VectorXd::Zero(scaled.rows());
+  for (const ReciprocatingRun& run : rhythm)
+    periodic
+        .segment(static_cast<Eigen::Index>(run.begin),
+                 static_cast<Eigen::Index>(run.end - run.begin + 1))
+        .setOnes();
+  aligned << withSpeed(ownShape(scaled) * consistency.asDiagonal(), speed), weight * periodic,
+      weight * scaled_sensors;
   *grid = onUniformGrid(aligned, clock, joint.grid_step);
 }
 
@@ -387,6 +423,7 @@ int timingPrecision(EvidenceKind kind) {
     case EvidenceKind::kMotionOnset:
       return 2;
     case EvidenceKind::kMotionStop:
+    case EvidenceKind::kRhythm:
       return 1;
     case EvidenceKind::kClasp:
       return 0;
@@ -710,13 +747,16 @@ SegmentationPipelineResult segmentJointly(const PreparedSegmentation& prepared,
 
   const std::vector<std::vector<SampleSpan>> stale =
       staleContactReadings(demos, contact, config.joint.stale_reading, &result.warnings);
+  const std::vector<std::vector<ReciprocatingRun>> rhythm = periodicPhases(
+      demos, states, result.selected_features, config.joint.pauses.smoothing, config.threads);
 
   std::vector<DemoEvidence> evidence(n);
   std::vector<Eigen::MatrixXd> grids(n);
   parallelFor(n, config.threads, [&](std::size_t d) {
     try {
       gatherEvidence(demos[d], scaled[d], consistency, speeds[d], scaled_sensors[d], result,
-                     contact, stale[d], config, &result.demos[d], &evidence[d], &grids[d]);
+                     contact, stale[d], rhythm[d], config, &result.demos[d], &evidence[d],
+                     &grids[d]);
     } catch (const std::invalid_argument& e) {
       throw std::invalid_argument(describe(e.what(), d));
     }

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "lfd_core/segmentation/multivariate_segmentation.hpp"
+#include "lfd_core/segmentation/reciprocating_motion.hpp"
 #include "lfd_core/segmentation/sensory_events.hpp"
 
 namespace lfd {
@@ -20,6 +21,7 @@ enum class EvidenceKind {
   kSensorLevel,  ///< a sensor's level steps while away from rest (a snap, a press that deepens)
   kMotionOnset,  ///< the state features move again after a pause
   kMotionStop,   ///< the state features stop for an instant (one motion ends, the next begins)
+  kRhythm,       ///< a periodic back-and-forth motion begins or ends (reciprocating_motion.hpp)
   kClasp,        ///< a changepoint of ClaSP's recursive segmentation (shape change)
 };
 
@@ -42,6 +44,9 @@ struct EvidenceWeights {
   /// one), it marks where a shape change ClaSP finds nearby begins.
   double motion_stop = 0.3;
   double clasp = 0.5;  ///< a ClaSP changepoint (significant by ClaSP's own test)
+  /// A periodic phase (grating, sawing, stroking) begins or ends: the only sign of it in a
+  /// pose-only recording, where every reversal inside is an instant of rest.
+  double rhythm = 0.6;
 };
 
 /// How pauses of the state features are found (all in seconds or as statistics).
@@ -109,6 +114,13 @@ void gatherIntoPauses(const std::vector<Pause>& pauses, std::size_t samples,
 std::vector<BoundaryEvidence> sensoryEvidence(const SensorEvents& events,
                                               const EvidenceWeights& weights,
                                               std::size_t fold_samples);
+
+/// Evidence of the periodic phases' edges. An edge within `fold_samples` of a contact (a rest
+/// edge in `contacts`) is that contact's own: the strokes of a wipe start a little after the press
+/// and stop a little before the lift, and the skill is the contact's.
+std::vector<BoundaryEvidence> rhythmEvidence(const std::vector<ReciprocatingRun>& runs,
+                                             const std::vector<BoundaryEvidence>& contacts,
+                                             double weight, std::size_t fold_samples);
 
 /// Evidence of ClaSP's accepted changepoints.
 std::vector<BoundaryEvidence> claspEvidence(const MultivariateSegmentation& clasp, double weight);
