@@ -300,4 +300,23 @@ TEST(SensoryEvidence, ALevelEventJustBeyondTheFoldStaysPut) {
     }
 }
 
+// ---- rhythmEvidence
+
+// A wipe's strokes start 0.4 s after the press and stop 0.3 s before the lift (50 Hz, fold 1 s):
+// both edges are the contact's own and join its rest edges; a grating with no contact nearby keeps
+// its edges where the strokes begin and end.
+TEST(RhythmEvidence, EdgesNearAContactJoinItAndOthersStayPut) {
+  const std::vector<lfd::BoundaryEvidence> contacts = {{100, 0.9, lfd::EvidenceKind::kContact},
+                                                       {400, 0.9, lfd::EvidenceKind::kContact},
+                                                       {120, 0.7, lfd::EvidenceKind::kSensorLevel}};
+  const auto out = lfd::rhythmEvidence({{120, 385}, {600, 800}}, contacts, 0.6, 50);
+  ASSERT_EQ(out.size(), 4u);
+  const std::vector<std::size_t> at = {100, 400, 600, 800};
+  for (std::size_t k = 0; k < out.size(); ++k) {
+    EXPECT_EQ(out[k].index, at[k]) << "edge " << k;
+    EXPECT_EQ(out[k].kind, lfd::EvidenceKind::kRhythm);
+    EXPECT_DOUBLE_EQ(out[k].weight, 0.6);
+  }
+}
+
 }  // namespace
