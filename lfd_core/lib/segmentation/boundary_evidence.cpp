@@ -190,7 +190,7 @@ std::vector<BoundaryEvidence> rhythmEvidence(const std::vector<ReciprocatingRun>
                                              const std::vector<BoundaryEvidence>& contacts,
                                              double weight, std::size_t fold_samples) {
   std::vector<BoundaryEvidence> out;
-  const auto onContact = [&](std::size_t index) {
+  const auto on_contact = [&](std::size_t index) {
     std::size_t nearest = fold_samples + 1, at = index;
     for (const BoundaryEvidence& c : contacts) {
       const std::size_t distance = c.index > index ? c.index - index : index - c.index;
@@ -202,8 +202,8 @@ std::vector<BoundaryEvidence> rhythmEvidence(const std::vector<ReciprocatingRun>
     return at;
   };
   for (const ReciprocatingRun& run : runs) {
-    out.push_back({onContact(run.begin), weight, EvidenceKind::kRhythm});
-    out.push_back({onContact(run.end), weight, EvidenceKind::kRhythm});
+    out.push_back({on_contact(run.begin), weight, EvidenceKind::kRhythm});
+    out.push_back({on_contact(run.end), weight, EvidenceKind::kRhythm});
   }
   return out;
 }
