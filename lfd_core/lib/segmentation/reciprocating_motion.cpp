@@ -5,7 +5,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "lfd_core/segmentation/smooth_derivatives.hpp"
+#include "lfd_core/segmentation/boundary_evidence.hpp"
 
 namespace lfd {
 namespace {
@@ -67,13 +67,7 @@ std::vector<ReciprocatingRun> reciprocatingRuns(const Eigen::MatrixXd& states,
                                 std::to_string(time.size()) + " timestamps");
   std::vector<ReciprocatingRun> runs;
   if (n < 5 || states.cols() == 0) return runs;
-  const Eigen::VectorXd t = Eigen::Map<const Eigen::VectorXd>(time.data(), n);
-  const Eigen::MatrixXd smooth = gaussianSmooth(t, states, smoothing_seconds);
-  Eigen::VectorXd speed(n);
-  for (Eigen::Index i = 0; i < n; ++i) {
-    const Eigen::Index a = std::max<Eigen::Index>(0, i - 1), b = std::min(n - 1, i + 1);
-    speed[i] = (smooth.row(b) - smooth.row(a)).norm() / (t[b] - t[a]);
-  }
+  const Eigen::VectorXd speed = stateSpeed(states, time, smoothing_seconds);
   const double typical = percentile95(speed);
   if (!(typical > 0.0)) return runs;
   const std::vector<std::size_t> ends = strokeEnds(speed, config.min_dip * typical);
