@@ -163,25 +163,38 @@ void gatherIntoPauses(const std::vector<Pause>& pauses, std::size_t samples,
   }
 }
 
+namespace {
+
+// The contact edge nearest to `index` within `fold_samples` of it (`index` when there is none):
+// a change that close to a contact made or lost is that contact's own.
+std::size_t foldOntoContact(const std::vector<std::size_t>& edges, std::size_t index,
+                            std::size_t fold_samples) {
+  std::size_t at = index, nearest = fold_samples + 1;
+  for (std::size_t edge : edges) {
+    const std::size_t distance = edge > index ? edge - index : index - edge;
+    if (distance <= fold_samples && distance < nearest) {
+      nearest = distance;
+      at = edge;
+    }
+  }
+  return at;
+}
+
+}  // namespace
+
 std::vector<BoundaryEvidence> sensoryEvidence(const SensorEvents& events,
                                               const EvidenceWeights& weights,
                                               std::size_t fold_samples) {
+  std::vector<std::size_t> edges;
+  for (const SensoryEvent& e : events.details)
+    if (e.rest_edge) edges.push_back(e.index);
   std::vector<BoundaryEvidence> out;
   for (const SensoryEvent& e : events.details) {
-    if (e.rest_edge) {
+    if (e.rest_edge)
       out.push_back({e.index, weights.contact, EvidenceKind::kContact});
-      continue;
-    }
-    std::size_t index = e.index, nearest = fold_samples + 1;
-    for (const SensoryEvent& edge : events.details) {
-      const std::size_t distance =
-          edge.index > e.index ? edge.index - e.index : e.index - edge.index;
-      if (edge.rest_edge && distance <= fold_samples && distance < nearest) {
-        nearest = distance;
-        index = edge.index;
-      }
-    }
-    out.push_back({index, weights.sensor_level, EvidenceKind::kSensorLevel});
+    else
+      out.push_back({foldOntoContact(edges, e.index, fold_samples), weights.sensor_level,
+                     EvidenceKind::kSensorLevel});
   }
   return out;
 }
@@ -189,21 +202,13 @@ std::vector<BoundaryEvidence> sensoryEvidence(const SensorEvents& events,
 std::vector<BoundaryEvidence> rhythmEvidence(const std::vector<ReciprocatingRun>& runs,
                                              const std::vector<BoundaryEvidence>& contacts,
                                              double weight, std::size_t fold_samples) {
+  std::vector<std::size_t> edges;
+  for (const BoundaryEvidence& c : contacts)
+    if (c.kind == EvidenceKind::kContact) edges.push_back(c.index);
   std::vector<BoundaryEvidence> out;
-  const auto on_contact = [&](std::size_t index) {
-    std::size_t nearest = fold_samples + 1, at = index;
-    for (const BoundaryEvidence& c : contacts) {
-      const std::size_t distance = c.index > index ? c.index - index : index - c.index;
-      if (c.kind == EvidenceKind::kContact && distance <= fold_samples && distance < nearest) {
-        nearest = distance;
-        at = c.index;
-      }
-    }
-    return at;
-  };
   for (const ReciprocatingRun& run : runs) {
-    out.push_back({on_contact(run.begin), weight, EvidenceKind::kRhythm});
-    out.push_back({on_contact(run.end), weight, EvidenceKind::kRhythm});
+    out.push_back({foldOntoContact(edges, run.begin, fold_samples), weight, EvidenceKind::kRhythm});
+    out.push_back({foldOntoContact(edges, run.end, fold_samples), weight, EvidenceKind::kRhythm});
   }
   return out;
 }

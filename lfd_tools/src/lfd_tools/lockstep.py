@@ -245,10 +245,11 @@ class Cell(object):
         feedback that says it moves; on a loaded machine the feedback can arrive first, and a
         trajectory taken in after its start runs late: the arm starts behind it (measured on a
         fresh root: 9.24 s for a motion planned for 8.66 s)."""
-        sent = [f for f in self.feedback if f.state != f.PLANNING]
-        if not sent:
+        # the latest motion's feedback, searched from the end: this runs at every step
+        sent = next((f for f in reversed(self.feedback) if f.state != f.PLANNING), None)
+        if sent is None:
             return False
-        start = sent[-1].motion_start.to_sec()
+        start = sent.motion_start.to_sec()
         return (self.trajectory_stamp < start - 1e-6 and
                 self.sim_time + STEP_CHUNK * 1e-3 > start)
 
