@@ -12,7 +12,7 @@ std::string clipped(const std::string& s) {
   return s.size() <= 40 ? s : s.substr(0, 40) + "... (" + std::to_string(s.size()) + " chars)";
 }
 
-std::string number(double v) {
+std::string formatted(double v) {
   std::ostringstream o;
   o << v;
   return o.str();
@@ -38,8 +38,8 @@ void checkLimits(const RequestLimits& l) {
 double checkedDurationScale(double scale, const RequestLimits& l) {
   if (scale == 0.0) return 1.0;
   if (!std::isfinite(scale) || scale < l.min_duration_scale || scale > l.max_duration_scale)
-    throw std::invalid_argument("duration_scale " + number(scale) + " is outside [" +
-                                number(l.min_duration_scale) + ", " + number(l.max_duration_scale) +
+    throw std::invalid_argument("duration_scale " + formatted(scale) + " is outside [" +
+                                formatted(l.min_duration_scale) + ", " + formatted(l.max_duration_scale) +
                                 "] (~limits/min_duration_scale, ~limits/max_duration_scale)");
   return scale;
 }
@@ -54,9 +54,9 @@ lfd::Pose checkedPose(const Eigen::Vector3d& position, const Eigen::Vector4d& wx
                                 " has a zero quaternion (no orientation; identity is "
                                 "w = 1)");
   if (std::abs(norm - 1.0) > l.quaternion_tolerance)
-    throw std::invalid_argument(what + " has a quaternion of norm " + number(norm) +
+    throw std::invalid_argument(what + " has a quaternion of norm " + formatted(norm) +
                                 ", not a rotation (|norm - 1| over ~limits/quaternion_tolerance " +
-                                number(l.quaternion_tolerance) + ")");
+                                formatted(l.quaternion_tolerance) + ")");
   lfd::Pose p;
   p.position = position;
   p.orientation = Eigen::Quaterniond(wxyz[0], wxyz[1], wxyz[2], wxyz[3]).normalized();

@@ -34,13 +34,6 @@
 namespace lfd {
 namespace {
 
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-
-bool isWeighted(ProfileCombination c) {
-  return c == ProfileCombination::kWeightedAverage || c == ProfileCombination::kWeightedProduct ||
-         c == ProfileCombination::kWeightedDistanceAverage;
-}
-
 void checkInputs(const Eigen::MatrixXd& features, const std::vector<double>& weights,
                  const MultivariateSegmentationConfig& config) {
   const std::size_t num_features = static_cast<std::size_t>(features.cols());
@@ -217,7 +210,8 @@ class ClaspRecursion {
 MultivariateSegmentation emptyResult(std::size_t n, std::size_t num_features) {
   MultivariateSegmentation out;
   out.window_sizes.assign(num_features, 0);
-  out.first_profile = Eigen::VectorXd::Constant(static_cast<Eigen::Index>(n), kNaN);
+  out.first_profile = Eigen::VectorXd::Constant(static_cast<Eigen::Index>(n),
+                                                std::numeric_limits<double>::quiet_NaN());
   out.first_profile_penalized = out.first_profile;
   out.first_feature_profiles.assign(num_features,
                                     Eigen::VectorXd::Zero(static_cast<Eigen::Index>(n)));

@@ -14,11 +14,6 @@ namespace {
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr double kMinScoreForLog = 1e-12;
 
-bool isWeighted(ProfileCombination c) {
-  return c == ProfileCombination::kWeightedAverage || c == ProfileCombination::kWeightedProduct ||
-         c == ProfileCombination::kWeightedDistanceAverage;
-}
-
 }  // namespace
 
 ProfileCombination parseProfileCombination(const std::string& name) {
@@ -31,6 +26,11 @@ ProfileCombination parseProfileCombination(const std::string& name) {
   throw std::invalid_argument("unknown profile combination '" + name +
                               "' (average, product, weighted_average, weighted_product, "
                               "distance_average, weighted_distance_average)");
+}
+
+bool isWeighted(ProfileCombination c) {
+  return c == ProfileCombination::kWeightedAverage || c == ProfileCombination::kWeightedProduct ||
+         c == ProfileCombination::kWeightedDistanceAverage;
 }
 
 std::string toString(ProfileCombination combination) {

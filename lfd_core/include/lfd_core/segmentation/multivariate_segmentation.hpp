@@ -34,6 +34,8 @@ enum class ProfileCombination {
 /// "weighted_distance_average" (throws std::invalid_argument).
 ProfileCombination parseProfileCombination(const std::string& name);
 std::string toString(ProfileCombination combination);
+/// Whether the combination weighs the profiles by feature relevance.
+bool isWeighted(ProfileCombination combination);
 
 /// Combines equally long profiles. NaN in any profile makes that sample NaN. Weights must be
 /// >= 0 with a positive sum (ignored by the unweighted methods; empty = all ones). Product
