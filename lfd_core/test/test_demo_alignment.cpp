@@ -2,6 +2,7 @@
 // (free and anchored), the medoid, and the interpolation of a map.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <vector>
@@ -163,6 +164,37 @@ TEST(AlignToMedoid, ThrowsOnNoDemoOrDifferentFeatureCounts) {
   EXPECT_THROW(lfd::alignToMedoid({sampled(10), Eigen::MatrixXd::Zero(10, 3)}, 1),
                std::invalid_argument);
   EXPECT_THROW(lfd::alignToMedoid({sampled(10), Eigen::MatrixXd(0, 2)}, 1), std::invalid_argument);
+}
+
+TEST(ByDtwCostToOthers, TheMedoidFirstAndTheOutlierLast) {
+  Eigen::MatrixXd outlier(60, 2);
+  for (int i = 0; i < 60; ++i) {
+    const double u = i / 59.0;
+    outlier.row(i) << 1.0 - u, 0.5 * std::sin(6.0 * M_PI * u);
+  }
+  const std::vector<Eigen::MatrixXd> demos = {outlier, sampled(50), sampled(60), sampled(75)};
+  const std::vector<std::size_t> order = lfd::byDtwCostToOthers(demos, 1);
+  ASSERT_EQ(order.size(), demos.size());
+  EXPECT_EQ(order.back(), 0u);
+  EXPECT_EQ(order.front(), lfd::alignToMedoid(demos, 1).reference);
+  std::vector<std::size_t> sorted = order;
+  std::sort(sorted.begin(), sorted.end());
+  EXPECT_EQ(sorted, (std::vector<std::size_t>{0, 1, 2, 3}));
+}
+
+TEST(AlignTo, MapsEveryDemoOntoTheGivenReference) {
+  const std::vector<Eigen::MatrixXd> demos = {sampled(50), sampled(60), sampled(75)};
+  const lfd::DemoAlignment alignment = lfd::alignTo(demos, 2, 1);
+  EXPECT_EQ(alignment.reference, 2u);
+  for (std::size_t d = 0; d < demos.size(); ++d) {
+    ASSERT_EQ(alignment.to_reference[d].size(), static_cast<std::size_t>(demos[d].rows()));
+    ASSERT_EQ(alignment.from_reference[d].size(), 75u);
+    // The same motion at another pace: each end maps onto the reference's ends.
+    EXPECT_NEAR(alignment.to_reference[d].front(), 0.0, 1.0);
+    EXPECT_NEAR(alignment.to_reference[d].back(), 74.0, 1.0);
+  }
+  EXPECT_DOUBLE_EQ(alignment.mean_cost[2], 0.0);
+  EXPECT_THROW(lfd::alignTo(demos, 3, 1), std::invalid_argument);
 }
 
 // ---- mapRow

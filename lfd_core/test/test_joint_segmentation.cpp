@@ -81,9 +81,10 @@ lfd::FeatureMatrix sampleLegs(const Eigen::Vector3d& start, const std::vector<Le
 // slides that far along y (a wipe), from the instant of contact to the release. With `snap` the
 // press lasts 4-4.5 s and its level steps twice while in contact, 0.6-0.7 s apart (a snap-fit:
 // pushed harder until the hook gives, then held lighter), 1.5 s after the onset; both steps are
-// boundaries too.
-std::vector<Demo> reachPressRetract(int count, unsigned seed, double slide = 0.0,
-                                    bool snap = false) {
+// boundaries too. The first `slips` demos lose contact for 0.9 s midway through the press (the
+// sensor back at rest) and press again: no boundary, a hand slipping off for a moment.
+std::vector<Demo> reachPressRetract(int count, unsigned seed, double slide = 0.0, bool snap = false,
+                                    int slips = 0) {
   std::mt19937 rng(seed);
   std::uniform_real_distribution<double> unit(0.0, 1.0);
   std::vector<Demo> demos;
@@ -98,8 +99,9 @@ std::vector<Demo> reachPressRetract(int count, unsigned seed, double slide = 0.0
     const double onset = rest + reach, release = onset + hold;
     const double level = 4.5 + unit(rng);
     const double harder = onset + 1.5, lighter = harder + (snap ? 0.6 + 0.1 * unit(rng) : 0.0);
+    const double slip = d < slips ? onset + 0.4 * hold : release + 1.0;
     auto touch = [=](double t, double noise) {
-      if (t < onset || t >= release + 0.15) return 0.0;
+      if (t < onset || t >= release + 0.15 || (t >= slip && t < slip + 0.9)) return 0.0;
       const double ramp = std::min({1.0, (t - onset) / 0.15, (release + 0.15 - t) / 0.15});
       double scale = 1.0;
       if (snap && t >= harder) scale = t < lighter ? 2.0 : 0.6;
@@ -259,6 +261,14 @@ TEST(JointSegmentation, AWipeWithADeadSensorIsSegmentedFromItsMotionOrWarned) {
   // onset goes to a ClaSP changepoint mid-slide, 1.9 s off (left open).
   GTEST_SKIP() << "the dead demo's onset has no evidence as sure as min_piece_weight";
   segmentWithADeadSensor(reachPressRetract(6, 11, 0.25), 2);
+}
+
+// Two demos of six slip off for 0.9 s midway through a wipe and press again: no boundary there.
+TEST(JointSegmentation, AContactLostMidwayInTwoDemosIsNoBoundary) {
+  const auto demos = reachPressRetract(6, 11, 0.25, false, 2);
+  const auto result = lfd::runSegmentationPipeline(matrices(demos), {"touch"}, jointConfig());
+  ASSERT_EQ(result.demos.size(), demos.size());
+  for (std::size_t d = 0; d < demos.size(); ++d) expectBoundaries(result, demos[d], d, 0.2);
 }
 
 // Two level steps 0.6-0.7 s apart while the hand presses and slides 40 cm (the snap-fit class's

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
+#include <string>
 
 #include "lfd_core/segmentation/time_alignment.hpp"
 #include "lfd_core/util/parallel_for.hpp"
@@ -101,7 +102,8 @@ double mapRow(const std::vector<double>& map, double row) {
   return (1.0 - w) * map[k] + w * map[k + 1];
 }
 
-DemoAlignment alignToMedoid(const std::vector<Eigen::MatrixXd>& gridded, int threads, double band) {
+std::vector<std::size_t> byDtwCostToOthers(const std::vector<Eigen::MatrixXd>& gridded, int threads,
+                                           double band) {
   const std::size_t n = gridded.size();
   if (n == 0) throw std::invalid_argument("no demonstrations to align");
   for (const Eigen::MatrixXd& g : gridded) checkPair(g, gridded.front());
@@ -119,22 +121,38 @@ DemoAlignment alignToMedoid(const std::vector<Eigen::MatrixXd>& gridded, int thr
     total[pairs[p].first] += cost[p];
     total[pairs[p].second] += cost[p];
   }
+  std::vector<std::size_t> order(n);
+  for (std::size_t d = 0; d < n; ++d) order[d] = d;
+  std::stable_sort(order.begin(), order.end(),
+                   [&](std::size_t a, std::size_t b) { return total[a] < total[b]; });
+  return order;
+}
+
+DemoAlignment alignTo(const std::vector<Eigen::MatrixXd>& gridded, std::size_t reference,
+                      int threads, double band) {
+  const std::size_t n = gridded.size();
+  if (reference >= n)
+    throw std::invalid_argument("alignTo: no demonstration " + std::to_string(reference) +
+                                " to align to");
+  for (const Eigen::MatrixXd& g : gridded) checkPair(g, gridded.front());
   DemoAlignment out;
-  out.reference =
-      static_cast<std::size_t>(std::min_element(total.begin(), total.end()) - total.begin());
+  out.reference = reference;
   out.to_reference.resize(n);
   out.from_reference.resize(n);
   out.mean_cost.assign(n, 0.0);
-  const Eigen::MatrixXd& ref = gridded[out.reference];
+  const Eigen::MatrixXd& ref = gridded[reference];
   parallelFor(n, threads, [&](std::size_t d) {
     out.to_reference[d] = multivariateDtwMap(gridded[d], ref, band);
     out.from_reference[d] = multivariateDtwMap(ref, gridded[d], band);
+    out.mean_cost[d] = d == reference ? 0.0
+                                      : multivariateDtwCost(gridded[d], ref, band) /
+                                            static_cast<double>(gridded[d].rows() + ref.rows());
   });
-  for (std::size_t p = 0; p < pairs.size(); ++p) {
-    if (pairs[p].first == out.reference) out.mean_cost[pairs[p].second] = cost[p];
-    if (pairs[p].second == out.reference) out.mean_cost[pairs[p].first] = cost[p];
-  }
   return out;
+}
+
+DemoAlignment alignToMedoid(const std::vector<Eigen::MatrixXd>& gridded, int threads, double band) {
+  return alignTo(gridded, byDtwCostToOthers(gridded, threads, band).front(), threads, band);
 }
 
 }  // namespace lfd

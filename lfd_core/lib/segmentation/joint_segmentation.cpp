@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 
@@ -519,22 +520,21 @@ std::string evidenceKinds(const DemoEvidence& e, std::size_t chosen, double colo
 // The agreement, boundary by boundary.
 class JointAgreement {
  public:
-  JointAgreement(std::vector<DemoEvidence> evidence, std::vector<Eigen::MatrixXd> grids,
-                 const JointSegmentationConfig& config, double min_segment_seconds, int threads)
+  JointAgreement(std::vector<DemoEvidence> evidence, const std::vector<Eigen::MatrixXd>& grids,
+                 DemoAlignment alignment, const JointSegmentationConfig& config,
+                 double min_segment_seconds, int threads)
       : evidence_(std::move(evidence)),
-        grids_(std::move(grids)),
+        grids_(grids),
         config_(config),
         min_segment_rows_(min_segment_seconds / config.grid_step),
         spread_rows_(config.spread / config.grid_step),
         agreement_spread_rows_(config.agreement_spread / config.grid_step),
         window_rows_(config.match_window / config.grid_step),
         colocation_rows_(config.colocation / config.grid_step),
-        threads_(threads) {
-    const DemoAlignment alignment = alignToMedoid(grids_, threads_, config_.alignment_band);
-    reference_ = alignment.reference;
-    to_reference_ = alignment.to_reference;
-    from_reference_ = alignment.from_reference;
-  }
+        threads_(threads),
+        reference_(alignment.reference),
+        to_reference_(std::move(alignment.to_reference)),
+        from_reference_(std::move(alignment.from_reference)) {}
 
   // Adds agreed boundaries, best supported first, re-aligning between them after each.
   void run(std::size_t max_boundaries) {
@@ -551,6 +551,18 @@ class JointAgreement {
   }
 
   const std::vector<Anchor>& anchors() const { return anchors_; }
+  // The weight of the strong evidence (extra_event_weight: contact made or lost) no agreed
+  // boundary claims, over every demo; and how many demos have any.
+  double unexplainedEvidence() const {
+    double sum = 0.0;
+    for (std::size_t d = 0; d < evidence_.size(); ++d) sum += unexplainedEvidenceOf(d);
+    return sum;
+  }
+  std::size_t demosWithUnexplainedEvidence() const {
+    std::size_t count = 0;
+    for (std::size_t d = 0; d < evidence_.size(); ++d) count += unexplainedEvidenceOf(d) > 0.0;
+    return count;
+  }
   const DemoEvidence& evidence(std::size_t d) const { return evidence_[d]; }
   double expectedRow(std::size_t d, double reference_row) const {
     return mapRow(from_reference_[d], reference_row);
@@ -559,6 +571,15 @@ class JointAgreement {
   double windowRows() const { return window_rows_; }
 
  private:
+  double unexplainedEvidenceOf(std::size_t d) const {
+    const DemoEvidence& e = evidence_[d];
+    double sum = 0.0;
+    for (std::size_t p = 0; p < e.pieces.size(); ++p)
+      if (!e.claimed[p] && e.pieces[p].weight >= config_.extra_event_weight)
+        sum += e.pieces[p].weight;
+    return sum;
+  }
+
   void mapEvidence() {
     for (DemoEvidence& e : evidence_) e.reference_rows.clear();
     for (std::size_t d = 0; d < evidence_.size(); ++d)
@@ -648,11 +669,11 @@ class JointAgreement {
   }
 
   std::vector<DemoEvidence> evidence_;
-  std::vector<Eigen::MatrixXd> grids_;
+  const std::vector<Eigen::MatrixXd>& grids_;
   const JointSegmentationConfig& config_;
   double min_segment_rows_, spread_rows_, agreement_spread_rows_, window_rows_, colocation_rows_;
   int threads_;
-  std::size_t reference_ = 0;
+  std::size_t reference_;
   std::vector<std::vector<double>> to_reference_, from_reference_;
   std::vector<Anchor> anchors_;
 };
@@ -716,6 +737,36 @@ void reportDemo(const JointAgreement& agreement, const FeatureMatrix& demo, std:
 
 }  // namespace
 
+// The agreement on the medoid's time axis (the demo with the least DTW cost to the others),
+// unless most demos are left with strong evidence (a contact made or lost) that no agreed
+// boundary explains: the sign that the alignment, not the demos, is wrong. The medoid can be a
+// demo with a phase the others lack (a push whose hand slips off the box midway and presses
+// again, onto whose second contact the others' one contact was mapped). Then the agreement is
+// sought on every demo's axis in turn, and the one leaving the least strong evidence
+// unexplained is kept (ties: the nearest the medoid). A few demos with unshared evidence are
+// what a demo with an extra phase looks like: they are reported, and the medoid kept.
+JointAgreement bestAgreement(const std::vector<DemoEvidence>& evidence,
+                             const std::vector<Eigen::MatrixXd>& grids,
+                             const SegmentationPipelineConfig& config) {
+  const double band = config.joint.alignment_band;
+  const std::vector<std::size_t> candidates = byDtwCostToOthers(grids, config.threads, band);
+  const auto agree_on = [&](std::size_t reference, int threads) {
+    JointAgreement agreement(evidence, grids, alignTo(grids, reference, threads, band),
+                             config.joint, config.seconds->min_segment, threads);
+    agreement.run(config.segmentation.max_changepoints);
+    return agreement;
+  };
+  JointAgreement medoid = agree_on(candidates.front(), config.threads);
+  if (2 * medoid.demosWithUnexplainedEvidence() <= evidence.size()) return medoid;
+  std::vector<std::optional<JointAgreement>> others(candidates.size() - 1);
+  parallelFor(others.size(), config.threads,
+              [&](std::size_t k) { others[k].emplace(agree_on(candidates[k + 1], 1)); });
+  JointAgreement* best = &medoid;
+  for (auto& other : others)
+    if (other->unexplainedEvidence() < best->unexplainedEvidence()) best = &*other;
+  return std::move(*best);
+}
+
 SegmentationPipelineResult segmentJointly(const PreparedSegmentation& prepared,
                                           const std::vector<FeatureMatrix>& demos,
                                           const SegmentationPipelineConfig& config) {
@@ -761,9 +812,7 @@ SegmentationPipelineResult segmentJointly(const PreparedSegmentation& prepared,
       throw std::invalid_argument(describe(e.what(), d));
     }
   });
-  JointAgreement agreement(std::move(evidence), std::move(grids), config.joint,
-                           config.seconds->min_segment, config.threads);
-  agreement.run(config.segmentation.max_changepoints);
+  const JointAgreement agreement = bestAgreement(evidence, grids, config);
   for (std::size_t d = 0; d < n; ++d)
     reportDemo(agreement, demos[d], d, config.joint, &result.demos[d], &result.warnings);
   addSensorWarnings(demos, sensors, &result);

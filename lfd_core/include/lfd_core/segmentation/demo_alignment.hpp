@@ -26,7 +26,7 @@ std::vector<double> multivariateDtwMap(const Eigen::MatrixXd& a, const Eigen::Ma
                                        double band = 1.0);
 
 struct DemoAlignment {
-  std::size_t reference = 0;  ///< the medoid demonstration
+  std::size_t reference = 0;  ///< the demonstration whose time axis is the common one
   /// Per demo, per grid row: the reference grid row it aligns to (the reference maps to itself).
   std::vector<std::vector<double>> to_reference;
   /// Per demo, per reference grid row: the demo's grid row aligned to it.
@@ -34,9 +34,19 @@ struct DemoAlignment {
   std::vector<double> mean_cost;  ///< per demo, DTW cost to the reference per aligned row
 };
 
-/// Aligns gridded demos (onUniformGrid) to their medoid; `threads` <= 0 = all cores; `band`
-/// as for multivariateDtwCost.
+/// The demos' indices, least summed DTW cost to all the others first (the medoid; ties keep the
+/// input order). Costs are per aligned row (normalized by the pair's lengths).
 /// Throws std::invalid_argument on no demos, an empty one or differing feature counts.
+std::vector<std::size_t> byDtwCostToOthers(const std::vector<Eigen::MatrixXd>& gridded, int threads,
+                                           double band = 1.0);
+
+/// Aligns gridded demos (onUniformGrid) to demo `reference`; `threads` <= 0 = all cores; `band`
+/// as for multivariateDtwCost. Throws std::invalid_argument as above, or on a reference out of
+/// range.
+DemoAlignment alignTo(const std::vector<Eigen::MatrixXd>& gridded, std::size_t reference,
+                      int threads, double band = 1.0);
+
+/// alignTo the medoid (byDtwCostToOthers' first).
 DemoAlignment alignToMedoid(const std::vector<Eigen::MatrixXd>& gridded, int threads,
                             double band = 1.0);
 
