@@ -39,7 +39,8 @@ double checkedDurationScale(double scale, const RequestLimits& l) {
   if (scale == 0.0) return 1.0;
   if (!std::isfinite(scale) || scale < l.min_duration_scale || scale > l.max_duration_scale)
     throw std::invalid_argument("duration_scale " + formatted(scale) + " is outside [" +
-                                formatted(l.min_duration_scale) + ", " + formatted(l.max_duration_scale) +
+                                formatted(l.min_duration_scale) + ", " +
+                                formatted(l.max_duration_scale) +
                                 "] (~limits/min_duration_scale, ~limits/max_duration_scale)");
   return scale;
 }
