@@ -320,3 +320,10 @@ TEST(RhythmEvidence, EdgesNearAContactJoinItAndOthersStayPut) {
 }
 
 }  // namespace
+
+TEST(TypicalSpeed, IsThe95thPercentileNotTheSpike) {
+  Eigen::VectorXd speed = Eigen::VectorXd::LinSpaced(101, 0.0, 1.0);  // 0, 0.01, ..., 1
+  speed[50] = 100.0;                                                  // one spike
+  EXPECT_NEAR(lfd::typicalSpeed(speed), 0.96, 1e-12);  // the 95th of the 101 values, spike last
+  EXPECT_EQ(lfd::typicalSpeed(Eigen::VectorXd()), 0.0);
+}

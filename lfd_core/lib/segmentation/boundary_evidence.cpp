@@ -10,14 +10,6 @@ namespace lfd {
 
 namespace {
 
-double percentile(Eigen::VectorXd values, double fraction) {
-  if (values.size() == 0) return 0.0;
-  std::vector<double> v(values.data(), values.data() + values.size());
-  const std::size_t k = static_cast<std::size_t>(fraction * static_cast<double>(v.size() - 1));
-  std::nth_element(v.begin(), v.begin() + static_cast<long>(k), v.end());
-  return v[k];
-}
-
 // Samples in motion: above the rest threshold, in a bout whose peak reaches the small-motion
 // level.
 std::vector<bool> movingSamples(const Eigen::VectorXd& speed, double rest, double small) {
@@ -52,7 +44,7 @@ double peakSpeedAfter(const Eigen::VectorXd& speed, const std::vector<double>& t
 std::vector<Pause> restRuns(const Eigen::VectorXd& speed, const std::vector<double>& time,
                             const PauseConfig& config) {
   std::vector<Pause> runs;
-  const double typical = percentile(speed, 0.95);
+  const double typical = typicalSpeed(speed);
   if (!(typical > 0) || time.size() != static_cast<std::size_t>(speed.size())) return runs;
   const std::vector<bool> moving =
       movingSamples(speed, config.rest_fraction * typical, config.small_motion_fraction * typical);
@@ -91,6 +83,14 @@ std::string toString(EvidenceKind kind) {
       return "rhythm";
   }
   return "clasp";
+}
+
+double typicalSpeed(const Eigen::VectorXd& speed) {
+  if (speed.size() == 0) return 0.0;
+  std::vector<double> v(speed.data(), speed.data() + speed.size());
+  const std::size_t k = (v.size() - 1) * 95 / 100;
+  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(k), v.end());
+  return v[k];
 }
 
 Eigen::VectorXd stateSpeed(const Eigen::MatrixXd& scaled_states, const std::vector<double>& time,
@@ -140,7 +140,7 @@ std::vector<BoundaryEvidence> motionOnsetEvidence(const Eigen::VectorXd& speed,
                                                   const std::vector<Pause>& pauses,
                                                   const PauseConfig& config, double weight) {
   std::vector<BoundaryEvidence> out;
-  const double typical = percentile(speed, 0.95);
+  const double typical = typicalSpeed(speed);
   if (!(typical > 0)) return out;
   for (const Pause& p : pauses) {
     // The demo starts and ends at rest: neither is a boundary between skills.

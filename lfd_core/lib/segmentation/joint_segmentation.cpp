@@ -109,14 +109,6 @@ Eigen::MatrixXd ownShape(const Eigen::MatrixXd& scaled) {
   return out;
 }
 
-double percentile95(const Eigen::VectorXd& values) {
-  std::vector<double> v(values.data(), values.data() + values.size());
-  if (v.empty()) return 0.0;
-  const std::size_t k = (v.size() - 1) * 95 / 100;
-  std::nth_element(v.begin(), v.begin() + static_cast<long>(k), v.end());
-  return v[k];
-}
-
 // The speed as one more feature for the alignment, in units of the demo's typical speed and
 // weighing as much as all the state features together: they stand still through a pause, and
 // only the speed says where motion resumes; a phase is a motion between pauses more than a
@@ -124,7 +116,7 @@ double percentile95(const Eigen::VectorXd& values) {
 Eigen::MatrixXd withSpeed(const Eigen::MatrixXd& states, const Eigen::VectorXd& speed) {
   Eigen::MatrixXd out(states.rows(), states.cols() + 1);
   out.leftCols(states.cols()) = states;
-  const double typical = percentile95(speed);
+  const double typical = typicalSpeed(speed);
   const double weight = std::sqrt(static_cast<double>(std::max<Eigen::Index>(1, states.cols())));
   out.col(states.cols()) = typical > 0 ? Eigen::VectorXd(weight * (speed / typical).cwiseMin(1.5))
                                        : Eigen::VectorXd::Zero(speed.size());

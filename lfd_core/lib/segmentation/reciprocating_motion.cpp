@@ -10,13 +10,6 @@
 namespace lfd {
 namespace {
 
-double percentile95(const Eigen::VectorXd& values) {
-  std::vector<double> v(values.data(), values.data() + values.size());
-  const std::size_t k = (v.size() - 1) * 95 / 100;
-  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(k), v.end());
-  return v[k];
-}
-
 // The speed's dips that end a stroke: local minima from which the speed rises by `depth` on both
 // sides (on the left since the previous dip), with the demo's first and last samples.
 std::vector<std::size_t> strokeEnds(const Eigen::VectorXd& speed, double depth) {
@@ -68,7 +61,7 @@ std::vector<ReciprocatingRun> reciprocatingRuns(const Eigen::MatrixXd& states,
   std::vector<ReciprocatingRun> runs;
   if (n < 5 || states.cols() == 0) return runs;
   const Eigen::VectorXd speed = stateSpeed(states, time, smoothing_seconds);
-  const double typical = percentile95(speed);
+  const double typical = typicalSpeed(speed);
   if (!(typical > 0.0)) return runs;
   const std::vector<std::size_t> ends = strokeEnds(speed, config.min_dip * typical);
   const std::size_t strokes = ends.size() - 1;

@@ -88,6 +88,10 @@ std::vector<Pause> findPauses(const Eigen::VectorXd& speed, const std::vector<do
 Eigen::VectorXd stateSpeed(const Eigen::MatrixXd& scaled_states, const std::vector<double>& time,
                            double smoothing_seconds);
 
+/// A demo's typical speed, the unit of every rest and motion threshold: the 95th percentile of
+/// its speed profile (its moves' peaks, not one spike's). 0 for an empty profile.
+double typicalSpeed(const Eigen::VectorXd& speed);
+
 /// Evidence of motion onsets after the pauses (not the first motion of the demo: it starts at
 /// rest).
 std::vector<BoundaryEvidence> motionOnsetEvidence(const Eigen::VectorXd& speed,
