@@ -281,7 +281,7 @@ class Learner {
   lfd_dmp::MonitoredSensors sensors_;
   lfd::PathPolicy paths_;
   lfd::StringBudget strings_;
-  int max_bags_ = 32;
+  int max_bags_ = 64;
   double max_total_bytes_ = 1e9;  // a double: ROS int parameters stop at 2^31
   int max_num_basis_ = 1000;
   double max_demo_seconds_ = 120.0;

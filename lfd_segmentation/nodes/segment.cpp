@@ -233,7 +233,7 @@ LoadedDemos loadDemos(const Options& o, const lfd_segmentation::SegmentationPara
   in.bags = bags != 0;
   // The CLI skips the roots (its user owns the shell) but not the budget.
   lfd_segmentation::checkRequestBudget(o.files, params.limits, lfd::PathPolicy{},
-                                       in.bags ? "bag" : "CSV file");
+                                       in.bags ? "bag" : "CSV");
   if (in.bags && o.resample > 0)
     throw std::invalid_argument("--resample is for CSV files: a bag's clock is set by --rate");
   in.sensors = o.sensors;

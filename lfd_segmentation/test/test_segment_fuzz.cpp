@@ -80,7 +80,7 @@ TEST(SegmentServiceFuzz, RandomExtremeRequestsGiveAResultOrAClearError) {
     lfd_msgs::Segment::Request request;
     const int n = static_cast<int>(rng() % 5);
     for (int b = 0; b < n; ++b) request.bag_paths.push_back(rng() % 2 ? pick(good) : pick(paths));
-    if (rng() % 8 == 0) request.bag_paths.assign(40, good[0]);  // over limits/max_bags
+    if (rng() % 8 == 0) request.bag_paths.assign(80, good[0]);  // over limits/max_bags
     request.combination = pick(std::vector<std::string>{"", "", "average", "median", "product"});
     if (rng() % 2) request.threshold = pick(numbers);
     if (rng() % 2) request.min_segment_seconds = pick(numbers);

@@ -351,14 +351,14 @@ TEST_F(SegmentService, PartsOfDemosCountAgainstTheBudgetBeforeAnyWork) {
   std::vector<std::string> entries;
   for (const std::string& b : bags) {
     std::string parts = b;
-    for (int k = 1; k < 40; ++k) parts += "," + b;  // 40 parts: 80 bags in two entries
+    for (int k = 1; k < 70; ++k) parts += "," + b;  // 70 parts: 140 bags in two entries
     entries.push_back(parts);
   }
   ASSERT_LE(entries.size(), params_.limits.max_bags);
   const auto start = std::chrono::steady_clock::now();
   const lfd_msgs::Segment::Response r = call(entries);
   EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), 1.0);
-  expectError(r, "80 bag files, over the limit of 64 (limits/max_bag_files)");
+  expectError(r, "140 bag files, over the limit of 128 (limits/max_bag_files)");
 
   lfd_segmentation::SegmentationParams small = params_;
   small.limits.max_total_bytes = fs::file_size(bags[0]) + fs::file_size(bags[1]) / 2;

@@ -125,9 +125,9 @@ class LearnerFuzz(unittest.TestCase):
         self.assertRefused(
             self.call(self.valid(os.path.join(self.dir, "b.json"), num_basis=100000)),
             "limits/max_num_basis")
-        req = self.valid(os.path.join(self.dir, "many.json"), bag_paths=self.bags * 20,
-                         changepoint_counts=[1] * 60,
-                         changepoint_times=[START + DURATION / 2] * 60)
+        req = self.valid(os.path.join(self.dir, "many.json"), bag_paths=self.bags * 30,
+                         changepoint_counts=[1] * 90,
+                         changepoint_times=[START + DURATION / 2] * 90)
         self.assertRefused(self.call(req), "limits/max_bags")
 
     def test_8_overwrite_replaces_only_a_library_lfd_wrote(self):

@@ -153,6 +153,15 @@ class SignalClasses(unittest.TestCase):
             self.assertLessEqual(sum(rows), limits["max_total_samples"], name)
             self.assertGreater(min(rows), 5000, name)  # not made to fit by shortening them
 
+    def test_the_limits_take_45_snap_fit_demos_in_one_call(self):
+        """Issue 22's robot-run snap-fit set has 45 demos at 200 Hz, segmented in one call."""
+        with open(SEG_CONFIG) as f:
+            limits = yaml.safe_load(f)["limits"]
+        rows = [len(r) for _, r in self.data["in_contact_level"][1]]
+        self.assertGreaterEqual(limits["max_bags"], 45)
+        self.assertGreaterEqual(limits["max_bag_files"], 45)
+        self.assertGreaterEqual(limits["max_total_samples"], 45 * max(rows))
+
     def test_rate_variants_keep_their_base_durations(self):
         base = self.data["contact_wipe@100"][0]["demos"]
         for rate in (25, 1000):

@@ -32,12 +32,12 @@ struct TopicConfig {
 /// Bounds on one request (config `limits:`): whatever a client sends, a request takes bounded
 /// memory and time and is refused, naming the limit's key, when it asks for more.
 struct RequestLimits {
-  std::size_t max_bags = 32;                   ///< bag paths (or CSV files) per request
-  std::size_t max_bag_files = 64;              ///< files after splitting demos' parts (a,b.bag)
+  std::size_t max_bags = 64;                   ///< bag paths (or CSV files) per request
+  std::size_t max_bag_files = 128;             ///< files after splitting demos' parts (a,b.bag)
   std::uint64_t max_total_bytes = 1000000000;  ///< size of all a request's files together
   double max_demo_seconds = 120.0;             ///< time span of one demo's stamps (s)
   std::size_t max_samples_per_demo = 12000;    ///< rows after resampling (span x rate)
-  std::size_t max_total_samples = 60000;       ///< rows summed over the request's demos
+  std::size_t max_total_samples = 300000;      ///< rows summed over the request's demos
   std::size_t max_csv_rows = 100000;           ///< data rows of one CSV file
   double max_abs_value = 1e100;                ///< |feature value|; squares must not overflow
   std::size_t max_features = 256;              ///< feature columns of a demo (bag fields, CSV)
