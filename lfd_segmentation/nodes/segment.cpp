@@ -41,7 +41,9 @@ const char* const kUsage = R"(usage: segment [options] FILE...
   --time-column NAME        CSV time column (default: time, t, timestamp or stamp if present)
   --rate HZ                 bag resampling rate / CSV sample rate (overrides a CSV time column)
   --resample HZ             CSV: average the rows onto a clock of HZ (a 1 kHz F/T: 100); the
-                            segmentation is in seconds, so only speed and the sample limits change
+                            segmentation is in seconds, so only speed and the sample limits change.
+                            Without it, demos over the sample limits go onto the fastest clock
+                            that fits (warned)
   --combination NAME[,NAME] average | product | weighted_average | weighted_product |
                             distance_average | weighted_distance_average, or 'all'. Several: the
                             features are selected once and the JSON holds one result per name
@@ -192,6 +194,47 @@ lfd::FeatureMatrix resampleWithinLimits(const lfd::FeatureMatrix& m, double rate
   }
 }
 
+// Every input file read (all bags or all CSV), with the feature roles and the clock warnings.
+struct LoadedDemos {
+  bool bags = false;
+  std::vector<lfd::FeatureMatrix> demos;
+  std::vector<std::string> sensors, states, clock_warnings;
+};
+
+// CSV demos too fine-grained for the sample limits (a 1 kHz F/T over 20 s) are averaged onto the
+// fastest whole-Hz clock that fits them all, with a warning: the segmentation is in seconds, so
+// only its speed changes. --resample HZ chooses the clock instead.
+void fitCsvClocks(const lfd_segmentation::SegmentationParams& params,
+                  const std::vector<std::string>& files, LoadedDemos* in) {
+  const lfd_segmentation::RequestLimits& lim = params.limits;
+  std::size_t most_rows = 0, total_rows = 0;
+  double longest = 0.0, total_span = 0.0;
+  for (const lfd::FeatureMatrix& m : in->demos) {
+    const std::size_t rows = static_cast<std::size_t>(m.rows());
+    const double span = m.time.empty() ? 0.0 : m.time.back() - m.time.front();
+    most_rows = std::max(most_rows, rows);
+    total_rows += rows;
+    longest = std::max(longest, span);
+    total_span += span;
+  }
+  if ((most_rows <= lim.max_samples_per_demo && total_rows <= lim.max_total_samples) ||
+      !(longest > 0.0))
+    return;
+  const double demos = static_cast<double>(in->demos.size());
+  const double rate =
+      std::floor(std::min((static_cast<double>(lim.max_samples_per_demo) - 1.0) / longest,
+                          (static_cast<double>(lim.max_total_samples) - demos) / total_span));
+  if (!(rate >= 1.0)) return;  // checkDemosFit names the limit
+  for (std::size_t d = 0; d < in->demos.size(); ++d)
+    in->demos[d] = resampleWithinLimits(in->demos[d], rate, files[d], params);
+  std::ostringstream note;
+  note << "the CSV demos (up to " << most_rows << " rows in one, " << total_rows
+       << " in all) were averaged onto a " << rate
+       << " Hz clock to fit limits/max_samples_per_demo and limits/max_total_samples; "
+          "--resample HZ chooses the clock";
+  in->clock_warnings.push_back(note.str());
+}
+
 // The shipped configuration with the command line's overrides.
 lfd_segmentation::SegmentationParams paramsFor(const Options& o) {
   lfd_segmentation::SegmentationParams params = lfd_segmentation::loadParamsFile(o.config);
@@ -216,13 +259,6 @@ lfd_segmentation::SegmentationParams paramsFor(const Options& o) {
   if (o.threads >= 0) params.pipeline.threads = static_cast<int>(o.threads);
   return params;
 }
-
-// Every input file read (all bags or all CSV), with the feature roles and the clock warnings.
-struct LoadedDemos {
-  bool bags = false;
-  std::vector<lfd::FeatureMatrix> demos;
-  std::vector<std::string> sensors, states, clock_warnings;
-};
 
 LoadedDemos loadDemos(const Options& o, const lfd_segmentation::SegmentationParams& params) {
   LoadedDemos in;
@@ -259,6 +295,7 @@ LoadedDemos loadDemos(const Options& o, const lfd_segmentation::SegmentationPara
     const std::string gap = lfd_segmentation::clockGapWarning(in.demos.back(), f);
     if (!gap.empty()) in.clock_warnings.push_back(gap);
   }
+  if (!in.bags && !(o.resample > 0)) fitCsvClocks(params, o.files, &in);
   lfd_segmentation::checkDemosFit(params, in.demos, o.files);
   return in;
 }
