@@ -727,8 +727,6 @@ void reportDemo(const JointAgreement& agreement, const FeatureMatrix& demo, std:
     out->rejected_times.push_back(demo.timeAt(static_cast<Eigen::Index>(cp)));
 }
 
-}  // namespace
-
 // The agreement on the medoid's time axis (the demo with the least DTW cost to the others),
 // unless most demos are left with strong evidence (a contact made or lost) that no agreed
 // boundary explains: the sign that the alignment, not the demos, is wrong. The medoid can be a
@@ -758,6 +756,8 @@ JointAgreement bestAgreement(const std::vector<DemoEvidence>& evidence,
     if (other->unexplainedEvidence() < best->unexplainedEvidence()) best = &*other;
   return std::move(*best);
 }
+
+}  // namespace
 
 SegmentationPipelineResult segmentJointly(const PreparedSegmentation& prepared,
                                           const std::vector<FeatureMatrix>& demos,
