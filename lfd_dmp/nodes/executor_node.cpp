@@ -588,7 +588,7 @@ class Executor {
     setState(lfd_msgs::ExecuteTaskFeedback::MOVING, plan);
     ros::Time t_end = t0 + ros::Duration(plan.duration());
     ClockWatch watch(clock_timeout_);
-    ros::Time reached;
+    ros::Time reached, settled;
     for (;;) {
       const ros::Time now = ros::Time::now();
       checkRunning(plan, t0, now, &watch);
@@ -606,9 +606,13 @@ class Executor {
           // the progress of the last joint sample then, which lags on a loaded machine (a fresh
           // root: 0.75 s behind the clock, progress 0.97). The joint states up to the plan's end
           // were published before the clock passed it: they are waited for, 1 wall s at most.
+          // The TCP counts as arrived only within the settle (a lockstep client may go on
+          // stepping meanwhile).
           const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(1.0);
           while (track(plan, t0, t_end, &reached) < t_end && ros::WallTime::now() < deadline)
             ros::WallDuration(0.001).sleep();
+          if (reached > now) reached = ros::Time();
+          settled = now;
           publishFeedback();
           break;
         }
@@ -616,7 +620,7 @@ class Executor {
       ros::WallDuration(0.001).sleep();
     }
     if (reached.isZero()) {
-      reached = ros::Time::now();
+      reached = settled;  // the settle's end
       result->warnings.push_back(
           "the TCP did not come within the IK tolerance of its final pose "
           "in ~settle_time");
