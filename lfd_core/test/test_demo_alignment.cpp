@@ -133,14 +133,19 @@ TEST(AnchoredDtwMap, ThrowsWhenTheAnchorListsDifferInLength) {
 
 // ---- alignToMedoid
 
-TEST(AlignToMedoid, TheOutlierIsNotTheMedoid) {
+// An outlier (a curve unlike the others) first, then the same curve at three paces: taking the
+// first demo would pick the outlier.
+std::vector<Eigen::MatrixXd> outlierFirst() {
   Eigen::MatrixXd outlier(60, 2);
   for (int i = 0; i < 60; ++i) {
     const double u = i / 59.0;
     outlier.row(i) << 1.0 - u, 0.5 * std::sin(6.0 * M_PI * u);
   }
-  // The outlier first: taking the first demo would pick it.
-  const std::vector<Eigen::MatrixXd> demos = {outlier, sampled(50), sampled(60), sampled(75)};
+  return {outlier, sampled(50), sampled(60), sampled(75)};
+}
+
+TEST(AlignToMedoid, TheOutlierIsNotTheMedoid) {
+  const std::vector<Eigen::MatrixXd> demos = outlierFirst();
   const lfd::DemoAlignment alignment = lfd::alignToMedoid(demos, 1);
   EXPECT_NE(alignment.reference, 0u);
   ASSERT_EQ(alignment.to_reference.size(), demos.size());
@@ -167,12 +172,7 @@ TEST(AlignToMedoid, ThrowsOnNoDemoOrDifferentFeatureCounts) {
 }
 
 TEST(ByDtwCostToOthers, TheMedoidFirstAndTheOutlierLast) {
-  Eigen::MatrixXd outlier(60, 2);
-  for (int i = 0; i < 60; ++i) {
-    const double u = i / 59.0;
-    outlier.row(i) << 1.0 - u, 0.5 * std::sin(6.0 * M_PI * u);
-  }
-  const std::vector<Eigen::MatrixXd> demos = {outlier, sampled(50), sampled(60), sampled(75)};
+  const std::vector<Eigen::MatrixXd> demos = outlierFirst();
   const std::vector<std::size_t> order = lfd::byDtwCostToOthers(demos, 1);
   ASSERT_EQ(order.size(), demos.size());
   EXPECT_EQ(order.back(), 0u);
