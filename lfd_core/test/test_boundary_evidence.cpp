@@ -236,12 +236,38 @@ TEST(GatherIntoPauses, EvidenceAsTheHandStopsStaysWhereItIs) {
 
 // ---- sensoryEvidence
 
-lfd::SensoryEvent event(std::size_t index, bool rest_edge) {
+lfd::SensoryEvent event(std::size_t index, bool rest_edge, bool away_from_rest = true) {
   lfd::SensoryEvent e;
   e.index = index;
   e.rest_edge = rest_edge;
   e.strength = 2.0;
+  e.away_from_rest = away_from_rest;
   return e;
+}
+
+// Where each level event ended up (sorted), the contacts left out.
+std::vector<std::size_t> levelIndices(const std::vector<lfd::BoundaryEvidence>& evidence) {
+  std::vector<std::size_t> out;
+  for (const auto& e : evidence)
+    if (e.kind == lfd::EvidenceKind::kSensorLevel) out.push_back(e.index);
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+// A press builds up after contact is made and eases off before it is lost: those join their
+// edge. A force that rises before an edge of contact lost (a push ending in a snap whose drop
+// reads as rest) does not, nor one that eases off long after contact is made; within the
+// reversal fold (a press overshooting as it lands) it does.
+TEST(SensoryEvidence, ALevelEventJoinsARestEdgeOnlyWhenItGoesTheEdgesWay) {
+  lfd::SensorEvents events;
+  events.details = {event(100, true, true),  event(115, false, true),  event(150, false, false),
+                    event(200, true, true),  event(203, false, false), event(380, false, true),
+                    event(400, true, false), event(480, false, false), event(500, true, false)};
+  const auto out = lfd::sensoryEvidence(events, lfd::EvidenceWeights{}, 25, 5);
+  // 115 builds up after 100: joins it. 150 eases off 50 after 100: beyond the fold either way.
+  // 203 eases off 3 after 200: within the reversal fold. 380 rises 20 before contact lost at
+  // 400: its own. 480 eases off 20 before 500: joins it.
+  EXPECT_EQ(levelIndices(out), (std::vector<std::size_t>{100, 150, 200, 380, 500}));
 }
 
 TEST(SensoryEvidence, ARestEdgeIsContactWithTheContactWeight) {
@@ -250,7 +276,7 @@ TEST(SensoryEvidence, ARestEdgeIsContactWithTheContactWeight) {
   lfd::EvidenceWeights weights;
   weights.contact = 0.77;
   weights.sensor_level = 0.55;
-  const auto out = lfd::sensoryEvidence(events, weights, 25);
+  const auto out = lfd::sensoryEvidence(events, weights, 25, 5);
   ASSERT_EQ(out.size(), 1u);
   EXPECT_EQ(out[0].index, 100u);
   EXPECT_EQ(out[0].kind, lfd::EvidenceKind::kContact);
@@ -263,7 +289,7 @@ TEST(SensoryEvidence, ALevelEventNearARestEdgeJoinsItAndAFarOneStaysPut) {
   lfd::EvidenceWeights weights;
   weights.contact = 0.77;
   weights.sensor_level = 0.55;
-  auto out = lfd::sensoryEvidence(events, weights, 25);
+  auto out = lfd::sensoryEvidence(events, weights, 25, 5);
   ASSERT_EQ(out.size(), 4u);
   std::sort(out.begin(), out.end(),
             [](const lfd::BoundaryEvidence& a, const lfd::BoundaryEvidence& b) {
@@ -292,7 +318,7 @@ TEST(SensoryEvidence, ALevelEventNearARestEdgeJoinsItAndAFarOneStaysPut) {
 TEST(SensoryEvidence, ALevelEventJustBeyondTheFoldStaysPut) {
   lfd::SensorEvents events;
   events.details = {event(100, true), event(126, false)};
-  const auto out = lfd::sensoryEvidence(events, lfd::EvidenceWeights{}, 25);
+  const auto out = lfd::sensoryEvidence(events, lfd::EvidenceWeights{}, 25, 5);
   ASSERT_EQ(out.size(), 2u);
   for (const auto& e : out)
     if (e.kind == lfd::EvidenceKind::kSensorLevel) {

@@ -119,6 +119,42 @@ std::vector<Demo> reachPressRetract(int count, unsigned seed, double slide = 0.0
   return demos;
 }
 
+// A snap-fit: reach the seat and stay there pressed (contact, the touch sensor at ~5), push
+// harder after 2-3 s (the level rising to 2.2x over 0.7-1.0 s as the hook deflects), then the
+// snap: the level falls to 0.3x, the operator's light hold to the end. That hold lies within the
+// sensor's rest band (a fraction of its largest change), so the snap reads as contact lost.
+// Truth: the contact, the start of the push, the snap.
+std::vector<Demo> snapFits(int count, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  std::vector<Demo> demos;
+  for (int d = 0; d < count; ++d) {
+    const double rest = 0.3 + 0.5 * unit(rng), reach = 2.5 + unit(rng), turn = 2.0 + unit(rng),
+                 push = 0.7 + 0.3 * unit(rng), held = 1.5 + unit(rng);
+    const Eigen::Vector3d home(0.0, 0.0, 0.3);
+    const Eigen::Vector3d seat(0.4 + 0.06 * (unit(rng) - 0.5), 0.1 + 0.06 * (unit(rng) - 0.5),
+                               0.05);
+    const double onset = rest + reach, harder = onset + turn, snap = harder + push;
+    const double level = 4.5 + unit(rng);
+    auto touch = [=](double t, double noise) {
+      double scale = 0.0;
+      if (t >= snap)
+        scale = 0.3;
+      else if (t >= harder)
+        scale = 1.0 + 1.2 * (t - harder) / push;
+      else if (t >= onset)
+        scale = std::min(1.0, (t - onset) / 0.15);
+      return level * scale + 0.1 * noise;
+    };
+    Demo demo;
+    demo.matrix = sampleLegs(home, {{rest, home}, {reach, seat}, {turn + push + held, seat}}, &rng,
+                             touch, true);
+    demo.truth = {onset, harder, snap};
+    demos.push_back(std::move(demo));
+  }
+  return demos;
+}
+
 // Pose only: move -> 2 s pause -> move -> 2 s pause -> move, each move hesitating 0.3 s halfway.
 // Truth: where motion resumes after each long pause. `lacking` (>= 0) names a demo without the
 // middle move (and its pause): move -> 2 s pause -> move home.
@@ -278,6 +314,17 @@ TEST(JointSegmentation, AContactLostMidwayInTwoDemosIsNoBoundary) {
 // placement's 0.5 s the two steps made one plateau and no demo got both (measured: 0 of 6).
 TEST(JointSegmentation, TwoLevelStepsInContactLessThanASecondApartAreTwoBoundaries) {
   const auto demos = reachPressRetract(6, 7, 0.4, true);
+  const auto result = lfd::runSegmentationPipeline(matrices(demos), {"touch"}, jointConfig());
+  ASSERT_EQ(result.demos.size(), demos.size());
+  for (std::size_t d = 0; d < demos.size(); ++d) expectBoundaries(result, demos[d], d, 0.3);
+}
+
+// The push that ends in the snap is a phase of its own, though the snap reads as contact lost
+// less than a second after the push began: a level step joins a contact edge within the ramp
+// fold only when it goes the way the edge goes (measured without that rule: the push's start
+// was folded onto the snap, two boundaries per demo instead of three).
+TEST(JointSegmentation, ARisingPushBeforeASnapThatReadsAsContactLostIsItsOwnPhase) {
+  const auto demos = snapFits(6, 11);
   const auto result = lfd::runSegmentationPipeline(matrices(demos), {"touch"}, jointConfig());
   ASSERT_EQ(result.demos.size(), demos.size());
   for (std::size_t d = 0; d < demos.size(); ++d) expectBoundaries(result, demos[d], d, 0.3);

@@ -359,6 +359,8 @@ TEST(SensoryEvents, FittedEventsAtTheStartAndEndOfSlowRamps) {
   ASSERT_EQ(rest_edges.size(), 2u) << ::testing::PrintToString(rest_edges);
   EXPECT_NEAR(static_cast<double>(rest_edges[0]), 200.0, 5.0);  // leaves rest
   EXPECT_NEAR(static_cast<double>(rest_edges[1]), 530.0, 5.0);  // back at rest
+  for (const lfd::SensoryEvent& e : events)
+    EXPECT_EQ(e.away_from_rest, e.index < 400) << e.index;  // building up, then fading
 }
 
 // A snap-fit in contact at 50 Hz: pressed at 13 N from 2 s, the force rises (quadratically, as the
@@ -384,6 +386,12 @@ TEST(SensoryEvents, ARiseAndAFallInOneBurstAreTwoChanges) {
   // The rise begins: a straight ramp fitted to a quadratic starts a third of the way in.
   EXPECT_NEAR(static_cast<double>(events[1]), 300.0, 15.0);
   EXPECT_NEAR(static_cast<double>(events[2]), 347.0, 10.0);  // the fall has settled
+  // Which way each goes: the press and the rise away from rest, the fall back towards it.
+  const auto details = lfd::detectSensoryEventDetails(force, joint);
+  ASSERT_EQ(details.size(), 3u);
+  EXPECT_TRUE(details[0].away_from_rest);
+  EXPECT_TRUE(details[1].away_from_rest);
+  EXPECT_FALSE(details[2].away_from_rest);
 }
 
 // Two pads of one sensor: pad A touches from 4 s to 7 s, pad B from 6.5 s to 10 s. As one sensor

@@ -184,17 +184,22 @@ std::size_t foldOntoContact(const std::vector<std::size_t>& edges, std::size_t i
 
 std::vector<BoundaryEvidence> sensoryEvidence(const SensorEvents& events,
                                               const EvidenceWeights& weights,
-                                              std::size_t fold_samples) {
-  std::vector<std::size_t> edges;
+                                              std::size_t fold_samples,
+                                              std::size_t reversal_fold_samples) {
+  std::vector<std::size_t> edges_away, edges_back;
   for (const SensoryEvent& e : events.details)
-    if (e.rest_edge) edges.push_back(e.index);
+    if (e.rest_edge) (e.away_from_rest ? edges_away : edges_back).push_back(e.index);
   std::vector<BoundaryEvidence> out;
   for (const SensoryEvent& e : events.details) {
-    if (e.rest_edge)
+    if (e.rest_edge) {
       out.push_back({e.index, weights.contact, EvidenceKind::kContact});
-    else
-      out.push_back({foldOntoContact(edges, e.index, fold_samples), weights.sensor_level,
-                     EvidenceKind::kSensorLevel});
+      continue;
+    }
+    const auto& same = e.away_from_rest ? edges_away : edges_back;
+    const auto& other = e.away_from_rest ? edges_back : edges_away;
+    std::size_t at = foldOntoContact(same, e.index, fold_samples);
+    if (at == e.index) at = foldOntoContact(other, e.index, reversal_fold_samples);
+    out.push_back({at, weights.sensor_level, EvidenceKind::kSensorLevel});
   }
   return out;
 }

@@ -313,8 +313,11 @@ void gatherEvidence(const FeatureMatrix& demo, const Eigen::MatrixXd& scaled,
     dropStaleEvents(stale, own.events.difference_lag, &events);
     out->events = events.all;
     out->event_details = events.details;
+    // A reversal within colocation of the edge is at the edge's instant (a press overshooting
+    // as it lands; teleop push).
     const auto s = sensoryEvidence(events, joint.weights,
-                                   static_cast<std::size_t>(std::lround(joint.ramp_fold * rate)));
+                                   static_cast<std::size_t>(std::lround(joint.ramp_fold * rate)),
+                                   static_cast<std::size_t>(std::lround(joint.colocation * rate)));
     pieces.insert(pieces.end(), s.begin(), s.end());
   }
   const auto r = rhythmEvidence(rhythm, pieces, joint.weights.rhythm,

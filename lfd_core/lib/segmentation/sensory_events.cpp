@@ -280,6 +280,11 @@ FitWindows fitWindows(const Burst& b, const Channel& c, const SensoryEventConfig
   return w;
 }
 
+// Whether a change from level `before` to `after` moves channel c away from its rest level.
+bool away(const Channel& c, double before, double after) {
+  return std::abs(after - c.rest) > std::abs(before - c.rest);
+}
+
 // EventPlacement::kFit: the burst's start where the level starts to change and its end where it
 // settles (fitRamp in fitWindows); the ends of a short ramp or step are one event. An event whose
 // outer level is the rest level (the level at the demo's start, within the activity threshold)
@@ -292,18 +297,23 @@ void placeByFit(const Burst& b, const Channel& c, const SensoryEventConfig& conf
   const RampFit first = fitRamp(c.y, w.first_begin, w.first_end);
   const bool from_rest = std::abs(first.before - c.rest) < c.on;
   if (b.end == n) {
-    events->push_back({{first.start, from_rest, strength}, from_rest, false});
+    events->push_back(
+        {{first.start, from_rest, strength, away(c, first.before, first.after)}, from_rest, false});
     return;
   }
   const RampFit last = fitRamp(c.y, w.last_begin, w.last_end);
   const bool to_rest = std::abs(last.after - c.rest) < c.on;
   if (last.end <= first.start + lag / 2) {  // one step: the rest side says where
     const std::size_t at = !from_rest && to_rest ? last.end : first.start;
-    events->push_back({{at, from_rest || to_rest, strength}, from_rest, to_rest});
+    events->push_back({{at, from_rest || to_rest, strength, away(c, first.before, last.after)},
+                       from_rest,
+                       to_rest});
     return;
   }
-  events->push_back({{first.start, from_rest, strength}, from_rest, false});
-  events->push_back({{last.end, to_rest, strength}, false, to_rest});
+  events->push_back(
+      {{first.start, from_rest, strength, away(c, first.before, first.after)}, from_rest, false});
+  events->push_back(
+      {{last.end, to_rest, strength, away(c, last.before, last.after)}, false, to_rest});
 }
 
 // EventPlacement::kThreshold and kShift: at the burst's ends, shifted back onto the change by
@@ -498,6 +508,7 @@ std::vector<SensoryEvent> uniqueByIndex(std::vector<SensoryEvent> events) {
   for (const SensoryEvent& e : events) {
     if (!unique.empty() && unique.back().index == e.index) {
       unique.back().rest_edge = unique.back().rest_edge || e.rest_edge;
+      if (e.strength > unique.back().strength) unique.back().away_from_rest = e.away_from_rest;
       unique.back().strength = std::max(unique.back().strength, e.strength);
     } else {
       unique.push_back(e);

@@ -113,11 +113,16 @@ void gatherIntoPauses(const std::vector<Pause>& pauses, std::size_t samples,
                       std::size_t start_samples, std::vector<BoundaryEvidence>* evidence);
 
 /// Evidence of the sensory events: rest edges as contact, the others as level steps. A level
-/// event within `fold_samples` of a rest edge is that contact's own force building up or fading
-/// (the ramp reaching its plateau), so it joins the rest edge instead of standing alone.
+/// event within `fold_samples` of a rest edge that changes the level the way the edge does (away
+/// from rest after contact is made, towards it before contact is lost) is that contact's own
+/// force building up or fading (the ramp reaching its plateau), so it joins the rest edge instead
+/// of standing alone. One that goes the other way joins it only within `reversal_fold_samples`
+/// (a press overshooting as it lands): further off it is a phase of its own, as an insertion's
+/// force rising before a snap whose drop ends within the sensor's rest band.
 std::vector<BoundaryEvidence> sensoryEvidence(const SensorEvents& events,
                                               const EvidenceWeights& weights,
-                                              std::size_t fold_samples);
+                                              std::size_t fold_samples,
+                                              std::size_t reversal_fold_samples);
 
 /// Evidence of the periodic phases' edges. An edge within `fold_samples` of a contact (a rest
 /// edge in `contacts`) is that contact's own: the strokes of a wipe start a little after the press

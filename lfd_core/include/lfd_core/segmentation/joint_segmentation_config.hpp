@@ -36,8 +36,9 @@ struct JointSegmentationConfig {
   /// agreement across demos, not a second of rest, tells a contact from chatter, so a stroke that
   /// lifts off for 0.8 s is a contact of its own.
   double event_merge_gap = 0.5;
-  /// A sensor level step within this of a rest edge (s) is that contact's own force building up
-  /// or fading, and joins the rest edge.
+  /// A sensor level step within this of a rest edge (s) that goes the edge's way is that
+  /// contact's own force building up or fading, and joins the rest edge (one going the other way
+  /// joins it within `colocation` only: boundary_evidence.hpp, sensoryEvidence).
   double ramp_fold = 1.0;
   /// A contact sensor that repeats one reading on all its channels for this long (s), while it
   /// repeats none in most demos (it has noise), did not measure then: its events within a lag
@@ -47,7 +48,8 @@ struct JointSegmentationConfig {
   /// hesitation is no boundary, even where the other demos have one.
   double min_piece_weight = 0.3;
   /// Pieces of one demo's evidence closer than this (s) mark one instant: they reinforce each
-  /// other when a boundary is placed, and are claimed by it together.
+  /// other when a boundary is placed, and are claimed by it together. A level step reversing a
+  /// rest edge this near it is at the edge's instant.
   double colocation = 0.25;
   /// A sensor whose magnitude correlates with the robot's speed above this (pooled over the
   /// demos) reports the robot's own motion (a tracking error, inertia), not contact: its events

@@ -118,6 +118,10 @@ struct SensoryEvent {
   bool rest_edge = false;
   /// Largest lagged difference of its burst over the activity threshold (>= 1).
   double strength = 1.0;
+  /// The level after the event is farther from the rest level than before it (a contact made, a
+  /// press deepening); false when it comes back towards rest (a force easing off, a release).
+  /// Over a sensor's channels: the strongest channel's. kFit only (true otherwise).
+  bool away_from_rest = true;
 };
 
 /// A closed interval of sample indices [begin, end] (eq. 1 uses closed intervals).
