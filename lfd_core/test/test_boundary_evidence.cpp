@@ -258,6 +258,24 @@ std::vector<std::size_t> levelIndices(const std::vector<lfd::BoundaryEvidence>& 
 // edge. A force that rises before an edge of contact lost (a push ending in a snap whose drop
 // reads as rest) does not, nor one that eases off long after contact is made; within the
 // reversal fold (a press overshooting as it lands) it does.
+// The start and the end of one ramp in contact are one change: each alone weighs less than a
+// step (under min_support: the start of a torque dying out is no boundary alone), the two together
+// as much as one. Folded onto a contact, the contact's weight is what counts.
+TEST(SensoryEvidence, EachEndOfOneRampWeighsHalfAStepInNoisyOr) {
+  lfd::SensorEvents events;
+  lfd::SensoryEvent start = event(300, false, false), end = event(320, false, false);
+  start.ramp_end = end.ramp_end = true;
+  events.details = {start, end, event(500, false, true)};
+  lfd::EvidenceWeights weights;
+  weights.sensor_level = 0.75;
+  const auto out = lfd::sensoryEvidence(events, weights, 25, 5);
+  ASSERT_EQ(out.size(), 3u);
+  EXPECT_NEAR(out[0].weight, 0.5, 1e-12);
+  EXPECT_NEAR(out[1].weight, 0.5, 1e-12);
+  EXPECT_NEAR(1.0 - (1.0 - out[0].weight) * (1.0 - out[1].weight), 0.75, 1e-12);
+  EXPECT_DOUBLE_EQ(out[2].weight, 0.75);
+}
+
 TEST(SensoryEvidence, ALevelEventJoinsARestEdgeOnlyWhenItGoesTheEdgesWay) {
   lfd::SensorEvents events;
   events.details = {event(100, true, true),  event(115, false, true),  event(150, false, false),

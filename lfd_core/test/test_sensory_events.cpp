@@ -392,6 +392,32 @@ TEST(SensoryEvents, ARiseAndAFallInOneBurstAreTwoChanges) {
   EXPECT_TRUE(details[0].away_from_rest);
   EXPECT_TRUE(details[1].away_from_rest);
   EXPECT_FALSE(details[2].away_from_rest);
+  // The rise and the fall are two changes, not the two ends of one.
+  EXPECT_FALSE(details[1].ramp_end);
+  EXPECT_FALSE(details[2].ramp_end);
+}
+
+// In contact at 10 N from 2 s, a torque-like level falls to 4 N over 0.4 s from 5 s (a twist dying
+// out as the turn slows), at 50 Hz: its start and its end are events, and both are flagged as the
+// two ends of one change.
+TEST(SensoryEvents, TheTwoEndsOfOneRampInContactAreFlaggedAsOneChange) {
+  std::mt19937 rng(9);
+  std::normal_distribution<double> g(0.0, 0.1);
+  Eigen::VectorXd x(400);
+  for (Eigen::Index t = 0; t < x.size(); ++t) {
+    const double on = std::clamp((t - 100.0) / 5.0, 0.0, 1.0);
+    const double fade = std::clamp((t - 250.0) / 20.0, 0.0, 1.0);
+    x[t] = 10.0 * on - 6.0 * fade + g(rng);
+  }
+  SensoryEventConfig joint = yamlAt50hz();
+  joint.merge_gap = 25;
+  const auto events = lfd::detectSensoryEventDetails(x, joint);
+  std::vector<std::size_t> ends;
+  for (const lfd::SensoryEvent& e : events)
+    if (e.ramp_end) ends.push_back(e.index);
+  ASSERT_EQ(ends.size(), 2u) << ::testing::PrintToString(ends);
+  EXPECT_NEAR(static_cast<double>(ends[0]), 250.0, 5.0);
+  EXPECT_NEAR(static_cast<double>(ends[1]), 270.0, 5.0);
 }
 
 // Two pads of one sensor: pad A touches from 4 s to 7 s, pad B from 6.5 s to 10 s. As one sensor

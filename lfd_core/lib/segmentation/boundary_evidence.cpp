@@ -199,7 +199,10 @@ std::vector<BoundaryEvidence> sensoryEvidence(const SensorEvents& events,
     const auto& other = e.away_from_rest ? edges_back : edges_away;
     std::size_t at = foldOntoContact(same, e.index, fold_samples);
     if (at == e.index) at = foldOntoContact(other, e.index, reversal_fold_samples);
-    out.push_back({at, weights.sensor_level, EvidenceKind::kSensorLevel});
+    // The two ends of one ramp are one change: together (noisy-OR) as sure as one step.
+    const double weight = e.ramp_end && at == e.index ? 1.0 - std::sqrt(1.0 - weights.sensor_level)
+                                                      : weights.sensor_level;
+    out.push_back({at, weight, EvidenceKind::kSensorLevel});
   }
   return out;
 }

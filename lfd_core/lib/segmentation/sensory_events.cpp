@@ -310,10 +310,11 @@ void placeByFit(const Burst& b, const Channel& c, const SensoryEventConfig& conf
                        to_rest});
     return;
   }
-  events->push_back(
-      {{first.start, from_rest, strength, away(c, first.before, first.after)}, from_rest, false});
-  events->push_back(
-      {{last.end, to_rest, strength, away(c, last.before, last.after)}, false, to_rest});
+  const bool away_first = away(c, first.before, first.after);
+  const bool away_last = away(c, last.before, last.after);
+  const bool one_change = away_first == away_last;
+  events->push_back({{first.start, from_rest, strength, away_first, one_change}, from_rest, false});
+  events->push_back({{last.end, to_rest, strength, away_last, one_change}, false, to_rest});
 }
 
 // EventPlacement::kThreshold and kShift: at the burst's ends, shifted back onto the change by
@@ -509,6 +510,7 @@ std::vector<SensoryEvent> uniqueByIndex(std::vector<SensoryEvent> events) {
     if (!unique.empty() && unique.back().index == e.index) {
       unique.back().rest_edge = unique.back().rest_edge || e.rest_edge;
       if (e.strength > unique.back().strength) unique.back().away_from_rest = e.away_from_rest;
+      unique.back().ramp_end = unique.back().ramp_end && e.ramp_end;
       unique.back().strength = std::max(unique.back().strength, e.strength);
     } else {
       unique.push_back(e);

@@ -37,8 +37,9 @@ struct BoundaryEvidence {
 /// support it alone gives a boundary; the consensus accepts a boundary whose support, averaged
 /// over the demos, reaches JointSegmentationConfig::min_support.
 struct EvidenceWeights {
-  double contact = 0.9;       ///< rest edges: the sensors say an interaction starts or ends
-  double sensor_level = 0.7;  ///< a level step in contact
+  double contact = 0.9;  ///< rest edges: the sensors say an interaction starts or ends
+  double sensor_level =
+      0.7;  ///< a level step in contact (each end of one ramp: see sensoryEvidence)
   double motion_onset = 0.8;  ///< motion after a long pause, scaled by pause and motion below
   /// An instant of rest between two motions: weak alone (every reversal of a periodic motion is
   /// one), it marks where a shape change ClaSP finds nearby begins.
@@ -118,7 +119,9 @@ void gatherIntoPauses(const std::vector<Pause>& pauses, std::size_t samples,
 /// force building up or fading (the ramp reaching its plateau), so it joins the rest edge instead
 /// of standing alone. One that goes the other way joins it only within `reversal_fold_samples`
 /// (a press overshooting as it lands): further off it is a phase of its own, as an insertion's
-/// force rising before a snap whose drop ends within the sensor's rest band.
+/// force rising before a snap whose drop ends within the sensor's rest band. The start and the
+/// end of one ramp (SensoryEvent::ramp_end) left standing are one change: each weighs
+/// 1 - sqrt(1 - sensor_level), the two together (noisy-OR) one step's weight.
 std::vector<BoundaryEvidence> sensoryEvidence(const SensorEvents& events,
                                               const EvidenceWeights& weights,
                                               std::size_t fold_samples,

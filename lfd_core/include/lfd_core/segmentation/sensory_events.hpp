@@ -122,6 +122,10 @@ struct SensoryEvent {
   /// press deepening); false when it comes back towards rest (a force easing off, a release).
   /// Over a sensor's channels: the strongest channel's. kFit only (true otherwise).
   bool away_from_rest = true;
+  /// The start or the end of one level change whose other end is an event too (a ramp longer
+  /// than half a lag that goes one way throughout: a torque dying out as a turn slows). kFit
+  /// only; over a sensor's channels, only when every event at this sample is.
+  bool ramp_end = false;
 };
 
 /// A closed interval of sample indices [begin, end] (eq. 1 uses closed intervals).
