@@ -38,8 +38,8 @@ struct BoundaryEvidence {
 /// over the demos, reaches JointSegmentationConfig::min_support.
 struct EvidenceWeights {
   double contact = 0.9;  ///< rest edges: the sensors say an interaction starts or ends
-  double sensor_level =
-      0.7;  ///< a level step in contact (each end of one ramp: see sensoryEvidence)
+  /// A level step in contact (each end of one ramp weighs less: sensoryEvidence).
+  double sensor_level = 0.7;
   double motion_onset = 0.8;  ///< motion after a long pause, scaled by pause and motion below
   /// An instant of rest between two motions: weak alone (every reversal of a periodic motion is
   /// one), it marks where a shape change ClaSP finds nearby begins.
