@@ -111,7 +111,7 @@ class Cell(object):
     def __init__(self, lockstep=True, node_name="lockstep_client"):
         import actionlib
         import rospy
-        from lfd_msgs.msg import ExecuteTaskAction
+        from lfd_msgs.msg import ExecuteTaskAction, ExecuteTaskActionFeedback
         from lfd_msgs.srv import ResetSim, SetScene, StepSim
         from std_srvs.srv import SetBool
         from lfd_tools import master
@@ -125,13 +125,23 @@ class Cell(object):
         # returned (a refusal answered within the caller's time slice), and its timeouts run on
         # sim time, which stands still while paused.
         self.action = actionlib.ActionClient("/executor/execute", ExecuteTaskAction)
+        # Every feedback of a goal, by goal id, from the topic itself: the action client drops
+        # feedback that arrives after its goal's result, and the executor's last feedback (the
+        # settle's, with the final progress) and its result travel on two connections, so a
+        # loaded machine may deliver them in either order (executor_action, fresh root).
+        self._feedback_by_goal = collections.defaultdict(list)
+        self._goal_id = None
+        self._feedback_sub = rospy.Subscriber(
+            "/executor/execute/feedback", ExecuteTaskActionFeedback,
+            lambda m: self._feedback_by_goal[m.status.goal_id.id].append(m.feedback),
+            queue_size=1000)
         deadline = time.time() + 120
         while not self._server_ready():
             if time.time() > deadline:
                 raise RuntimeError("the executor's action /executor/execute did not come up in "
                                    "120 s")
             time.sleep(0.01)
-        self.goal_handle, self.feedback = None, []
+        self.goal_handle = None
         # Wall s and calls by activity since the last take_wall()
         # (bench/pipeline/profile_reproduction.py).
         self.wall, self.calls = collections.Counter(), collections.Counter()
@@ -149,7 +159,13 @@ class Cell(object):
         server = a.last_status_msg._connection_header["callerid"]
         return (a.pub_goal.impl.has_connection(server) and a.pub_cancel.impl.has_connection(server)
                 and any(c.callerid_pub == server for c in a.result_sub.impl.connections)
-                and any(c.callerid_pub == server for c in a.feedback_sub.impl.connections))
+                and any(c.callerid_pub == server for c in a.feedback_sub.impl.connections)
+                and any(c.callerid_pub == server for c in self._feedback_sub.impl.connections))
+
+    @property
+    def feedback(self):
+        """The feedback of the last goal sent, in arrival order (also after its result)."""
+        return self._feedback_by_goal[self._goal_id] if self._goal_id else []
 
     @contextlib.contextmanager
     def timed(self, activity):
@@ -215,9 +231,8 @@ class Cell(object):
 
     def send(self, goal):
         """Sends a goal; its feedback is collected in self.feedback."""
-        self.feedback = []
-        self.goal_handle = self.action.send_goal(
-            goal, feedback_cb=lambda gh, fb: self.feedback.append(fb))
+        self.goal_handle = self.action.send_goal(goal)
+        self._goal_id = self.goal_handle.comm_state_machine.action_goal.goal_id.id
 
     def cancel(self):
         self.goal_handle.cancel()
