@@ -278,6 +278,24 @@ TEST(ConfidenceZones, FullValidationOverSeveralSensors) {
 namespace {
 
 // The settings of config/segmentation.yaml at 50 Hz: quiet-excursion floor, fitted placement.
+// A level made of linear ramps (each from sample `start`, over `samples`, by `height`) with
+// Gaussian noise of `sigma` (seeded): contacts made and lost, levels stepping in contact.
+struct Ramp {
+  double start, samples, height;
+};
+Eigen::VectorXd rampsWithNoise(Eigen::Index n, const std::vector<Ramp>& ramps, double sigma,
+                               unsigned seed) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> g(0.0, sigma);
+  Eigen::VectorXd x(n);
+  for (Eigen::Index t = 0; t < n; ++t) {
+    x[t] = 0.0;
+    for (const Ramp& r : ramps) x[t] += r.height * std::clamp((t - r.start) / r.samples, 0.0, 1.0);
+    x[t] += g(rng);
+  }
+  return x;
+}
+
 SensoryEventConfig yamlAt50hz() {
   SensoryEventConfig c = configAt50hz(lfd::EventThreshold::kRatioOfMax);
   c.noise_floor_sigmas = 0.0;
@@ -344,14 +362,7 @@ TEST(SensoryEvents, ABusyDemoWithOneQuietSecondKeepsItsPresses) {
 // A contact force building up over 0.8 s (noise a tenth of its height) and fading over 0.6 s: the
 // fitted events sit where the force leaves rest and where it is back at rest, within 0.1 s.
 TEST(SensoryEvents, FittedEventsAtTheStartAndEndOfSlowRamps) {
-  std::mt19937 rng(12);
-  std::normal_distribution<double> g(0.0, 0.3);
-  Eigen::VectorXd x(800);
-  for (Eigen::Index t = 0; t < x.size(); ++t) {
-    const double up = std::clamp((t - 200.0) / 40.0, 0.0, 1.0);
-    const double down = std::clamp((t - 500.0) / 30.0, 0.0, 1.0);
-    x[t] = 3.0 * (up - down) + g(rng);
-  }
+  const Eigen::VectorXd x = rampsWithNoise(800, {{200, 40, 3.0}, {500, 30, -3.0}}, 0.3, 12);
   const auto events = lfd::detectSensoryEventDetails(x, yamlAt50hz());
   std::vector<std::size_t> rest_edges;
   for (const lfd::SensoryEvent& e : events)
@@ -401,14 +412,7 @@ TEST(SensoryEvents, ARiseAndAFallInOneBurstAreTwoChanges) {
 // out as the turn slows), at 50 Hz: its start and its end are events, and both are flagged as the
 // two ends of one change.
 TEST(SensoryEvents, TheTwoEndsOfOneRampInContactAreFlaggedAsOneChange) {
-  std::mt19937 rng(9);
-  std::normal_distribution<double> g(0.0, 0.1);
-  Eigen::VectorXd x(400);
-  for (Eigen::Index t = 0; t < x.size(); ++t) {
-    const double on = std::clamp((t - 100.0) / 5.0, 0.0, 1.0);
-    const double fade = std::clamp((t - 250.0) / 20.0, 0.0, 1.0);
-    x[t] = 10.0 * on - 6.0 * fade + g(rng);
-  }
+  const Eigen::VectorXd x = rampsWithNoise(400, {{100, 5, 10.0}, {250, 20, -6.0}}, 0.1, 9);
   SensoryEventConfig joint = yamlAt50hz();
   joint.merge_gap = 25;
   const auto events = lfd::detectSensoryEventDetails(x, joint);

@@ -231,6 +231,7 @@ class Cell(object):
 
     def send(self, goal):
         """Sends a goal; its feedback is collected in self.feedback."""
+        self._feedback_by_goal.clear()  # the earlier goals' (a run sends hundreds)
         self.goal_handle = self.action.send_goal(goal)
         self._goal_id = self.goal_handle.comm_state_machine.action_goal.goal_id.id
 
