@@ -75,6 +75,19 @@ TEST(StaleReadings, ANoiseFreeSensorsRestIsNotStale) {
   for (const auto& spans : lfd::staleReadings(demos, {20, 20, 20})) EXPECT_TRUE(spans.empty());
 }
 
+// A noise-free touch pad that never changes in one demo while it feels contact in the others did
+// not measure there (dead); constant in every demo, it is a sensor the task does not use.
+TEST(StaleReadings, ANoiseFreeSensorDeadInOneDemoIsStaleThroughout) {
+  const Eigen::MatrixXd dead = Eigen::MatrixXd::Zero(290, 1);
+  const auto stale = lfd::staleReadings({touchPad(300), dead, touchPad(310)}, {20, 20, 20});
+  EXPECT_TRUE(stale[0].empty());
+  ASSERT_EQ(stale[1].size(), 1u);
+  EXPECT_EQ(stale[1][0].begin, 0u);
+  EXPECT_EQ(stale[1][0].end, 290u);
+  EXPECT_TRUE(stale[2].empty());
+  for (const auto& spans : lfd::staleReadings({dead, dead}, {20, 20})) EXPECT_TRUE(spans.empty());
+}
+
 TEST(StaleReadings, BadArgumentsAreErrors) {
   EXPECT_THROW(lfd::repeatedReadings(touchPad(10), 1), std::invalid_argument);
   EXPECT_THROW(lfd::staleReadings({touchPad(10)}, {5, 5}), std::invalid_argument);

@@ -144,6 +144,8 @@ void parseJoint(const YAML::Node& node, lfd::JointSegmentationConfig* joint) {
   section.readNonNegative("event_merge_gap_seconds", joint->event_merge_gap);
   section.readNonNegative("ramp_fold_seconds", joint->ramp_fold);
   section.readNonNegative("stale_reading_seconds", joint->stale_reading);
+  section.readPositive("motion_match_window_seconds", joint->motion_match_window);
+  section.readPositive("motion_match_step_seconds", joint->motion_match_step);
   section.readFraction("min_piece_weight", joint->min_piece_weight);
   section.readNonNegative("colocation_seconds", joint->colocation);
   joint->max_speed_correlation =

@@ -8,6 +8,7 @@
 #include <stdexcept>
 
 #include "lfd_core/segmentation/demo_alignment.hpp"
+#include "lfd_core/segmentation/motion_match.hpp"
 #include "lfd_core/segmentation/stale_readings.hpp"
 #include "lfd_core/util/parallel_for.hpp"
 
@@ -213,7 +214,8 @@ SensorSelection contactSensors(const std::vector<std::string>& names,
 }
 
 // Per demo, where a contact sensor repeated one reading although it has noise (stale_readings.hpp):
-// the union over the sensors, each reported.
+// the union over the sensors, each reported (a sensor dead throughout is reported as constant by
+// addSensorWarnings).
 std::vector<std::vector<SampleSpan>> staleContactReadings(const std::vector<FeatureMatrix>& demos,
                                                           const SensorSelection& contact,
                                                           double min_seconds,
@@ -234,8 +236,8 @@ std::vector<std::vector<SampleSpan>> staleContactReadings(const std::vector<Feat
     const auto stale = staleReadings(channels, min_samples);
     for (std::size_t d = 0; d < demos.size(); ++d) {
       for (const SampleSpan& s : stale[d]) {
-        if (s.begin == 0 && s.end == static_cast<std::size_t>(demos[d].rows())) continue;  // dead
         out[d].push_back(s);
+        if (s.begin == 0 && s.end == static_cast<std::size_t>(demos[d].rows())) continue;  // dead
         std::ostringstream msg;
         msg.precision(3);
         msg << "sensor " << names.front() << (names.size() > 1 ? ", ..." : "")
@@ -247,6 +249,32 @@ std::vector<std::vector<SampleSpan>> staleContactReadings(const std::vector<Feat
     }
   }
   return out;
+}
+
+// The events of `channels` (rows = samples) detected from where the sensor began to measure: a
+// stale stretch that opens the demo is left out. Over a driver's cached reading the noise is nil,
+// and a floor set by that quiet makes every wiggle of the contact an event (stale F/T: touch and
+// release lost among level steps); the rest level is the first measured one. The part kept ends
+// whole noise blocks at the demo's end (SensoryEventConfig::noise_block): its only quiet second
+// may be its last (the rest after the retract).
+SensorEvents measuredEvents(const Eigen::MatrixXd& channels, const SensoryEventConfig& config,
+                            const std::vector<std::size_t>& groups,
+                            const std::vector<SampleSpan>& stale) {
+  const auto rows = static_cast<std::size_t>(channels.rows());
+  std::size_t begin = 0;
+  for (const SampleSpan& s : stale)
+    if (s.begin == 0 && s.end < rows) begin = std::max(begin, s.end);
+  if (begin == 0) return detectSensorEvents(channels, config, groups);
+  const std::size_t block = std::max<std::size_t>(1, config.noise_block);
+  begin = rows - std::min(rows, (rows - begin + block - 1) / block * block);
+  SensorEvents events = detectSensorEvents(
+      channels.bottomRows(static_cast<Eigen::Index>(rows - begin)), config, groups);
+  for (std::size_t& i : events.all) i += begin;
+  for (auto& sensor : events.per_sensor)
+    for (std::size_t& i : sensor) i += begin;
+  for (SensoryEvent& e : events.details) e.index += begin;
+  for (std::size_t& i : events.zone_events) i += begin;
+  return events;
 }
 
 // Drops the events within `margin` samples of a stale stretch: the sensor wakes up there.
@@ -309,7 +337,7 @@ void gatherEvidence(const FeatureMatrix& demo, const Eigen::MatrixXd& scaled,
   pieces = claspEvidence(out->clasp, joint.weights.clasp);
   if (!contact.names.empty()) {
     SensorEvents events =
-        detectSensorEvents(demo.select(contact.names).data, own.events, contact.groups);
+        measuredEvents(demo.select(contact.names).data, own.events, contact.groups, stale);
     dropStaleEvents(stale, own.events.difference_lag, &events);
     out->events = events.all;
     out->event_details = events.details;
@@ -512,10 +540,78 @@ std::string evidenceKinds(const DemoEvidence& e, std::size_t chosen, double colo
   return out;
 }
 
+// The demos on the alignment grid, per demo which of its columns say something, and where its
+// contact sensor was blind (grid rows): where it did not measure (stale_readings.hpp), and a lag
+// on either side, where its events are dropped (dropStaleEvents).
+struct AlignmentGrids {
+  std::vector<Eigen::MatrixXd> full;
+  std::vector<std::vector<bool>> informative;
+  std::vector<std::vector<std::pair<double, double>>> blind;
+
+  // The grids demos a and b are aligned on: the columns informative in both. A column one demo
+  // cannot fill pulls the other's motion onto the wrong part of it: a dead sensor's constant or a
+  // stale one's cached reading reads as rest while the other demo is in contact; a periodic phase
+  // found in one demo and missed in the other is squeezed onto a few of the other's rows (stale
+  // F/T: touches expected 0.4-2 s from where they were).
+  std::pair<Eigen::MatrixXd, Eigen::MatrixXd> pair(std::size_t a, std::size_t b) const {
+    std::vector<Eigen::Index> shared;
+    for (std::size_t c = 0; c < informative[a].size(); ++c)
+      if (informative[a][c] && informative[b][c]) shared.push_back(static_cast<Eigen::Index>(c));
+    return {full[a](Eigen::all, shared), full[b](Eigen::all, shared)};
+  }
+
+  bool blindAt(std::size_t d, double row) const {
+    return std::any_of(blind[d].begin(), blind[d].end(),
+                       [&](const auto& span) { return row >= span.first && row <= span.second; });
+  }
+};
+
+// Which columns of a demo's alignment grid (gatherEvidence: states, speed, periodic, sensors) say
+// something: the periodic one where the demo has a periodic phase, the sensors' where they
+// measured throughout.
+std::vector<bool> informativeColumns(Eigen::Index columns, Eigen::Index sensor_columns,
+                                     bool periodic, bool sensors_measured) {
+  std::vector<bool> out(static_cast<std::size_t>(columns), true);
+  const auto first_sensor = static_cast<std::size_t>(columns - sensor_columns);
+  out[first_sensor - 1] = periodic;
+  for (std::size_t c = first_sensor; c < out.size(); ++c) out[c] = sensors_measured;
+  return out;
+}
+
+// `spans` of `demo`, widened by `margin` s on either side, in rows of a grid of `step` s from its
+// first sample.
+std::vector<std::pair<double, double>> gridSpans(const FeatureMatrix& demo,
+                                                 const std::vector<SampleSpan>& spans,
+                                                 double margin, double step) {
+  std::vector<std::pair<double, double>> out;
+  const auto row = [&](std::size_t i) {
+    return (demo.timeAt(static_cast<Eigen::Index>(i)) - demo.timeAt(0)) / step;
+  };
+  for (const SampleSpan& s : spans)
+    out.emplace_back(row(s.begin) - margin / step, row(s.end - 1) + margin / step);
+  return out;
+}
+
+// Every demo aligned to `reference`, each pair on the grids AlignmentGrids::pair gives it.
+DemoAlignment alignPairs(const AlignmentGrids& grids, std::size_t reference, int threads,
+                         double band) {
+  const std::size_t n = grids.full.size();
+  DemoAlignment out;
+  out.reference = reference;
+  out.to_reference.resize(n);
+  out.from_reference.resize(n);
+  parallelFor(n, threads, [&](std::size_t d) {
+    const auto [demo, ref] = grids.pair(d, reference);
+    out.to_reference[d] = multivariateDtwMap(demo, ref, band);
+    out.from_reference[d] = multivariateDtwMap(ref, demo, band);
+  });
+  return out;
+}
+
 // The agreement, boundary by boundary.
 class JointAgreement {
  public:
-  JointAgreement(std::vector<DemoEvidence> evidence, const std::vector<Eigen::MatrixXd>& grids,
+  JointAgreement(std::vector<DemoEvidence> evidence, const AlignmentGrids& grids,
                  DemoAlignment alignment, const JointSegmentationConfig& config,
                  double min_segment_seconds, int threads)
       : evidence_(std::move(evidence)),
@@ -563,6 +659,22 @@ class JointAgreement {
     return mapRow(from_reference_[d], reference_row);
   }
   double colocationRows() const { return colocation_rows_; }
+  // Whether demo d placed boundary k where its contact sensor felt a change.
+  bool felt(std::size_t d, std::size_t k) const {
+    const long p = anchors_[k].piece[d];
+    if (p < 0) return false;
+    const DemoEvidence& e = evidence_[d];
+    const double row = e.grid_rows[static_cast<std::size_t>(p)];
+    if (grids_.blindAt(d, row)) return false;
+    for (std::size_t q = 0; q < e.pieces.size(); ++q)
+      if (std::abs(e.grid_rows[q] - row) <= colocation_rows_ &&
+          (e.pieces[q].kind == EvidenceKind::kContact ||
+           e.pieces[q].kind == EvidenceKind::kSensorLevel))
+        return true;
+    return false;
+  }
+  bool everBlind(std::size_t d) const { return !grids_.blind[d].empty(); }
+  bool blindAt(std::size_t d, double row) const { return grids_.blindAt(d, row); }
   double windowRows() const { return window_rows_; }
 
  private:
@@ -583,7 +695,7 @@ class JointAgreement {
   }
 
   Eigen::VectorXd support() const {
-    const Eigen::Index rows = grids_[reference_].rows();
+    const Eigen::Index rows = grids_.full[reference_].rows();
     Eigen::VectorXd s = Eigen::VectorXd::Zero(rows);
     for (const DemoEvidence& e : evidence_)
       s += demoSupport(e, rows, agreement_spread_rows_) / static_cast<double>(evidence_.size());
@@ -616,7 +728,7 @@ class JointAgreement {
 
   // Places anchor `a` in demo d on its best piece between the demo's neighbouring anchors.
   bool place(Anchor* a, std::size_t d) {
-    const double rows = static_cast<double>(grids_[d].rows());
+    const double rows = static_cast<double>(grids_.full[d].rows());
     const auto [after, before] = neighbouringRows(anchors_, d, a->reference_row, rows);
     const long p = bestPiece(
         evidence_[d], a->reference_row,
@@ -656,15 +768,16 @@ class JointAgreement {
         own.push_back(a.demo_row[d]);
         reference_rows.push_back(static_cast<std::size_t>(std::lround(a.reference_row)));
       }
-      to_reference_[d] = anchoredDtwMap(grids_[d], grids_[reference_], own, reference_rows,
-                                        config_.alignment_band);
-      from_reference_[d] = anchoredDtwMap(grids_[reference_], grids_[d], reference_rows, own,
-                                          config_.alignment_band);
+      const auto [demo, reference] = grids_.pair(d, reference_);
+      to_reference_[d] =
+          anchoredDtwMap(demo, reference, own, reference_rows, config_.alignment_band);
+      from_reference_[d] =
+          anchoredDtwMap(reference, demo, reference_rows, own, config_.alignment_band);
     });
   }
 
   std::vector<DemoEvidence> evidence_;
-  const std::vector<Eigen::MatrixXd>& grids_;
+  const AlignmentGrids& grids_;
   const JointSegmentationConfig& config_;
   double min_segment_rows_, spread_rows_, agreement_spread_rows_, window_rows_, colocation_rows_;
   int threads_;
@@ -680,10 +793,83 @@ std::string secondsAfterStart(const FeatureMatrix& demo, std::size_t index) {
   return out.str();
 }
 
+// Each demo's motion for placeByMotion on a grid of `step` s: the state features II-B selected
+// (those the demos move alike), each over its range in the task; every moving one without II-B
+// (one demo) or when it selected sensors only. A wrist that turns a little at random in each demo
+// makes every instant of a wipe look like every other (stale F/T: a touch matched 3 s late).
+std::vector<Eigen::MatrixXd> motionGrids(const std::vector<FeatureMatrix>& demos,
+                                         const std::vector<std::string>& moving,
+                                         const std::vector<std::string>& selected, double step) {
+  std::vector<std::string> names;
+  for (const std::string& name : moving)
+    if (std::find(selected.begin(), selected.end(), name) != selected.end()) names.push_back(name);
+  if (names.empty()) names = moving;
+  const std::vector<Eigen::MatrixXd> scaled = scaledStates(demos, names);
+  std::vector<Eigen::MatrixXd> out;
+  for (std::size_t d = 0; d < demos.size(); ++d)
+    out.push_back(onUniformGrid(scaled[d], clockOf(demos[d]), step));
+  return out;
+}
+
+// Per demo and agreed boundary, the sample placed by the motion around it in the demos that felt
+// it (motion_match.hpp), where that lands while the demo's contact sensor was blind; -1
+// elsewhere. `motion`: each demo's state features on a grid of config.motion_match_step. The
+// search spans the demo between its neighbouring boundaries, not the match window around where
+// the alignment expects it: a blind sensor leaves the alignment itself 0.5-2 s off.
+std::vector<std::vector<long>> placeByMotion(const JointAgreement& agreement,
+                                             const std::vector<FeatureMatrix>& demos,
+                                             const std::vector<Eigen::MatrixXd>& motion,
+                                             const JointSegmentationConfig& config) {
+  const auto& anchors = agreement.anchors();
+  std::vector<std::vector<long>> out(demos.size(), std::vector<long>(anchors.size(), -1));
+  if (motion.empty()) return out;
+  const double step = config.motion_match_step;
+  const auto half =
+      static_cast<std::size_t>(std::max(1L, std::lround(config.motion_match_window / step)));
+  const auto motion_row = [&](std::size_t d, std::size_t sample) {
+    const double t = demos[d].timeAt(static_cast<Eigen::Index>(sample)) - demos[d].timeAt(0);
+    return std::clamp(std::lround(t / step), 0L, static_cast<long>(motion[d].rows()) - 1);
+  };
+  const auto placed = [&](std::size_t d, std::size_t k) {
+    const auto p = static_cast<std::size_t>(anchors[k].piece[d]);
+    return motion_row(d, agreement.evidence(d).pieces[p].index);
+  };
+  for (std::size_t k = 0; k < anchors.size(); ++k) {
+    for (std::size_t d = 0; d < demos.size(); ++d) {
+      if (!agreement.everBlind(d)) continue;
+      std::vector<MotionAround> felt;
+      for (std::size_t s = 0; s < demos.size(); ++s)
+        if (s != d && agreement.felt(s, k))
+          felt.push_back(motionAround(motion[s], static_cast<std::size_t>(placed(s, k)), half));
+      if (felt.empty()) continue;
+      // Between the boundaries the demo felt, and after the one placed before. A boundary it
+      // felt is matched too: a level step after the sensor woke up may stand for a touch it
+      // missed.
+      long first = 0, last = static_cast<long>(motion[d].rows()) - 1;
+      for (std::size_t j = 0; j < anchors.size(); ++j) {
+        long row = -1;
+        if (j < k && out[d][j] >= 0) row = motion_row(d, static_cast<std::size_t>(out[d][j]));
+        if (j != k && agreement.felt(d, j)) row = placed(d, j);
+        if (row < 0) continue;
+        if (j < k) first = std::max(first, row + 1);
+        if (j > k) last = std::min(last, row - 1);
+      }
+      if (first > last) continue;
+      const std::size_t row = bestMatchingRow(motion[d], felt, static_cast<std::size_t>(first),
+                                              static_cast<std::size_t>(last), half);
+      // Only where the sensor was blind: elsewhere the demo's own evidence holds.
+      if (agreement.blindAt(d, static_cast<double>(row) * step / config.grid_step))
+        out[d][k] = static_cast<long>(sampleAt(demos[d], static_cast<double>(row), step));
+    }
+  }
+  return out;
+}
+
 // The demo's changepoints, zones (the match windows), and what it lacks or has in excess.
+// `by_motion`: per agreed boundary, the sample placeByMotion gave it in this demo (-1: none).
 void reportDemo(const JointAgreement& agreement, const FeatureMatrix& demo, std::size_t d,
-                const JointSegmentationConfig& config, DemoSegmentationResult* out,
-                std::vector<std::string>* warnings) {
+                const std::vector<long>& by_motion, const JointSegmentationConfig& config,
+                DemoSegmentationResult* out, std::vector<std::string>* warnings) {
   const DemoEvidence& e = agreement.evidence(d);
   const std::size_t half = static_cast<std::size_t>(config.match_window * out->sample_rate);
   const auto& anchors = agreement.anchors();
@@ -693,6 +879,16 @@ void reportDemo(const JointAgreement& agreement, const FeatureMatrix& demo, std:
     out->zones.push_back(
         {expected > half ? expected - half : 0, std::min(expected + half, out->num_samples - 1)});
     const long p = anchors[k].piece[d];
+    if (by_motion[k] >= 0) {
+      warnings->push_back(describe(
+          "boundary " + std::to_string(k + 1) + " of " + std::to_string(anchors.size()) +
+              " placed by the motion around it in the other demonstrations: the contact sensor "
+              "did not measure there",
+          d));
+      out->changepoints.push_back(static_cast<std::size_t>(by_motion[k]));
+      out->changepoint_evidence.push_back("motion_match");
+      continue;
+    }
     if (p < 0) {
       warnings->push_back(describe(
           "no evidence of boundary " + std::to_string(k + 1) + " of " +
@@ -738,13 +934,12 @@ void reportDemo(const JointAgreement& agreement, const FeatureMatrix& demo, std:
 // sought on every demo's axis in turn, and the one leaving the least strong evidence
 // unexplained is kept (ties: the nearest the medoid). A few demos with unshared evidence are
 // what a demo with an extra phase looks like: they are reported, and the medoid kept.
-JointAgreement bestAgreement(const std::vector<DemoEvidence>& evidence,
-                             const std::vector<Eigen::MatrixXd>& grids,
+JointAgreement bestAgreement(const std::vector<DemoEvidence>& evidence, const AlignmentGrids& grids,
                              const SegmentationPipelineConfig& config) {
   const double band = config.joint.alignment_band;
-  const std::vector<std::size_t> candidates = byDtwCostToOthers(grids, config.threads, band);
+  const std::vector<std::size_t> candidates = byDtwCostToOthers(grids.full, config.threads, band);
   const auto agree_on = [&](std::size_t reference, int threads) {
-    JointAgreement agreement(evidence, grids, alignTo(grids, reference, threads, band),
+    JointAgreement agreement(evidence, grids, alignPairs(grids, reference, threads, band),
                              config.joint, config.seconds->min_segment, threads);
     agreement.run(config.segmentation.max_changepoints);
     return agreement;
@@ -797,19 +992,31 @@ SegmentationPipelineResult segmentJointly(const PreparedSegmentation& prepared,
       demos, states, result.selected_features, config.joint.pauses.smoothing, config.threads);
 
   std::vector<DemoEvidence> evidence(n);
-  std::vector<Eigen::MatrixXd> grids(n);
+  AlignmentGrids grids;
+  grids.full.resize(n);
   parallelFor(n, config.threads, [&](std::size_t d) {
     try {
       gatherEvidence(demos[d], scaled[d], consistency, speeds[d], scaled_sensors[d], result,
                      contact, stale[d], rhythm[d], config, &result.demos[d], &evidence[d],
-                     &grids[d]);
+                     &grids.full[d]);
     } catch (const std::invalid_argument& e) {
       throw std::invalid_argument(describe(e.what(), d));
     }
   });
+  for (std::size_t d = 0; d < n; ++d) {
+    grids.blind.push_back(gridSpans(demos[d], stale[d], config.seconds->event_difference_lag,
+                                    config.joint.grid_step));
+    grids.informative.push_back(informativeColumns(grids.full[d].cols(), scaled_sensors[d].cols(),
+                                                   !rhythm[d].empty(), stale[d].empty()));
+  }
   const JointAgreement agreement = bestAgreement(evidence, grids, config);
+  std::vector<Eigen::MatrixXd> motion;
+  if (std::any_of(stale.begin(), stale.end(), [](const auto& s) { return !s.empty(); }))
+    motion = motionGrids(demos, states, result.selected_features, config.joint.motion_match_step);
+  const auto by_motion = placeByMotion(agreement, demos, motion, config.joint);
   for (std::size_t d = 0; d < n; ++d)
-    reportDemo(agreement, demos[d], d, config.joint, &result.demos[d], &result.warnings);
+    reportDemo(agreement, demos[d], d, by_motion[d], config.joint, &result.demos[d],
+               &result.warnings);
   addSensorWarnings(demos, sensors, &result);
   result.segmentation_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

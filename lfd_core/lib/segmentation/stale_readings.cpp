@@ -34,17 +34,24 @@ std::vector<std::vector<SampleSpan>> staleReadings(const std::vector<Eigen::Matr
   if (channels.size() != min_samples.size())
     throw std::invalid_argument("stale readings: one minimum length per demo needed");
   std::vector<std::vector<SampleSpan>> runs(channels.size());
+  std::vector<bool> whole(channels.size(), false);
   std::size_t never_repeat = 0, dead = 0;
   for (std::size_t d = 0; d < channels.size(); ++d) {
     runs[d] = repeatedReadings(channels[d], min_samples[d]);
     if (runs[d].empty()) ++never_repeat;
     // A sensor dead throughout says nothing of its noise (it is reported as constant).
-    const bool whole = runs[d].size() == 1 && runs[d][0].begin == 0 &&
-                       runs[d][0].end == static_cast<std::size_t>(channels[d].rows());
-    if (whole) ++dead;
+    whole[d] = runs[d].size() == 1 && runs[d][0].begin == 0 &&
+               runs[d][0].end == static_cast<std::size_t>(channels[d].rows());
+    if (whole[d]) ++dead;
   }
-  if (2 * never_repeat <= channels.size() - dead)
-    return std::vector<std::vector<SampleSpan>>(runs.size());
+  if (2 * never_repeat <= channels.size() - dead) {
+    // A noise-free sensor repeats its rest reading: only where it never changed at all, while it
+    // did in another demo, it did not measure.
+    std::vector<std::vector<SampleSpan>> out(runs.size());
+    for (std::size_t d = 0; d < runs.size(); ++d)
+      if (whole[d] && dead < channels.size()) out[d] = runs[d];
+    return out;
+  }
   return runs;
 }
 

@@ -44,6 +44,11 @@ struct JointSegmentationConfig {
   /// repeats none in most demos (it has noise), did not measure then: its events within a lag
   /// of that stretch are not used (stale_readings.hpp). 0 = off.
   double stale_reading = 0.5;
+  /// Where a demo's contact sensor did not measure near a boundary, the boundary is placed by the
+  /// motion within this (s) on either side of it in the demos whose sensor did (motion_match.hpp).
+  double motion_match_window = 1.0;
+  /// The grid step of that match (s): finer than grid_step, since it places a boundary.
+  double motion_match_step = 0.02;
   /// A demo's own evidence for a boundary must be at least this sure (as an instant of rest): a
   /// hesitation is no boundary, even where the other demos have one.
   double min_piece_weight = 0.3;

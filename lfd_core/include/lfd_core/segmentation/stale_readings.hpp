@@ -30,8 +30,9 @@ namespace lfd {
 /// Per demo, the stretches where one sensor did not measure: its repeated readings (at least
 /// min_samples[d] rows in demo d), when the sensor has noise, i.e. when more than half the demos
 /// (`channels`: the sensor's columns per demo) repeat no reading that long, demos where it holds
-/// one reading throughout (dead) not counted. Otherwise (a noise-free sensor) none. Throws
-/// std::invalid_argument on a size mismatch.
+/// one reading throughout (dead) not counted. Otherwise (a noise-free sensor, which repeats its
+/// rest reading) only the demos where it holds one reading throughout while it changes in
+/// another (dead). Throws std::invalid_argument on a size mismatch.
 std::vector<std::vector<SampleSpan>> staleReadings(const std::vector<Eigen::MatrixXd>& channels,
                                                    const std::vector<std::size_t>& min_samples);
 
