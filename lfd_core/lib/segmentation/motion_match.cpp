@@ -1,6 +1,7 @@
 // Boundaries placed by the siblings' motion around theirs (see motion_match.hpp).
 #include "lfd_core/segmentation/motion_match.hpp"
 
+#include <algorithm>
 #include <limits>
 #include <stdexcept>
 
@@ -42,18 +43,30 @@ std::size_t bestMatchingRow(const Eigen::MatrixXd& grid, const std::vector<Motio
   for (const MotionAround& s : siblings)
     if (s.before.cols() != grid.cols() || s.after.cols() != grid.cols())
       throw std::invalid_argument("bestMatchingRow: the siblings have other features");
+  const auto cost = [&](std::size_t row) {
+    const MotionAround own = motionAround(grid, row, half);
+    double sum = 0.0;
+    for (const MotionAround& s : siblings)
+      sum += costPerRow(own.before, s.before) + costPerRow(own.after, s.after);
+    return sum;
+  };
+  // Coarse to fine: every stride-th row, then the rows around the best of them. The cost is a
+  // sum over windows of 2 x half rows, so it varies slowly from row to row.
+  const std::size_t stride = std::max<std::size_t>(1, half / 10);
   std::size_t best = first;
   double best_cost = std::numeric_limits<double>::infinity();
-  for (std::size_t row = first; row <= last; ++row) {
-    const MotionAround own = motionAround(grid, row, half);
-    double cost = 0.0;
-    for (const MotionAround& s : siblings)
-      cost += costPerRow(own.before, s.before) + costPerRow(own.after, s.after);
-    if (cost < best_cost) {
-      best_cost = cost;
+  const auto consider = [&](std::size_t row) {
+    const double c = cost(row);
+    if (c < best_cost) {
+      best_cost = c;
       best = row;
     }
-  }
+  };
+  for (std::size_t row = first; row <= last; row += stride) consider(row);
+  const std::size_t coarse = best;
+  for (std::size_t row = coarse > first + stride ? coarse - stride : first;
+       row <= std::min(last, coarse + stride); ++row)
+    consider(row);
   return best;
 }
 

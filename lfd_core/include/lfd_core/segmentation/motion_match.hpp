@@ -26,7 +26,8 @@ MotionAround motionAround(const Eigen::MatrixXd& grid, std::size_t at, std::size
 
 /// The row of `grid` in [first, last] whose motion around it (motionAround, `half` rows) matches
 /// the siblings' best: the least summed DTW cost per aligned row, before and after, over the
-/// siblings. Throws std::invalid_argument for no siblings, first > last, last out of range, or a
+/// siblings (searched every half / 10 rows, then row by row around the best). Throws
+/// std::invalid_argument for no siblings, first > last, last out of range, or a
 /// column count that differs from the siblings'.
 std::size_t bestMatchingRow(const Eigen::MatrixXd& grid, const std::vector<MotionAround>& siblings,
                             std::size_t first, std::size_t last, std::size_t half);
