@@ -804,6 +804,7 @@ std::vector<Eigen::MatrixXd> motionGrids(const std::vector<FeatureMatrix>& demos
   for (const std::string& name : moving)
     if (std::find(selected.begin(), selected.end(), name) != selected.end()) names.push_back(name);
   if (names.empty()) names = moving;
+  if (names.empty()) return {};  // no state feature moves: nothing to match
   const std::vector<Eigen::MatrixXd> scaled = scaledStates(demos, names);
   std::vector<Eigen::MatrixXd> out;
   for (std::size_t d = 0; d < demos.size(); ++d)
