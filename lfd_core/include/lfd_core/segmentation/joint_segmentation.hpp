@@ -3,8 +3,10 @@
 // sensor level steps, motion after a pause, ClaSP) is carried onto one reference demo's time axis
 // by multivariate DTW (demo_alignment.hpp); where the demos' combined evidence agrees, the task
 // has a boundary. Each demo's boundary is then placed on its own strongest evidence near the
-// agreed one. A demo with a dead or stale sensor still has its motion and ClaSP evidence; a demo
-// with no evidence near an agreed boundary is reported as lacking it, not forced.
+// agreed one. Where a demo's contact sensor was blind (dead, or repeating a cached reading:
+// stale_readings.hpp), a boundary its siblings felt goes where its motion around it matches
+// theirs (motion_match.hpp); a demo with no evidence near an agreed boundary is reported as
+// lacking it, not forced.
 #pragma once
 
 #include <vector>
