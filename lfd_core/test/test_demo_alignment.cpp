@@ -197,6 +197,29 @@ TEST(AlignTo, MapsEveryDemoOntoTheGivenReference) {
   EXPECT_THROW(lfd::alignTo(demos, 3, 1), std::invalid_argument);
 }
 
+// A column one demo cannot fill (a dead sensor at rest while the others press in the middle third
+// of the motion) is left out of that pair's alignment: the map is the one without it. With it,
+// DTW squeezes the reference's press onto as few of the dead demo's rows as it can.
+TEST(AlignTo, LeavesOutTheColumnsADemoCannotFill) {
+  const std::vector<Eigen::MatrixXd> demos = {sampled(50), sampled(60), sampled(75)};
+  std::vector<Eigen::MatrixXd> with_sensor;
+  for (const Eigen::MatrixXd& d : demos) {
+    Eigen::MatrixXd m = Eigen::MatrixXd::Zero(d.rows(), d.cols() + 1);
+    m.leftCols(d.cols()) = d;
+    m.col(d.cols()).segment(d.rows() / 3, d.rows() / 3).setConstant(10.0);  // the press
+    with_sensor.push_back(m);
+  }
+  with_sensor[2].col(demos[2].cols()).setZero();  // dead, the slowest demo
+  lfd::ColumnMasks masks(3, std::vector<bool>(with_sensor[0].cols(), true));
+  masks[2].back() = false;
+  const lfd::DemoAlignment masked = lfd::alignTo(with_sensor, 0, 1, 1.0, masks);
+  const lfd::DemoAlignment plain = lfd::alignTo(demos, 0, 1);
+  EXPECT_EQ(masked.to_reference[2], plain.to_reference[2]);
+  EXPECT_NE(lfd::alignTo(with_sensor, 0, 1).to_reference[2], plain.to_reference[2]);
+  masks[1].pop_back();
+  EXPECT_THROW(lfd::alignTo(with_sensor, 0, 1, 1.0, masks), std::invalid_argument);
+}
+
 // ---- mapRow
 
 TEST(MapRow, InterpolatesBetweenRowsAndClampsAtTheEnds) {

@@ -128,8 +128,21 @@ std::vector<std::size_t> byDtwCostToOthers(const std::vector<Eigen::MatrixXd>& g
   return order;
 }
 
+std::pair<Eigen::MatrixXd, Eigen::MatrixXd> sharedColumns(
+    const std::vector<Eigen::MatrixXd>& gridded, const ColumnMasks& masks, std::size_t a,
+    std::size_t b) {
+  if (masks.empty()) return {gridded[a], gridded[b]};
+  for (std::size_t d : {a, b})
+    if (masks[d].size() != static_cast<std::size_t>(gridded[d].cols()))
+      throw std::invalid_argument("alignment: a column mask per column of the demo's grid needed");
+  std::vector<Eigen::Index> shared;
+  for (std::size_t c = 0; c < masks[a].size(); ++c)
+    if (masks[a][c] && masks[b][c]) shared.push_back(static_cast<Eigen::Index>(c));
+  return {gridded[a](Eigen::all, shared), gridded[b](Eigen::all, shared)};
+}
+
 DemoAlignment alignTo(const std::vector<Eigen::MatrixXd>& gridded, std::size_t reference,
-                      int threads, double band) {
+                      int threads, double band, const ColumnMasks& masks) {
   const std::size_t n = gridded.size();
   if (reference >= n)
     throw std::invalid_argument("alignTo: no demonstration " + std::to_string(reference) +
@@ -140,13 +153,15 @@ DemoAlignment alignTo(const std::vector<Eigen::MatrixXd>& gridded, std::size_t r
   out.to_reference.resize(n);
   out.from_reference.resize(n);
   out.mean_cost.assign(n, 0.0);
-  const Eigen::MatrixXd& ref = gridded[reference];
+  if (!masks.empty() && masks.size() != n)
+    throw std::invalid_argument("alignTo: one column mask per demo needed");
   parallelFor(n, threads, [&](std::size_t d) {
-    out.to_reference[d] = multivariateDtwMap(gridded[d], ref, band);
-    out.from_reference[d] = multivariateDtwMap(ref, gridded[d], band);
+    const auto [demo, ref] = sharedColumns(gridded, masks, d, reference);
+    out.to_reference[d] = multivariateDtwMap(demo, ref, band);
+    out.from_reference[d] = multivariateDtwMap(ref, demo, band);
     out.mean_cost[d] = d == reference ? 0.0
-                                      : multivariateDtwCost(gridded[d], ref, band) /
-                                            static_cast<double>(gridded[d].rows() + ref.rows());
+                                      : multivariateDtwCost(demo, ref, band) /
+                                            static_cast<double>(demo.rows() + ref.rows());
   });
   return out;
 }

@@ -315,14 +315,15 @@ std::vector<std::vector<ReciprocatingRun>> periodicPhases(const std::vector<Feat
   return out;
 }
 
-// A demo's evidence of every kind, and its features and speed on the alignment grid.
+// A demo's evidence of every kind, its features and speed on the alignment grid, and which of
+// the grid's columns it can fill.
 void gatherEvidence(const FeatureMatrix& demo, const Eigen::MatrixXd& scaled,
                     const Eigen::VectorXd& consistency, const Eigen::VectorXd& speed,
                     const Eigen::MatrixXd& scaled_sensors, const SegmentationPipelineResult& base,
                     const SensorSelection& contact, const std::vector<SampleSpan>& stale,
                     const std::vector<ReciprocatingRun>& rhythm,
                     const SegmentationPipelineConfig& config, DemoSegmentationResult* out,
-                    DemoEvidence* evidence, Eigen::MatrixXd* grid) {
+                    DemoEvidence* evidence, Eigen::MatrixXd* grid, std::vector<bool>* usable) {
   const JointSegmentationConfig& joint = config.joint;
   const double rate = sampleRateOf(demo);
   SegmentationPipelineConfig own = inSamples(config, rate);
@@ -380,6 +381,15 @@ void gatherEvidence(const FeatureMatrix& demo, const Eigen::MatrixXd& scaled,
   aligned << withSpeed(ownShape(scaled) * consistency.asDiagonal(), speed), weight * periodic,
       weight * scaled_sensors;
   *grid = onUniformGrid(aligned, clock, joint.grid_step);
+  // The columns this demo can fill: the periodic one where it has a periodic phase (one found in
+  // one demo and missed in another is squeezed onto a few of the other's rows), the sensors'
+  // where they measured throughout (a dead sensor's constant or a stale one's cached reading
+  // reads as rest while the other demo is in contact; stale F/T: touches expected 0.4-2 s from
+  // where they were).
+  usable->assign(static_cast<std::size_t>(aligned.cols()), true);
+  const auto periodic_column = static_cast<std::size_t>(scaled.cols() + 1);
+  (*usable)[periodic_column] = !rhythm.empty();
+  for (std::size_t c = periodic_column + 1; c < usable->size(); ++c) (*usable)[c] = stale.empty();
 }
 
 // Noisy-OR of a demo's unclaimed evidence around each reference row: how sure this demo is that
@@ -540,43 +550,19 @@ std::string evidenceKinds(const DemoEvidence& e, std::size_t chosen, double colo
   return out;
 }
 
-// The demos on the alignment grid, per demo which of its columns say something, and where its
-// contact sensor was blind (grid rows): where it did not measure (stale_readings.hpp), and a lag
-// on either side, where its events are dropped (dropStaleEvents).
+// The demos on the alignment grid, per demo the columns it can fill (gatherEvidence), and where
+// its contact sensor was blind (grid rows): where it did not measure (stale_readings.hpp), and a
+// lag on either side, where its events are dropped (dropStaleEvents).
 struct AlignmentGrids {
   std::vector<Eigen::MatrixXd> full;
-  std::vector<std::vector<bool>> informative;
+  ColumnMasks usable;
   std::vector<std::vector<std::pair<double, double>>> blind;
-
-  // The grids demos a and b are aligned on: the columns informative in both. A column one demo
-  // cannot fill pulls the other's motion onto the wrong part of it: a dead sensor's constant or a
-  // stale one's cached reading reads as rest while the other demo is in contact; a periodic phase
-  // found in one demo and missed in the other is squeezed onto a few of the other's rows (stale
-  // F/T: touches expected 0.4-2 s from where they were).
-  std::pair<Eigen::MatrixXd, Eigen::MatrixXd> pair(std::size_t a, std::size_t b) const {
-    std::vector<Eigen::Index> shared;
-    for (std::size_t c = 0; c < informative[a].size(); ++c)
-      if (informative[a][c] && informative[b][c]) shared.push_back(static_cast<Eigen::Index>(c));
-    return {full[a](Eigen::all, shared), full[b](Eigen::all, shared)};
-  }
 
   bool blindAt(std::size_t d, double row) const {
     return std::any_of(blind[d].begin(), blind[d].end(),
                        [&](const auto& span) { return row >= span.first && row <= span.second; });
   }
 };
-
-// Which columns of a demo's alignment grid (gatherEvidence: states, speed, periodic, sensors) say
-// something: the periodic one where the demo has a periodic phase, the sensors' where they
-// measured throughout.
-std::vector<bool> informativeColumns(Eigen::Index columns, Eigen::Index sensor_columns,
-                                     bool periodic, bool sensors_measured) {
-  std::vector<bool> out(static_cast<std::size_t>(columns), true);
-  const auto first_sensor = static_cast<std::size_t>(columns - sensor_columns);
-  out[first_sensor - 1] = periodic;
-  for (std::size_t c = first_sensor; c < out.size(); ++c) out[c] = sensors_measured;
-  return out;
-}
 
 // `spans` of `demo`, widened by `margin` s on either side, in rows of a grid of `step` s from its
 // first sample.
@@ -589,22 +575,6 @@ std::vector<std::pair<double, double>> gridSpans(const FeatureMatrix& demo,
   };
   for (const SampleSpan& s : spans)
     out.emplace_back(row(s.begin) - margin / step, row(s.end - 1) + margin / step);
-  return out;
-}
-
-// Every demo aligned to `reference`, each pair on the grids AlignmentGrids::pair gives it.
-DemoAlignment alignPairs(const AlignmentGrids& grids, std::size_t reference, int threads,
-                         double band) {
-  const std::size_t n = grids.full.size();
-  DemoAlignment out;
-  out.reference = reference;
-  out.to_reference.resize(n);
-  out.from_reference.resize(n);
-  parallelFor(n, threads, [&](std::size_t d) {
-    const auto [demo, ref] = grids.pair(d, reference);
-    out.to_reference[d] = multivariateDtwMap(demo, ref, band);
-    out.from_reference[d] = multivariateDtwMap(ref, demo, band);
-  });
   return out;
 }
 
@@ -768,7 +738,7 @@ class JointAgreement {
         own.push_back(a.demo_row[d]);
         reference_rows.push_back(static_cast<std::size_t>(std::lround(a.reference_row)));
       }
-      const auto [demo, reference] = grids_.pair(d, reference_);
+      const auto [demo, reference] = sharedColumns(grids_.full, grids_.usable, d, reference_);
       to_reference_[d] =
           anchoredDtwMap(demo, reference, own, reference_rows, config_.alignment_band);
       from_reference_[d] =
@@ -836,12 +806,15 @@ std::vector<std::vector<long>> placeByMotion(const JointAgreement& agreement,
     return motion_row(d, agreement.evidence(d).pieces[p].index);
   };
   for (std::size_t k = 0; k < anchors.size(); ++k) {
+    std::vector<std::optional<MotionAround>> around(demos.size());  // the demos that felt it
+    for (std::size_t s = 0; s < demos.size(); ++s)
+      if (agreement.felt(s, k))
+        around[s] = motionAround(motion[s], static_cast<std::size_t>(placed(s, k)), half);
     for (std::size_t d = 0; d < demos.size(); ++d) {
       if (!agreement.everBlind(d)) continue;
-      std::vector<MotionAround> felt;
+      std::vector<MotionAround> felt;  // never the demo itself: it would match its own piece
       for (std::size_t s = 0; s < demos.size(); ++s)
-        if (s != d && agreement.felt(s, k))
-          felt.push_back(motionAround(motion[s], static_cast<std::size_t>(placed(s, k)), half));
+        if (s != d && around[s]) felt.push_back(*around[s]);
       if (felt.empty()) continue;
       // Between the boundaries the demo felt, and after the one placed before. A boundary it
       // felt is matched too: a level step after the sensor woke up may stand for a touch it
@@ -940,7 +913,8 @@ JointAgreement bestAgreement(const std::vector<DemoEvidence>& evidence, const Al
   const double band = config.joint.alignment_band;
   const std::vector<std::size_t> candidates = byDtwCostToOthers(grids.full, config.threads, band);
   const auto agree_on = [&](std::size_t reference, int threads) {
-    JointAgreement agreement(evidence, grids, alignPairs(grids, reference, threads, band),
+    JointAgreement agreement(evidence, grids,
+                             alignTo(grids.full, reference, threads, band, grids.usable),
                              config.joint, config.seconds->min_segment, threads);
     agreement.run(config.segmentation.max_changepoints);
     return agreement;
@@ -995,11 +969,12 @@ SegmentationPipelineResult segmentJointly(const PreparedSegmentation& prepared,
   std::vector<DemoEvidence> evidence(n);
   AlignmentGrids grids;
   grids.full.resize(n);
+  grids.usable.resize(n);
   parallelFor(n, config.threads, [&](std::size_t d) {
     try {
       gatherEvidence(demos[d], scaled[d], consistency, speeds[d], scaled_sensors[d], result,
                      contact, stale[d], rhythm[d], config, &result.demos[d], &evidence[d],
-                     &grids.full[d]);
+                     &grids.full[d], &grids.usable[d]);
     } catch (const std::invalid_argument& e) {
       throw std::invalid_argument(describe(e.what(), d));
     }
@@ -1007,8 +982,6 @@ SegmentationPipelineResult segmentJointly(const PreparedSegmentation& prepared,
   for (std::size_t d = 0; d < n; ++d) {
     grids.blind.push_back(gridSpans(demos[d], stale[d], config.seconds->event_difference_lag,
                                     config.joint.grid_step));
-    grids.informative.push_back(informativeColumns(grids.full[d].cols(), scaled_sensors[d].cols(),
-                                                   !rhythm[d].empty(), stale[d].empty()));
   }
   const JointAgreement agreement = bestAgreement(evidence, grids, config);
   std::vector<Eigen::MatrixXd> motion;

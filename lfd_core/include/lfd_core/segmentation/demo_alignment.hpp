@@ -6,6 +6,7 @@
 
 #include <Eigen/Core>
 #include <cstddef>
+#include <utility>
 #include <vector>
 
 namespace lfd {
@@ -40,11 +41,22 @@ struct DemoAlignment {
 std::vector<std::size_t> byDtwCostToOthers(const std::vector<Eigen::MatrixXd>& gridded, int threads,
                                            double band = 1.0);
 
-/// Aligns gridded demos (onUniformGrid) to demo `reference`; `threads` <= 0 = all cores; `band`
-/// as for multivariateDtwCost. Throws std::invalid_argument as above, or on a reference out of
-/// range.
+/// Per demo, which columns of its grid say something (true) and which it cannot fill (a dead
+/// sensor's, a periodic phase it lacks); empty = every column of every demo.
+using ColumnMasks = std::vector<std::vector<bool>>;
+
+/// Demos a's and b's grids on the columns both can fill (`masks` as above): a column one demo
+/// cannot fill pulls the other's motion onto the wrong part of it. Throws std::invalid_argument
+/// when a mask's size differs from its grid's columns.
+std::pair<Eigen::MatrixXd, Eigen::MatrixXd> sharedColumns(
+    const std::vector<Eigen::MatrixXd>& gridded, const ColumnMasks& masks, std::size_t a,
+    std::size_t b);
+
+/// Aligns gridded demos (onUniformGrid) to demo `reference`, each on the columns it shares with
+/// it (sharedColumns); `threads` <= 0 = all cores; `band` as for multivariateDtwCost. Throws
+/// std::invalid_argument as above, or on a reference out of range.
 DemoAlignment alignTo(const std::vector<Eigen::MatrixXd>& gridded, std::size_t reference,
-                      int threads, double band = 1.0);
+                      int threads, double band = 1.0, const ColumnMasks& masks = {});
 
 /// alignTo the medoid (byDtwCostToOthers' first).
 DemoAlignment alignToMedoid(const std::vector<Eigen::MatrixXd>& gridded, int threads,
