@@ -1,11 +1,16 @@
-// Periodic back-and-forth motion (reciprocating_motion.hpp) on hand-made 2-D paths at 100 Hz.
+// Periodic back-and-forth motion (reciprocating_motion.hpp) on hand-made 2-D paths at 100 Hz, and
+// the periodic phases of a task's demos (periodic_phases.hpp) on hand-made poses.
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <random>
+#include <stdexcept>
+#include <string>
 #include <vector>
 
+#include "lfd_core/segmentation/periodic_phases.hpp"
 #include "lfd_core/segmentation/reciprocating_motion.hpp"
+#include "lfd_core/segmentation/state_features.hpp"
 
 namespace {
 
@@ -97,6 +102,131 @@ TEST(ReciprocatingMotion, RejectsAClockOfTheWrongLength) {
   EXPECT_THROW(lfd::reciprocatingRuns(Eigen::MatrixXd::Zero(10, 2), clock(9), 0.1),
                std::invalid_argument);
   EXPECT_TRUE(lfd::reciprocatingRuns(Eigen::MatrixXd::Zero(10, 2), clock(10), 0.1).empty());
+}
+
+// ---- periodic phases of a task (periodic_phases.hpp)
+// ---------------------------------------------
+
+// A demo's pose as features x, y, z (m) and two quaternion components: qx drifting with a slow
+// turn of the wrist over a range of 0.01, qz still; all with 2e-4 of noise.
+lfd::FeatureMatrix pose(const std::vector<Eigen::Vector3d>& points, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> noise(0.0, 2e-4);
+  std::uniform_real_distribution<double> phase(0.0, kPi);
+  lfd::FeatureMatrix demo;
+  demo.names = {"x", "y", "z", "qx", "qz"};
+  const auto n = static_cast<Eigen::Index>(points.size());
+  demo.data.resize(n, 5);
+  demo.time = clock(points.size());
+  const double turn = phase(rng), seconds = static_cast<double>(n) / kRate;
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const double t = static_cast<double>(i) / kRate;
+    const Eigen::Vector3d& p = points[static_cast<std::size_t>(i)];
+    demo.data.row(i) << p.x(), p.y(), p.z(),
+        0.99 + 0.005 * std::sin(2 * kPi * t / (1.3 * seconds) + turn), 0.0;
+    for (Eigen::Index c = 0; c < 5; ++c) demo.data(i, c) += noise(rng);
+  }
+  return demo;
+}
+
+struct Path3 {
+  std::vector<Eigen::Vector3d> points;
+  void move(const Eigen::Vector3d& to, double seconds) {
+    const Eigen::Vector3d from = points.empty() ? to : points.back();
+    const int n = static_cast<int>(seconds * kRate);
+    for (int i = 1; i <= n; ++i) points.push_back(from + (to - from) * minJerk(i / double(n)));
+  }
+  void grateAlongX(int cycles, double amplitude, double period) {
+    const Eigen::Vector3d at = points.back();
+    const int n = static_cast<int>(period * kRate);
+    for (int c = 0; c < cycles; ++c)
+      for (int i = 1; i <= n; ++i)
+        points.push_back(at + Eigen::Vector3d::UnitX() * amplitude *
+                                  (1.0 - std::cos(2.0 * kPi * i / n)) / 2.0);
+  }
+  double now() const { return static_cast<double>(points.size()) / kRate; }
+};
+
+std::vector<Eigen::VectorXd> speedsOf(const std::vector<lfd::FeatureMatrix>& demos) {
+  const auto moving = lfd::movingStates(demos, demos.front().names);
+  const auto scaled = lfd::scaledStates(demos, moving);
+  std::vector<Eigen::VectorXd> out;
+  for (std::size_t d = 0; d < demos.size(); ++d)
+    out.push_back(lfd::stateSpeed(scaled[d], demos[d].clock(), 0.1));
+  return out;
+}
+
+// A grater reached along y and z and worked along x, 3-6 strokes of 3-6 cm per demo: II-B would
+// keep y and z (x differs from demo to demo), on which the strokes do not show.
+struct Grating {
+  std::vector<lfd::FeatureMatrix> demos;
+  std::vector<std::pair<double, double>> truth;  // per demo, the grating's start and end (s)
+};
+
+Grating grating() {
+  Grating g;
+  for (int d = 0; d < 5; ++d) {
+    Path3 path;
+    path.move({0.3, 0.2 + 0.01 * d, 0.35}, 0.5);
+    path.move({0.32, 0.0, 0.2}, 2.0 + 0.2 * d);
+    const double begin = path.now();
+    path.grateAlongX(3 + d % 4, 0.03 + 0.008 * d, 0.6 + 0.1 * d);
+    g.truth.emplace_back(begin, path.now());
+    path.move({0.3, 0.2, 0.4}, 2.0);
+    path.move({0.3, 0.2, 0.4}, 0.5);
+    g.demos.push_back(pose(path.points, 10u + static_cast<unsigned>(d)));
+  }
+  return g;
+}
+
+TEST(PeriodicPhases, StrokesAlongAFeatureIIBLeftOutAreFoundOnAPairWithoutAContactSensor) {
+  const Grating g = grating();
+  const auto moving = lfd::movingStates(g.demos, g.demos.front().names);
+  const auto runs = lfd::periodicPhases(g.demos, moving, {"y", "z"}, speedsOf(g.demos), false, {});
+  for (std::size_t d = 0; d < g.demos.size(); ++d) {
+    ASSERT_EQ(runs[d].size(), 1u) << "demo " << d;
+    EXPECT_NEAR(runs[d][0].begin / kRate, g.truth[d].first, 0.25) << "demo " << d;
+    EXPECT_NEAR(runs[d][0].end / kRate, g.truth[d].second, 0.25) << "demo " << d;
+  }
+}
+
+// With a contact sensor its events mark the strokes; the pairs are not searched.
+TEST(PeriodicPhases, WithAContactSensorOnlyTheSelectedFeaturesAreSearched) {
+  const Grating g = grating();
+  const auto moving = lfd::movingStates(g.demos, g.demos.front().names);
+  const auto runs = lfd::periodicPhases(g.demos, moving, {"y", "z"}, speedsOf(g.demos), true, {});
+  for (const auto& demo : runs) EXPECT_TRUE(demo.empty());
+}
+
+// Out and back between two places four times, with a still pause of 1 s at each end: an
+// operator's separate motions, no periodic phase (each stroke alike, each reversal straight back).
+TEST(PeriodicPhases, StrokesSeparatedByPausesAreNoPeriodicPhase) {
+  std::vector<lfd::FeatureMatrix> demos;
+  for (unsigned d = 0; d < 3; ++d) {
+    Path3 path;
+    path.move({0.0, 0.0, 0.2}, 0.5);
+    for (int k = 0; k < 6; ++k) {
+      path.move(k % 2 ? Eigen::Vector3d(0.0, 0.0, 0.2) : Eigen::Vector3d(0.2, 0.1, 0.2), 1.0);
+      path.move(path.points.back(), 1.0);
+    }
+    demos.push_back(pose(path.points, 20u + d));
+  }
+  const auto moving = lfd::movingStates(demos, demos.front().names);
+  const auto runs = lfd::periodicPhases(demos, moving, {"x", "y"}, speedsOf(demos), false, {});
+  for (const auto& demo : runs) EXPECT_TRUE(demo.empty()) << demo.size() << " runs";
+}
+
+TEST(PeriodicPhases, RejectsASpeedProfilePerDemoMissing) {
+  const Grating g = grating();
+  EXPECT_THROW(lfd::periodicPhases(g.demos, {"x", "y"}, {}, {}, false, {}), std::invalid_argument);
+}
+
+TEST(StateFeatures, AFeatureThatOnlyJittersIsNotAboveItsNoise) {
+  const Grating g = grating();
+  const auto moving = lfd::movingStates(g.demos, g.demos.front().names);
+  EXPECT_EQ(moving.size(), 5u);  // qz's noise moves it
+  EXPECT_EQ(lfd::featuresAboveNoise(g.demos, moving, 20.0),
+            (std::vector<std::string>{"x", "y", "z", "qx"}));
 }
 
 }  // namespace

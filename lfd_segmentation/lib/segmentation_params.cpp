@@ -146,6 +146,7 @@ void parseJoint(const YAML::Node& node, lfd::JointSegmentationConfig* joint) {
   section.readNonNegative("stale_reading_seconds", joint->stale_reading);
   section.readPositive("motion_match_window_seconds", joint->motion_match_window);
   section.readPositive("motion_match_step_seconds", joint->motion_match_step);
+  section.readPositive("rhythm_min_range_sigmas", joint->rhythm_min_range_sigmas);
   section.readFraction("min_piece_weight", joint->min_piece_weight);
   section.readNonNegative("colocation_seconds", joint->colocation);
   joint->max_speed_correlation =

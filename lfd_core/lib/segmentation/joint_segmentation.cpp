@@ -9,7 +9,9 @@
 
 #include "lfd_core/segmentation/demo_alignment.hpp"
 #include "lfd_core/segmentation/motion_match.hpp"
+#include "lfd_core/segmentation/periodic_phases.hpp"
 #include "lfd_core/segmentation/stale_readings.hpp"
+#include "lfd_core/segmentation/state_features.hpp"
 #include "lfd_core/util/parallel_for.hpp"
 
 namespace lfd {
@@ -37,38 +39,6 @@ struct Anchor {
 
 std::string describe(const std::string& what, std::size_t d) {
   return "demonstration " + std::to_string(d) + ": " + what;
-}
-
-// State features that move in at least one demo.
-std::vector<std::string> movingStates(const std::vector<FeatureMatrix>& demos,
-                                      const std::vector<std::string>& states) {
-  std::vector<std::string> out;
-  for (const std::string& name : states) {
-    for (const FeatureMatrix& demo : demos) {
-      const auto col = demo.data.col(demo.require(name));
-      if (col.maxCoeff() - col.minCoeff() > 1e-12 * (1.0 + col.cwiseAbs().maxCoeff())) {
-        out.push_back(name);
-        break;
-      }
-    }
-  }
-  return out;
-}
-
-// The moving state features of every demo, each divided by its largest range over the task, so
-// that DTW and the speed weigh a joint angle and a position alike.
-std::vector<Eigen::MatrixXd> scaledStates(const std::vector<FeatureMatrix>& demos,
-                                          const std::vector<std::string>& names) {
-  std::vector<Eigen::MatrixXd> out;
-  for (const FeatureMatrix& demo : demos) out.push_back(demo.select(names).data);
-  for (Eigen::Index c = 0; c < static_cast<Eigen::Index>(names.size()); ++c) {
-    double range = 0.0;
-    for (const Eigen::MatrixXd& m : out)
-      range = std::max(range, m.col(c).maxCoeff() - m.col(c).minCoeff());
-    if (!(range > 0)) range = 1.0;
-    for (Eigen::MatrixXd& m : out) m.col(c) = (m.col(c).array() - m.col(c).minCoeff()) / range;
-  }
-  return out;
 }
 
 // Per sensor, how far its channels are from their level at the demo's start (the norm over the
@@ -122,12 +92,6 @@ Eigen::MatrixXd withSpeed(const Eigen::MatrixXd& states, const Eigen::VectorXd& 
   out.col(states.cols()) = typical > 0 ? Eigen::VectorXd(weight * (speed / typical).cwiseMin(1.5))
                                        : Eigen::VectorXd::Zero(speed.size());
   return out;
-}
-
-std::vector<double> clockOf(const FeatureMatrix& demo) {
-  std::vector<double> t(static_cast<std::size_t>(demo.rows()));
-  for (Eigen::Index i = 0; i < demo.rows(); ++i) t[static_cast<std::size_t>(i)] = demo.timeAt(i);
-  return t;
 }
 
 std::size_t sampleAt(const FeatureMatrix& demo, double grid_row, double step) {
@@ -292,26 +256,10 @@ void dropStaleEvents(const std::vector<SampleSpan>& stale, std::size_t margin,
                     events->all.end());
 }
 
-// Each demo's periodic phases, found on the state features II-B selected (those the demos move
-// consistently: a wrist that turns a little at random in each demo adds its own drift to every
-// stroke and hides the reversals); on every moving state feature without II-B (one demo). At least
-// two: along a single feature every reversal goes straight back, and the test of direction says
-// nothing (PR2's one selected joint: its wiggles while the leg is screwed in were taken for a
-// periodic phase, 3/6 -> 2/6 at 1 s).
-std::vector<std::vector<ReciprocatingRun>> periodicPhases(const std::vector<FeatureMatrix>& demos,
-                                                          const std::vector<std::string>& moving,
-                                                          const std::vector<std::string>& selected,
-                                                          double smoothing, int threads) {
-  std::vector<std::string> names;
-  for (const std::string& name : moving)
-    if (selected.empty() || std::find(selected.begin(), selected.end(), name) != selected.end())
-      names.push_back(name);
-  std::vector<std::vector<ReciprocatingRun>> out(demos.size());
-  if (names.size() < 2) return out;
-  const std::vector<Eigen::MatrixXd> states = scaledStates(demos, names);
-  parallelFor(demos.size(), threads, [&](std::size_t d) {
-    out[d] = reciprocatingRuns(states[d], clockOf(demos[d]), smoothing);
-  });
+PeriodicPhaseConfig periodicConfig(const JointSegmentationConfig& joint) {
+  PeriodicPhaseConfig out;
+  out.pauses = joint.pauses;
+  out.min_range_sigmas = joint.rhythm_min_range_sigmas;
   return out;
 }
 
@@ -352,7 +300,7 @@ void gatherEvidence(const FeatureMatrix& demo, const Eigen::MatrixXd& scaled,
   const auto r = rhythmEvidence(rhythm, pieces, joint.weights.rhythm,
                                 static_cast<std::size_t>(std::lround(joint.ramp_fold * rate)));
   pieces.insert(pieces.end(), r.begin(), r.end());
-  const std::vector<double> clock = clockOf(demo);
+  const std::vector<double> clock = demo.clock();
   const std::vector<Pause> pauses = findPauses(speed, clock, joint.pauses);
   for (const Pause& p : pauses) out->pauses.push_back({p.begin, p.end - 1});
   const auto m =
@@ -778,7 +726,7 @@ std::vector<Eigen::MatrixXd> motionGrids(const std::vector<FeatureMatrix>& demos
   const std::vector<Eigen::MatrixXd> scaled = scaledStates(demos, names);
   std::vector<Eigen::MatrixXd> out;
   for (std::size_t d = 0; d < demos.size(); ++d)
-    out.push_back(onUniformGrid(scaled[d], clockOf(demos[d]), step));
+    out.push_back(onUniformGrid(scaled[d], demos[d].clock(), step));
   return out;
 }
 
@@ -953,7 +901,7 @@ SegmentationPipelineResult segmentJointly(const PreparedSegmentation& prepared,
 
   std::vector<Eigen::VectorXd> speeds(n);
   parallelFor(n, config.threads, [&](std::size_t d) {
-    speeds[d] = stateSpeed(scaled[d] * consistency.asDiagonal(), clockOf(demos[d]),
+    speeds[d] = stateSpeed(scaled[d] * consistency.asDiagonal(), demos[d].clock(),
                            config.joint.pauses.smoothing);
   });
   const SensorSelection contact =
@@ -963,8 +911,9 @@ SegmentationPipelineResult segmentJointly(const PreparedSegmentation& prepared,
 
   const std::vector<std::vector<SampleSpan>> stale =
       staleContactReadings(demos, contact, config.joint.stale_reading, &result.warnings);
-  const std::vector<std::vector<ReciprocatingRun>> rhythm = periodicPhases(
-      demos, states, result.selected_features, config.joint.pauses.smoothing, config.threads);
+  const std::vector<std::vector<ReciprocatingRun>> rhythm =
+      periodicPhases(demos, states, result.selected_features, speeds, !contact.names.empty(),
+                     periodicConfig(config.joint), config.threads);
 
   std::vector<DemoEvidence> evidence(n);
   AlignmentGrids grids;

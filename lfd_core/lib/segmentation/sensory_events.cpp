@@ -9,6 +9,7 @@
 #include <string>
 
 #include "lfd_core/segmentation/ramp_fit.hpp"
+#include "lfd_core/util/robust_statistics.hpp"
 
 namespace lfd {
 namespace {
@@ -29,15 +30,6 @@ void checkConfig(const SensoryEventConfig& c) {
         ">= 0");
   if (c.difference_lag < 1)
     throw std::invalid_argument("sensory events: difference_lag must be >= 1");
-}
-
-double medianOf(std::vector<double> v);
-
-// Robust sigma (1.4826 x MAD about the median) of v.
-double robustSigma(std::vector<double> v) {
-  const double med = medianOf(v);
-  for (double& x : v) x = std::abs(x - med);
-  return 1.4826 * medianOf(v);
 }
 
 // SensoryEventConfig::noise_block: the quiet blocks' sigma (10th percentile of the blocks that
@@ -83,15 +75,6 @@ double quietExcursion(const Eigen::Ref<const Eigen::VectorXd>& signal,
   const std::size_t k = maxima.size() / kQuietBlocksPerQuiet;
   std::nth_element(maxima.begin(), maxima.begin() + static_cast<std::ptrdiff_t>(k), maxima.end());
   return maxima[k];
-}
-
-double medianOf(std::vector<double> v) {
-  if (v.empty()) return 0.0;
-  const std::size_t mid = v.size() / 2;
-  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(mid), v.end());
-  double m = v[mid];
-  if (v.size() % 2 == 0) m = 0.5 * (m + *std::max_element(v.begin(), v.begin() + mid));
-  return m;
 }
 
 // Running median with a window shrunk symmetrically at the ends (so edges are not invented).

@@ -22,6 +22,12 @@ double FeatureMatrix::timeAt(Eigen::Index row) const {
   return time.empty() ? static_cast<double>(row) : time.at(static_cast<size_t>(row));
 }
 
+std::vector<double> FeatureMatrix::clock() const {
+  std::vector<double> t(static_cast<size_t>(rows()));
+  for (Eigen::Index i = 0; i < rows(); ++i) t[static_cast<size_t>(i)] = timeAt(i);
+  return t;
+}
+
 FeatureMatrix FeatureMatrix::select(const std::vector<std::string>& features) const {
   FeatureMatrix out;
   out.time = time;

@@ -49,6 +49,10 @@ struct JointSegmentationConfig {
   double motion_match_window = 1.0;
   /// The grid step of that match (s): finer than grid_step, since it places a boundary.
   double motion_match_step = 0.02;
+  /// Where no contact sensor is there and the features II-B selected show no periodic phase,
+  /// pairs of the features moving at least this many noise sigmas are searched for one
+  /// (periodic_phases.hpp).
+  double rhythm_min_range_sigmas = 20.0;
   /// A demo's own evidence for a boundary must be at least this sure (as an instant of rest): a
   /// hesitation is no boundary, even where the other demos have one.
   double min_piece_weight = 0.3;

@@ -37,6 +37,8 @@ struct FeatureMatrix {
   int require(const std::string& name) const;
   /// Time of a row: the stored timestamp, or the row index when no clock is stored.
   double timeAt(Eigen::Index row) const;
+  /// timeAt of every row.
+  std::vector<double> clock() const;
   /// The sub-matrix of the listed features (in that order); throws if one is missing.
   FeatureMatrix select(const std::vector<std::string>& features) const;
   /// Throws std::invalid_argument if the shape is inconsistent (names/time vs data).

@@ -1,0 +1,84 @@
+// The periodic phases of a task's demos (see periodic_phases.hpp).
+#include "lfd_core/segmentation/periodic_phases.hpp"
+
+#include <algorithm>
+#include <stdexcept>
+#include <string>
+
+#include "lfd_core/segmentation/state_features.hpp"
+#include "lfd_core/util/parallel_for.hpp"
+
+namespace lfd {
+namespace {
+
+using Runs = std::vector<ReciprocatingRun>;
+
+// The runs of `states` that hold no pause.
+Runs pauseFreeRuns(const Eigen::MatrixXd& states, const std::vector<double>& clock,
+                   const std::vector<Pause>& pauses, const PeriodicPhaseConfig& config) {
+  Runs runs = reciprocatingRuns(states, clock, config.pauses.smoothing, config.reciprocation);
+  const auto holds_pause = [&](const ReciprocatingRun& run) {
+    return std::any_of(pauses.begin(), pauses.end(),
+                       [&](const Pause& p) { return p.end > run.begin && p.begin < run.end; });
+  };
+  runs.erase(std::remove_if(runs.begin(), runs.end(), holds_pause), runs.end());
+  return runs;
+}
+
+std::size_t coverage(const Runs& runs) {
+  std::size_t samples = 0;
+  for (const ReciprocatingRun& run : runs) samples += run.end - run.begin;
+  return samples;
+}
+
+// The runs of the pair of `states`' columns whose runs cover the most samples.
+Runs bestPairRuns(const Eigen::MatrixXd& states, const std::vector<double>& clock,
+                  const std::vector<Pause>& pauses, const PeriodicPhaseConfig& config) {
+  Runs best;
+  Eigen::MatrixXd pair(states.rows(), 2);
+  for (Eigen::Index i = 0; i < states.cols(); ++i) {
+    for (Eigen::Index j = i + 1; j < states.cols(); ++j) {
+      pair << states.col(i), states.col(j);
+      Runs runs = pauseFreeRuns(pair, clock, pauses, config);
+      if (coverage(runs) > coverage(best)) best = std::move(runs);
+    }
+  }
+  return best;
+}
+
+std::vector<std::string> selectedMoving(const std::vector<std::string>& moving,
+                                        const std::vector<std::string>& selected) {
+  if (selected.empty()) return moving;
+  std::vector<std::string> out;
+  for (const std::string& name : moving)
+    if (std::find(selected.begin(), selected.end(), name) != selected.end()) out.push_back(name);
+  return out;
+}
+
+}  // namespace
+
+std::vector<std::vector<ReciprocatingRun>> periodicPhases(
+    const std::vector<FeatureMatrix>& demos, const std::vector<std::string>& moving,
+    const std::vector<std::string>& selected, const std::vector<Eigen::VectorXd>& speeds,
+    bool contact_sensed, const PeriodicPhaseConfig& config, int threads) {
+  if (speeds.size() != demos.size())
+    throw std::invalid_argument("periodicPhases: " + std::to_string(demos.size()) + " demos but " +
+                                std::to_string(speeds.size()) + " speed profiles");
+  const std::vector<std::string> names = selectedMoving(moving, selected);
+  const std::vector<Eigen::MatrixXd> states = scaledStates(demos, names);
+  const std::vector<std::string> above_noise =
+      contact_sensed ? std::vector<std::string>{}
+                     : featuresAboveNoise(demos, moving, config.min_range_sigmas);
+  const std::vector<Eigen::MatrixXd> candidates = scaledStates(demos, above_noise);
+  std::vector<Runs> out(demos.size());
+  parallelFor(demos.size(), threads, [&](std::size_t d) {
+    const std::vector<double> clock = demos[d].clock();
+    const std::vector<Pause> pauses = findPauses(speeds[d], clock, config.pauses);
+    if (names.size() >= 2) out[d] = pauseFreeRuns(states[d], clock, pauses, config);
+    if (out[d].empty() && above_noise.size() >= 2)
+      out[d] = bestPairRuns(candidates[d], clock, pauses, config);
+  });
+  return out;
+}
+
+}  // namespace lfd
