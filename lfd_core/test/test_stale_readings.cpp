@@ -1,12 +1,17 @@
 // Repeated and stale sensor readings (stale_readings.hpp): a noisy sensor's cached reading is found
 // with its exact extent, a noise-free sensor's resting zeros are not stale, a single channel that
-// repeats is not the sensor repeating, and bad arguments are errors.
+// repeats is not the sensor repeating, and bad arguments are errors; and the joint segmentation's
+// sensor steps built on them (contact_sensors.hpp).
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <random>
 #include <stdexcept>
+#include <string>
 #include <vector>
 
+#include "lfd_core/segmentation/contact_sensors.hpp"
 #include "lfd_core/segmentation/stale_readings.hpp"
 
 namespace {
@@ -94,3 +99,58 @@ TEST(StaleReadings, BadArgumentsAreErrors) {
 }
 
 }  // namespace
+
+// ---- the joint segmentation's sensor steps (contact_sensors.hpp) --------------------------------
+
+// A wrench cached for its first 300 samples (a driver's stale start), stepping by 8 N at 500: the
+// events are found on the rows it measured, at the demo's own indices; the noise's onset where the
+// cache ends is no event.
+TEST(MeasuredEvents, AStalePrefixIsLeftOutAndTheEventsKeepTheDemosIndices) {
+  const Eigen::MatrixXd wrench = noisyWrench(1000, 0, 300, 7);
+  lfd::SensoryEventConfig config;
+  config.noise_block = 100;
+  const lfd::SensorEvents events =
+      lfd::measuredEvents(wrench, config, {0, 0, 0}, {lfd::SampleSpan{0, 300}});
+  ASSERT_FALSE(events.all.empty());
+  for (std::size_t i : events.all) EXPECT_GE(i, 495u);  // nothing where the cached reading ends
+  EXPECT_TRUE(std::any_of(events.all.begin(), events.all.end(), [](std::size_t i) {
+    return i >= 495 && i <= 510;
+  })) << events.all.front();
+}
+
+TEST(DropStaleEvents, DropsTheEventsWithinTheMarginOfAStaleStretch) {
+  lfd::SensorEvents events;
+  events.all = {100, 290, 315, 330, 600};
+  for (std::size_t i : events.all) events.details.push_back(lfd::SensoryEvent{i});
+  lfd::dropStaleEvents({lfd::SampleSpan{0, 300}}, 20, &events);
+  EXPECT_EQ(events.all, (std::vector<std::size_t>{330, 600}));
+  ASSERT_EQ(events.details.size(), 2u);
+  EXPECT_EQ(events.details[0].index, 330u);
+}
+
+// A tracking error that rises and falls with the robot's speed is motion, not contact: left out
+// and named; a pad pressed while the arm stands still is kept, renumbered.
+TEST(ContactSensors, ASensorThatFollowsTheRobotsSpeedIsNotAContactSensor) {
+  std::vector<Eigen::MatrixXd> magnitudes;
+  std::vector<Eigen::VectorXd> speeds;
+  for (int d = 0; d < 3; ++d) {
+    const Eigen::Index n = 400;
+    Eigen::VectorXd speed(n);
+    Eigen::MatrixXd m(n, 2);
+    for (Eigen::Index i = 0; i < n; ++i) {
+      speed[i] = std::max(0.0, std::sin(0.03 * static_cast<double>(i + 10 * d)));
+      m(i, 0) = 0.8 * speed[i] + 0.01 * std::cos(0.7 * static_cast<double>(i));
+      m(i, 1) = (i > 150 && i < 250 && speed[i] < 0.2) ? 1.0 : 0.0;
+    }
+    magnitudes.push_back(m);
+    speeds.push_back(speed);
+  }
+  std::vector<std::string> warnings;
+  const lfd::SensorSelection contact = lfd::contactSensors({"error_a", "error_b", "pad"}, {0, 0, 1},
+                                                           magnitudes, speeds, 0.4, &warnings);
+  EXPECT_EQ(contact.names, (std::vector<std::string>{"pad"}));
+  EXPECT_EQ(contact.groups, (std::vector<std::size_t>{0}));
+  ASSERT_EQ(warnings.size(), 1u);
+  EXPECT_NE(warnings[0].find("error_a, error_b follows the robot's own speed"), std::string::npos)
+      << warnings[0];
+}
