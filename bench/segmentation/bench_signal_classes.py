@@ -13,14 +13,16 @@ truth with the project's scorer (lfd_tools.segmentation_scoring / lfd_tools.judg
             boundaries of demos with any changepoint; `none` counts boundaries of demos without
   cps       changepoints per demo (mean) against the truth's boundaries per demo
 
-  bench_signal_classes.py [--seeds 0,1,2] [--classes a,b] [--cli PATH] [--config YAML]
-                          [--procedure NAME] [--out result.json] [--min-success X] [--keep DIR]
-                          [--update-docs]
+  bench_signal_classes.py [--seeds 0,1,2] [--classes a,b] [--demos N] [--cli PATH]
+                          [--config YAML] [--procedure NAME] [--out result.json]
+                          [--min-success X] [--keep DIR] [--update-docs]
 
 Run with devel/setup.bash sourced (lfd_tools). A failed CLI run scores its demos with no
 changepoint and prints its error. --min-success X (0-1): exit 1 when any class's rate at 0.5 s
 is below X (for CI). --update-docs: rewrite docs/results.md's section bench-signal-classes from
-the result (lfd_tools.results_doc).
+the result (lfd_tools.results_doc). --demos N: every task with its first N demos (default: the
+count each seed draws, 6-8, fewer for long demos): how the segmentation holds up when a user
+records only a few.
 """
 import argparse
 import json
@@ -88,7 +90,8 @@ def no_answer(n, error):
 def score_seed(args, name, seed, work):
     """{tolerance: scores} of one class and seed (lfd_tools.segmentation_scoring.score_answer),
     plus the run's error and time."""
-    truth = signal_classes.write_class(name, seed, os.path.join(work, "seed%d" % seed))
+    truth = signal_classes.write_class(name, seed, os.path.join(work, "seed%d" % seed),
+                                       args.demos)
     folder = os.path.join(work, "seed%d" % seed, name)
     inputs = [os.path.join(folder, d["file"]) for d in truth["demos"]]
     clocks = [np.loadtxt(p, delimiter=",", skiprows=1, usecols=0) for p in inputs]
@@ -146,6 +149,8 @@ def parse_args():
     ap.add_argument("--classes", default="",
                     help="comma-separated (default: all, rate variants included)")
     ap.add_argument("--seeds", default="0,1,2")
+    ap.add_argument("--demos", type=int, default=None,
+                    help="demos per task (default: the count each seed draws)")
     ap.add_argument("--out", default="", help="write every figure and per-demo detail here (JSON)")
     ap.add_argument("--min-success", type=float, default=None,
                     help="exit 1 when a class's success rate at 0.5 s is below this (0-1)")
@@ -160,6 +165,10 @@ def parse_args():
     if unknown:
         ap.error("unknown class %s; known: %s"
                  % (", ".join(unknown), ", ".join(signal_classes.CLASSES)))
+    if args.demos is not None and args.demos < 2:
+        ap.error("--demos must be at least 2 (the segmentation compares demos)")
+    if args.update_docs and args.demos is not None:
+        ap.error("--update-docs records the default demo counts; run without --demos")
     if not os.access(args.cli, os.X_OK):
         ap.error("no `segment` CLI at %s (./lfd build, or --cli)" % args.cli)
     if args.update_docs:
@@ -174,8 +183,9 @@ def main():
     args, names = parse_args()
     work = args.keep or tempfile.mkdtemp(prefix="signal_classes_")
     results = {}
-    print("cli %s, procedure %s, config %s, seeds %s" % (args.cli, args.procedure or "(config's)",
-                                                         args.config or "(shipped)", args.seeds))
+    print("cli %s, procedure %s, config %s, seeds %s, demos %s"
+          % (args.cli, args.procedure or "(config's)", args.config or "(shipped)", args.seeds,
+             args.demos or "(drawn)"))
     print(HEADER)
     try:
         for name in names:
@@ -185,7 +195,8 @@ def main():
         if not args.keep:
             shutil.rmtree(work, ignore_errors=True)
     result = {"cli": args.cli, "config": args.config, "procedure": args.procedure,
-              "seeds": args.seeds, "tolerances_s": list(TOLERANCES), "classes": results}
+              "seeds": args.seeds, "demos": args.demos, "tolerances_s": list(TOLERANCES),
+              "classes": results}
     if args.out:
         with open(args.out, "w") as f:
             json.dump(result, f, indent=1)
