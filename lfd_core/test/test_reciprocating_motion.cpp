@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "lfd_core/segmentation/boundary_evidence.hpp"
 #include "lfd_core/segmentation/periodic_phases.hpp"
 #include "lfd_core/segmentation/reciprocating_motion.hpp"
 #include "lfd_core/segmentation/state_features.hpp"
@@ -102,6 +103,27 @@ TEST(ReciprocatingMotion, RejectsAClockOfTheWrongLength) {
   EXPECT_THROW(lfd::reciprocatingRuns(Eigen::MatrixXd::Zero(10, 2), clock(9), 0.1),
                std::invalid_argument);
   EXPECT_TRUE(lfd::reciprocatingRuns(Eigen::MatrixXd::Zero(10, 2), clock(10), 0.1).empty());
+  EXPECT_THROW(lfd::reciprocatingRuns(Eigen::MatrixXd::Zero(10, 2), Eigen::VectorXd::Zero(9)),
+               std::invalid_argument);
+}
+
+// A pair's speed from the features' velocities, each smoothed once, is the speed of the pair.
+TEST(ReciprocatingMotion, APairsSpeedFromTheFeaturesVelocitiesIsThePairsSpeed) {
+  Path path;
+  path.move({0.0, 0.0}, 0.5);
+  path.move({0.3, 0.1}, 2.5);
+  path.grate(Eigen::Vector2d(0.6, 0.8), {{0.04, 0.8}, {0.06, 0.9}, {0.03, 0.6}, {0.05, 1.0}});
+  const Eigen::MatrixXd x = states(path, 3);
+  const std::vector<double> t = clock(path.points.size());
+  const Eigen::MatrixXd v = lfd::stateVelocities(x, t, 0.1);
+  EXPECT_LT((v.rowwise().norm() - lfd::stateSpeed(x, t, 0.1)).cwiseAbs().maxCoeff(), 1e-9);
+  const auto given = lfd::reciprocatingRuns(x, Eigen::VectorXd(v.rowwise().norm()));
+  const auto computed = lfd::reciprocatingRuns(x, t, 0.1);
+  ASSERT_EQ(given.size(), computed.size());
+  for (std::size_t k = 0; k < given.size(); ++k) {
+    EXPECT_EQ(given[k].begin, computed[k].begin);
+    EXPECT_EQ(given[k].end, computed[k].end);
+  }
 }
 
 // ---- periodic phases of a task (periodic_phases.hpp)
@@ -131,7 +153,7 @@ lfd::FeatureMatrix pose(const std::vector<Eigen::Vector3d>& points, unsigned see
 
 struct Path3 {
   std::vector<Eigen::Vector3d> points;
-  void move(const Eigen::Vector3d& to, double seconds) {
+  void move(Eigen::Vector3d to, double seconds) {  // by value: `to` may be points.back()
     const Eigen::Vector3d from = points.empty() ? to : points.back();
     const int n = static_cast<int>(seconds * kRate);
     for (int i = 1; i <= n; ++i) points.push_back(from + (to - from) * minJerk(i / double(n)));

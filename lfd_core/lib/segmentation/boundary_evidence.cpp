@@ -93,21 +93,26 @@ double typicalSpeed(const Eigen::VectorXd& speed) {
   return v[k];
 }
 
-Eigen::VectorXd stateSpeed(const Eigen::MatrixXd& scaled_states, const std::vector<double>& time,
-                           double smoothing_seconds) {
+Eigen::MatrixXd stateVelocities(const Eigen::MatrixXd& scaled_states,
+                                const std::vector<double>& time, double smoothing_seconds) {
   const Eigen::Index n = scaled_states.rows();
   if (static_cast<std::size_t>(n) != time.size())
     throw std::invalid_argument("stateSpeed: " + std::to_string(n) + " samples but " +
                                 std::to_string(time.size()) + " timestamps");
-  Eigen::VectorXd speed = Eigen::VectorXd::Zero(n);
-  if (n < 3 || scaled_states.cols() == 0) return speed;
+  Eigen::MatrixXd velocity = Eigen::MatrixXd::Zero(n, scaled_states.cols());
+  if (n < 3 || scaled_states.cols() == 0) return velocity;
   const Eigen::VectorXd t = Eigen::Map<const Eigen::VectorXd>(time.data(), n);
   const Eigen::MatrixXd smooth = gaussianSmooth(t, scaled_states, smoothing_seconds);
   for (Eigen::Index i = 0; i < n; ++i) {
     const Eigen::Index a = std::max<Eigen::Index>(0, i - 1), b = std::min(n - 1, i + 1);
-    speed[i] = (smooth.row(b) - smooth.row(a)).norm() / (t[b] - t[a]);
+    velocity.row(i) = (smooth.row(b) - smooth.row(a)) / (t[b] - t[a]);
   }
-  return speed;
+  return velocity;
+}
+
+Eigen::VectorXd stateSpeed(const Eigen::MatrixXd& scaled_states, const std::vector<double>& time,
+                           double smoothing_seconds) {
+  return stateVelocities(scaled_states, time, smoothing_seconds).rowwise().norm();
 }
 
 std::vector<Pause> findPauses(const Eigen::VectorXd& speed, const std::vector<double>& time,

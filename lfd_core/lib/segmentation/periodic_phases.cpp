@@ -13,15 +13,18 @@ namespace {
 
 using Runs = std::vector<ReciprocatingRun>;
 
-// The runs of `states` that hold no pause.
-Runs pauseFreeRuns(const Eigen::MatrixXd& states, const std::vector<double>& clock,
+bool holdsPause(const ReciprocatingRun& run, const std::vector<Pause>& pauses) {
+  return std::any_of(pauses.begin(), pauses.end(),
+                     [&](const Pause& p) { return p.end > run.begin && p.begin < run.end; });
+}
+
+// The runs of `states` (speed: their speed profile) that hold no pause.
+Runs pauseFreeRuns(const Eigen::MatrixXd& states, const Eigen::VectorXd& speed,
                    const std::vector<Pause>& pauses, const PeriodicPhaseConfig& config) {
-  Runs runs = reciprocatingRuns(states, clock, config.pauses.smoothing, config.reciprocation);
-  const auto holds_pause = [&](const ReciprocatingRun& run) {
-    return std::any_of(pauses.begin(), pauses.end(),
-                       [&](const Pause& p) { return p.end > run.begin && p.begin < run.end; });
-  };
-  runs.erase(std::remove_if(runs.begin(), runs.end(), holds_pause), runs.end());
+  Runs runs = reciprocatingRuns(states, speed, config.reciprocation);
+  runs.erase(std::remove_if(runs.begin(), runs.end(),
+                            [&](const ReciprocatingRun& run) { return holdsPause(run, pauses); }),
+             runs.end());
   return runs;
 }
 
@@ -31,15 +34,20 @@ std::size_t coverage(const Runs& runs) {
   return samples;
 }
 
-// The runs of the pair of `states`' columns whose runs cover the most samples.
+// The runs of the pair of `states`' columns whose runs cover the most samples. Each feature is
+// smoothed once: a pair's speed is the norm of its two velocity columns.
 Runs bestPairRuns(const Eigen::MatrixXd& states, const std::vector<double>& clock,
                   const std::vector<Pause>& pauses, const PeriodicPhaseConfig& config) {
   Runs best;
+  if (states.rows() < 5) return best;
+  const Eigen::MatrixXd velocity = stateVelocities(states, clock, config.pauses.smoothing);
   Eigen::MatrixXd pair(states.rows(), 2);
   for (Eigen::Index i = 0; i < states.cols(); ++i) {
     for (Eigen::Index j = i + 1; j < states.cols(); ++j) {
       pair << states.col(i), states.col(j);
-      Runs runs = pauseFreeRuns(pair, clock, pauses, config);
+      const Eigen::VectorXd speed =
+          (velocity.col(i).array().square() + velocity.col(j).array().square()).sqrt();
+      Runs runs = pauseFreeRuns(pair, speed, pauses, config);
       if (coverage(runs) > coverage(best)) best = std::move(runs);
     }
   }
@@ -74,7 +82,9 @@ std::vector<std::vector<ReciprocatingRun>> periodicPhases(
   parallelFor(demos.size(), threads, [&](std::size_t d) {
     const std::vector<double> clock = demos[d].clock();
     const std::vector<Pause> pauses = findPauses(speeds[d], clock, config.pauses);
-    if (names.size() >= 2) out[d] = pauseFreeRuns(states[d], clock, pauses, config);
+    if (names.size() >= 2 && states[d].rows() >= 5)
+      out[d] = pauseFreeRuns(states[d], stateSpeed(states[d], clock, config.pauses.smoothing),
+                             pauses, config);
     if (out[d].empty() && above_noise.size() >= 2)
       out[d] = bestPairRuns(candidates[d], clock, pauses, config);
   });

@@ -58,9 +58,19 @@ std::vector<ReciprocatingRun> reciprocatingRuns(const Eigen::MatrixXd& states,
   if (static_cast<std::size_t>(n) != time.size())
     throw std::invalid_argument("reciprocatingRuns: " + std::to_string(n) + " samples but " +
                                 std::to_string(time.size()) + " timestamps");
+  if (n < 5 || states.cols() == 0) return {};
+  return reciprocatingRuns(states, stateSpeed(states, time, smoothing_seconds), config);
+}
+
+std::vector<ReciprocatingRun> reciprocatingRuns(const Eigen::MatrixXd& states,
+                                                const Eigen::VectorXd& speed,
+                                                const ReciprocationConfig& config) {
+  const Eigen::Index n = states.rows();
+  if (speed.size() != n)
+    throw std::invalid_argument("reciprocatingRuns: " + std::to_string(n) + " samples but " +
+                                std::to_string(speed.size()) + " speeds");
   std::vector<ReciprocatingRun> runs;
   if (n < 5 || states.cols() == 0) return runs;
-  const Eigen::VectorXd speed = stateSpeed(states, time, smoothing_seconds);
   const double typical = typicalSpeed(speed);
   if (!(typical > 0.0)) return runs;
   const std::vector<std::size_t> ends = strokeEnds(speed, config.min_dip * typical);

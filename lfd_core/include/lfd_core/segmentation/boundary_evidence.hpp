@@ -89,6 +89,11 @@ std::vector<Pause> findPauses(const Eigen::VectorXd& speed, const std::vector<do
 Eigen::VectorXd stateSpeed(const Eigen::MatrixXd& scaled_states, const std::vector<double>& time,
                            double smoothing_seconds);
 
+/// Each feature's velocity as stateSpeed sees it (smoothed, central differences): stateSpeed is
+/// the norm of a row, and the speed of any subset of the features the norm of its columns.
+Eigen::MatrixXd stateVelocities(const Eigen::MatrixXd& scaled_states,
+                                const std::vector<double>& time, double smoothing_seconds);
+
 /// A demo's typical speed, the unit of every rest and motion threshold: the 95th percentile of
 /// its speed profile (its moves' peaks, not one spike's). 0 for an empty profile.
 double typicalSpeed(const Eigen::VectorXd& speed);

@@ -46,4 +46,11 @@ std::vector<ReciprocatingRun> reciprocatingRuns(const Eigen::MatrixXd& states,
                                                 double smoothing_seconds,
                                                 const ReciprocationConfig& config = {});
 
+/// The same with the states' speed profile given (stateSpeed of `states`, one value per row):
+/// a caller that tries many subsets of features smooths each feature once. Throws
+/// std::invalid_argument on a size mismatch.
+std::vector<ReciprocatingRun> reciprocatingRuns(const Eigen::MatrixXd& states,
+                                                const Eigen::VectorXd& speed,
+                                                const ReciprocationConfig& config = {});
+
 }  // namespace lfd
