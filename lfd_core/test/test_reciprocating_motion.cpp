@@ -169,12 +169,14 @@ struct Path3 {
   double now() const { return static_cast<double>(points.size()) / kRate; }
 };
 
-std::vector<Eigen::VectorXd> speedsOf(const std::vector<lfd::FeatureMatrix>& demos) {
+std::vector<std::vector<lfd::Pause>> pausesOf(const std::vector<lfd::FeatureMatrix>& demos) {
   const auto moving = lfd::movingStates(demos, demos.front().names);
   const auto scaled = lfd::scaledStates(demos, moving);
-  std::vector<Eigen::VectorXd> out;
-  for (std::size_t d = 0; d < demos.size(); ++d)
-    out.push_back(lfd::stateSpeed(scaled[d], demos[d].clock(), 0.1));
+  std::vector<std::vector<lfd::Pause>> out;
+  for (std::size_t d = 0; d < demos.size(); ++d) {
+    const std::vector<double> clock = demos[d].clock();
+    out.push_back(lfd::findPauses(lfd::stateSpeed(scaled[d], clock, 0.1), clock, {}));
+  }
   return out;
 }
 
@@ -204,7 +206,7 @@ Grating grating() {
 TEST(PeriodicPhases, StrokesAlongAFeatureIIBLeftOutAreFoundOnAPairWithoutAContactSensor) {
   const Grating g = grating();
   const auto moving = lfd::movingStates(g.demos, g.demos.front().names);
-  const auto runs = lfd::periodicPhases(g.demos, moving, {"y", "z"}, speedsOf(g.demos), false, {});
+  const auto runs = lfd::periodicPhases(g.demos, moving, {"y", "z"}, pausesOf(g.demos), false, {});
   for (std::size_t d = 0; d < g.demos.size(); ++d) {
     ASSERT_EQ(runs[d].size(), 1u) << "demo " << d;
     EXPECT_NEAR(runs[d][0].begin / kRate, g.truth[d].first, 0.25) << "demo " << d;
@@ -216,7 +218,7 @@ TEST(PeriodicPhases, StrokesAlongAFeatureIIBLeftOutAreFoundOnAPairWithoutAContac
 TEST(PeriodicPhases, WithAContactSensorOnlyTheSelectedFeaturesAreSearched) {
   const Grating g = grating();
   const auto moving = lfd::movingStates(g.demos, g.demos.front().names);
-  const auto runs = lfd::periodicPhases(g.demos, moving, {"y", "z"}, speedsOf(g.demos), true, {});
+  const auto runs = lfd::periodicPhases(g.demos, moving, {"y", "z"}, pausesOf(g.demos), true, {});
   for (const auto& demo : runs) EXPECT_TRUE(demo.empty());
 }
 
@@ -234,11 +236,11 @@ TEST(PeriodicPhases, StrokesSeparatedByPausesAreNoPeriodicPhase) {
     demos.push_back(pose(path.points, 20u + d));
   }
   const auto moving = lfd::movingStates(demos, demos.front().names);
-  const auto runs = lfd::periodicPhases(demos, moving, {"x", "y"}, speedsOf(demos), false, {});
+  const auto runs = lfd::periodicPhases(demos, moving, {"x", "y"}, pausesOf(demos), false, {});
   for (const auto& demo : runs) EXPECT_TRUE(demo.empty()) << demo.size() << " runs";
 }
 
-TEST(PeriodicPhases, RejectsASpeedProfilePerDemoMissing) {
+TEST(PeriodicPhases, RejectsDemosWithoutTheirPauses) {
   const Grating g = grating();
   EXPECT_THROW(lfd::periodicPhases(g.demos, {"x", "y"}, {}, {}, false, {}), std::invalid_argument);
 }

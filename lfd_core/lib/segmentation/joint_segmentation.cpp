@@ -76,7 +76,7 @@ Eigen::VectorXd consistencyWeights(const SegmentationPipelineResult& result,
 
 PeriodicPhaseConfig periodicConfig(const JointSegmentationConfig& joint) {
   PeriodicPhaseConfig out;
-  out.pauses = joint.pauses;
+  out.smoothing = joint.pauses.smoothing;
   out.min_range_sigmas = joint.rhythm_min_range_sigmas;
   return out;
 }
@@ -85,8 +85,9 @@ PeriodicPhaseConfig periodicConfig(const JointSegmentationConfig& joint) {
 // the grid's columns it can fill.
 void gatherEvidence(const FeatureMatrix& demo, const Eigen::MatrixXd& scaled,
                     const Eigen::VectorXd& consistency, const Eigen::VectorXd& speed,
-                    const Eigen::MatrixXd& scaled_sensors, const SegmentationPipelineResult& base,
-                    const SensorSelection& contact, const std::vector<SampleSpan>& stale,
+                    const std::vector<Pause>& pauses, const Eigen::MatrixXd& scaled_sensors,
+                    const SegmentationPipelineResult& base, const SensorSelection& contact,
+                    const std::vector<SampleSpan>& stale,
                     const std::vector<ReciprocatingRun>& rhythm,
                     const SegmentationPipelineConfig& config, DemoSegmentationResult* out,
                     DemoPieces* evidence, Eigen::MatrixXd* grid, std::vector<bool>* usable) {
@@ -119,7 +120,6 @@ void gatherEvidence(const FeatureMatrix& demo, const Eigen::MatrixXd& scaled,
                                 static_cast<std::size_t>(std::lround(joint.ramp_fold * rate)));
   pieces.insert(pieces.end(), r.begin(), r.end());
   const std::vector<double> clock = demo.clock();
-  const std::vector<Pause> pauses = findPauses(speed, clock, joint.pauses);
   for (const Pause& p : pauses) out->pauses.push_back({p.begin, p.end - 1});
   const auto m =
       motionOnsetEvidence(speed, clock, pauses, joint.pauses, joint.weights.motion_onset);
@@ -199,9 +199,7 @@ std::string secondsAfterStart(const FeatureMatrix& demo, std::size_t index) {
 std::vector<Eigen::MatrixXd> motionGrids(const std::vector<FeatureMatrix>& demos,
                                          const std::vector<std::string>& moving,
                                          const std::vector<std::string>& selected, double step) {
-  std::vector<std::string> names;
-  for (const std::string& name : moving)
-    if (std::find(selected.begin(), selected.end(), name) != selected.end()) names.push_back(name);
+  std::vector<std::string> names = selectedStates(moving, selected);
   if (names.empty()) names = moving;
   if (names.empty()) return {};  // no state feature moves: nothing to match
   const std::vector<Eigen::MatrixXd> scaled = scaledStates(demos, names);
@@ -351,9 +349,11 @@ SegmentationPipelineResult segmentJointly(const PreparedSegmentation& prepared,
                        sensors ? groups : std::vector<std::size_t>{});
 
   std::vector<Eigen::VectorXd> speeds(n);
+  std::vector<std::vector<Pause>> pauses(n);
   parallelFor(n, config.threads, [&](std::size_t d) {
     speeds[d] = stateSpeed(scaled[d] * consistency.asDiagonal(), demos[d].clock(),
                            config.joint.pauses.smoothing);
+    pauses[d] = findPauses(speeds[d], demos[d].clock(), config.joint.pauses);
   });
   const SensorSelection contact =
       sensors ? contactSensors(result.sensor_features, groups, scaled_sensors, speeds,
@@ -363,7 +363,7 @@ SegmentationPipelineResult segmentJointly(const PreparedSegmentation& prepared,
   const std::vector<std::vector<SampleSpan>> stale =
       staleContactReadings(demos, contact, config.joint.stale_reading, &result.warnings);
   const std::vector<std::vector<ReciprocatingRun>> rhythm =
-      periodicPhases(demos, states, result.selected_features, speeds, !contact.names.empty(),
+      periodicPhases(demos, states, result.selected_features, pauses, !contact.names.empty(),
                      periodicConfig(config.joint), config.threads);
 
   std::vector<DemoPieces> evidence(n);
@@ -372,8 +372,8 @@ SegmentationPipelineResult segmentJointly(const PreparedSegmentation& prepared,
   grids.usable.resize(n);
   parallelFor(n, config.threads, [&](std::size_t d) {
     try {
-      gatherEvidence(demos[d], scaled[d], consistency, speeds[d], scaled_sensors[d], result,
-                     contact, stale[d], rhythm[d], config, &result.demos[d], &evidence[d],
+      gatherEvidence(demos[d], scaled[d], consistency, speeds[d], pauses[d], scaled_sensors[d],
+                     result, contact, stale[d], rhythm[d], config, &result.demos[d], &evidence[d],
                      &grids.full[d], &grids.usable[d]);
     } catch (const std::invalid_argument& e) {
       throw std::invalid_argument(describe(e.what(), d));

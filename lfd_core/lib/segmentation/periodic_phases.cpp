@@ -40,7 +40,7 @@ Runs bestPairRuns(const Eigen::MatrixXd& states, const std::vector<double>& cloc
                   const std::vector<Pause>& pauses, const PeriodicPhaseConfig& config) {
   Runs best;
   if (states.rows() < 5) return best;
-  const Eigen::MatrixXd velocity = stateVelocities(states, clock, config.pauses.smoothing);
+  const Eigen::MatrixXd velocity = stateVelocities(states, clock, config.smoothing);
   Eigen::MatrixXd pair(states.rows(), 2);
   for (Eigen::Index i = 0; i < states.cols(); ++i) {
     for (Eigen::Index j = i + 1; j < states.cols(); ++j) {
@@ -54,25 +54,17 @@ Runs bestPairRuns(const Eigen::MatrixXd& states, const std::vector<double>& cloc
   return best;
 }
 
-std::vector<std::string> selectedMoving(const std::vector<std::string>& moving,
-                                        const std::vector<std::string>& selected) {
-  if (selected.empty()) return moving;
-  std::vector<std::string> out;
-  for (const std::string& name : moving)
-    if (std::find(selected.begin(), selected.end(), name) != selected.end()) out.push_back(name);
-  return out;
-}
-
 }  // namespace
 
 std::vector<std::vector<ReciprocatingRun>> periodicPhases(
     const std::vector<FeatureMatrix>& demos, const std::vector<std::string>& moving,
-    const std::vector<std::string>& selected, const std::vector<Eigen::VectorXd>& speeds,
+    const std::vector<std::string>& selected, const std::vector<std::vector<Pause>>& pauses,
     bool contact_sensed, const PeriodicPhaseConfig& config, int threads) {
-  if (speeds.size() != demos.size())
+  if (pauses.size() != demos.size())
     throw std::invalid_argument("periodicPhases: " + std::to_string(demos.size()) + " demos but " +
-                                std::to_string(speeds.size()) + " speed profiles");
-  const std::vector<std::string> names = selectedMoving(moving, selected);
+                                std::to_string(pauses.size()) + " lists of pauses");
+  const std::vector<std::string> names =
+      selected.empty() ? moving : selectedStates(moving, selected);
   const std::vector<Eigen::MatrixXd> states = scaledStates(demos, names);
   const std::vector<std::string> above_noise =
       contact_sensed ? std::vector<std::string>{}
@@ -81,12 +73,11 @@ std::vector<std::vector<ReciprocatingRun>> periodicPhases(
   std::vector<Runs> out(demos.size());
   parallelFor(demos.size(), threads, [&](std::size_t d) {
     const std::vector<double> clock = demos[d].clock();
-    const std::vector<Pause> pauses = findPauses(speeds[d], clock, config.pauses);
     if (names.size() >= 2 && states[d].rows() >= 5)
-      out[d] = pauseFreeRuns(states[d], stateSpeed(states[d], clock, config.pauses.smoothing),
-                             pauses, config);
+      out[d] = pauseFreeRuns(states[d], stateSpeed(states[d], clock, config.smoothing), pauses[d],
+                             config);
     if (out[d].empty() && above_noise.size() >= 2)
-      out[d] = bestPairRuns(candidates[d], clock, pauses, config);
+      out[d] = bestPairRuns(candidates[d], clock, pauses[d], config);
   });
   return out;
 }

@@ -22,6 +22,14 @@ std::vector<std::string> movingStates(const std::vector<FeatureMatrix>& demos,
   return out;
 }
 
+std::vector<std::string> selectedStates(const std::vector<std::string>& moving,
+                                        const std::vector<std::string>& selected) {
+  std::vector<std::string> out;
+  for (const std::string& name : moving)
+    if (std::find(selected.begin(), selected.end(), name) != selected.end()) out.push_back(name);
+  return out;
+}
+
 std::vector<std::string> featuresAboveNoise(const std::vector<FeatureMatrix>& demos,
                                             const std::vector<std::string>& names,
                                             double min_range_sigmas) {

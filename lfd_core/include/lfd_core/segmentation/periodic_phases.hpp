@@ -30,8 +30,8 @@
 namespace lfd {
 
 struct PeriodicPhaseConfig {
-  /// The speed's smoothing and what a pause is (the joint segmentation's own).
-  PauseConfig pauses;
+  /// The Gaussian sigma of the speed (s; PauseConfig::smoothing).
+  double smoothing = 0.1;
   /// A feature the pairs may use moves at least this many noise sigmas in some demo
   /// (state_features.hpp: featuresAboveNoise).
   double min_range_sigmas = 20.0;
@@ -39,12 +39,12 @@ struct PeriodicPhaseConfig {
 };
 
 /// Each demo's periodic phases. `moving`: the task's moving state features; `selected`: those
-/// II-B selected (empty: all of `moving`); `speeds`: each demo's speed profile on its clock (the
-/// one its pauses are found on); `contact_sensed`: whether the task has a contact sensor.
-/// Throws std::invalid_argument when `speeds` and `demos` differ in count.
+/// II-B selected (empty: all of `moving`); `pauses`: each demo's pauses (findPauses);
+/// `contact_sensed`: whether the task has a contact sensor. Throws std::invalid_argument when
+/// `pauses` and `demos` differ in count.
 std::vector<std::vector<ReciprocatingRun>> periodicPhases(
     const std::vector<FeatureMatrix>& demos, const std::vector<std::string>& moving,
-    const std::vector<std::string>& selected, const std::vector<Eigen::VectorXd>& speeds,
+    const std::vector<std::string>& selected, const std::vector<std::vector<Pause>>& pauses,
     bool contact_sensed, const PeriodicPhaseConfig& config, int threads = 1);
 
 }  // namespace lfd

@@ -15,6 +15,10 @@ namespace lfd {
 std::vector<std::string> movingStates(const std::vector<FeatureMatrix>& demos,
                                       const std::vector<std::string>& states);
 
+/// The features of `moving` that are in `selected` (II-B's selection), in `moving`'s order.
+std::vector<std::string> selectedStates(const std::vector<std::string>& moving,
+                                        const std::vector<std::string>& selected);
+
 /// The features (of `names`) whose range in some demo is at least `min_range_sigmas` times their
 /// measurement noise there (robust_statistics.hpp: measurementNoiseSigma). A quaternion component
 /// that only jitters passes movingStates; scaled to its range, its noise would be as large as a
